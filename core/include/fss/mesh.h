@@ -1,0 +1,35 @@
+#pragma once
+/// \file mesh.h
+/// The mesh type of FSS and the names of the per-element properties that FSS keeps on it.
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Surface_mesh.h>
+
+#include <cstdint>
+
+namespace fss {
+
+/// Geometry kernel: exact predicates, double constructions (robust combinatorial decisions).
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point3 = Kernel::Point_3;
+using Vector3 = Kernel::Vector_3;
+
+/// The one mesh type of FSS: a CGAL halfedge surface mesh of triangles.
+using Mesh = CGAL::Surface_mesh<Point3>;
+using VertexIndex = Mesh::Vertex_index;
+using FaceIndex = Mesh::Face_index;
+using EdgeIndex = Mesh::Edge_index;
+using HalfedgeIndex = Mesh::Halfedge_index;
+
+/// Names of the optional face properties FSS maintains. PLY files keep them (see mesh_io.h).
+namespace props {
+/// `float` sampling quality of a face made by a scan (lower is better, see scan.h); input faces have none.
+inline constexpr const char* faceQuality = "f:quality";
+/// `std::int32_t` id of the scan that made the face; -1 (or absent) for faces of the input mesh.
+inline constexpr const char* faceScanId = "f:scan_id";
+} // namespace props
+
+/// Quality value of a face that no scan has made (input faces rank lowest: any scan sample beats them).
+inline constexpr float kInputFaceQuality = 1e30f;
+
+} // namespace fss
