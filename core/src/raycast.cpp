@@ -21,8 +21,12 @@ using Primitive = CGAL::AABB_face_graph_triangle_primitive<Mesh>;
 using Traits = CGAL::AABB_traits<Kernel, Primitive>;
 using Tree = CGAL::AABB_tree<Traits>;
 
-Eigen::Vector3d toEigen(const Point3& p) { return {p.x(), p.y(), p.z()}; }
-Point3 toPoint(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+Eigen::Vector3d toEigen(const Point3& p) {
+    return {p.x(), p.y(), p.z()};
+}
+Point3 toPoint(const Eigen::Vector3d& v) {
+    return {v.x(), v.y(), v.z()};
+}
 
 Kernel::Ray_3 toCgalRay(const Ray& ray) {
     return {toPoint(ray.origin), Kernel::Vector_3(ray.direction.x(), ray.direction.y(), ray.direction.z())};
@@ -35,8 +39,7 @@ Kernel::Triangle_3 triangleOf(const Mesh& mesh, FaceIndex f) {
 
 // Ray parameter of a ray/triangle intersection result (a point, or a segment when the ray lies in the
 // triangle's plane: its entry point is the nearer end).
-template <class Variant>
-double hitParameter(const Variant& v, const Ray& ray, Eigen::Vector3d& point) {
+template <class Variant> double hitParameter(const Variant& v, const Ray& ray, Eigen::Vector3d& point) {
     if (const Point3* p = boost::get<Point3>(&v)) {
         point = toEigen(*p);
     } else if (const Kernel::Segment_3* s = boost::get<Kernel::Segment_3>(&v)) {
@@ -106,7 +109,9 @@ RayCaster::~RayCaster() = default;
 RayCaster::RayCaster(RayCaster&&) noexcept = default;
 RayCaster& RayCaster::operator=(RayCaster&&) noexcept = default;
 
-const Mesh& RayCaster::mesh() const { return *impl_->mesh; }
+const Mesh& RayCaster::mesh() const {
+    return *impl_->mesh;
+}
 
 SurfacePoint RayCaster::intersect(const Ray& ray) const {
     SurfacePoint result;
@@ -138,7 +143,8 @@ SurfacePoint RayCaster::intersect(const Ray& ray, FaceIndex hint, const LocalSea
     if (!best) return intersect(ray);
     if (options.verifyUnoccluded && best.distance > 0) {
         const Eigen::Vector3d end = ray.origin + best.distance * (1.0 - 1e-7) * ray.direction;
-        if (impl_->tree.do_intersect(Kernel::Segment_3(toPoint(ray.origin), toPoint(end)))) return intersect(ray);
+        if (impl_->tree.do_intersect(Kernel::Segment_3(toPoint(ray.origin), toPoint(end))))
+            return intersect(ray);
     }
     return best;
 }
@@ -210,9 +216,9 @@ SurfacePoint closestPointNear(const Mesh& mesh, const Eigen::Vector3d& p, FaceIn
         collectRings(mesh, centre, std::max(0, options.rings), candidates, seen);
         for (FaceIndex f : candidates) {
             const HalfedgeIndex h = mesh.halfedge(f);
-            const Eigen::Vector3d q =
-                closestPointOnTriangle(p, toEigen(mesh.point(mesh.source(h))), toEigen(mesh.point(mesh.target(h))),
-                                       toEigen(mesh.point(mesh.target(mesh.next(h)))));
+            const Eigen::Vector3d q = closestPointOnTriangle(p, toEigen(mesh.point(mesh.source(h))),
+                                                             toEigen(mesh.point(mesh.target(h))),
+                                                             toEigen(mesh.point(mesh.target(mesh.next(h)))));
             const double d = (q - p).norm();
             if (d < best.distance) best = {f, q, d};
         }

@@ -20,7 +20,9 @@ using fss::SurfacePoint;
 
 namespace {
 
-Eigen::Vector3d toEigen(const fss::Point3& p) { return {p.x(), p.y(), p.z()}; }
+Eigen::Vector3d toEigen(const fss::Point3& p) {
+    return {p.x(), p.y(), p.z()};
+}
 
 struct Plane {
     Eigen::Vector3d n; // outward unit normal
@@ -88,7 +90,8 @@ TEST(RayCast, CpuRasterOfSphereMatchesAnalyticCounts) {
     const Mesh sphere = fss::shapes::icosphere(3, R);
     const auto planes = facePlanes(sphere);
     double rIn = R;
-    for (const Plane& p : planes) rIn = std::min(rIn, p.d);
+    for (const Plane& p : planes)
+        rIn = std::min(rIn, p.d);
     ASSERT_GT(rIn, 0.99);
     for (bool parallel : {false, true}) {
         SCOPED_TRACE(parallel ? "parallel" : "perspective");
@@ -190,13 +193,13 @@ TEST(RayCast, HintedIntersectionOnFarSideIsCaughtByVerification) {
 TEST(RayCast, ClosestPointOnTriangleRegions) {
     const Eigen::Vector3d a(0, 0, 0), b(2, 0, 0), c(0, 2, 0);
     auto cp = [&](double x, double y, double z) { return fss::closestPointOnTriangle({x, y, z}, a, b, c); };
-    EXPECT_TRUE(cp(0.5, 0.5, 3).isApprox(Eigen::Vector3d(0.5, 0.5, 0)));   // interior
-    EXPECT_TRUE(cp(-1, -1, 1).isApprox(a));                                // corner a
-    EXPECT_TRUE(cp(3, -1, 0).isApprox(b));                                 // corner b
-    EXPECT_TRUE(cp(-1, 5, 0).isApprox(c));                                 // corner c
-    EXPECT_TRUE(cp(1, -3, 0).isApprox(Eigen::Vector3d(1, 0, 0)));          // edge ab
-    EXPECT_TRUE(cp(-4, 1, 2).isApprox(Eigen::Vector3d(0, 1, 0)));          // edge ca
-    EXPECT_TRUE(cp(2, 2, 0).isApprox(Eigen::Vector3d(1, 1, 0)));           // edge bc
+    EXPECT_TRUE(cp(0.5, 0.5, 3).isApprox(Eigen::Vector3d(0.5, 0.5, 0))); // interior
+    EXPECT_TRUE(cp(-1, -1, 1).isApprox(a));                              // corner a
+    EXPECT_TRUE(cp(3, -1, 0).isApprox(b));                               // corner b
+    EXPECT_TRUE(cp(-1, 5, 0).isApprox(c));                               // corner c
+    EXPECT_TRUE(cp(1, -3, 0).isApprox(Eigen::Vector3d(1, 0, 0)));        // edge ab
+    EXPECT_TRUE(cp(-4, 1, 2).isApprox(Eigen::Vector3d(0, 1, 0)));        // edge ca
+    EXPECT_TRUE(cp(2, 2, 0).isApprox(Eigen::Vector3d(1, 1, 0)));         // edge bc
     // Degenerate (collinear) triangle.
     const Eigen::Vector3d q = fss::closestPointOnTriangle({1, 1, 0}, a, b, Eigen::Vector3d(1, 0, 0));
     EXPECT_TRUE(q.isApprox(Eigen::Vector3d(1, 0, 0)));
