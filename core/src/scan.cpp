@@ -12,7 +12,9 @@ namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 
-Eigen::Vector3d toEigen(const Point3& p) { return {p.x(), p.y(), p.z()}; }
+Eigen::Vector3d toEigen(const Point3& p) {
+    return {p.x(), p.y(), p.z()};
+}
 
 struct FaceGeometry {
     Eigen::Vector3d a;
@@ -43,7 +45,7 @@ float sampleQuality(double footprint, double samplingAngle, double qualityAngleL
     return float(footprint / std::max(std::cos(samplingAngle), cosLimit));
 }
 
-float faceQuality(const Sample& a, const Sample& b, const Sample& c) {
+float triangleQuality(const Sample& a, const Sample& b, const Sample& c) {
     return float((double(a.quality) + double(b.quality) + double(c.quality)) / 3.0);
 }
 
@@ -85,11 +87,13 @@ SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& r
             const std::uint32_t id = referenceBuffers.faceAt(c, r);
             if (id == FrameBuffers::kNoFace) continue;
             const FaceIndex f(id);
-            if (std::size_t(id) >= reference.num_faces() || reference.is_removed(f) || reference.degree(f) != 3)
+            if (std::size_t(id) >= reference.num_faces() || reference.is_removed(f) ||
+                reference.degree(f) != 3)
                 throw InvalidInputError("The face-id buffer names face " + std::to_string(id) +
                                         ", which is not a triangle of the reference mesh: the buffers were "
                                         "not rendered from this mesh.");
-            const Eigen::Vector3d unprojected = camera.unprojectPixelCentre(c, r, referenceBuffers.depthAt(c, r));
+            const Eigen::Vector3d unprojected =
+                camera.unprojectPixelCentre(c, r, referenceBuffers.depthAt(c, r));
             // Snap along the viewing ray onto the face's plane (removes depth quantisation).
             Eigen::Vector3d point = unprojected;
             const FaceGeometry g = faceGeometry(reference, f);

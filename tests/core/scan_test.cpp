@@ -36,19 +36,22 @@ Camera tiltedCamera(double tiltDeg, bool parallel, double distance = 3.0, int si
 }
 
 // The grid [0,4]² split into 80×80 quads (z = 0, normal +z).
-Mesh plane() { return fss::shapes::grid(80, 80, 0.05); }
+Mesh plane() {
+    return fss::shapes::grid(80, 80, 0.05);
+}
 
 } // namespace
 
 TEST(Scan, SamplesLieOnIcosphere) {
     const Mesh sphere = fss::shapes::icosphere(5, 1.0);
     const fss::RayCaster caster(sphere);
-    Camera cam = Camera::standardView(fss::StandardView::Iso,
-                                      Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1)),
-                                      256, 256);
+    Camera cam = Camera::standardView(
+        fss::StandardView::Iso, Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1)),
+        256, 256);
     FrameBuffers fb = fss::rasterizeOnCpu(caster, cam);
     // A 24-bit depth buffer (what a GPU gives): the snap onto the face plane must remove the quantisation.
-    for (float& d : fb.depth) d = float(std::round(double(d) * 16777215.0) / 16777215.0);
+    for (float& d : fb.depth)
+        d = float(std::round(double(d) * 16777215.0) / 16777215.0);
     const SampleGrid grid = fss::sampleRegularGrid(fb, sphere, {.scanId = 7});
     ASSERT_EQ(grid.rows, 256);
     ASSERT_EQ(grid.cols, 256);
@@ -98,8 +101,8 @@ TEST(Scan, PlaneSamplesAreExactAndAnglesAnalytic) {
                 EXPECT_LE(std::abs(s.point.z()), 1e-12 * (1 + s.point.norm()));
                 EXPECT_LE(std::abs(s.point.z()), 0.01 * s.footprint);
                 EXPECT_EQ(s.normal, Eigen::Vector3d(0, 0, 1));
-                const double expected = parallel ? tilt * kDeg
-                                                 : std::acos((cam.eye - s.point).normalized().z());
+                const double expected =
+                    parallel ? tilt * kDeg : std::acos((cam.eye - s.point).normalized().z());
                 EXPECT_NEAR(s.samplingAngle, expected, 1e-6);
                 const double fp = parallel ? 2.0 * 0.5 / 64 : cam.pixelFootprint(s.point);
                 EXPECT_NEAR(s.footprint, fp, 1e-6 * fp);
@@ -151,7 +154,7 @@ TEST(Scan, QualityFormula) {
     a.quality = 1;
     b.quality = 2;
     c.quality = 6;
-    EXPECT_FLOAT_EQ(fss::faceQuality(a, b, c), 3.0f);
+    EXPECT_FLOAT_EQ(fss::triangleQuality(a, b, c), 3.0f);
 }
 
 TEST(Scan, BackFacingSamplesAreNotAdmissible) {

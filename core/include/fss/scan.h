@@ -15,9 +15,10 @@
 /// θ). Shorter edges (zoomed-in, closer camera, higher resolution) and more frontal views give a lower q;
 /// the clamp keeps q finite at grazing angles.
 ///
-/// **Face quality** of a triangle made from samples (triangulate.h writes it to props::faceQuality): the
-/// mean of the q of its three corner samples, so a face's q and a sample's q are the same kind of number
-/// (an expected edge length in world units) and the quality mask compares them directly.
+/// **Face quality** of a triangle made from samples (triangleQuality; triangulate.h writes it to
+/// props::faceQuality): the mean of the q of its three corner samples, so a face's q and a sample's q are
+/// the same kind of number (an expected edge length in world units) and the quality mask compares them
+/// directly.
 
 #include "fss/frame_buffers.h"
 #include "fss/mesh.h"
@@ -47,7 +48,7 @@ struct ScanOptions {
 float sampleQuality(double footprint, double samplingAngle, double qualityAngleLimitDeg = 85.0);
 
 /// The quality of a triangle whose corners are the samples \p a, \p b, \p c: the mean of their q.
-float faceQuality(const Sample& a, const Sample& b, const Sample& c);
+float triangleQuality(const Sample& a, const Sample& b, const Sample& c);
 
 /// Fills \p sample as a sample of the reference surface at \p point on face \p face, seen by \p camera:
 /// point, face, unit face normal, sampling angle (between the reversed viewing ray towards \p point and
