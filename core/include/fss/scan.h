@@ -1,0 +1,80 @@
+#pragma once
+/// \file scan.h
+/// **Scan (regular grid)**, DESIGN.md §1: the reference mesh rendered from the scan camera gives one
+/// sample per covered pixel centre; this file turns those buffers into a SampleGrid and defines the
+/// *sampling quality* that the quality mask (mask.h) compares.
+///
+/// **Sampling quality** (Vorsatz et al. 2000, "Mask"): lower is better. For a sample with pixel footprint
+/// f (Camera::pixelFootprint: world size of one pixel at the sample's depth) and sampling angle θ (between
+/// the reversed view ray and the surface normal),
+///
+///     q = f / max(cos θ, cos θ_limit)          (θ_limit = ScanOptions::qualityAngleLimitDeg, 85°)
+///
+/// which is the expected length on the surface of a grid edge between neighbouring samples, measured in
+/// the direction of steepest tilt (a one-pixel step on the screen covers f / cos θ on a surface tilted by
+/// θ). Shorter edges (zoomed-in, closer camera, higher resolution) and more frontal views give a lower q;
+/// the clamp keeps q finite at grazing angles.
+///
+/// **Face quality** of a triangle made from samples (triangleQuality; triangulate.h writes it to
+/// props::faceQuality): the mean of the q of its three corner samples, so a face's q and a sample's q are
+/// the same kind of number (an expected edge length in world units) and the quality mask compares them
+/// directly.
+
+#include "fss/frame_buffers.h"
+#include "fss/mesh.h"
+#include "fss/progress.h"
+#include "fss/sample_grid.h"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+
+namespace fss {
+
+/// Options of sampleRegularGrid (and setSampleOnSurface).
+struct ScanOptions {
+    /// Id given to the grid (SampleGrid::scanId), later to the faces it becomes (props::faceScanId).
+    std::int32_t scanId = -1;
+    /// θ_limit of the quality formula, degrees: beyond it the sampling angle counts as θ_limit.
+    double qualityAngleLimitDeg = 85.0;
+    /// The snap onto the face plane (see sampleRegularGrid) is applied only when it moves the unprojected
+    /// point by at most this many pixel footprints; a larger move means the face id and the depth disagree
+    /// (a corrupted ID buffer), and the unprojected point is kept.
+    double maxSnapFootprints = 2.0;
+};
+
+/// The sampling quality q = footprint / max(cos(samplingAngle), cos(qualityAngleLimitDeg)) (see the file
+/// comment). \p samplingAngle in radians.
+float sampleQuality(double footprint, double samplingAngle, double qualityAngleLimitDeg = 85.0);
+
+/// The quality of a triangle whose corners are the samples \p a, \p b, \p c: the mean of their q.
+float triangleQuality(const Sample& a, const Sample& b, const Sample& c);
+
+/// Fills \p sample as a sample of the reference surface at \p point on face \p face, seen by \p camera:
+/// point, face, unit face normal, sampling angle (between the reversed viewing ray towards \p point and
+/// the normal), footprint, quality, hit = true; admissible = valid = true when the face is front-facing
+/// (cos θ > 0). A back-facing or degenerate face (we look at the back of the reference surface, e.g. into
+/// an open mesh) gives admissible = valid = false: a patch there could not be oriented like the
+/// reference. The screen position is left as it is. Shared by the regular and the fishbone scan.
+/// \pre \p face is a triangle of \p reference.
+void setSampleOnSurface(Sample& sample, const Mesh& reference, const Camera& camera, FaceIndex face,
+                        const Eigen::Vector3d& point, const ScanOptions& options = {});
+
+/// The regular-grid scan: a SampleGrid of rows = image height, cols = image width, sample (r, c) at the
+/// pixel centre (c+½, r+½), from the buffers of the *reference* mesh rendered from the scan camera.
+///
+/// For every covered pixel: the point is the pixel centre unprojected with the buffer's depth (in double)
+/// and then **snapped onto the plane of the reference face under it** along the viewing ray through the
+/// pixel centre. The ID buffer tells which face the ray hits, so intersecting the ray with that face's
+/// plane gives the exact surface point; this removes the depth buffer's quantisation (24-bit depth, or
+/// float) entirely, and the sample lies on the reference surface up to rounding. The rest as
+/// setSampleOnSurface. Uncovered pixels give samples with hit = admissible = valid = false.
+/// Cost: linear in the number of pixels.
+/// \pre the buffers were rendered from \p reference (their face ids are faces of it) and have
+///      camera.width × camera.height entries.
+/// \throw InvalidInputError when the camera is invalid, the buffer sizes do not match the camera, or a
+///        face id is not a triangle of \p reference. CancelledError through \p progress (once per row).
+SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& reference,
+                             const ScanOptions& options = {}, const Progress& progress = {});
+
+} // namespace fss

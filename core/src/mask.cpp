@@ -1,0 +1,300 @@
+#include "fss/mask.h"
+
+#include "fss/error.h"
+#include "fss/raycast.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <utility>
+
+namespace fss {
+namespace {
+
+using Point2 = Kernel::Point_2;
+
+// The lasso's edges bucketed into horizontal bands, so a point query only visits the edges whose
+// y-range can contain the point's y. Floating-point band indices are monotone in y, so an edge whose
+// y-range contains y is always found in y's band.
+class LassoIndex {
+public:
+    explicit LassoIndex(const Lasso& lasso) {
+        if (lasso.points.empty()) return; // encloses nothing (validateLasso rejects it)
+        points_.reserve(lasso.points.size());
+        for (const Eigen::Vector2d& p : lasso.points)
+            points_.emplace_back(p.x(), p.y());
+        const auto [xmin, xmax] = std::minmax_element(lasso.points.begin(), lasso.points.end(),
+                                                      [](auto& a, auto& b) { return a.x() < b.x(); });
+        const auto [ymin, ymax] = std::minmax_element(lasso.points.begin(), lasso.points.end(),
+                                                      [](auto& a, auto& b) { return a.y() < b.y(); });
+        x0_ = xmin->x();
+        x1_ = xmax->x();
+        y0_ = ymin->y();
+        y1_ = ymax->y();
+        const std::size_t m = points_.size();
+        bandCount_ = int(std::clamp<std::size_t>(m / 2, 1, 1024));
+        bandHeight_ = (y1_ - y0_) / bandCount_;
+        bands_.resize(std::size_t(bandCount_));
+        for (std::size_t i = 0; i < m; ++i) {
+            const Point2& a = points_[i];
+            const Point2& b = points_[(i + 1) % m];
+            const int lo = band(std::min(a.y(), b.y())), hi = band(std::max(a.y(), b.y()));
+            for (int k = lo; k <= hi; ++k)
+                bands_[std::size_t(k)].push_back(std::uint32_t(i));
+        }
+    }
+
+    // Non-zero winding rule (Sunday's crossing form of the winding number), boundary inside.
+    bool inside(const Eigen::Vector2d& q) const {
+        if (points_.empty()) return false;
+        if (!(q.x() >= x0_ && q.x() <= x1_ && q.y() >= y0_ && q.y() <= y1_)) return false;
+        const Point2 p(q.x(), q.y());
+        const std::size_t m = points_.size();
+        int winding = 0;
+        for (std::uint32_t i : bands_[std::size_t(band(q.y()))]) {
+            const Point2& a = points_[i];
+            const Point2& b = points_[(i + 1) % m];
+            const CGAL::Orientation o = CGAL::orientation(a, b, p);
+            if (o == CGAL::COLLINEAR && std::min(a.x(), b.x()) <= p.x() && p.x() <= std::max(a.x(), b.x()) &&
+                std::min(a.y(), b.y()) <= p.y() && p.y() <= std::max(a.y(), b.y()))
+                return true; // on the boundary
+            if (a.y() <= p.y()) {
+                if (b.y() > p.y() && o == CGAL::LEFT_TURN) ++winding;
+            } else if (b.y() <= p.y() && o == CGAL::RIGHT_TURN) {
+                --winding;
+            }
+        }
+        return winding != 0;
+    }
+
+private:
+    int band(double y) const {
+        if (!(bandHeight_ > 0)) return 0;
+        return std::clamp(int(std::floor((y - y0_) / bandHeight_)), 0, bandCount_ - 1);
+    }
+
+    std::vector<Point2> points_;
+    double x0_ = 0, x1_ = 0, y0_ = 0, y1_ = 0, bandHeight_ = 0;
+    int bandCount_ = 1;
+    std::vector<std::vector<std::uint32_t>> bands_;
+};
+
+void requireRadius(int radius) {
+    if (radius < 0)
+        throw InvalidInputError("The morphology radius " + std::to_string(radius) + " is negative.");
+}
+
+// Number of set entries in the window [i − radius, i + radius] along rows (axis 0) or columns (axis 1),
+// entries outside the grid counting as unset. O(rows · cols), independent of the radius.
+std::vector<std::uint16_t> windowCounts(const std::vector<std::uint8_t>& in, int rows, int cols, int radius,
+                                        bool alongColumns) {
+    std::vector<std::uint16_t> out(in.size(), 0);
+    const int lines = alongColumns ? cols : rows, length = alongColumns ? rows : cols;
+    auto at = [&](int line, int i) {
+        return alongColumns ? std::size_t(i) * cols + line : std::size_t(line) * cols + i;
+    };
+    for (int line = 0; line < lines; ++line) {
+        int count = 0;
+        for (int i = 0; i < std::min(radius, length); ++i)
+            count += in[at(line, i)];
+        for (int i = 0; i < length; ++i) {
+            if (i + radius < length) count += in[at(line, i + radius)];
+            if (i - radius - 1 >= 0) count -= in[at(line, i - radius - 1)];
+            out[at(line, i)] = std::uint16_t(count);
+        }
+    }
+    return out;
+}
+
+std::vector<std::uint8_t> validFlags(const SampleGrid& grid) {
+    std::vector<std::uint8_t> v(grid.samples.size());
+    for (std::size_t i = 0; i < v.size(); ++i)
+        v[i] = grid.samples[i].valid ? 1 : 0;
+    return v;
+}
+
+void requireGridShape(const SampleGrid& grid) {
+    if (grid.rows < 0 || grid.cols < 0 ||
+        grid.samples.size() != std::size_t(grid.rows) * std::size_t(grid.cols))
+        throw InvalidInputError("The sample grid holds " + std::to_string(grid.samples.size()) +
+                                " samples instead of its " + std::to_string(grid.rows) + "x" +
+                                std::to_string(grid.cols) + ".");
+}
+
+} // namespace
+
+void validateLasso(const Lasso& lasso) {
+    for (const Eigen::Vector2d& p : lasso.points)
+        if (!p.allFinite()) throw InvalidInputError("The lasso has a point with a non-finite coordinate.");
+    std::vector<std::pair<double, double>> distinct;
+    for (const Eigen::Vector2d& p : lasso.points)
+        distinct.emplace_back(p.x(), p.y());
+    std::sort(distinct.begin(), distinct.end());
+    distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+    if (distinct.size() < 3)
+        throw InvalidInputError("The lasso has " + std::to_string(distinct.size()) +
+                                " distinct points; it needs at least 3 to enclose an area.");
+    const Point2 a(distinct[0].first, distinct[0].second), b(distinct[1].first, distinct[1].second);
+    for (std::size_t i = 2; i < distinct.size(); ++i)
+        if (CGAL::orientation(a, b, Point2(distinct[i].first, distinct[i].second)) != CGAL::COLLINEAR) return;
+    throw InvalidInputError("The lasso's points all lie on one line, so it encloses no area.");
+}
+
+bool insideLasso(const Lasso& lasso, const Eigen::Vector2d& p) {
+    return LassoIndex(lasso).inside(p);
+}
+
+std::size_t applyLasso(SampleGrid& grid, const Lasso& lasso) {
+    validateLasso(lasso);
+    const LassoIndex index(lasso);
+    std::size_t dropped = 0;
+    for (Sample& s : grid.samples) {
+        if (!s.admissible || index.inside(s.screen)) continue;
+        s.admissible = s.valid = false;
+        ++dropped;
+    }
+    return dropped;
+}
+
+std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameBuffers& currentBuffers,
+                             const QualityMaskOptions& options) {
+    requireGridShape(grid);
+    if (currentBuffers.width() != grid.camera.width || currentBuffers.height() != grid.camera.height)
+        throw InvalidInputError("The current mesh's buffers are " + std::to_string(currentBuffers.width()) +
+                                "x" + std::to_string(currentBuffers.height()) +
+                                " but the scan camera's image is " + std::to_string(grid.camera.width) + "x" +
+                                std::to_string(grid.camera.height) +
+                                ": they must be rendered from the scan camera.");
+    const std::size_t n = std::size_t(currentBuffers.width()) * std::size_t(currentBuffers.height());
+    if (currentBuffers.faceId.size() != n)
+        throw InvalidInputError("The current mesh's face-id buffer holds " +
+                                std::to_string(currentBuffers.faceId.size()) + " values instead of " +
+                                std::to_string(n) + ".");
+    if (!(options.margin >= 0 && options.margin < 1))
+        throw InvalidInputError("The quality margin " + std::to_string(options.margin) +
+                                " is outside the range [0, 1).");
+    if (options.searchRings < 0)
+        throw InvalidInputError("The quality mask's search rings " + std::to_string(options.searchRings) +
+                                " is negative.");
+    if (options.forceReplace) return 0;
+
+    const auto [qualityMap, hasQuality] = current.property_map<FaceIndex, float>(props::faceQuality);
+    const LocalSearchOptions search{.rings = options.searchRings, .verifyUnoccluded = false};
+    std::size_t dropped = 0;
+    for (Sample& s : grid.samples) {
+        if (!s.admissible) continue;
+        const double fx = std::floor(s.screen.x()), fy = std::floor(s.screen.y());
+        if (!(fx >= 0 && fy >= 0 && fx < currentBuffers.width() && fy < currentBuffers.height())) continue;
+        const std::uint32_t id = currentBuffers.faceAt(int(fx), int(fy));
+        if (id == FrameBuffers::kNoFace) continue;
+        const FaceIndex hint(id);
+        if (std::size_t(id) >= current.num_faces() || current.is_removed(hint))
+            throw InvalidInputError("The current mesh's face-id buffer names face " + std::to_string(id) +
+                                    ", which the current mesh does not have.");
+        const SurfacePoint closest = closestPointNear(current, s.point, hint, search);
+        float faceQ = hasQuality ? qualityMap[closest.face] : kInputFaceQuality;
+        if (std::isnan(faceQ)) faceQ = kInputFaceQuality;
+        if (double(s.quality) < (1.0 - options.margin) * double(faceQ)) continue;
+        s.admissible = s.valid = false;
+        ++dropped;
+    }
+    return dropped;
+}
+
+std::size_t erode(SampleGrid& grid, int radius) {
+    requireRadius(radius);
+    requireGridShape(grid);
+    if (radius == 0 || grid.samples.empty()) return 0;
+    const long long side = 2LL * radius + 1;
+    if (side > std::min(grid.rows, grid.cols)) { // no square fits in the grid
+        std::size_t removed = 0;
+        for (Sample& s : grid.samples)
+            removed += std::exchange(s.valid, false) ? 1 : 0;
+        return removed;
+    }
+    // Separable: a full square = full rows of full columns.
+    std::vector<std::uint8_t> rowsFull(grid.samples.size());
+    {
+        const auto counts = windowCounts(validFlags(grid), grid.rows, grid.cols, radius, false);
+        for (std::size_t i = 0; i < counts.size(); ++i)
+            rowsFull[i] = (long long)counts[i] == side ? 1 : 0;
+    }
+    const auto counts = windowCounts(rowsFull, grid.rows, grid.cols, radius, true);
+    std::size_t removed = 0;
+    for (std::size_t i = 0; i < counts.size(); ++i) {
+        Sample& s = grid.samples[i];
+        if (s.valid && (long long)counts[i] != side) {
+            s.valid = false;
+            ++removed;
+        }
+    }
+    return removed;
+}
+
+std::size_t dilate(SampleGrid& grid, int radius) {
+    requireRadius(radius);
+    requireGridShape(grid);
+    if (radius == 0 || grid.samples.empty()) return 0;
+    radius = std::min(radius, std::max(grid.rows, grid.cols)); // larger squares cover the grid all the same
+    std::vector<std::uint8_t> rowsAny(grid.samples.size());
+    {
+        const auto counts = windowCounts(validFlags(grid), grid.rows, grid.cols, radius, false);
+        for (std::size_t i = 0; i < counts.size(); ++i)
+            rowsAny[i] = counts[i] > 0 ? 1 : 0;
+    }
+    const auto counts = windowCounts(rowsAny, grid.rows, grid.cols, radius, true);
+    std::size_t added = 0;
+    for (std::size_t i = 0; i < counts.size(); ++i) {
+        Sample& s = grid.samples[i];
+        if (!s.valid && s.admissible && counts[i] > 0) {
+            s.valid = true;
+            ++added;
+        }
+    }
+    return added;
+}
+
+std::size_t removeUntriangulatableSamples(SampleGrid& grid) {
+    requireGridShape(grid);
+    if (grid.rows < 2 || grid.cols < 2) {
+        std::size_t removed = 0;
+        for (Sample& s : grid.samples)
+            removed += std::exchange(s.valid, false) ? 1 : 0;
+        return removed;
+    }
+    // quadFull(r, c): the quad with top-left corner (r, c) has four valid corners.
+    const int qr = grid.rows - 1, qc = grid.cols - 1;
+    std::vector<std::uint8_t> quadFull(std::size_t(qr) * std::size_t(qc));
+    for (int r = 0; r < qr; ++r)
+        for (int c = 0; c < qc; ++c)
+            quadFull[std::size_t(r) * qc + c] = grid.at(r, c).valid && grid.at(r, c + 1).valid &&
+                                                grid.at(r + 1, c).valid && grid.at(r + 1, c + 1).valid;
+    auto full = [&](int r, int c) {
+        return r >= 0 && c >= 0 && r < qr && c < qc && quadFull[std::size_t(r) * qc + c];
+    };
+    std::size_t removed = 0;
+    for (int r = 0; r < grid.rows; ++r) {
+        for (int c = 0; c < grid.cols; ++c) {
+            Sample& s = grid.at(r, c);
+            if (s.valid && !full(r - 1, c - 1) && !full(r - 1, c) && !full(r, c - 1) && !full(r, c)) {
+                s.valid = false;
+                ++removed;
+            }
+        }
+    }
+    return removed;
+}
+
+MorphologyReport applyMorphology(SampleGrid& grid, const MorphologyOptions& options) {
+    requireRadius(options.radius);
+    MorphologyReport report;
+    report.eroded = erode(grid, options.radius);
+    report.restored = dilate(grid, options.radius);
+    report.untriangulatable = removeUntriangulatableSamples(grid);
+    return report;
+}
+
+} // namespace fss

@@ -1,0 +1,115 @@
+#include "fss/scan.h"
+
+#include "fss/error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+namespace fss {
+namespace {
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+
+Eigen::Vector3d toEigen(const Point3& p) {
+    return {p.x(), p.y(), p.z()};
+}
+
+struct FaceGeometry {
+    Eigen::Vector3d a;
+    Eigen::Vector3d normal; // unit, or zero for a degenerate face
+};
+
+FaceGeometry faceGeometry(const Mesh& mesh, FaceIndex f) {
+    const HalfedgeIndex h = mesh.halfedge(f);
+    const Eigen::Vector3d a = toEigen(mesh.point(mesh.source(h))), b = toEigen(mesh.point(mesh.target(h))),
+                          c = toEigen(mesh.point(mesh.target(mesh.next(h))));
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    const double len = n.norm();
+    return {a, len > 0 && std::isfinite(len) ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero()};
+}
+
+// Unit vector from the sample towards the viewer along its viewing ray.
+Eigen::Vector3d towardsViewer(const Camera& camera, const Eigen::Vector3d& point) {
+    if (camera.parallel) return -camera.viewDirection();
+    const Eigen::Vector3d d = camera.eye - point;
+    const double len = d.norm();
+    return len > 0 ? Eigen::Vector3d(d / len) : Eigen::Vector3d(-camera.viewDirection());
+}
+
+} // namespace
+
+float sampleQuality(double footprint, double samplingAngle, double qualityAngleLimitDeg) {
+    const double cosLimit = std::cos(std::clamp(qualityAngleLimitDeg, 0.0, 89.9) * kDegToRad);
+    return float(footprint / std::max(std::cos(samplingAngle), cosLimit));
+}
+
+float triangleQuality(const Sample& a, const Sample& b, const Sample& c) {
+    return float((double(a.quality) + double(b.quality) + double(c.quality)) / 3.0);
+}
+
+void setSampleOnSurface(Sample& sample, const Mesh& reference, const Camera& camera, FaceIndex face,
+                        const Eigen::Vector3d& point, const ScanOptions& options) {
+    const FaceGeometry g = faceGeometry(reference, face);
+    const double cosAngle = std::clamp(g.normal.dot(towardsViewer(camera, point)), -1.0, 1.0);
+    const bool frontFacing = g.normal.squaredNorm() > 0 && cosAngle > 0;
+    sample.point = point;
+    sample.face = std::uint32_t(face.idx());
+    sample.normal = g.normal;
+    sample.samplingAngle = float(g.normal.squaredNorm() > 0 ? std::acos(cosAngle) : std::numbers::pi / 2);
+    sample.footprint = float(camera.pixelFootprint(point));
+    sample.quality = sampleQuality(sample.footprint, sample.samplingAngle, options.qualityAngleLimitDeg);
+    sample.hit = true;
+    sample.admissible = frontFacing;
+    sample.valid = frontFacing;
+}
+
+SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& reference,
+                             const ScanOptions& options, const Progress& progress) {
+    const Camera& camera = referenceBuffers.camera;
+    camera.validate();
+    const int w = camera.width, h = camera.height;
+    const std::size_t n = std::size_t(w) * std::size_t(h);
+    if (referenceBuffers.depth.size() != n || referenceBuffers.faceId.size() != n)
+        throw InvalidInputError("The scan buffers hold " + std::to_string(referenceBuffers.depth.size()) +
+                                " depth and " + std::to_string(referenceBuffers.faceId.size()) +
+                                " face-id values instead of " + std::to_string(n) + " for a " +
+                                std::to_string(w) + "x" + std::to_string(h) + " camera.");
+    SampleGrid grid(h, w);
+    grid.camera = camera;
+    grid.scanId = options.scanId;
+    for (int r = 0; r < h; ++r) {
+        progress.report(double(r) / h, "Sampling");
+        for (int c = 0; c < w; ++c) {
+            Sample& s = grid.at(r, c);
+            s.screen = {c + 0.5, r + 0.5};
+            const std::uint32_t id = referenceBuffers.faceAt(c, r);
+            if (id == FrameBuffers::kNoFace) continue;
+            const FaceIndex f(id);
+            if (std::size_t(id) >= reference.num_faces() || reference.is_removed(f) ||
+                reference.degree(f) != 3)
+                throw InvalidInputError("The face-id buffer names face " + std::to_string(id) +
+                                        ", which is not a triangle of the reference mesh: the buffers were "
+                                        "not rendered from this mesh.");
+            const Eigen::Vector3d unprojected =
+                camera.unprojectPixelCentre(c, r, referenceBuffers.depthAt(c, r));
+            // Snap along the viewing ray onto the face's plane (removes depth quantisation).
+            Eigen::Vector3d point = unprojected;
+            const FaceGeometry g = faceGeometry(reference, f);
+            const Ray ray = camera.ray(s.screen.x(), s.screen.y());
+            const double denom = g.normal.dot(ray.direction);
+            if (g.normal.squaredNorm() > 0 && std::abs(denom) > 1e-12) {
+                const Eigen::Vector3d snapped =
+                    ray.origin + (g.normal.dot(g.a - ray.origin) / denom) * ray.direction;
+                const double limit = options.maxSnapFootprints * camera.pixelFootprint(unprojected);
+                if (snapped.allFinite() && (snapped - unprojected).norm() <= limit) point = snapped;
+            }
+            setSampleOnSurface(s, reference, camera, f, point, options);
+        }
+    }
+    progress.report(1.0, "Sampling");
+    return grid;
+}
+
+} // namespace fss
