@@ -1,0 +1,135 @@
+// scanPatch end to end with the CPU renderer: a real mesh gives a regular manifold patch; every kind of
+// bad scan gives one clear sentence.
+#include "fss/error.h"
+#include "fss/metrics.h"
+#include "fss/scan_pipeline.h"
+#include "fss/shapes.h"
+#include "test_data.h"
+
+#include <CGAL/boost/graph/IO/polygon_mesh_io.h>
+#include <CGAL/boost/graph/helpers.h>
+
+#include <gtest/gtest.h>
+
+namespace {
+
+fss::Mesh load(const std::string& name) {
+    fss::Mesh m;
+    if (!CGAL::IO::read_polygon_mesh(fss::test::meshPath(name).string(), m)) ADD_FAILURE() << "cannot read " << name;
+    return m;
+}
+
+Eigen::AlignedBox3d bbox(const fss::Mesh& m) {
+    Eigen::AlignedBox3d b;
+    for (auto v : m.vertices()) b.extend(Eigen::Vector3d(m.point(v).x(), m.point(v).y(), m.point(v).z()));
+    return b;
+}
+
+std::string messageOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const fss::InvalidInputError& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+} // namespace
+
+TEST(ScanPipeline, IsoScanOfFandiskIsARegularManifoldPatch) {
+    const fss::Mesh ref = load("fandisk.off");
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(ref);
+    fss::ScanParams params;
+    params.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(ref), 256, 256);
+    const fss::ScanResult r = fss::scanPatch(ref, renderer, ref, renderer, params);
+
+    EXPECT_EQ(r.counts.pixels, 256u * 256u);
+    EXPECT_GT(r.counts.covered, 256u * 256u / 5);
+    EXPECT_EQ(r.counts.afterLasso, r.counts.frontFacing);    // no lasso
+    EXPECT_EQ(r.counts.afterQuality, r.counts.afterLasso);   // first scan: input faces always lose
+    EXPECT_LE(r.counts.afterMorphology, r.counts.afterQuality);
+    // Triangles across silhouettes are dropped, so a few valid samples end up in no triangle.
+    EXPECT_LE(r.patch.mesh.number_of_vertices(), r.counts.afterMorphology);
+    EXPECT_GT(r.patch.mesh.number_of_vertices(), r.counts.afterMorphology * 95 / 100);
+    ASSERT_TRUE(CGAL::is_valid_polygon_mesh(r.patch.mesh));
+    const fss::Metrics m = fss::computeMetrics(r.patch.mesh, {.selfIntersections = false, .reference = &ref});
+    EXPECT_EQ(m.nonManifoldVertices, 0u);
+    EXPECT_GE(m.fracValence6Interior, 0.98);
+    EXPECT_LE(*m.hausdorffToRefRel, 0.0025);
+    EXPECT_GT(r.timings.total, 0.0);
+    EXPECT_GE(r.timings.total, r.timings.renderReference + r.timings.triangulate);
+}
+
+TEST(ScanPipeline, LassoGivesAStrictSubset) {
+    const fss::Mesh ref = load("fandisk.off");
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(ref);
+    fss::ScanParams params;
+    params.camera = fss::Camera::standardView(fss::StandardView::PosX, bbox(ref), 96, 96);
+    const auto full = fss::scanPatch(ref, renderer, ref, renderer, params);
+    params.lasso = fss::Lasso{{{20, 20}, {76, 24}, {60, 80}, {30, 70}}};
+    const auto part = fss::scanPatch(ref, renderer, ref, renderer, params);
+    EXPECT_LT(part.patch.mesh.number_of_faces(), full.patch.mesh.number_of_faces());
+    EXPECT_GT(part.patch.mesh.number_of_faces(), 0u);
+    EXPECT_LT(part.counts.afterLasso, part.counts.frontFacing);
+    for (int r = 0; r < part.grid.rows; ++r)
+        for (int c = 0; c < part.grid.cols; ++c)
+            if (part.grid.at(r, c).valid) {
+                EXPECT_TRUE(full.grid.at(r, c).admissible);
+            }
+}
+
+TEST(ScanPipeline, BadScansAreExplainedInOneSentence) {
+    const fss::Mesh sphere = fss::shapes::icosphere(3, 1.0);
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(sphere);
+    fss::ScanParams params;
+    params.camera = fss::Camera::standardView(fss::StandardView::PosZ, bbox(sphere), 32, 32);
+
+    auto scan = [&](const fss::ScanParams& p) { fss::scanPatch(sphere, renderer, sphere, renderer, p); };
+    {
+        auto p = params;  // looking away from the sphere
+        p.camera.focal = p.camera.eye + (p.camera.eye - p.camera.focal);
+        EXPECT_NE(messageOf([&] { scan(p); }).find("behind"), std::string::npos);
+    }
+    {
+        auto p = params;  // eye at the centre of the sphere
+        p.camera.eye = {0, 0, 0};
+        p.camera.focal = {0, 0, -1};
+        EXPECT_NE(messageOf([&] { scan(p); }).find("inside the mesh"), std::string::npos);
+    }
+    {
+        auto p = params;  // looking beside the sphere
+        p.camera.focal = p.camera.eye + Eigen::Vector3d(1, 0, 0);
+        p.camera.up = {0, 0, 1};
+        const std::string msg = messageOf([&] { scan(p); });
+        EXPECT_TRUE(msg.find("sees no part") != std::string::npos || msg.find("behind") != std::string::npos) << msg;
+    }
+    {
+        auto p = params;
+        p.camera.width = 0;
+        EXPECT_NE(messageOf([&] { scan(p); }).find("resolution"), std::string::npos);
+    }
+    {
+        auto p = params;
+        p.lasso = fss::Lasso{{{1, 1}, {2, 2}, {3, 3}}};
+        EXPECT_NE(messageOf([&] { scan(p); }), "(no error)");
+    }
+    {
+        auto p = params;  // a lasso in a corner where the sphere is not
+        p.lasso = fss::Lasso{{{0, 0}, {2, 0}, {0, 2}}};
+        EXPECT_NE(messageOf([&] { scan(p); }).find("lasso selects no part"), std::string::npos);
+    }
+    {
+        auto p = params;
+        p.erodeRadius = -1;
+        EXPECT_NE(messageOf([&] { scan(p); }).find("radii"), std::string::npos);
+    }
+}
+
+TEST(ScanPipeline, CpuRendererNeedsAMesh) {
+    fss::CpuMeshRenderer renderer;
+    EXPECT_THROW(renderer.render(fss::Camera{}), fss::InvalidInputError);
+    EXPECT_THROW(renderer.setMesh(fss::Mesh{}), fss::InvalidInputError);
+}
