@@ -1,0 +1,211 @@
+// fss-remesh scan MESH -o OUT [--view V | --camera ...] [--parallel] [--resolution W[xH]] [--zoom F]
+//                  [--lasso "x,y;x,y;..."] [--erode N] [--dilate N] [--json] ...
+#include "args.h"
+#include "commands.h"
+
+#include "fss/camera.h"
+#include "fss/error.h"
+#include "fss/mesh_io.h"
+#include "fss/render/gpu_mesh_renderer.h"
+#include "fss/scan_pipeline.h"
+
+#include <nlohmann/json.hpp>
+
+#include <iostream>
+#include <memory>
+
+namespace fss::cli {
+namespace {
+
+Eigen::AlignedBox3d boundingBox(const Mesh& mesh) {
+    Eigen::AlignedBox3d box;
+    for (VertexIndex v : mesh.vertices()) {
+        const Point3& p = mesh.point(v);
+        box.extend(Eigen::Vector3d(p.x(), p.y(), p.z()));
+    }
+    return box;
+}
+
+// "ex,ey,ez,fx,fy,fz,ux,uy,uz[,angle]"
+Camera parseCamera(const std::string& text, const Eigen::AlignedBox3d& box, int w, int h, bool parallel) {
+    const std::vector<double> v = parseDoubleList("--camera", text);
+    if (v.size() != 9 && v.size() != 10)
+        throw UsageError("The option --camera needs 9 or 10 comma-separated numbers "
+                         "(eye, focal point, up, and optionally the view angle in degrees), not " +
+                         std::to_string(v.size()) + ".");
+    Camera c;
+    c.eye = {v[0], v[1], v[2]};
+    c.focal = {v[3], v[4], v[5]};
+    c.up = {v[6], v[7], v[8]};
+    c.viewAngleDeg = v.size() == 10 ? v[9] : 30.0;
+    c.parallel = parallel;
+    c.width = w;
+    c.height = h;
+    // A parallel camera shows the whole bounding box (its radius) around the focal point.
+    c.parallelScale = 0.5 * box.diagonal().norm() * std::max(1.0, double(h) / double(w));
+    c.validate();
+    return c;
+}
+
+// "x,y;x,y;..." in normalised image coordinates (0,0 top-left, 1,1 bottom-right) → pixels.
+Lasso parseLasso(const std::string& text, int w, int h) {
+    Lasso lasso;
+    std::size_t start = 0;
+    while (start <= text.size()) {
+        const auto semi = text.find(';', start);
+        const std::string item = text.substr(start, semi == std::string::npos ? std::string::npos : semi - start);
+        if (!item.empty()) {
+            const std::vector<double> xy = parseDoubleList("--lasso", item);
+            if (xy.size() != 2)
+                throw UsageError("Each --lasso point needs two numbers x,y (normalised 0..1), not '" + item + "'.");
+            lasso.points.emplace_back(xy[0] * w, xy[1] * h);
+        }
+        if (semi == std::string::npos) break;
+        start = semi + 1;
+    }
+    try {
+        validateLasso(lasso);
+    } catch (const InvalidInputError& e) {
+        throw UsageError(std::string("The --lasso polygon is degenerate: ") + e.what());
+    }
+    return lasso;
+}
+
+std::unique_ptr<MeshRenderer> makeRenderer(const std::string& kind, std::string& used) {
+    if (kind == "cpu") {
+        used = "cpu";
+        return std::make_unique<CpuMeshRenderer>();
+    }
+    try {
+        auto gpu = std::make_unique<render::GpuMeshRenderer>();
+        used = "gpu (" + gpu->rasterizer().glRenderer() + ")";
+        return gpu;
+    } catch (const Error& e) {
+        if (kind == "gpu") throw;
+        std::cerr << "fss-remesh scan: note: " << e.what() << " Falling back to CPU ray casting.\n";
+        used = "cpu";
+        return std::make_unique<CpuMeshRenderer>();
+    }
+}
+
+} // namespace
+
+int runScan(const std::vector<std::string>& args) {
+    std::string meshPath, outPath, view = "iso", cameraText, resolution = "256", zoom = "1", lassoText, erodeText = "1",
+                                   dilateText = "1", rendererKind = "auto", scanIdText = "0", maxEdge = "3",
+                                   maxAngle = "80", margin = "0.1";
+    bool haveView = false, haveCamera = false, haveLasso = false, parallel = false, json = false, force = false;
+    ArgParser p("fss-remesh scan", "Scan MESH from a camera: render it off-screen, turn every covered pixel into a "
+                                   "sample on the surface, mask the samples and triangulate the pixel grid into a "
+                                   "regular patch (interior valence 6), written to OUT.");
+    p.positional("MESH", "The reference mesh to scan (.off .obj .ply .stl).", &meshPath);
+    p.option("-o", "OUT", "Output file of the patch (.ply keeps per-face quality and scan id).", &outPath);
+    p.option("--output", "OUT", "Same as -o.", &outPath);
+    p.option("--view", "V", "Standard view fitted to the mesh: iso, +x, -x, +y, -y, +z, -z (default iso). '+x' looks "
+                            "from the +x side.", &view, &haveView);
+    p.option("--camera", "E,F,U[,A]",
+             "Explicit camera \"ex,ey,ez,fx,fy,fz,ux,uy,uz[,angle]\": eye, focal point, up vector and the vertical "
+             "view angle in degrees (default 30).", &cameraText, &haveCamera);
+    p.flag("--parallel", "Parallel (orthographic) projection instead of perspective.", &parallel);
+    p.option("--resolution", "W[xH]", "Scan resolution in pixels, 1 to 8192 per side (default 256).", &resolution);
+    p.option("--zoom", "F", "Zoom factor > 0 (2 = twice as close, finer sampling; default 1).", &zoom);
+    p.option("--lasso", "\"x,y;x,y;...\"",
+             "Keep only samples inside this polygon, in normalised image coordinates (0,0 top-left, 1,1 "
+             "bottom-right). Self-intersecting polygons use the non-zero winding rule.", &lassoText, &haveLasso);
+    p.option("--erode", "N", "Erosion radius in samples (default 1; 0 = none).", &erodeText);
+    p.option("--dilate", "N", "Dilation radius after the erosion (default 1); never re-admits rejected samples.",
+             &dilateText);
+    p.option("--max-edge-footprints", "X", "Drop triangles with an edge longer than X pixel footprints (default 3).",
+             &maxEdge);
+    p.option("--max-angle", "DEG", "Drop triangles seen at more than DEG degrees from frontal (default 80).",
+             &maxAngle);
+    p.option("--quality-margin", "M", "A sample replaces a face only when better by this fraction (default 0.1).",
+             &margin);
+    p.flag("--force-replace", "Keep every sample regardless of the quality of the mesh already there.", &force);
+    p.option("--scan-id", "N", "Scan id stored on the patch faces (default 0).", &scanIdText);
+    p.option("--renderer", "R", "auto (GPU, else CPU), gpu (head-less OpenGL) or cpu (ray casting).",
+             &rendererKind);
+    p.flag("--json", "Print a JSON report: counts and the timing of each stage.", &json);
+    p.epilog("examples:\n  fss-remesh scan fandisk.off -o patch.ply --view iso --resolution 512\n"
+             "  fss-remesh scan fandisk.off -o patch.ply --view +x --lasso \"0.2,0.2;0.8,0.2;0.5,0.9\" --erode 2");
+    if (!p.parse(args)) return 0;
+
+    if (outPath.empty()) throw UsageError("'fss-remesh scan' needs an output file: -o OUT.");
+    if (!isSupportedMeshFile(outPath))
+        throw UsageError("The output file " + outPath + " has no supported extension (.off .obj .ply .stl).");
+    if (haveView && haveCamera) throw UsageError("Give either --view or --camera, not both.");
+    if (rendererKind != "auto" && rendererKind != "gpu" && rendererKind != "cpu")
+        throw UsageError("The value '" + rendererKind + "' of --renderer is not one of auto, gpu, cpu.");
+    const auto [w, h] = parseResolution("--resolution", resolution, Camera::kMaxResolution);
+    const double zoomFactor = parseDouble("--zoom", zoom);
+    if (!(zoomFactor > 0)) throw UsageError("The value of --zoom must be positive.");
+    ScanParams params;
+    params.erodeRadius = parseInt("--erode", erodeText, 0, 64);
+    params.dilateRadius = parseInt("--dilate", dilateText, 0, 64);
+    params.triangulate.maxEdgeFootprints = parseDouble("--max-edge-footprints", maxEdge);
+    params.triangulate.maxSamplingAngleDeg = parseDouble("--max-angle", maxAngle);
+    params.quality.margin = parseDouble("--quality-margin", margin);
+    params.quality.forceReplace = force;
+    params.scan.scanId = parseInt("--scan-id", scanIdText, 0, 1 << 30);
+
+    const Mesh reference = readMesh(meshPath);
+    const Eigen::AlignedBox3d box = boundingBox(reference);
+    if (haveCamera) {
+        params.camera = parseCamera(cameraText, box, w, h, parallel);
+    } else {
+        const auto sv = parseStandardView(view);
+        if (!sv) throw UsageError("The value '" + view + "' of --view is not one of iso, +x, -x, +y, -y, +z, -z.");
+        params.camera = Camera::standardView(*sv, box, w, h, parallel);
+    }
+    params.camera.zoom(zoomFactor);
+    if (haveLasso) params.lasso = parseLasso(lassoText, w, h);
+
+    std::string rendererUsed;
+    std::unique_ptr<MeshRenderer> renderer = makeRenderer(rendererKind, rendererUsed);
+    renderer->setMesh(reference);
+    const ScanResult result = scanPatch(reference, *renderer, reference, *renderer, params);
+    writeMesh(result.patch.mesh, outPath, WriteOptions{.binary = false});
+
+    if (json) {
+        const ScanCounts& c = result.counts;
+        const ScanTimings& t = result.timings;
+        const TriangulateReport& tr = result.patch.report;
+        nlohmann::json j;
+        j["input"] = meshPath;
+        j["output"] = outPath;
+        j["renderer"] = rendererUsed;
+        j["resolution"] = {w, h};
+        j["camera"] = {{"eye", {params.camera.eye.x(), params.camera.eye.y(), params.camera.eye.z()}},
+                       {"focal", {params.camera.focal.x(), params.camera.focal.y(), params.camera.focal.z()}},
+                       {"up", {params.camera.up.x(), params.camera.up.y(), params.camera.up.z()}},
+                       {"parallel", params.camera.parallel},
+                       {"view_angle_deg", params.camera.viewAngleDeg},
+                       {"parallel_scale", params.camera.parallelScale}};
+        j["counts"] = {{"pixels", c.pixels},
+                       {"covered", c.covered},
+                       {"front_facing", c.frontFacing},
+                       {"after_lasso", c.afterLasso},
+                       {"after_quality", c.afterQuality},
+                       {"after_morphology", c.afterMorphology},
+                       {"patch_vertices", result.patch.mesh.number_of_vertices()},
+                       {"patch_faces", result.patch.mesh.number_of_faces()},
+                       {"dropped_flipped", tr.flipped},
+                       {"dropped_back_facing", tr.backFacing},
+                       {"dropped_long_edges", tr.longEdges},
+                       {"dropped_grazing", tr.grazing},
+                       {"dropped_non_manifold", tr.nonManifoldTriangles}};
+        j["timings_s"] = {{"render_reference", t.renderReference}, {"render_current", t.renderCurrent},
+                          {"sample", t.sample},                    {"lasso", t.lasso},
+                          {"quality_mask", t.qualityMask},         {"morphology", t.morphology},
+                          {"triangulate", t.triangulate},          {"total", t.total}};
+        std::cout << j.dump(2) << "\n";
+    } else {
+        std::cout << "scanned " << meshPath << " at " << w << "x" << h << " (" << rendererUsed << "): "
+                  << result.counts.covered << " covered pixels -> patch of " << result.patch.mesh.number_of_vertices()
+                  << " vertices, " << result.patch.mesh.number_of_faces() << " faces in " << result.timings.total
+                  << " s, written to " << outPath << "\n";
+    }
+    return 0;
+}
+
+} // namespace fss::cli
