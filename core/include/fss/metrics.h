@@ -3,6 +3,17 @@
 /// Quality metrics of a triangle mesh: counts, topology, regularity (valence), triangle shape, and the
 /// distance to a reference surface. The JSON keys used by `fss-remesh info --json` are the snake_case
 /// names given in the comments.
+///
+/// Definitions used throughout:
+/// - Removed (garbage) elements of a Surface_mesh are ignored; indices need not be dense.
+/// - A *boundary* edge has a face on one side only; a *boundary loop* is one cycle of border halfedges
+///   (as PMP::extract_boundary_cycles; holes that touch at a pinched vertex may form a single cycle).
+/// - An *interior* vertex is a manifold vertex with no incident boundary edge (isolated vertices are not
+///   interior); its valence is its number of incident edges.
+/// - A *non-manifold* (pinched) vertex is one whose incident faces form more than one fan (umbrella).
+/// - *Components* are maximal sets of faces connected through shared edges (two fans that only share a
+///   pinched vertex are two components); isolated vertices belong to no component.
+/// - Angles are the three corner angles of each triangle, in degrees.
 
 #include "fss/mesh.h"
 #include "fss/progress.h"
@@ -18,10 +29,11 @@ namespace fss {
 struct MetricsOptions {
     /// Count self-intersecting face pairs (CGAL PMP); skipped automatically above selfIntersectionMaxFaces.
     bool selfIntersections = true;
-    std::size_t selfIntersectionMaxFaces = 2'000'000;
+    std::size_t selfIntersectionMaxFaces = 2'000'000; ///< above this many faces selfIntersections is null
     /// When set, Hausdorff and RMS distances to this surface are measured.
     const Mesh* reference = nullptr;
-    /// Sampling density of the distance measurement: points per squared bbox diagonal (both ways).
+    /// Sampling density of the distance measurement: random points per squared bbox diagonal of the
+    /// reference, on each surface (both ways); the vertices of each surface are always sampled as well.
     double distanceSamplesPerArea = 0; ///< 0: choose automatically (about 100k samples each way)
 };
 
@@ -32,45 +44,61 @@ struct Metrics {
     std::size_t edges = 0;               ///< edges
     std::size_t boundaryEdges = 0;       ///< boundary_edges
     std::size_t boundaryLoops = 0;       ///< boundary_loops
-    std::size_t components = 0;          ///< components (connected by edges)
-    bool closed = false;                 ///< closed (no boundary edge)
+    std::size_t components = 0;          ///< components (faces connected by edges)
+    bool closed = false;                 ///< closed (no boundary edge; an empty mesh is closed)
     std::size_t nonManifoldVertices = 0; ///< non_manifold_vertices of the mesh (pinched vertices)
     std::size_t degenerateFaces = 0;     ///< degenerate_faces (collinear corners, exact predicate)
-    std::optional<std::size_t> selfIntersections; ///< self_intersections (face pairs), null when skipped
+    /// self_intersections: pairs of distinct non-degenerate faces that intersect other than through their
+    /// shared vertices/edge (CGAL PMP::self_intersections); null when skipped. Degenerate faces are
+    /// counted in degenerateFaces only.
+    std::optional<std::size_t> selfIntersections;
 
-    std::map<int, std::size_t> valenceHistogram; ///< valence_histogram (interior vertices only)
-    std::size_t interiorVertices = 0;            ///< interior_vertices
-    double fracValence6Interior = 0;             ///< frac_valence6_interior
+    /// valence_histogram (interior vertices only). JSON: an object {"valence": count}, e.g. {"5":12}.
+    std::map<int, std::size_t> valenceHistogram;
+    std::size_t interiorVertices = 0; ///< interior_vertices
+    double fracValence6Interior = 0;  ///< frac_valence6_interior (0 without interior vertices)
 
-    double minAngleDeg = 0;            ///< min_angle_deg over all corners
-    double maxAngleDeg = 0;            ///< max_angle_deg over all corners
-    double meanMinAngleDeg = 0;        ///< mean_min_angle_deg: mean of each triangle's smallest angle
-    double fracMinAngleBelow30 = 0;    ///< frac_min_angle_below_30
-    double fracMinAngleBelow10 = 0;    ///< frac_min_angle_below_10
-    double radiusRatioMean = 0;        ///< radius_ratio_mean: 2 r_in / r_circ, 1 for equilateral
-    double radiusRatioMin = 0;         ///< radius_ratio_min
-    double edgeLengthMean = 0;         ///< edge_length_mean
-    double edgeLengthCv = 0;           ///< edge_length_cv: standard deviation / mean
-    double bboxDiagonal = 0;           ///< bbox_diagonal
-    double area = 0;                   ///< area
+    double minAngleDeg = 0;         ///< min_angle_deg over all corners
+    double maxAngleDeg = 0;         ///< max_angle_deg over all corners
+    double meanMinAngleDeg = 0;     ///< mean_min_angle_deg: mean of each triangle's smallest angle
+    double fracMinAngleBelow30 = 0; ///< frac_min_angle_below_30 (of the triangles)
+    double fracMinAngleBelow10 = 0; ///< frac_min_angle_below_10 (of the triangles)
+    double radiusRatioMean = 0;     ///< radius_ratio_mean: 2 r_in / r_circ, 1 for equilateral, 0 degenerate
+    double radiusRatioMin = 0;      ///< radius_ratio_min
+    double edgeLengthMean = 0;      ///< edge_length_mean
+    double edgeLengthCv = 0;        ///< edge_length_cv: (population) standard deviation / mean
+    double bboxDiagonal = 0;        ///< bbox_diagonal of the (non-removed) vertices
+    double area = 0;                ///< area
 
     /// Distances to the reference (MetricsOptions::reference), absolute and relative to its bbox diagonal.
+    /// Each one-sided Hausdorff distance is the maximum, over the vertices and uniformly random points
+    /// (fixed seed) of one surface, of the exact distance to the other surface (CGAL AABB tree): a lower
+    /// bound of the true value that converges with the sample density. The distances *to* the reference
+    /// are null when this mesh has no vertex, those *from* it when this mesh has no non-degenerate face.
     std::optional<double> hausdorffToRef;      ///< hausdorff_to_ref: max over this mesh of distance to ref
     std::optional<double> hausdorffFromRef;    ///< hausdorff_from_ref: max over ref of distance to this mesh
     std::optional<double> hausdorffToRefRel;   ///< hausdorff_to_ref_rel
     std::optional<double> hausdorffFromRefRel; ///< hausdorff_from_ref_rel
-    std::optional<double> rmsToRef;            ///< rms_to_ref
+    /// rms_to_ref: root mean square distance to ref over area-uniform random points of this mesh (over its
+    /// vertices when it has no area).
+    std::optional<double> rmsToRef;
 };
 
 /// Computes the metrics of \p mesh. Linear in the mesh size except self-intersections (O(n log n)) and
-/// the distance measurement (AABB trees of both meshes).
-/// \throw InvalidInputError when the reference is given but empty. CancelledError through \p progress.
+/// the distance measurement (AABB trees of both meshes). Deterministic: the same input gives the same
+/// numbers. Reports progress (stages "self-intersections", "distance to reference", "distance from
+/// reference") through \p progress.
+/// \pre every face of \p mesh (and of the reference) is a triangle.
+/// \throw InvalidInputError when a face is not a triangle, or when the reference is given but empty or
+///        without any non-degenerate face. CancelledError through \p progress.
 Metrics computeMetrics(const Mesh& mesh, const MetricsOptions& options = {}, const Progress& progress = {});
 
-/// The metrics as one JSON object with the snake_case keys documented above (no trailing newline).
+/// The metrics as one JSON object with the snake_case keys documented above, in declaration order, with
+/// null for unmeasured values (no trailing newline). \p indent < 0 gives a single line.
 std::string metricsToJson(const Metrics& metrics, int indent = 2);
 
-/// A human-readable multi-line summary (for `fss-remesh info` without --json).
+/// A human-readable multi-line summary (for `fss-remesh info` without --json): one "label  value" line
+/// per metric with aligned labels and units, the valence histogram as one compact line; ends with '\n'.
 std::string metricsToText(const Metrics& metrics);
 
 } // namespace fss
