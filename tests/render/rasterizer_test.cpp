@@ -6,6 +6,7 @@
 #include "fss/frame_buffers.h"
 #include "fss/mesh.h"
 #include "fss/render/rasterizer.h"
+#include "fss/shapes.h"
 
 #include "test_data.h"
 
@@ -22,11 +23,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
 #include <limits>
-#include <map>
 #include <numbers>
 #include <utility>
 
@@ -56,43 +57,13 @@ Eigen::AlignedBox3d boundsOf(const Mesh& mesh) {
     return box;
 }
 
-// Icosphere (icosahedron subdivided `levels` times, vertices on the sphere), outward oriented.
+// fss::shapes::icosphere moved to \p centre.
 Mesh icosphere(int levels, double radius, const Eigen::Vector3d& centre) {
-    const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-    std::vector<Eigen::Vector3d> p = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                                      {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-    for (auto& q : p) q.normalize();
-    std::vector<std::array<int, 3>> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
-                                         {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
-                                         {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
-                                         {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
-    for (int l = 0; l < levels; ++l) {
-        std::map<std::pair<int, int>, int> mid;
-        auto midpoint = [&](int a, int b) {
-            const auto key = std::minmax(a, b);
-            auto it = mid.find(key);
-            if (it != mid.end()) return it->second;
-            p.push_back((p[a] + p[b]).normalized());
-            return mid[key] = int(p.size()) - 1;
-        };
-        std::vector<std::array<int, 3>> g;
-        g.reserve(f.size() * 4);
-        for (auto [a, b, c] : f) {
-            const int ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
-            g.push_back({a, ab, ca});
-            g.push_back({b, bc, ab});
-            g.push_back({c, ca, bc});
-            g.push_back({ab, bc, ca});
-        }
-        f = std::move(g);
+    Mesh mesh = fss::shapes::icosphere(levels, radius);
+    for (auto v : mesh.vertices()) {
+        const auto& p = mesh.point(v);
+        mesh.point(v) = fss::Point3(p.x() + centre.x(), p.y() + centre.y(), p.z() + centre.z());
     }
-    Mesh mesh;
-    std::vector<fss::VertexIndex> vs;
-    for (const auto& q : p) {
-        const Eigen::Vector3d x = centre + radius * q;
-        vs.push_back(mesh.add_vertex(fss::Point3(x.x(), x.y(), x.z())));
-    }
-    for (auto [a, b, c] : f) mesh.add_face(vs[a], vs[b], vs[c]);
     return mesh;
 }
 
