@@ -50,7 +50,7 @@ void BM_Scan(benchmark::State& state) {
     const int faces = int(state.range(0)), resolution = int(state.range(1));
     fss::render::Rasterizer& r = rasterizerWith(faces);
     fss::FrameBuffers fb;
-    r.render(scanCamera(r.bounds(), resolution, 0), fb);  // warm: upload, shaders, framebuffer size
+    r.render(scanCamera(r.bounds(), resolution, 0), fb); // warm: upload, shaders, framebuffer size
     double renderSum = 0, readSum = 0;
     int step = 0;
     for (auto _ : state) {
@@ -77,7 +77,7 @@ void BM_SetMeshAndFirstScan(benchmark::State& state) {
     fss::render::Rasterizer r;
     fss::FrameBuffers fb;
     r.setMesh(mesh);
-    r.render(scanCamera(r.bounds(), 512, 0), fb);  // shaders compiled once
+    r.render(scanCamera(r.bounds(), 512, 0), fb); // shaders compiled once
     for (auto _ : state) {
         r.setMesh(mesh);
         r.render(scanCamera(r.bounds(), 512, 1), fb);
@@ -85,7 +85,12 @@ void BM_SetMeshAndFirstScan(benchmark::State& state) {
     }
     state.SetLabel(std::to_string(faces) + " faces");
 }
-BENCHMARK(BM_SetMeshAndFirstScan)->Arg(100000)->Arg(1000000)->ArgName("faces")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SetMeshAndFirstScan)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->ArgName("faces")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 } // namespace
 

@@ -76,7 +76,9 @@ double outsideDistance(const Camera& cam, const Mesh& mesh, std::uint32_t f, dou
         const auto& p = mesh.point(v);
         s[i++] = cam.project(Eigen::Vector3d(p.x(), p.y(), p.z())).head<2>();
     }
-    const auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); };
+    const auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+        return a.x() * b.y() - a.y() * b.x();
+    };
     const double orientation = cross(s[1] - s[0], s[2] - s[0]) > 0 ? 1.0 : -1.0;
     const Eigen::Vector2d q(sx, sy);
     double outside = -std::numeric_limits<double>::infinity();
@@ -95,7 +97,7 @@ constexpr double kTiePx = 1.0 / 256.0;
 
 struct Agreement {
     std::size_t gpuCovered = 0, cpuHits = 0, unionCovered = 0, agree = 0;
-    double worstTie = 0;  // largest distance of a disagreeing pixel centre from the faces' boundaries
+    double worstTie = 0; // largest distance of a disagreeing pixel centre from the faces' boundaries
     double fraction() const { return unionCovered ? double(agree) / double(unionCovered) : 1.0; }
     std::size_t disagree() const { return unionCovered - agree; }
 };
@@ -137,7 +139,8 @@ Camera orbitView(const Eigen::AlignedBox3d& box, double azimuthDeg, double eleva
     Camera c = Camera::standardView(fss::StandardView::PosX, box, w, h, parallel);
     const double az = azimuthDeg * std::numbers::pi / 180, el = elevationDeg * std::numbers::pi / 180;
     const double dist = (c.eye - c.focal).norm();
-    c.eye = c.focal + dist * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+    c.eye = c.focal +
+            dist * Eigen::Vector3d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
     c.up = {0, 0, 1};
     c.zoom(zoom);
     c.fitClippingRange(box);
@@ -160,8 +163,13 @@ public:
         EGLConfig config = nullptr;
         EGLint count = 0;
         eglChooseConfig(display_, cfgAttribs, &config, 1, &count);
-        const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 1,
-                                  EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+        const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                  4,
+                                  EGL_CONTEXT_MINOR_VERSION,
+                                  1,
+                                  EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                  EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                  EGL_NONE};
         context_ = eglCreateContext(display_, count ? config : nullptr, EGL_NO_CONTEXT, attribs);
         if (context_ == EGL_NO_CONTEXT) throw std::runtime_error("test EGL context");
     }
@@ -223,15 +231,30 @@ TEST_P(RasterizerVsRayCasting, FaceIdsAgreeWithFirstRayHit) {
     const Camera cam = orbitView(boundsOf(mesh), c.azimuth, c.elevation, 800, 600, c.parallel, c.zoom);
     const FrameBuffers fb = rasterizer.render(cam);
     const Agreement a = compareWithRayCasting(fb, tree, mesh);
-    std::cout << "  " << c.mesh << " az " << c.azimuth << " el " << c.elevation << (c.parallel ? " parallel" : " perspective")
-              << ": gpu covered " << a.gpuCovered << ", cpu hits " << a.cpuHits << ", agree " << a.agree << "/"
-              << a.unionCovered << " = " << 100.0 * a.fraction() << " %, disagreeing centres within " << a.worstTie
+    std::cout << "  " << c.mesh << " az " << c.azimuth << " el " << c.elevation
+              << (c.parallel ? " parallel" : " perspective") << ": gpu covered " << a.gpuCovered
+              << ", cpu hits " << a.cpuHits << ", agree " << a.agree << "/" << a.unionCovered << " = "
+              << 100.0 * a.fraction() << " %, disagreeing centres within " << a.worstTie
               << " px of an edge\n";
-    EXPECT_GT(a.gpuCovered, 100000u);  // the mesh fills a good part of the image
+    EXPECT_GT(a.gpuCovered, 100000u); // the mesh fills a good part of the image
     EXPECT_GE(a.fraction(), 0.999);
     EXPECT_LE(a.worstTie, kTiePx);
     const auto diff = std::size_t(std::llabs(std::int64_t(a.gpuCovered) - std::int64_t(a.cpuHits)));
     EXPECT_LE(diff, a.disagree());
+}
+
+std::string caseName(const ::testing::TestParamInfo<RayCastCase>& info) {
+    const RayCastCase& c = info.param;
+    std::string mesh = c.mesh;
+    mesh = mesh.substr(0, mesh.find('.'));
+    const auto angle = [](double a) { return (a < 0 ? "m" : "") + std::to_string(int(std::abs(a))); };
+    return mesh + "_az" + angle(c.azimuth) + "_el" + angle(c.elevation) +
+           (c.parallel ? "_parallel" : "_perspective");
+}
+
+void PrintTo(const RayCastCase& c, std::ostream* os) {
+    *os << c.mesh << " azimuth " << c.azimuth << " elevation " << c.elevation
+        << (c.parallel ? " parallel" : " perspective") << " zoom " << c.zoom;
 }
 
 INSTANTIATE_TEST_SUITE_P(Meshes, RasterizerVsRayCasting,
@@ -240,14 +263,15 @@ INSTANTIATE_TEST_SUITE_P(Meshes, RasterizerVsRayCasting,
                                            RayCastCase{"fandisk.off", 90, 80, false, 1.6},
                                            RayCastCase{"bunny00.off", 20, 15, false, 1.5},
                                            RayCastCase{"bunny00.off", 250, 30, true, 1.5},
-                                           RayCastCase{"bunny00.off", 140, -60, false, 1.5}));
+                                           RayCastCase{"bunny00.off", 140, -60, false, 1.5}),
+                         caseName);
 
 // ---- depth: every covered pixel unprojects onto the sphere -------------------------------------------
 
 TEST(Rasterizer, DepthUnprojectsOntoTheSphere) {
     const Eigen::Vector3d centre(0.3, -0.2, 0.5);
     const double radius = 1.0;
-    const Mesh sphere = icosphere(7, radius, centre);  // 327 680 faces: polyhedral error < 2e-5 · radius
+    const Mesh sphere = icosphere(7, radius, centre); // 327 680 faces: polyhedral error < 2e-5 · radius
     Rasterizer rasterizer;
     rasterizer.setMesh(sphere);
     for (bool parallel : {false, true}) {
@@ -277,8 +301,8 @@ TEST(Rasterizer, DepthUnprojectsOntoTheSphere) {
                 ++samples;
             }
         std::cout << "  " << (parallel ? "parallel" : "perspective") << ": " << samples
-                  << " samples, max distance to the sphere " << worst << " px, to the face plane " << worstPlane
-                  << " px\n";
+                  << " samples, max distance to the sphere " << worst << " px, to the face plane "
+                  << worstPlane << " px\n";
         EXPECT_GT(samples, 10000u);
         EXPECT_LT(worst, 0.01);
         EXPECT_LT(worstPlane, 0.01);
@@ -288,12 +312,12 @@ TEST(Rasterizer, DepthUnprojectsOntoTheSphere) {
 // ---- VTK's projection is our Camera's ------------------------------------------------------------------
 
 TEST(Rasterizer, VtkCompositeProjectionEqualsCameraMatrix) {
-    Rasterizer rasterizer;  // needs no mesh and no GL for this
+    Rasterizer rasterizer; // needs no mesh and no GL for this
     for (bool parallel : {false, true}) {
         Camera c;
         c.eye = {3, 2, 5};
         c.focal = {0.5, -0.2, 0.1};
-        c.up = {0.1, 0, 1};  // not orthogonal to the view direction: both orthogonalise it the same way
+        c.up = {0.1, 0, 1}; // not orthogonal to the view direction: both orthogonalise it the same way
         c.parallel = parallel;
         c.viewAngleDeg = 40;
         c.parallelScale = 1.7;
@@ -304,7 +328,8 @@ TEST(Rasterizer, VtkCompositeProjectionEqualsCameraMatrix) {
         const Eigen::Matrix4d vtk = rasterizer.vtkViewProjectionMatrix(c);
         const Eigen::Matrix4d ours = c.viewProjectionMatrix();
         const double rel = (vtk - ours).cwiseAbs().maxCoeff() / ours.cwiseAbs().maxCoeff();
-        std::cout << "  " << (parallel ? "parallel" : "perspective") << ": max relative difference " << rel << "\n";
+        std::cout << "  " << (parallel ? "parallel" : "perspective") << ": max relative difference " << rel
+                  << "\n";
         EXPECT_LT(rel, 1e-9) << "VTK:\n" << vtk << "\nCamera:\n" << ours;
     }
 }
@@ -343,7 +368,7 @@ TEST(Rasterizer, FrameBuffersCarryTheFittedOrTheGivenCamera) {
 // ---- id decode over several passes -----------------------------------------------------------------
 
 TEST(Rasterizer, MultiPassIdDecodeIsExact) {
-    const Mesh mesh = loadMesh("fandisk.off");  // 12 946 faces: 14 bits → 4 passes of 4 bits
+    const Mesh mesh = loadMesh("fandisk.off"); // 12 946 faces: 14 bits → 4 passes of 4 bits
     Rasterizer single, multi;
     multi.setIdBitsPerPass(4);
     EXPECT_EQ(multi.idBitsPerPass(), 4);
@@ -361,8 +386,10 @@ TEST(Rasterizer, MultiPassIdDecodeIsExact) {
         EXPECT_TRUE(a.depth == b.depth);
         // Ids above 4 bits really occur, so the high passes carried information.
         EXPECT_GT(*std::max_element(a.faceId.begin(), a.faceId.end(),
-                                    [](auto u, auto v) { return (u == FrameBuffers::kNoFace ? 0 : u) <
-                                                                (v == FrameBuffers::kNoFace ? 0 : v); }),
+                                    [](auto u, auto v) {
+                                        return (u == FrameBuffers::kNoFace ? 0 : u) <
+                                               (v == FrameBuffers::kNoFace ? 0 : v);
+                                    }),
                   1u << 12);
     }
     // Switching back rebuilds the passes for the stored mesh.
@@ -381,7 +408,8 @@ TEST(Rasterizer, MeshWithRemovedFacesReportsTheirOwnIndices) {
     std::vector<fss::FaceIndex> gone;
     for (auto f : mesh.faces())
         if (std::size_t(f) % 3 == 0) gone.push_back(f);
-    for (auto f : gone) CGAL::Euler::remove_face(mesh.halfedge(f), mesh);
+    for (auto f : gone)
+        CGAL::Euler::remove_face(mesh.halfedge(f), mesh);
     ASSERT_TRUE(mesh.has_garbage());
     const Tree tree(faces(mesh).first, faces(mesh).second, mesh);
     Rasterizer rasterizer;
@@ -394,7 +422,7 @@ TEST(Rasterizer, MeshWithRemovedFacesReportsTheirOwnIndices) {
             ASSERT_FALSE(mesh.is_removed(fss::FaceIndex(id)));
         }
     const Agreement a = compareWithRayCasting(fb, tree, mesh);
-    EXPECT_GE(a.fraction(), 0.998);  // 200 × 160: relatively more edge pixels
+    EXPECT_GE(a.fraction(), 0.998); // 200 × 160: relatively more edge pixels
     EXPECT_LE(a.worstTie, kTiePx);
 }
 
@@ -406,7 +434,8 @@ TEST(Rasterizer, MeshIsUploadedOnceForManyCameras) {
     EXPECT_EQ(rasterizer.uploadCount(), 0u);
     rasterizer.setMesh(mesh);
     for (int i = 0; i < 5; ++i) {
-        const Camera cam = orbitView(rasterizer.bounds(), 70.0 * i, 10.0 * i - 20, 96 + 32 * i, 80, i % 2 == 1);
+        const Camera cam =
+            orbitView(rasterizer.bounds(), 70.0 * i, 10.0 * i - 20, 96 + 32 * i, 80, i % 2 == 1);
         rasterizer.render(cam);
     }
     EXPECT_EQ(rasterizer.uploadCount(), 1u);
@@ -430,8 +459,10 @@ TEST(Rasterizer, RendersInACallerSuppliedContextAndRestoresItsState) {
 
         // The application has its own framebuffer bound and its own viewport.
         context.makeCurrent();
-        auto genFramebuffers = reinterpret_cast<PFNGLGENFRAMEBUFFERSPROC>(eglGetProcAddress("glGenFramebuffers"));
-        auto bindFramebuffer = reinterpret_cast<PFNGLBINDFRAMEBUFFERPROC>(eglGetProcAddress("glBindFramebuffer"));
+        auto genFramebuffers =
+            reinterpret_cast<PFNGLGENFRAMEBUFFERSPROC>(eglGetProcAddress("glGenFramebuffers"));
+        auto bindFramebuffer =
+            reinterpret_cast<PFNGLBINDFRAMEBUFFERPROC>(eglGetProcAddress("glBindFramebuffer"));
         auto deleteFramebuffers =
             reinterpret_cast<PFNGLDELETEFRAMEBUFFERSPROC>(eglGetProcAddress("glDeleteFramebuffers"));
         GLuint fbo = 0;
@@ -440,7 +471,7 @@ TEST(Rasterizer, RendersInACallerSuppliedContextAndRestoresItsState) {
         glViewport(3, 4, 50, 60);
 
         theirs = rasterizer.render(cam);
-        EXPECT_TRUE(context.isCurrent());  // it was current before: the Rasterizer leaves it so
+        EXPECT_TRUE(context.isCurrent()); // it was current before: the Rasterizer leaves it so
         GLint draw = -1, read = -1, viewport[4] = {};
         glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &draw);
         glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &read);
@@ -496,10 +527,13 @@ TEST(Rasterizer, TwoRasterizersInOneProcess) {
     EXPECT_TRUE(b1.faceId == b2.faceId);
     EXPECT_GT(a1.coveredCount(), 1000u);
     EXPECT_GT(b1.coveredCount(), 1000u);
-    EXPECT_LE(*std::max_element(a1.faceId.begin(), a1.faceId.end(), [](auto u, auto v) {
-        return (u == FrameBuffers::kNoFace ? 0 : u) < (v == FrameBuffers::kNoFace ? 0 : v);
-    }), fandisk.number_of_faces());
-    a.reset();  // destroying one leaves the other working
+    EXPECT_LE(*std::max_element(a1.faceId.begin(), a1.faceId.end(),
+                                [](auto u, auto v) {
+                                    return (u == FrameBuffers::kNoFace ? 0 : u) <
+                                           (v == FrameBuffers::kNoFace ? 0 : v);
+                                }),
+              fandisk.number_of_faces());
+    a.reset(); // destroying one leaves the other working
     const FrameBuffers b3 = b.render(cb);
     EXPECT_TRUE(b1.faceId == b3.faceId);
     // Moving keeps it working.
@@ -511,7 +545,7 @@ TEST(Rasterizer, TwoRasterizersInOneProcess) {
 
 TEST(Rasterizer, RejectsBadInputWithOneSentence) {
     Rasterizer rasterizer;
-    EXPECT_THROW(rasterizer.render(Camera{}), fss::InvalidInputError);  // no mesh yet
+    EXPECT_THROW(rasterizer.render(Camera{}), fss::InvalidInputError); // no mesh yet
     EXPECT_THROW(rasterizer.setMesh(Mesh{}), fss::InvalidInputError);
     Mesh bad = icosphere(0, 1.0, Eigen::Vector3d::Zero());
     bad.point(*bad.vertices().begin()) = fss::Point3(std::nan(""), 0, 0);
@@ -527,7 +561,7 @@ TEST(Rasterizer, RejectsBadInputWithOneSentence) {
     noDirection.focal = noDirection.eye;
     EXPECT_THROW(rasterizer.render(noDirection), fss::InvalidInputError);
     Camera lookingAway = cam;
-    lookingAway.focal = cam.eye + (cam.eye - cam.focal);  // the mesh is behind the eye
+    lookingAway.focal = cam.eye + (cam.eye - cam.focal); // the mesh is behind the eye
     try {
         rasterizer.render(lookingAway);
         ADD_FAILURE() << "a mesh behind the camera was accepted";
@@ -558,6 +592,7 @@ TEST(Rasterizer, NoCurrentContextGivesAClearError) {
         rasterizer.render(orbitView(rasterizer.bounds(), 0, 0, 16, 16, false));
         ADD_FAILURE() << "rendering without a context succeeded";
     } catch (const fss::Error& e) {
-        EXPECT_STREQ(e.what(), "No OpenGL context is current: the Rasterizer's GlContext did not make one current.");
+        EXPECT_STREQ(e.what(),
+                     "No OpenGL context is current: the Rasterizer's GlContext did not make one current.");
     }
 }

@@ -26,17 +26,28 @@ bool hasExtension(const char* list, std::string_view name) {
 
 std::string eglErrorName(EGLint code) {
     switch (code) {
-    case EGL_SUCCESS: return "EGL_SUCCESS";
-    case EGL_NOT_INITIALIZED: return "EGL_NOT_INITIALIZED";
-    case EGL_BAD_ACCESS: return "EGL_BAD_ACCESS";
-    case EGL_BAD_ALLOC: return "EGL_BAD_ALLOC";
-    case EGL_BAD_ATTRIBUTE: return "EGL_BAD_ATTRIBUTE";
-    case EGL_BAD_CONFIG: return "EGL_BAD_CONFIG";
-    case EGL_BAD_CONTEXT: return "EGL_BAD_CONTEXT";
-    case EGL_BAD_DISPLAY: return "EGL_BAD_DISPLAY";
-    case EGL_BAD_MATCH: return "EGL_BAD_MATCH";
-    case EGL_BAD_PARAMETER: return "EGL_BAD_PARAMETER";
-    default: return "EGL error " + std::to_string(code);
+    case EGL_SUCCESS:
+        return "EGL_SUCCESS";
+    case EGL_NOT_INITIALIZED:
+        return "EGL_NOT_INITIALIZED";
+    case EGL_BAD_ACCESS:
+        return "EGL_BAD_ACCESS";
+    case EGL_BAD_ALLOC:
+        return "EGL_BAD_ALLOC";
+    case EGL_BAD_ATTRIBUTE:
+        return "EGL_BAD_ATTRIBUTE";
+    case EGL_BAD_CONFIG:
+        return "EGL_BAD_CONFIG";
+    case EGL_BAD_CONTEXT:
+        return "EGL_BAD_CONTEXT";
+    case EGL_BAD_DISPLAY:
+        return "EGL_BAD_DISPLAY";
+    case EGL_BAD_MATCH:
+        return "EGL_BAD_MATCH";
+    case EGL_BAD_PARAMETER:
+        return "EGL_BAD_PARAMETER";
+    default:
+        return "EGL error " + std::to_string(code);
     }
 }
 
@@ -105,7 +116,7 @@ HeadlessGlContext::HeadlessGlContext() : impl_(std::make_unique<Impl>()) {
     ScopedOpenGLApi api;
     if (!eglBindAPI(EGL_OPENGL_API)) fail("EGL does not support the desktop OpenGL API");
 
-    EGLConfig config = nullptr;  // EGL_NO_CONFIG_KHR
+    EGLConfig config = nullptr; // EGL_NO_CONFIG_KHR
     if (!hasExtension(displayExtensions, "EGL_KHR_no_config_context")) {
         const EGLint configAttribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
         EGLint count = 0;
@@ -134,7 +145,8 @@ HeadlessGlContext::HeadlessGlContext() : impl_(std::make_unique<Impl>()) {
 HeadlessGlContext::~HeadlessGlContext() {
     if (!impl_) return;
     ScopedOpenGLApi api;
-    if (eglGetCurrentContext() == impl_->context) eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (eglGetCurrentContext() == impl_->context)
+        eglMakeCurrent(impl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     eglDestroyContext(impl_->display, impl_->context);
 }
 
@@ -143,7 +155,7 @@ void HeadlessGlContext::makeCurrent() {
     const EGLenum api = eglQueryAPI();
     if (api != EGL_OPENGL_API) eglBindAPI(EGL_OPENGL_API);
     const EGLContext current = eglGetCurrentContext();
-    if (current == d.context) return;  // the common case while VTK renders
+    if (current == d.context) return; // the common case while VTK renders
     d.saved = true;
     d.savedApi = api;
     d.savedContext = current;
@@ -178,7 +190,11 @@ void HeadlessGlContext::doneCurrent() {
     d.saved = false;
 }
 
-const std::string& HeadlessGlContext::renderer() const { return impl_->renderer; }
-const std::string& HeadlessGlContext::version() const { return impl_->version; }
+const std::string& HeadlessGlContext::renderer() const {
+    return impl_->renderer;
+}
+const std::string& HeadlessGlContext::version() const {
+    return impl_->version;
+}
 
 } // namespace fss::render

@@ -71,7 +71,8 @@ std::string condense(std::string text) {
         const auto close = text.find("): ", open);
         if (close != std::string::npos) text.erase(open, close + 1 - open);
     }
-    while (!text.empty() && (text.back() == '\n' || text.back() == ' ' || text.back() == '.')) text.pop_back();
+    while (!text.empty() && (text.back() == '\n' || text.back() == ' ' || text.back() == '.'))
+        text.pop_back();
     for (char& c : text)
         if (c == '\n') c = ' ';
     return text;
@@ -203,7 +204,7 @@ public:
         glGetIntegerv(GL_PACK_SKIP_PIXELS, &packSkipPixels_);
     }
     ~ScopedGlState() {
-        if (!glBindFramebuffer || !glBindBuffer) return;  // VTK never initialised GLEW: nothing was changed
+        if (!glBindFramebuffer || !glBindBuffer) return; // VTK never initialised GLEW: nothing was changed
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(drawFramebuffer_));
         glBindFramebuffer(GL_READ_FRAMEBUFFER, GLuint(readFramebuffer_));
         glViewport(viewport_[0], viewport_[1], viewport_[2], viewport_[3]);
@@ -225,12 +226,18 @@ private:
 
 std::string glErrorName(GLenum code) {
     switch (code) {
-    case GL_INVALID_ENUM: return "GL_INVALID_ENUM";
-    case GL_INVALID_VALUE: return "GL_INVALID_VALUE";
-    case GL_INVALID_OPERATION: return "GL_INVALID_OPERATION";
-    case GL_INVALID_FRAMEBUFFER_OPERATION: return "GL_INVALID_FRAMEBUFFER_OPERATION";
-    case GL_OUT_OF_MEMORY: return "GL_OUT_OF_MEMORY";
-    default: return "GL error " + std::to_string(code);
+    case GL_INVALID_ENUM:
+        return "GL_INVALID_ENUM";
+    case GL_INVALID_VALUE:
+        return "GL_INVALID_VALUE";
+    case GL_INVALID_OPERATION:
+        return "GL_INVALID_OPERATION";
+    case GL_INVALID_FRAMEBUFFER_OPERATION:
+        return "GL_INVALID_FRAMEBUFFER_OPERATION";
+    case GL_OUT_OF_MEMORY:
+        return "GL_OUT_OF_MEMORY";
+    default:
+        return "GL error " + std::to_string(code);
     }
 }
 
@@ -279,14 +286,14 @@ struct Rasterizer::Impl {
     // Mesh data (shared by all passes).
     vtkSmartPointer<vtkPoints> points;
     vtkSmartPointer<vtkCellArray> triangles;
-    std::vector<std::uint32_t> cellToFace;  // VTK cell id → Face_index
+    std::vector<std::uint32_t> cellToFace; // VTK cell id → Face_index
     Eigen::AlignedBox3d box;
 
     int bitsPerPass = 24;
     std::uint64_t uploads = 0;
     RenderStats stats;
-    std::vector<std::uint32_t> scratch;  // colours of passes after the first
-    std::exception_ptr callbackError;    // exception thrown by the GlContext inside a VTK callback
+    std::vector<std::uint32_t> scratch; // colours of passes after the first
+    std::exception_ptr callbackError;   // exception thrown by the GlContext inside a VTK callback
 
     explicit Impl(GlContext* ctx) : context(ctx) {
         windowCallback->SetClientData(this);
@@ -301,8 +308,8 @@ struct Rasterizer::Impl {
             window->AddObserver(event, windowCallback);
         window->AddObserver(vtkCommand::ErrorEvent, errorCallback);
         window->SetOwnContext(0);
-        window->SetMultiSamples(0);          // multisampling blends ids at face borders
-        window->SetFrameBlitModeToNoBlit();  // the image stays in VTK's framebuffer; we read it there
+        window->SetMultiSamples(0);         // multisampling blends ids at face borders
+        window->SetFrameBlitModeToNoBlit(); // the image stays in VTK's framebuffer; we read it there
         window->SetUseSRGBColorSpace(false);
         window->SetSize(1, 1);
         window->SetReadyForRendering(false);
@@ -319,7 +326,8 @@ struct Rasterizer::Impl {
                 ScopedGlState state;
                 window->Finalize();
             }
-            for (auto& pass : passes) window->RemoveRenderer(pass->renderer);
+            for (auto& pass : passes)
+                window->RemoveRenderer(pass->renderer);
             passes.clear();
             window->RemoveAllObservers();
             window = nullptr;
@@ -332,12 +340,22 @@ struct Rasterizer::Impl {
         auto* self = static_cast<Impl*>(clientData);
         try {
             switch (event) {
-            case vtkCommand::WindowMakeCurrentEvent: self->context->makeCurrent(); break;
-            case vtkCommand::WindowIsCurrentEvent: *static_cast<bool*>(callData) = self->context->isCurrent(); break;
-            case vtkCommand::WindowSupportsOpenGLEvent: *static_cast<int*>(callData) = 1; break;
-            case vtkCommand::WindowIsDirectEvent: *static_cast<int*>(callData) = 1; break;
-            case vtkCommand::WindowFrameEvent: break;  // nothing to present: the scan is read back
-            default: break;
+            case vtkCommand::WindowMakeCurrentEvent:
+                self->context->makeCurrent();
+                break;
+            case vtkCommand::WindowIsCurrentEvent:
+                *static_cast<bool*>(callData) = self->context->isCurrent();
+                break;
+            case vtkCommand::WindowSupportsOpenGLEvent:
+                *static_cast<int*>(callData) = 1;
+                break;
+            case vtkCommand::WindowIsDirectEvent:
+                *static_cast<int*>(callData) = 1;
+                break;
+            case vtkCommand::WindowFrameEvent:
+                break; // nothing to present: the scan is read back
+            default:
+                break;
             }
         } catch (...) {
             if (!self->callbackError) self->callbackError = std::current_exception();
@@ -380,7 +398,8 @@ struct Rasterizer::Impl {
 
     int passCountFor(std::size_t faces) const {
         int n = 1;
-        while (bitsPerPass * n < 32 && (std::uint64_t(faces) >> (bitsPerPass * n)) != 0) ++n;
+        while (bitsPerPass * n < 32 && (std::uint64_t(faces) >> (bitsPerPass * n)) != 0)
+            ++n;
         return n;
     }
 
@@ -395,7 +414,8 @@ struct Rasterizer::Impl {
             window->RemoveRenderer(passes.back()->renderer);
             passes.pop_back();
         }
-        while (int(passes.size()) < count) passes.push_back(makePass());
+        while (int(passes.size()) < count)
+            passes.push_back(makePass());
         const std::uint32_t mask = (1u << bitsPerPass) - 1u;
         for (int p = 0; p < count; ++p) {
             vtkNew<vtkUnsignedCharArray> colours;
@@ -421,8 +441,7 @@ struct Rasterizer::Impl {
 
     // commit() then buildPasses(), with VTK's messages routed and, once GL is initialised, the context
     // current and the caller's GL state kept. commit() runs only once the context is current.
-    template <class Commit>
-    void updatePasses(Commit&& commit) {
+    template <class Commit> void updatePasses(Commit&& commit) {
         ScopedVtkMessages route(messages);
         std::optional<ScopedCurrent> current;
         std::optional<ScopedGlState> saved;
@@ -441,10 +460,10 @@ struct Rasterizer::Impl {
         auto pass = std::make_unique<IdPass>();
         CountingMapper* mapper = pass->mapper;
         mapper->uploads = &uploads;
-        mapper->SetStatic(1);  // no pipeline behind the data: never ask it for updates
+        mapper->SetStatic(1); // no pipeline behind the data: never ask it for updates
         mapper->ScalarVisibilityOn();
         mapper->SetScalarModeToUseCellData();
-        mapper->SetColorModeToDirectScalars();  // RGB bytes as they are: no lookup table
+        mapper->SetColorModeToDirectScalars(); // RGB bytes as they are: no lookup table
         mapper->InterpolateScalarsBeforeMappingOff();
         mapper->AddObserver(vtkCommand::ErrorEvent, errorCallback);
 
@@ -464,7 +483,7 @@ struct Rasterizer::Impl {
         pass->actor->PickableOff();
 
         vtkOpenGLRenderer* renderer = pass->renderer;
-        renderer->SetBackground(0.0, 0.0, 0.0);  // colour 0 = no face
+        renderer->SetBackground(0.0, 0.0, 0.0); // colour 0 = no face
         renderer->SetBackgroundAlpha(0.0);
         renderer->UseFXAAOff();
         renderer->UseDepthPeelingOff();
@@ -540,7 +559,8 @@ void Rasterizer::setMesh(const Mesh& mesh) {
     connectivity->SetNumberOfValues(corners);
     vtkIdType* conn = connectivity->GetPointer(0);
     for (FaceIndex f : mesh.faces())
-        for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) *conn++ = pointId[std::size_t(v)];
+        for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
+            *conn++ = pointId[std::size_t(v)];
     auto triangles = vtkSmartPointer<vtkCellArray>::New();
     triangles->SetData(offsets, connectivity);
 
@@ -553,13 +573,27 @@ void Rasterizer::setMesh(const Mesh& mesh) {
     });
 }
 
-bool Rasterizer::hasMesh() const { return !impl_->cellToFace.empty(); }
-std::size_t Rasterizer::faceCount() const { return impl_->cellToFace.size(); }
-const Eigen::AlignedBox3d& Rasterizer::bounds() const { return impl_->box; }
-std::uint64_t Rasterizer::uploadCount() const { return impl_->uploads; }
-const RenderStats& Rasterizer::lastStats() const { return impl_->stats; }
-std::string Rasterizer::glRenderer() const { return impl_->renderer; }
-int Rasterizer::idBitsPerPass() const { return impl_->bitsPerPass; }
+bool Rasterizer::hasMesh() const {
+    return !impl_->cellToFace.empty();
+}
+std::size_t Rasterizer::faceCount() const {
+    return impl_->cellToFace.size();
+}
+const Eigen::AlignedBox3d& Rasterizer::bounds() const {
+    return impl_->box;
+}
+std::uint64_t Rasterizer::uploadCount() const {
+    return impl_->uploads;
+}
+const RenderStats& Rasterizer::lastStats() const {
+    return impl_->stats;
+}
+std::string Rasterizer::glRenderer() const {
+    return impl_->renderer;
+}
+int Rasterizer::idBitsPerPass() const {
+    return impl_->bitsPerPass;
+}
 
 Eigen::Matrix4d Rasterizer::vtkViewProjectionMatrix(const Camera& camera) const {
     camera.validate();
@@ -568,7 +602,8 @@ Eigen::Matrix4d Rasterizer::vtkViewProjectionMatrix(const Camera& camera) const 
     vtkMatrix4x4* m = vc->GetCompositeProjectionTransformMatrix(camera.aspect(), -1.0, 1.0);
     Eigen::Matrix4d result;
     for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) result(i, j) = m->GetElement(i, j);
+        for (int j = 0; j < 4; ++j)
+            result(i, j) = m->GetElement(i, j);
     return result;
 }
 
@@ -595,7 +630,8 @@ void Rasterizer::render(const Camera& camera, FrameBuffers& out, const RenderOpt
 }
 
 void Rasterizer::Impl::render(const Camera& requested, FrameBuffers& out, const RenderOptions& options) {
-    if (cellToFace.empty()) throw InvalidInputError("Cannot render a scan before a mesh was given (setMesh).");
+    if (cellToFace.empty())
+        throw InvalidInputError("Cannot render a scan before a mesh was given (setMesh).");
     requested.validate();
     Camera cam = requested;
     if (!options.keepClippingRange) cam.fitClippingRange(box);
@@ -623,7 +659,8 @@ void Rasterizer::Impl::render(const Camera& requested, FrameBuffers& out, const 
     const std::uint32_t mask = (1u << bits) - 1u;
     double readSeconds = 0;
     for (int p = 0; p < passCount; ++p) {
-        for (int q = 0; q < passCount; ++q) passes[q]->renderer->SetDraw(q == p);
+        for (int q = 0; q < passCount; ++q)
+            passes[q]->renderer->SetDraw(q == p);
         window->Render();
         rethrowCallbackError();
         messages.throwIfAny("while rendering the scan");
@@ -642,18 +679,20 @@ void Rasterizer::Impl::render(const Camera& requested, FrameBuffers& out, const 
             glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, out.depth.data());
             readColour(out.faceId.data(), w, h);
             if (passCount > 1)
-                for (auto& v : out.faceId) v = rgbValue(v) & mask;
+                for (auto& v : out.faceId)
+                    v = rgbValue(v) & mask;
         } else {
             readColour(scratch.data(), w, h);
             const int shift = bits * p;
-            for (std::size_t i = 0; i < n; ++i) out.faceId[i] |= (rgbValue(scratch[i]) & mask) << shift;
+            for (std::size_t i = 0; i < n; ++i)
+                out.faceId[i] |= (rgbValue(scratch[i]) & mask) << shift;
         }
         const GLenum err = glGetError();
-        if (err != GL_NO_ERROR)
-            throw Error("Reading back the scan failed with " + glErrorName(err) + ".");
+        if (err != GL_NO_ERROR) throw Error("Reading back the scan failed with " + glErrorName(err) + ".");
         readSeconds += secondsSince(r0);
     }
-    for (int q = 0; q < passCount; ++q) passes[q]->renderer->SetDraw(q == 0);
+    for (int q = 0; q < passCount; ++q)
+        passes[q]->renderer->SetDraw(q == 0);
 
     // GL rows go bottom-up: flip to row 0 = top while decoding the ids.
     const auto d0 = Clock::now();
@@ -672,20 +711,23 @@ void Rasterizer::Impl::render(const Camera& requested, FrameBuffers& out, const 
         std::uint32_t* a = out.faceId.data() + std::size_t(top) * w;
         std::uint32_t* b = out.faceId.data() + std::size_t(bottom) * w;
         if (a == b) {
-            for (int x = 0; x < w; ++x) a[x] = decode(a[x]);
+            for (int x = 0; x < w; ++x)
+                a[x] = decode(a[x]);
         } else {
             for (int x = 0; x < w; ++x) {
                 const std::uint32_t va = a[x];
                 a[x] = decode(b[x]);
                 b[x] = decode(va);
             }
-            std::swap_ranges(out.depth.data() + std::size_t(top) * w, out.depth.data() + std::size_t(top + 1) * w,
+            std::swap_ranges(out.depth.data() + std::size_t(top) * w,
+                             out.depth.data() + std::size_t(top + 1) * w,
                              out.depth.data() + std::size_t(bottom) * w);
         }
     }
     if (bad)
-        throw Error("The ID render produced " + std::to_string(bad) +
-                    " pixels with colours that are no face id (multisampling or colour management interfered).");
+        throw Error(
+            "The ID render produced " + std::to_string(bad) +
+            " pixels with colours that are no face id (multisampling or colour management interfered).");
     readSeconds += secondsSince(d0);
 
     stats.passes = passCount;

@@ -35,9 +35,9 @@ struct RenderOptions {
 
 /// Wall-clock cost of the last render() (GL work finished before each figure is taken).
 struct RenderStats {
-    int passes = 0;             ///< ID passes rendered (1 unless the mesh has ≥ 2^bits − 1 faces)
-    double renderSeconds = 0;   ///< camera set-up + drawing all passes, until the GL finished
-    double readSeconds = 0;     ///< glReadPixels of depth and colours, row flip and id decoding
+    int passes = 0;           ///< ID passes rendered (1 unless the mesh has ≥ 2^bits − 1 faces)
+    double renderSeconds = 0; ///< camera set-up + drawing all passes, until the GL finished
+    double readSeconds = 0;   ///< glReadPixels of depth and colours, row flip and id decoding
 };
 
 /// Off-screen ID + depth renderer of one mesh. Not copyable; movable. Use from one thread at a time (the
