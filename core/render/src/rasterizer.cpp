@@ -310,6 +310,8 @@ struct Rasterizer::Impl {
         window->SetOwnContext(0);
         window->SetMultiSamples(0);         // multisampling blends ids at face borders
         window->SetFrameBlitModeToNoBlit(); // the image stays in VTK's framebuffer; we read it there
+        // No Frame(): it would copy the image into VTK's display framebuffer, which nobody reads.
+        window->SetSwapBuffers(0);
         window->SetUseSRGBColorSpace(false);
         window->SetSize(1, 1);
         window->SetReadyForRendering(false);
