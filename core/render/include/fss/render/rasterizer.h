@@ -12,7 +12,9 @@
 /// The mesh is uploaded once by setMesh(); render() may then be called any number of times with
 /// different cameras without sending the mesh to the GL again.
 ///
-/// Uses VTK (OpenGL2 backend) behind this header: consumers need only FSS headers.
+/// Uses VTK (OpenGL2 backend) behind this header: consumers need only FSS headers. While a Rasterizer
+/// call runs, VTK's process-wide output window is replaced by one that turns VTK errors into fss::Error
+/// (warnings are passed on to the previous one); it is put back before the call returns.
 
 #include "fss/camera.h"
 #include "fss/frame_buffers.h"
@@ -35,13 +37,13 @@ struct RenderOptions {
 
 /// Wall-clock cost of the last render() (GL work finished before each figure is taken).
 struct RenderStats {
-    int passes = 0;           ///< ID passes rendered (1 unless the mesh has ≥ 2^bits − 1 faces)
+    int passes = 0;           ///< ID passes rendered (1 unless the mesh has more than 2^24 − 1 faces)
     double renderSeconds = 0; ///< camera set-up + drawing all passes, until the GL finished
     double readSeconds = 0;   ///< glReadPixels of depth and colours, row flip and id decoding
 };
 
-/// Off-screen ID + depth renderer of one mesh. Not copyable; movable. Use from one thread at a time (the
-/// thread its context is used on).
+/// Off-screen ID + depth renderer of one mesh. Not copyable; movable. Several may live in one process.
+/// Use each from one thread at a time (the thread its context is used on), and VTK from one thread.
 class Rasterizer {
 public:
     /// Creates a Rasterizer with its own head-less HeadlessGlContext (Mesa EGL surfaceless): works
@@ -49,28 +51,29 @@ public:
     /// \throw fss::Error when no OpenGL context could be created (see HeadlessGlContext).
     Rasterizer();
 
-    /// Creates a Rasterizer that renders in the caller's context \p context. Rendering happens in
-    /// framebuffer objects of the Rasterizer; the caller's framebuffer bindings and viewport are restored
-    /// after every call.
-    /// \pre \p context outlives the Rasterizer, is an OpenGL 3.2+ context usable on the calling thread.
-    /// \throw fss::Error when VTK cannot initialise OpenGL in that context.
+    /// Creates a Rasterizer that renders in the caller's context \p context (e.g. a Qt widget's). Rendering
+    /// happens in framebuffer objects of the Rasterizer; the caller's framebuffer bindings, viewport,
+    /// scissor box and pixel-pack state are restored after every call. Does not use GL yet: the context
+    /// is first made current by render(), where problems with it are reported.
+    /// \pre \p context outlives the Rasterizer and is an OpenGL 3.2+ context usable on the calling thread.
     explicit Rasterizer(GlContext& context);
 
-    /// Releases the GL resources (making the context current for that).
+    /// Releases the GL resources (making the context current for that). A moved-from Rasterizer may only be
+    /// destroyed or assigned to.
     ~Rasterizer();
     Rasterizer(Rasterizer&&) noexcept;
     Rasterizer& operator=(Rasterizer&&) noexcept;
     Rasterizer(const Rasterizer&) = delete;
     Rasterizer& operator=(const Rasterizer&) = delete;
 
-    /// Copies the mesh's triangles into GL buffers (built once, reused by every render()). Face ids in the
-    /// FrameBuffers are the mesh's own Face_index values, valid also when the mesh has removed elements
-    /// (garbage): only live faces are drawn. Polygons with more than three corners are drawn as fans.
-    /// The Rasterizer keeps no reference to \p mesh. When the mesh is rejected or the context cannot be made
-    /// current, the previous mesh stays (strong guarantee).
+    /// Copies the mesh's points and faces; they are sent to the GL once, by the next render(), and reused by
+    /// every later render(). Face ids in the FrameBuffers are the mesh's own Face_index values, valid also
+    /// when the mesh has removed elements (garbage): only live faces are drawn. Polygons with more than
+    /// three corners are drawn as fans. The Rasterizer keeps no reference to \p mesh. When the mesh is
+    /// rejected or the context cannot be made current, the previous mesh stays (strong guarantee).
     /// \pre the mesh has at least one face, all vertex coordinates are finite.
     /// \throw InvalidInputError when the mesh has no face or a non-finite point.
-    /// \throw fss::Error when the GL fails to store it.
+    /// \throw fss::Error when the context cannot be made current or VTK reports an error.
     void setMesh(const Mesh& mesh);
 
     /// Whether setMesh() has been called.
@@ -91,7 +94,8 @@ public:
     /// \pre setMesh() was called; camera.validate() passes; with the fitted range, the mesh is not
     ///      entirely behind the eye.
     /// \throw InvalidInputError when there is no mesh, the camera is invalid or the mesh is behind it.
-    /// \throw fss::Error when VTK or the GL report an error (message names it). \p out is then unspecified.
+    /// \throw fss::Error when the context cannot be made current, is not OpenGL 3.2+, or VTK or the GL
+    ///        report an error (the message names it). \p out is then unspecified.
     void render(const Camera& camera, FrameBuffers& out, const RenderOptions& options = {});
 
     /// Number of times mesh data were uploaded to the GL (VTK buffer objects built): one per ID pass after
