@@ -136,7 +136,12 @@ HeadlessGlContext::HeadlessGlContext() : impl_(std::make_unique<Impl>()) {
     impl_->display = display;
     impl_->context = context;
 
-    makeCurrent();
+    try {
+        makeCurrent();
+    } catch (const Error&) {
+        eglDestroyContext(display, context);
+        fail("the new EGL context could not be made current without a surface");
+    }
     impl_->renderer = glString(GL_RENDERER);
     impl_->version = glString(GL_VERSION);
     doneCurrent();
