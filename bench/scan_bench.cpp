@@ -1,0 +1,100 @@
+// One regular scan, stage by stage, at 256², 512², 1024² of a 100k- and a 1M-face torus: GPU render and
+// read-back (Rasterizer statistics) against our CPU stages (unprojection into the SampleGrid, lasso,
+// quality mask against the current mesh, erosion + dilation, grid triangulation). The paper claims the
+// sampling adds "only few overhead" to the render: target CPU stages ≤ 30 % of render + read-back.
+// Counters: render_ms, read_ms, sample_ms, lasso_ms, quality_ms, morph_ms, triangulate_ms, cpu_ms and
+// cpu_over_gpu = cpu_ms / (render_ms + read_ms).
+#include "fss/camera.h"
+#include "fss/mask.h"
+#include "fss/render/rasterizer.h"
+#include "fss/scan.h"
+#include "fss/shapes.h"
+#include "fss/triangulate.h"
+
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <map>
+#include <memory>
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+struct Scene {
+    fss::Mesh mesh;
+    fss::render::Rasterizer rasterizer;
+    Eigen::AlignedBox3d box;
+};
+
+// torus(nu, nv) has 2·nu·nv faces: a self-occluding closed surface with exact face counts.
+Scene& sceneWith(int faces) {
+    static std::map<int, std::unique_ptr<Scene>> cache;
+    auto& s = cache[faces];
+    if (!s) {
+        s = std::make_unique<Scene>();
+        const int nu = faces >= 1000000 ? 1000 : 250;
+        s->mesh = fss::shapes::torus(nu, faces / (2 * nu), 1.0, 0.35);
+        s->rasterizer.setMesh(s->mesh);
+        for (auto v : s->mesh.vertices()) {
+            const auto& p = s->mesh.point(v);
+            s->box.extend(Eigen::Vector3d(p.x(), p.y(), p.z()));
+        }
+    }
+    return *s;
+}
+
+void BM_ScanStages(benchmark::State& state) {
+    const int faces = int(state.range(0)), res = int(state.range(1));
+    Scene& scene = sceneWith(faces);
+    const fss::Camera camera = fss::Camera::standardView(fss::StandardView::Iso, scene.box, res, res);
+    const fss::Lasso lasso{{{0.1 * res, 0.1 * res}, {0.9 * res, 0.15 * res}, {0.8 * res, 0.9 * res}, {0.15 * res, 0.8 * res}}};
+    double render = 0, read = 0, sample = 0, lassoMs = 0, quality = 0, morph = 0, tri = 0;
+    std::size_t patchFaces = 0;
+    for (auto _ : state) {
+        const fss::FrameBuffers buffers = scene.rasterizer.render(camera);
+        render += scene.rasterizer.lastStats().renderSeconds * 1e3;
+        read += scene.rasterizer.lastStats().readSeconds * 1e3;
+        auto t = Clock::now();
+        fss::SampleGrid grid = fss::sampleRegularGrid(buffers, scene.mesh);
+        sample += msSince(t);
+        t = Clock::now();
+        fss::applyLasso(grid, lasso);
+        lassoMs += msSince(t);
+        // The current mesh is the input itself here (worst case for the search: every sample looks up a face).
+        t = Clock::now();
+        fss::applyQualityMask(grid, scene.mesh, buffers);
+        quality += msSince(t);
+        t = Clock::now();
+        fss::applyMorphology(grid, {.radius = 1});
+        morph += msSince(t);
+        t = Clock::now();
+        const fss::Patch patch = fss::triangulateGrid(grid);
+        tri += msSince(t);
+        patchFaces = patch.mesh.number_of_faces();
+        benchmark::DoNotOptimize(patchFaces);
+    }
+    const double n = double(state.iterations());
+    const double cpu = (sample + lassoMs + quality + morph + tri) / n;
+    state.counters["render_ms"] = render / n;
+    state.counters["read_ms"] = read / n;
+    state.counters["sample_ms"] = sample / n;
+    state.counters["lasso_ms"] = lassoMs / n;
+    state.counters["quality_ms"] = quality / n;
+    state.counters["morph_ms"] = morph / n;
+    state.counters["triangulate_ms"] = tri / n;
+    state.counters["cpu_ms"] = cpu;
+    state.counters["cpu_over_gpu"] = cpu / ((render + read) / n);
+    state.counters["patch_faces"] = double(patchFaces);
+}
+
+} // namespace
+
+BENCHMARK(BM_ScanStages)
+    ->ArgsProduct({{100000, 1000000}, {256, 512, 1024}})
+    ->ArgNames({"faces", "res"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+BENCHMARK_MAIN();
