@@ -64,7 +64,8 @@ std::string quoteToken(std::string_view token) {
 
 std::string lower(std::string_view s) {
     std::string r(s);
-    for (char& c : r) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    for (char& c : r)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return r;
 }
 
@@ -76,8 +77,12 @@ bool equalsNoCase(std::string_view a, std::string_view b) {
     return true;
 }
 
-bool isBlank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-bool isSpace(char c) { return isBlank(c) || c == '\n'; }
+bool isBlank(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+}
+bool isSpace(char c) {
+    return isBlank(c) || c == '\n';
+}
 
 enum class NumberParse { Ok, NotANumber, OutOfRange };
 
@@ -117,8 +122,10 @@ public:
             pos_ = end + 1;
             number_ = next_++;
             if (comment_ != '\0') l = l.substr(0, std::min(l.find(comment_), l.size()));
-            while (!l.empty() && isBlank(l.back())) l.remove_suffix(1);
-            while (!l.empty() && isBlank(l.front())) l.remove_prefix(1);
+            while (!l.empty() && isBlank(l.back()))
+                l.remove_suffix(1);
+            while (!l.empty() && isBlank(l.front()))
+                l.remove_prefix(1);
             if (!l.empty()) {
                 line = l;
                 return true;
@@ -144,10 +151,12 @@ class Tokens {
 public:
     explicit Tokens(std::string_view line) : line_(line) {}
     bool next(std::string_view& token) {
-        while (pos_ < line_.size() && isBlank(line_[pos_])) ++pos_;
+        while (pos_ < line_.size() && isBlank(line_[pos_]))
+            ++pos_;
         if (pos_ >= line_.size()) return false;
         const std::size_t start = pos_;
-        while (pos_ < line_.size() && !isBlank(line_[pos_])) ++pos_;
+        while (pos_ < line_.size() && !isBlank(line_[pos_]))
+            ++pos_;
         token = line_.substr(start, pos_ - start);
         return true;
     }
@@ -168,14 +177,16 @@ public:
         }
         if (pos_ >= text_.size()) return false;
         const std::size_t start = pos_;
-        while (pos_ < text_.size() && !isSpace(text_[pos_])) ++pos_;
+        while (pos_ < text_.size() && !isSpace(text_[pos_]))
+            ++pos_;
         token = text_.substr(start, pos_ - start);
         tokenLine_ = line_;
         return true;
     }
     /// Skips the rest of the current line (e.g. the name after 'solid').
     void skipLine() {
-        while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
+        while (pos_ < text_.size() && text_[pos_] != '\n')
+            ++pos_;
     }
     std::string where() const { return "line " + std::to_string(tokenLine_) + ": "; }
 
@@ -186,8 +197,7 @@ private:
     std::size_t tokenLine_ = 1;
 };
 
-template <class T>
-T loadBinary(const char* p, bool swap) {
+template <class T> T loadBinary(const char* p, bool swap) {
     std::array<char, sizeof(T)> bytes;
     std::memcpy(bytes.data(), p, sizeof(T));
     if (swap) std::reverse(bytes.begin(), bytes.end());
@@ -203,7 +213,7 @@ PointKey keyOf(const Point3& p) {
     auto norm = [](double v) { return v == 0.0 ? 0.0 : v; };
     return {norm(p.x()), norm(p.y()), norm(p.z())};
 }
-std::uint64_t mixBits(std::uint64_t x) {  // splitmix64's finaliser
+std::uint64_t mixBits(std::uint64_t x) { // splitmix64's finaliser
     x ^= x >> 30;
     x *= 0xbf58476d1ce4e5b9ull;
     x ^= x >> 27;
@@ -242,13 +252,15 @@ private:
     static constexpr std::size_t kEmpty = std::numeric_limits<std::size_t>::max();
     void rehash(std::size_t expected) {
         std::size_t capacity = 16;
-        while (capacity < 2 * expected) capacity <<= 1;
+        while (capacity < 2 * expected)
+            capacity <<= 1;
         std::vector<std::size_t> old = std::move(slots_);
         slots_.assign(capacity, kEmpty);
         for (std::size_t s : old) {
             if (s == kEmpty) continue;
             std::size_t h = hashOf(keyOf(points_[s])) & (capacity - 1);
-            while (slots_[h] != kEmpty) h = (h + 1) & (capacity - 1);
+            while (slots_[h] != kEmpty)
+                h = (h + 1) & (capacity - 1);
             slots_[h] = s;
         }
     }
@@ -263,7 +275,8 @@ class DisjointSets {
 public:
     explicit DisjointSets(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
     std::size_t find(std::size_t i) {
-        while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
+        while (parent_[i] != i)
+            i = parent_[i] = parent_[parent_[i]];
         return i;
     }
     void unite(std::size_t a, std::size_t b) {
@@ -287,8 +300,8 @@ using Polygon = boost::container::small_vector<std::size_t, 4>;
 struct Soup {
     std::vector<Point3> points;
     std::vector<Polygon> polygons;
-    std::vector<float> quality;        ///< per polygon, empty when the file has none
-    std::vector<std::int32_t> scanId;  ///< per polygon, empty when the file has none
+    std::vector<float> quality;       ///< per polygon, empty when the file has none
+    std::vector<std::int32_t> scanId; ///< per polygon, empty when the file has none
 };
 
 /// The bytes of a file plus its name for messages.
@@ -336,7 +349,8 @@ Source loadFile(const fs::path& path) {
         src.fail("it cannot be read (" + (errno ? std::generic_category().message(errno) : "read error") +
                  ")");
     if (src.data.empty()) src.fail("the file is empty");
-    if (std::all_of(src.data.begin(), src.data.end(), isSpace)) src.fail("the file contains only white space");
+    if (std::all_of(src.data.begin(), src.data.end(), isSpace))
+        src.fail("the file contains only white space");
     return src;
 }
 
@@ -348,7 +362,8 @@ enum class Format { Off, Obj, Ply, StlAscii, StlBinary };
 
 std::string_view skipBomAndSpace(std::string_view d) {
     if (d.substr(0, 3) == "\xEF\xBB\xBF") d.remove_prefix(3);
-    while (!d.empty() && isSpace(d.front())) d.remove_prefix(1);
+    while (!d.empty() && isSpace(d.front()))
+        d.remove_prefix(1);
     return d;
 }
 
@@ -375,8 +390,8 @@ bool startsWithWordNoCase(std::string_view d, std::string_view word) {
 /// OFF header keywords: [ST][C][N][4][n]OFF.
 struct OffKeyword {
     bool valid = false;
-    bool homogeneous = false;  // 4OFF
-    bool dimension = false;    // nOFF
+    bool homogeneous = false; // 4OFF
+    bool dimension = false;   // nOFF
 };
 OffKeyword parseOffKeyword(std::string_view t) {
     OffKeyword k;
@@ -412,7 +427,8 @@ std::optional<Format> sniffFormat(std::string_view d) {
     Lines lines(s, '#');
     std::string_view line, keyword;
     if (lines.next(line) && Tokens(line).next(keyword)) {
-        static constexpr std::string_view objStarts[] = {"v", "vt", "vn", "vp", "f", "o", "g", "s", "mtllib", "usemtl"};
+        static constexpr std::string_view objStarts[] = {"v", "vt", "vn", "vp",     "f",
+                                                         "o", "g",  "s",  "mtllib", "usemtl"};
         if (std::find(std::begin(objStarts), std::end(objStarts), keyword) != std::end(objStarts))
             return Format::Obj;
     }
@@ -427,7 +443,8 @@ Format detectFormat(const Source& src) {
     if (ext == ".stl") return stlKind(src.data);
     if (auto f = sniffFormat(src.data)) return *f;
     src.fail("its format is not recognised: " +
-             (ext.empty() ? std::string("it has no extension") : "the extension " + quoteToken(ext) + " is not .off, .obj, .ply or .stl") +
+             (ext.empty() ? std::string("it has no extension")
+                          : "the extension " + quoteToken(ext) + " is not .off, .obj, .ply or .stl") +
              " and the content is not OFF, OBJ, PLY or STL either");
 }
 
@@ -455,7 +472,8 @@ Point3 readCoordinates(const Source& src, Tokens& tok, const std::string& where,
     }
     if (homogeneous) {
         if (c[3] == 0.0) src.fail(where + "vertex " + std::to_string(index) + " has homogeneous weight 0");
-        for (int i = 0; i < 3; ++i) c[std::size_t(i)] /= c[3];
+        for (int i = 0; i < 3; ++i)
+            c[std::size_t(i)] /= c[3];
         if (!std::isfinite(c[0]) || !std::isfinite(c[1]) || !std::isfinite(c[2]))
             src.fail(where + "vertex " + std::to_string(index) + " has an infinite coordinate");
     }
@@ -497,8 +515,7 @@ Soup parseOff(const Source& src) {
             numbers.push_back(v);
         }
         if (numbers.size() >= need) break;
-        if (!lines.next(line))
-            src.fail("the file ends before the vertex and face counts of the OFF header");
+        if (!lines.next(line)) src.fail("the file ends before the vertex and face counts of the OFF header");
         next = Tokens(line);
         tok = &next;
     }
@@ -546,10 +563,11 @@ Soup parseOff(const Source& src) {
             if (!parseInteger(t, index))
                 src.fail(where + "expected a vertex index of " + face + " but found " + quoteToken(t));
             if (index < 0 || index >= nv)
-                src.fail(where + face + " uses vertex index " + std::to_string(index) + ", but the file has " +
+                src.fail(where + face + " uses vertex index " + std::to_string(index) +
+                         ", but the file has " +
                          (nv == 0 ? std::string("no vertices")
-                                  : "only " + quantity(std::size_t(nv), "vertex", "vertices") + " (indices 0 to " +
-                                        std::to_string(nv - 1) + ")"));
+                                  : "only " + quantity(std::size_t(nv), "vertex", "vertices") +
+                                        " (indices 0 to " + std::to_string(nv - 1) + ")"));
             poly.push_back(std::size_t(index));
         }
         expectOnlyNumbers(src, ft, where, "the corners of " + face);
@@ -567,10 +585,10 @@ Soup parseOff(const Source& src) {
 
 Soup parseObj(const Source& src) {
     static constexpr std::string_view ignored[] = {
-        "vt",   "vn",   "vp",  "l",         "p",         "o",       "g",    "s",      "usemtl",
-        "mtllib", "cstype", "deg", "bmat",   "step",      "curv",    "curv2", "surf", "parm",   "trim",
-        "hole", "scrv", "sp",  "end",       "con",       "mg",      "bevel", "c_interp", "d_interp",
-        "lod",  "shadow_obj", "trace_obj", "ctech", "stech", "maplib", "usemap"};
+        "vt",       "vn",     "vp",         "l",         "p",     "o",     "g",      "s",     "usemtl",
+        "mtllib",   "cstype", "deg",        "bmat",      "step",  "curv",  "curv2",  "surf",  "parm",
+        "trim",     "hole",   "scrv",       "sp",        "end",   "con",   "mg",     "bevel", "c_interp",
+        "d_interp", "lod",    "shadow_obj", "trace_obj", "ctech", "stech", "maplib", "usemap"};
     Lines lines(skipBomAndSpace(src.data), '#');
     Soup soup;
     std::vector<std::size_t> faceLine;
@@ -598,7 +616,8 @@ Soup parseObj(const Source& src) {
                     ok = part.empty() || parseInteger(part, other);
                     s = e < t.size() ? e : std::string_view::npos;
                 }
-                if (!ok) src.fail(where + "expected a vertex index of " + face + " but found " + quoteToken(t));
+                if (!ok)
+                    src.fail(where + "expected a vertex index of " + face + " but found " + quoteToken(t));
                 if (index == 0) src.fail(where + face + " uses vertex index 0, but OBJ indices start at 1");
                 if (index < 0) {
                     const long long absolute = static_cast<long long>(soup.points.size()) + index;
@@ -653,18 +672,24 @@ std::optional<PlyType> plyType(std::string_view n) {
 std::size_t plySize(PlyType t) {
     switch (t) {
     case PlyType::Int8:
-    case PlyType::Uint8: return 1;
+    case PlyType::Uint8:
+        return 1;
     case PlyType::Int16:
-    case PlyType::Uint16: return 2;
+    case PlyType::Uint16:
+        return 2;
     case PlyType::Int32:
     case PlyType::Uint32:
-    case PlyType::Float32: return 4;
-    case PlyType::Float64: return 8;
+    case PlyType::Float32:
+        return 4;
+    case PlyType::Float64:
+        return 8;
     }
     return 8;
 }
 
-bool plyIsInteger(PlyType t) { return t != PlyType::Float32 && t != PlyType::Float64; }
+bool plyIsInteger(PlyType t) {
+    return t != PlyType::Float32 && t != PlyType::Float64;
+}
 
 struct PlyProperty {
     std::string name;
@@ -695,14 +720,22 @@ public:
         const char* p = body_.data() + pos_;
         pos_ += plySize(t);
         switch (t) {
-        case PlyType::Int8: return loadBinary<std::int8_t>(p, false);
-        case PlyType::Uint8: return loadBinary<std::uint8_t>(p, false);
-        case PlyType::Int16: return loadBinary<std::int16_t>(p, swap_);
-        case PlyType::Uint16: return loadBinary<std::uint16_t>(p, swap_);
-        case PlyType::Int32: return loadBinary<std::int32_t>(p, swap_);
-        case PlyType::Uint32: return loadBinary<std::uint32_t>(p, swap_);
-        case PlyType::Float32: return loadBinary<float>(p, swap_);
-        case PlyType::Float64: return loadBinary<double>(p, swap_);
+        case PlyType::Int8:
+            return loadBinary<std::int8_t>(p, false);
+        case PlyType::Uint8:
+            return loadBinary<std::uint8_t>(p, false);
+        case PlyType::Int16:
+            return loadBinary<std::int16_t>(p, swap_);
+        case PlyType::Uint16:
+            return loadBinary<std::uint16_t>(p, swap_);
+        case PlyType::Int32:
+            return loadBinary<std::int32_t>(p, swap_);
+        case PlyType::Uint32:
+            return loadBinary<std::uint32_t>(p, swap_);
+        case PlyType::Float32:
+            return loadBinary<float>(p, swap_);
+        case PlyType::Float64:
+            return loadBinary<double>(p, swap_);
         }
         return 0;
     }
@@ -752,7 +785,8 @@ public:
         std::string_view line;
         if (!lines_.next(line))
             src_.fail("the header announces " + std::to_string(e.count) + " " + e.name +
-                      " elements but the file ends after " + std::to_string(index) + " (the file is truncated)");
+                      " elements but the file ends after " + std::to_string(index) +
+                      " (the file is truncated)");
         tokens_ = Tokens(line);
     }
     std::string where() const { return lines_.where(); }
@@ -764,8 +798,8 @@ public:
         if (plyIsInteger(t)) {
             long long v = 0;
             if (!parseInteger(tok, v))
-                src_.fail(where() + "expected an integer in " + element_->name + " " + std::to_string(index_) +
-                          " but found " + quoteToken(tok));
+                src_.fail(where() + "expected an integer in " + element_->name + " " +
+                          std::to_string(index_) + " but found " + quoteToken(tok));
             return static_cast<double>(v);
         }
         double v = 0;
@@ -777,7 +811,8 @@ public:
         return v;
     }
     void skip(PlyType t, unsigned long long n) {
-        for (unsigned long long i = 0; i < n; ++i) scalar(t);
+        for (unsigned long long i = 0; i < n; ++i)
+            scalar(t);
     }
     void expectItems(PlyType, unsigned long long) {}
     void end() {
@@ -809,13 +844,13 @@ struct PlyLayout {
 };
 
 template <class Reader>
-void readPlyBody(const Source& src, Reader& r, const std::vector<PlyElement>& elements, const PlyLayout& layout,
-                 Soup& soup) {
+void readPlyBody(const Source& src, Reader& r, const std::vector<PlyElement>& elements,
+                 const PlyLayout& layout, Soup& soup) {
     bool verticesKnown = false;
     for (const PlyElement& e : elements) {
         const bool isVertex = &e == layout.vertex;
         const bool isFace = &e == layout.face;
-        if (e.properties.empty()) continue;  // nothing stored per element
+        if (e.properties.empty()) continue; // nothing stored per element
         for (unsigned long long k = 0; k < e.count; ++k) {
             r.begin(e, k);
             std::array<double, 3> xyz{0, 0, 0};
@@ -824,7 +859,8 @@ void readPlyBody(const Source& src, Reader& r, const std::vector<PlyElement>& el
                 const PlyProperty& p = e.properties[pi];
                 if (p.list) {
                     const double n = r.scalar(p.countType);
-                    if (n < 0) src.fail(r.where() + e.name + " " + std::to_string(k) + " has a negative list size");
+                    if (n < 0)
+                        src.fail(r.where() + e.name + " " + std::to_string(k) + " has a negative list size");
                     const auto items = static_cast<unsigned long long>(n);
                     if (!(isFace && pi == layout.indices)) {
                         r.skip(p.type, items);
@@ -842,8 +878,8 @@ void readPlyBody(const Source& src, Reader& r, const std::vector<PlyElement>& el
                             src.fail(r.where() + "face " + std::to_string(k) + " uses vertex index " +
                                      std::to_string(static_cast<long long>(index)) + ", but the file has " +
                                      (nv == 0 ? std::string("no vertices")
-                                              : "only " + quantity(nv, "vertex", "vertices") + " (indices 0 to " +
-                                                    std::to_string(nv - 1) + ")"));
+                                              : "only " + quantity(nv, "vertex", "vertices") +
+                                                    " (indices 0 to " + std::to_string(nv - 1) + ")"));
                         poly.push_back(static_cast<std::size_t>(index));
                     }
                     continue;
@@ -858,8 +894,8 @@ void readPlyBody(const Source& src, Reader& r, const std::vector<PlyElement>& el
                 } else if (isFace && layout.scanId && pi == *layout.scanId) {
                     if (!(v >= std::numeric_limits<std::int32_t>::min() &&
                           v <= std::numeric_limits<std::int32_t>::max() && v == std::floor(v)))
-                        src.fail(r.where() + "face " + std::to_string(k) + " has scan_id " + std::to_string(v) +
-                                 ", which is not a 32-bit integer");
+                        src.fail(r.where() + "face " + std::to_string(k) + " has scan_id " +
+                                 std::to_string(v) + ", which is not a 32-bit integer");
                     soup.scanId.push_back(static_cast<std::int32_t>(v));
                 }
             }
@@ -879,9 +915,10 @@ void readPlyBody(const Source& src, Reader& r, const std::vector<PlyElement>& el
     for (std::size_t f = 0; f < soup.polygons.size(); ++f)
         for (std::size_t index : soup.polygons[f])
             if (index >= nv)
-                src.fail("face " + std::to_string(f) + " uses vertex index " + std::to_string(index) +
-                         ", but the file has " +
-                         (nv == 0 ? std::string("no vertices") : "only " + quantity(nv, "vertex", "vertices")));
+                src.fail(
+                    "face " + std::to_string(f) + " uses vertex index " + std::to_string(index) +
+                    ", but the file has " +
+                    (nv == 0 ? std::string("no vertices") : "only " + quantity(nv, "vertex", "vertices")));
 }
 
 Soup parsePly(const Source& src, bool& binary) {
@@ -913,10 +950,14 @@ Soup parsePly(const Source& src, bool& binary) {
             ended = true;
         } else if (t == "format") {
             tok.next(t);
-            if (t == "ascii") encoding = Encoding::Ascii;
-            else if (t == "binary_little_endian") encoding = Encoding::Little;
-            else if (t == "binary_big_endian") encoding = Encoding::Big;
-            else src.fail(where + "unknown PLY format " + quoteToken(t));
+            if (t == "ascii")
+                encoding = Encoding::Ascii;
+            else if (t == "binary_little_endian")
+                encoding = Encoding::Little;
+            else if (t == "binary_big_endian")
+                encoding = Encoding::Big;
+            else
+                src.fail(where + "unknown PLY format " + quoteToken(t));
         } else if (t == "element") {
             PlyElement e;
             std::string_view name, n;
@@ -1042,7 +1083,7 @@ private:
 Soup parseStlAscii(const Source& src) {
     TokenStream ts(skipBomAndSpace(src.data));
     Soup soup;
-    CornerMerger merger(soup, src.data.size() / 200);  // ~ 250 bytes per facet, ~ half a point each
+    CornerMerger merger(soup, src.data.size() / 200); // ~ 250 bytes per facet, ~ half a point each
     std::string_view t;
     auto expect = [&](std::string_view keyword, const std::string& context) {
         if (!ts.next(t))
@@ -1056,7 +1097,8 @@ Soup parseStlAscii(const Source& src) {
         if (!ts.next(t)) src.fail("the file ends inside " + what + " (the file is truncated)");
         double v = 0;
         const NumberParse r = parseDouble(t, v);
-        if (r == NumberParse::NotANumber) src.fail(ts.where() + "expected a number in " + what + " but found " + quoteToken(t));
+        if (r == NumberParse::NotANumber)
+            src.fail(ts.where() + "expected a number in " + what + " but found " + quoteToken(t));
         if (r == NumberParse::OutOfRange) v = std::numeric_limits<double>::infinity();
         return v;
     };
@@ -1078,7 +1120,8 @@ Soup parseStlAscii(const Source& src) {
         if (!equalsNoCase(t, "facet"))
             src.fail(ts.where() + "expected 'facet' or 'endsolid' but found " + quoteToken(t));
         expect("normal", facet);
-        for (int i = 0; i < 3; ++i) number("the normal of " + facet);  // recomputed, not stored
+        for (int i = 0; i < 3; ++i)
+            number("the normal of " + facet); // recomputed, not stored
         expect("outer", facet);
         expect("loop", facet);
         Polygon poly;
@@ -1086,10 +1129,12 @@ Soup parseStlAscii(const Source& src) {
             if (!ts.next(t)) src.fail("the file ends inside " + facet + " (the file is truncated)");
             if (equalsNoCase(t, "endloop")) break;
             if (!equalsNoCase(t, "vertex"))
-                src.fail(ts.where() + "expected 'vertex' or 'endloop' in " + facet + " but found " + quoteToken(t));
+                src.fail(ts.where() + "expected 'vertex' or 'endloop' in " + facet + " but found " +
+                         quoteToken(t));
             const std::string where = ts.where();
             std::array<double, 3> c{};
-            for (double& v : c) v = number("a vertex of " + facet);
+            for (double& v : c)
+                v = number("a vertex of " + facet);
             if (!std::isfinite(c[0]) || !std::isfinite(c[1]) || !std::isfinite(c[2]))
                 src.fail(where + facet + " has a NaN or infinite coordinate");
             poly.push_back(merger.add({c[0], c[1], c[2]}));
@@ -1106,8 +1151,9 @@ Soup parseStlAscii(const Source& src) {
 Soup parseStlBinary(const Source& src) {
     const std::string_view d = src.data;
     if (d.size() < 84)
-        src.fail("it is neither an ascii STL file (starting with 'solid') nor a binary STL file (it has only " +
-                 quantity(d.size(), "byte", "bytes") + ", fewer than the 84 of a binary STL header)");
+        src.fail(
+            "it is neither an ascii STL file (starting with 'solid') nor a binary STL file (it has only " +
+            quantity(d.size(), "byte", "bytes") + ", fewer than the 84 of a binary STL header)");
     const auto n = loadBinary<std::uint32_t>(d.data() + 80, std::endian::native == std::endian::big);
     const std::uint64_t expected = 84 + 50 * std::uint64_t(n);
     if (d.size() < expected)
@@ -1127,7 +1173,8 @@ Soup parseStlBinary(const Source& src) {
         Polygon tri(3);
         for (std::size_t c = 0; c < 3; ++c) {
             std::array<double, 3> xyz{};
-            for (std::size_t k = 0; k < 3; ++k) xyz[k] = loadBinary<float>(rec + 12 + 12 * c + 4 * k, swap);
+            for (std::size_t k = 0; k < 3; ++k)
+                xyz[k] = loadBinary<float>(rec + 12 + 12 * c + 4 * k, swap);
             if (!std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2]))
                 src.fail("triangle " + std::to_string(i) + " has a NaN or infinite coordinate");
             tri[c] = merger.add({xyz[0], xyz[1], xyz[2]});
@@ -1145,7 +1192,8 @@ Soup parseStlBinary(const Source& src) {
 bool hasZeroArea(const std::vector<Point3>& pts, const Polygon& poly) {
     const Point3& p = pts[poly[0]];
     std::size_t j = 1;
-    while (j < poly.size() && pts[poly[j]] == p) ++j;
+    while (j < poly.size() && pts[poly[j]] == p)
+        ++j;
     if (j == poly.size()) return true;
     const Point3& q = pts[poly[j]];
     for (std::size_t k = j + 1; k < poly.size(); ++k)
@@ -1164,9 +1212,9 @@ bool hasRepeatedCorner(const Polygon& p) {
 /// corners. The soup is a valid oriented polygon mesh exactly when all three counts are zero (the
 /// condition of CGAL's is_polygon_soup_a_polygon_mesh, computed here in linear time).
 struct Topology {
-    std::size_t nonManifoldEdges = 0;     ///< undirected edges in more than two polygons
-    std::size_t nonManifoldVertices = 0;  ///< vertices whose polygons form more than one fan
-    std::size_t misorientedEdges = 0;     ///< directed edges used twice (neighbours of opposite orientation)
+    std::size_t nonManifoldEdges = 0;    ///< undirected edges in more than two polygons
+    std::size_t nonManifoldVertices = 0; ///< vertices whose polygons form more than one fan
+    std::size_t misorientedEdges = 0;    ///< directed edges used twice (neighbours of opposite orientation)
     bool isMesh() const { return nonManifoldEdges == 0 && nonManifoldVertices == 0 && misorientedEdges == 0; }
 };
 
@@ -1177,7 +1225,8 @@ Topology analyseTopology(const std::vector<Polygon>& polys, std::size_t pointCou
     std::vector<std::size_t> start(pointCount + 1, 0);
     for (std::size_t f = 0; f < polys.size(); ++f)
         if (!skip || !(*skip)[f])
-            for (std::size_t c : polys[f]) ++start[c + 1];
+            for (std::size_t c : polys[f])
+                ++start[c + 1];
     std::partial_sum(start.begin(), start.end(), start.begin());
     std::vector<std::pair<std::size_t, std::size_t>> wedges(start.back());
     std::vector<std::size_t> fill(start.begin(), start.end() - 1);
@@ -1185,11 +1234,12 @@ Topology analyseTopology(const std::vector<Polygon>& polys, std::size_t pointCou
         if (skip && (*skip)[f]) continue;
         const Polygon& p = polys[f];
         const std::size_t m = p.size();
-        for (std::size_t j = 0; j < m; ++j) wedges[fill[p[j]]++] = {p[(j + m - 1) % m], p[(j + 1) % m]};
+        for (std::size_t j = 0; j < m; ++j)
+            wedges[fill[p[j]]++] = {p[(j + m - 1) % m], p[(j + 1) % m]};
     }
 
     Topology t;
-    std::vector<std::pair<std::size_t, bool>> around;  // (neighbour, edge points towards it)
+    std::vector<std::pair<std::size_t, bool>> around; // (neighbour, edge points towards it)
     std::vector<std::size_t> neighbours;
     for (std::size_t v = 0; v < pointCount; ++v) {
         const std::size_t b = start[v], e = start[v + 1];
@@ -1203,7 +1253,8 @@ Topology analyseTopology(const std::vector<Polygon>& polys, std::size_t pointCou
         neighbours.clear();
         for (std::size_t i = 0; i < around.size();) {
             std::size_t j = i, outgoing = 0;
-            for (; j < around.size() && around[j].first == around[i].first; ++j) outgoing += around[j].second;
+            for (; j < around.size() && around[j].first == around[i].first; ++j)
+                outgoing += around[j].second;
             // Each polygon with the edge v–x has exactly one corner at v next to x.
             if (around[i].first > v && j - i > 2) ++t.nonManifoldEdges;
             if (outgoing > 1) t.misorientedEdges += outgoing - 1;
@@ -1213,12 +1264,15 @@ Topology analyseTopology(const std::vector<Polygon>& polys, std::size_t pointCou
         if (e - b < 2) continue;
         // One fan exactly when the link (segments previous–next around v) is connected.
         auto local = [&](std::size_t x) {
-            return std::size_t(std::lower_bound(neighbours.begin(), neighbours.end(), x) - neighbours.begin());
+            return std::size_t(std::lower_bound(neighbours.begin(), neighbours.end(), x) -
+                               neighbours.begin());
         };
         DisjointSets sets(neighbours.size());
-        for (std::size_t k = b; k < e; ++k) sets.unite(local(wedges[k].first), local(wedges[k].second));
+        for (std::size_t k = b; k < e; ++k)
+            sets.unite(local(wedges[k].first), local(wedges[k].second));
         std::size_t fans = 0;
-        for (std::size_t k = 0; k < neighbours.size(); ++k) fans += sets.find(k) == k;
+        for (std::size_t k = 0; k < neighbours.size(); ++k)
+            fans += sets.find(k) == k;
         if (fans > 1) ++t.nonManifoldVertices;
     }
     return t;
@@ -1241,7 +1295,8 @@ SoupStats computeStats(const Soup& soup, std::vector<std::size_t>& canonical, To
     if (s.duplicatePoints > 0) {
         merged = soup.polygons;
         for (Polygon& p : merged)
-            for (std::size_t& c : p) c = canonical[c];
+            for (std::size_t& c : p)
+                c = canonical[c];
     }
     const std::vector<Polygon>& polys = s.duplicatePoints > 0 ? merged : soup.polygons;
     std::vector<char> repeated(polys.size(), 0);
@@ -1269,12 +1324,13 @@ constexpr std::size_t kMaxEarClippingCorners = 10000;
 void triangulatePolygon(const std::vector<Point3>& pts, const Polygon& poly, std::vector<Polygon>& out) {
     const std::size_t n = poly.size();
     auto fan = [&](const std::vector<std::size_t>& ids) {
-        for (std::size_t i = 1; i + 1 < ids.size(); ++i) out.push_back({poly[ids[0]], poly[ids[i]], poly[ids[i + 1]]});
+        for (std::size_t i = 1; i + 1 < ids.size(); ++i)
+            out.push_back({poly[ids[0]], poly[ids[i]], poly[ids[i + 1]]});
     };
     std::vector<std::size_t> remaining(n);
     std::iota(remaining.begin(), remaining.end(), 0);
 
-    std::array<double, 3> normal{0, 0, 0};  // Newell's normal
+    std::array<double, 3> normal{0, 0, 0}; // Newell's normal
     for (std::size_t i = 0; i < n; ++i) {
         const Point3& a = pts[poly[i]];
         const Point3& b = pts[poly[(i + 1) % n]];
@@ -1338,7 +1394,7 @@ struct ReversalRecorder : PMP::Default_orientation_visitor {
 /// orient_polygon_soup keeps the orientation of the first polygon of each component; flip back the
 /// components where that reversed the majority of the file's polygons, so the fewest are changed.
 void keepMajorityOrientation(std::vector<Polygon>& polys, std::vector<char>& reversed) {
-    std::vector<std::array<std::size_t, 3>> edges;  // (min, max, polygon)
+    std::vector<std::array<std::size_t, 3>> edges; // (min, max, polygon)
     for (std::size_t f = 0; f < polys.size(); ++f)
         for (std::size_t j = 0; j < polys[f].size(); ++j) {
             const std::size_t a = polys[f][j], b = polys[f][(j + 1) % polys[f].size()];
@@ -1347,7 +1403,8 @@ void keepMajorityOrientation(std::vector<Polygon>& polys, std::vector<char>& rev
     std::sort(edges.begin(), edges.end());
     DisjointSets sets(polys.size());
     for (std::size_t i = 1; i < edges.size(); ++i)
-        if (edges[i][0] == edges[i - 1][0] && edges[i][1] == edges[i - 1][1]) sets.unite(edges[i][2], edges[i - 1][2]);
+        if (edges[i][0] == edges[i - 1][0] && edges[i][1] == edges[i - 1][1])
+            sets.unite(edges[i][2], edges[i - 1][2]);
     std::vector<std::size_t> size(polys.size(), 0), flipped(polys.size(), 0);
     for (std::size_t f = 0; f < polys.size(); ++f) {
         ++size[sets.find(f)];
@@ -1363,7 +1420,8 @@ void keepMajorityOrientation(std::vector<Polygon>& polys, std::vector<char>& rev
 }
 
 /// Removes triangles with the same corners as an earlier one (either orientation); true when any.
-bool removeDuplicateTriangles(std::vector<Polygon>& polys, std::vector<std::size_t>& origin, ReadReport& report) {
+bool removeDuplicateTriangles(std::vector<Polygon>& polys, std::vector<std::size_t>& origin,
+                              ReadReport& report) {
     std::vector<std::array<std::size_t, 4>> keys(polys.size());
     for (std::size_t f = 0; f < polys.size(); ++f) {
         keys[f] = {polys[f][0], polys[f][1], polys[f][2], f};
@@ -1381,7 +1439,7 @@ bool removeDuplicateTriangles(std::vector<Polygon>& polys, std::vector<std::size
     std::size_t kept = 0;
     for (std::size_t f = 0; f < polys.size(); ++f) {
         if (drop[f]) continue;
-        if (kept != f) polys[kept] = std::move(polys[f]);  // self-move would empty it
+        if (kept != f) polys[kept] = std::move(polys[f]); // self-move would empty it
         origin[kept++] = origin[f];
     }
     polys.resize(kept);
@@ -1393,15 +1451,17 @@ bool removeDuplicateTriangles(std::vector<Polygon>& polys, std::vector<std::size
 /// Turns the soup into a valid triangle mesh, repairing (and reporting) what must be repaired.
 Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOptions& options) {
     if (soup.polygons.empty())
-        src.fail(soup.points.empty() ? std::string("it contains no faces")
-                                     : "it contains no faces, only " + quantity(soup.points.size(), "point", "points"));
+        src.fail(soup.points.empty()
+                     ? std::string("it contains no faces")
+                     : "it contains no faces, only " + quantity(soup.points.size(), "point", "points"));
     std::vector<std::size_t> canonical;
     Topology topology;
     report.soup = computeStats(soup, canonical, topology);
-    bool changed = report.soup.duplicatePoints > 0;  // topology above is that of the current soup until changed
+    bool changed =
+        report.soup.duplicatePoints > 0; // topology above is that of the current soup until changed
     const SoupStats& stats = report.soup;
     std::vector<Polygon>& polys = soup.polygons;
-    std::vector<std::size_t> origin(polys.size());  // polygon of the file each current polygon comes from
+    std::vector<std::size_t> origin(polys.size()); // polygon of the file each current polygon comes from
     std::iota(origin.begin(), origin.end(), 0);
     auto refuse = [&](const std::string& problem) {
         src.fail("it is not a valid oriented manifold mesh (" + problem + ") and repair is disabled");
@@ -1411,8 +1471,10 @@ Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOpt
     const bool merge = options.repair && stats.duplicatePoints > 0;
     if (merge) {
         for (Polygon& p : polys)
-            for (std::size_t& c : p) c = canonical[c];
-        report.repairs.push_back("merged " + quantity(stats.duplicatePoints, "duplicate point", "duplicate points"));
+            for (std::size_t& c : p)
+                c = canonical[c];
+        report.repairs.push_back("merged " +
+                                 quantity(stats.duplicatePoints, "duplicate point", "duplicate points"));
     }
 
     // 2. Polygons with repeated corners: drop consecutive repeats, remove what is still degenerate.
@@ -1441,10 +1503,11 @@ Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOpt
                                      quantity(removed, "degenerate polygon", "degenerate polygons") +
                                      " with repeated corners");
         if (simplified)
-            report.repairs.push_back("removed repeated corners from " + quantity(simplified, "polygon", "polygons"));
+            report.repairs.push_back("removed repeated corners from " +
+                                     quantity(simplified, "polygon", "polygons"));
         if (polys.empty())
-            src.fail("nothing is left after repair: all " + quantity(stats.polygons, "polygon is", "polygons are") +
-                     " degenerate");
+            src.fail("nothing is left after repair: all " +
+                     quantity(stats.polygons, "polygon is", "polygons are") + " degenerate");
     }
 
     // 3. Triangulate polygons with more than three corners (a Mesh holds triangles).
@@ -1463,10 +1526,10 @@ Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOpt
             }
             triangleOrigin.insert(triangleOrigin.end(), triangles.size() - before, origin[f]);
         }
-        report.repairs.push_back("triangulated " +
-                                 quantity(split, "polygon with more than three corners",
-                                       "polygons with more than three corners") +
-                                 " into " + quantity(triangles.size() - (polys.size() - split), "triangle", "triangles"));
+        report.repairs.push_back(
+            "triangulated " +
+            quantity(split, "polygon with more than three corners", "polygons with more than three corners") +
+            " into " + quantity(triangles.size() - (polys.size() - split), "triangle", "triangles"));
         polys = std::move(triangles);
         origin = std::move(triangleOrigin);
         changed = true;
@@ -1478,19 +1541,23 @@ Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOpt
         if (!options.repair) {
             std::vector<std::string> parts;
             if (topology.nonManifoldEdges)
-                parts.push_back(quantity(topology.nonManifoldEdges, "non-manifold edge", "non-manifold edges"));
+                parts.push_back(
+                    quantity(topology.nonManifoldEdges, "non-manifold edge", "non-manifold edges"));
             if (topology.nonManifoldVertices)
-                parts.push_back(quantity(topology.nonManifoldVertices, "non-manifold vertex", "non-manifold vertices"));
+                parts.push_back(
+                    quantity(topology.nonManifoldVertices, "non-manifold vertex", "non-manifold vertices"));
             if (topology.misorientedEdges)
                 parts.push_back(quantity(topology.misorientedEdges, "edge", "edges") +
                                 " between polygons of opposite orientation");
             std::string joined = parts[0];
-            for (std::size_t i = 1; i < parts.size(); ++i) joined += ", " + parts[i];
+            for (std::size_t i = 1; i < parts.size(); ++i)
+                joined += ", " + parts[i];
             refuse(joined);
         }
         // Duplicate triangles (same corners, either orientation) always show up here: their edges are
         // non-manifold or misoriented. Keep the first of each.
-        if (removeDuplicateTriangles(polys, origin, report)) topology = analyseTopology(polys, soup.points.size());
+        if (removeDuplicateTriangles(polys, origin, report))
+            topology = analyseTopology(polys, soup.points.size());
     }
     if (!topology.isMesh()) {
         const std::size_t pointsBefore = soup.points.size();
@@ -1506,9 +1573,11 @@ Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOpt
                                      " to match the orientation of their neighbours");
         if (nonManifoldEdges)
             report.repairs.push_back("separated the polygons around " +
-                                     quantity(nonManifoldEdges, "edge", "edges") + " shared by more than two polygons");
+                                     quantity(nonManifoldEdges, "edge", "edges") +
+                                     " shared by more than two polygons");
         if (const std::size_t added = soup.points.size() - pointsBefore)
-            report.repairs.push_back("duplicated " + quantity(added, "non-manifold vertex", "non-manifold vertices") +
+            report.repairs.push_back("duplicated " +
+                                     quantity(added, "non-manifold vertex", "non-manifold vertices") +
                                      " to make the mesh manifold");
         if (!analyseTopology(polys, soup.points.size()).isMesh())
             src.fail("it could not be repaired into a manifold mesh");
@@ -1517,7 +1586,8 @@ Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOpt
     // 5. Points no polygon uses (merged-away duplicates are not counted again) are dropped.
     std::vector<char> used(soup.points.size(), 0);
     for (const Polygon& p : polys)
-        for (std::size_t c : p) used[c] = 1;
+        for (std::size_t c : p)
+            used[c] = 1;
     std::size_t isolated = 0;
     for (std::size_t i = 0; i < used.size(); ++i)
         if (!used[i] && !(merge && i < canonical.size() && canonical[i] != i)) ++isolated;
@@ -1538,19 +1608,22 @@ Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOpt
     std::vector<FaceIndex> faces(polys.size());
     std::array<VertexIndex, 3> corners;
     for (std::size_t f = 0; f < polys.size(); ++f) {
-        for (std::size_t j = 0; j < 3; ++j) corners[j] = vertex[polys[f][j]];
+        for (std::size_t j = 0; j < 3; ++j)
+            corners[j] = vertex[polys[f][j]];
         faces[f] = CGAL::Euler::add_face(corners, mesh);
         if (faces[f] == Mesh::null_face())
             src.fail("face " + std::to_string(origin[f]) + " could not be added to the mesh");
     }
     if (!soup.quality.empty()) {
         auto map = mesh.add_property_map<FaceIndex, float>(props::faceQuality, kInputFaceQuality).first;
-        for (std::size_t f = 0; f < polys.size(); ++f) map[faces[f]] = soup.quality[origin[f]];
+        for (std::size_t f = 0; f < polys.size(); ++f)
+            map[faces[f]] = soup.quality[origin[f]];
         report.hasFaceQuality = true;
     }
     if (!soup.scanId.empty()) {
         auto map = mesh.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1).first;
-        for (std::size_t f = 0; f < polys.size(); ++f) map[faces[f]] = soup.scanId[origin[f]];
+        for (std::size_t f = 0; f < polys.size(); ++f)
+            map[faces[f]] = soup.scanId[origin[f]];
         report.hasScanId = true;
     }
     return mesh;
@@ -1567,7 +1640,7 @@ Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOpt
 /// The mesh with contiguous indices over its valid elements, in iteration order.
 struct FlatMesh {
     std::vector<Point3> points;
-    std::vector<std::size_t> faceStart{0};  // faces() + 1 entries
+    std::vector<std::size_t> faceStart{0}; // faces() + 1 entries
     std::vector<std::size_t> corners;
     std::vector<float> quality;
     std::vector<std::int32_t> scanId;
@@ -1592,7 +1665,8 @@ FlatMesh flatten(const Mesh& mesh) {
     flat.faceStart.reserve(mesh.number_of_faces() + 1);
     flat.corners.reserve(3 * mesh.number_of_faces());
     for (FaceIndex f : mesh.faces()) {
-        for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) flat.corners.push_back(index[std::size_t(v)]);
+        for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
+            flat.corners.push_back(index[std::size_t(v)]);
         flat.faceStart.push_back(flat.corners.size());
         if (flat.hasQuality) flat.quality.push_back(quality.first[f]);
         if (flat.hasScanId) flat.scanId.push_back(scanId.first[f]);
@@ -1612,8 +1686,8 @@ public:
         errno = 0;
         file_ = std::fopen(temp_.c_str(), "wb");
         if (!file_)
-            failWrite(target_, "a temporary file cannot be created in the folder '" + folder.string() + "' (" +
-                                   std::generic_category().message(errno) + ")");
+            failWrite(target_, "a temporary file cannot be created in the folder '" + folder.string() +
+                                   "' (" + std::generic_category().message(errno) + ")");
         buffer_.reserve(kChunk + 256);
     }
     AtomicFile(const AtomicFile&) = delete;
@@ -1663,19 +1737,17 @@ void putDouble(std::string& s, double v, int precision) {
     const auto r = std::to_chars(b, b + sizeof b, v, std::chars_format::general, precision);
     s.append(b, r.ptr);
 }
-void putFloat(std::string& s, float v) {  // shortest text that reads back to the same float
+void putFloat(std::string& s, float v) { // shortest text that reads back to the same float
     char b[64];
     const auto r = std::to_chars(b, b + sizeof b, v);
     s.append(b, r.ptr);
 }
-template <class T>
-void putInteger(std::string& s, T v) {
+template <class T> void putInteger(std::string& s, T v) {
     char b[32];
     const auto r = std::to_chars(b, b + sizeof b, v);
     s.append(b, r.ptr);
 }
-template <class T>
-void putBinary(std::string& s, T v, bool bigEndian) {
+template <class T> void putBinary(std::string& s, T v, bool bigEndian) {
     auto bytes = std::bit_cast<std::array<char, sizeof(T)>>(v);
     if (bigEndian != (std::endian::native == std::endian::big)) std::reverse(bytes.begin(), bytes.end());
     s.append(bytes.data(), bytes.size());
@@ -1735,7 +1807,8 @@ void writePly(const FlatMesh& m, AtomicFile& file, bool binary, int precision) {
     std::string& s = file.out();
     const bool bigEndian = std::endian::native == std::endian::big;
     std::size_t maxDegree = 0;
-    for (std::size_t f = 0; f < m.faces(); ++f) maxDegree = std::max(maxDegree, m.degree(f));
+    for (std::size_t f = 0; f < m.faces(); ++f)
+        maxDegree = std::max(maxDegree, m.degree(f));
     const bool wideCount = maxDegree > 255;
     s += "ply\nformat ";
     s += !binary ? "ascii" : bigEndian ? "binary_big_endian" : "binary_little_endian";
@@ -1743,7 +1816,8 @@ void writePly(const FlatMesh& m, AtomicFile& file, bool binary, int precision) {
     putInteger(s, m.points.size());
     s += "\nproperty double x\nproperty double y\nproperty double z\nelement face ";
     putInteger(s, m.faces());
-    s += wideCount ? "\nproperty list uint int vertex_indices\n" : "\nproperty list uchar int vertex_indices\n";
+    s += wideCount ? "\nproperty list uint int vertex_indices\n"
+                   : "\nproperty list uchar int vertex_indices\n";
     if (m.hasQuality) s += "property float quality\n";
     if (m.hasScanId) s += "property int scan_id\n";
     s += "end_header\n";
@@ -1761,9 +1835,12 @@ void writePly(const FlatMesh& m, AtomicFile& file, bool binary, int precision) {
     for (std::size_t f = 0; f < m.faces(); ++f) {
         const std::size_t d = m.degree(f);
         if (binary) {
-            if (wideCount) putBinary(s, static_cast<std::uint32_t>(d), bigEndian);
-            else putBinary(s, static_cast<std::uint8_t>(d), bigEndian);
-            for (std::size_t j = 0; j < d; ++j) putBinary(s, static_cast<std::int32_t>(m.corner(f, j)), bigEndian);
+            if (wideCount)
+                putBinary(s, static_cast<std::uint32_t>(d), bigEndian);
+            else
+                putBinary(s, static_cast<std::uint8_t>(d), bigEndian);
+            for (std::size_t j = 0; j < d; ++j)
+                putBinary(s, static_cast<std::int32_t>(m.corner(f, j)), bigEndian);
             if (m.hasQuality) putBinary(s, m.quality[f], bigEndian);
             if (m.hasScanId) putBinary(s, m.scanId[f], bigEndian);
         } else {
@@ -1790,9 +1867,10 @@ void writeStl(const FlatMesh& m, AtomicFile& file, bool binary, int precision) {
     std::string& s = file.out();
     // STL holds triangles only: faces with more corners are written as fans.
     std::size_t triangles = 0;
-    for (std::size_t f = 0; f < m.faces(); ++f) triangles += m.degree(f) >= 3 ? m.degree(f) - 2 : 0;
+    for (std::size_t f = 0; f < m.faces(); ++f)
+        triangles += m.degree(f) >= 3 ? m.degree(f) - 2 : 0;
     if (binary) {
-        std::string header = "FSS binary STL";  // must not start with "solid"
+        std::string header = "FSS binary STL"; // must not start with "solid"
         header.resize(80, ' ');
         s += header;
         putBinary(s, static_cast<std::uint32_t>(triangles), false);
@@ -1807,9 +1885,11 @@ void writeStl(const FlatMesh& m, AtomicFile& file, bool binary, int precision) {
             const double len = std::sqrt(n.squared_length());
             n = len > 0 && std::isfinite(len) ? n / len : Vector3(0, 0, 0);
             if (binary) {
-                for (int k = 0; k < 3; ++k) putBinary(s, static_cast<float>(n[k]), false);
+                for (int k = 0; k < 3; ++k)
+                    putBinary(s, static_cast<float>(n[k]), false);
                 for (const Point3* q : p)
-                    for (int k = 0; k < 3; ++k) putBinary(s, static_cast<float>((*q)[k]), false);
+                    for (int k = 0; k < 3; ++k)
+                        putBinary(s, static_cast<float>((*q)[k]), false);
                 putBinary(s, std::uint16_t(0), false);
             } else {
                 s += "  facet normal ";
@@ -1875,25 +1955,31 @@ bool isSupportedMeshFile(const fs::path& path) {
 void writeMesh(const Mesh& mesh, const fs::path& path, const WriteOptions& options) {
     const std::string ext = lower(path.extension().string());
     if (!isSupportedMeshFile(path))
-        failWrite(path, (ext.empty() ? std::string("it has no extension") : "the extension " + quoteToken(ext)) +
-                            " does not name a format (use .off, .obj, .ply or .stl)");
+        failWrite(path,
+                  (ext.empty() ? std::string("it has no extension") : "the extension " + quoteToken(ext)) +
+                      " does not name a format (use .off, .obj, .ply or .stl)");
     std::error_code ec;
     if (fs::is_directory(path, ec)) failWrite(path, "it is a folder");
     const int precision = std::clamp(options.precision, 1, 17);
     const FlatMesh flat = flatten(mesh);
     if (ext == ".stl") {
         std::size_t triangles = 0;
-        for (std::size_t f = 0; f < flat.faces(); ++f) triangles += flat.degree(f) >= 3 ? flat.degree(f) - 2 : 0;
+        for (std::size_t f = 0; f < flat.faces(); ++f)
+            triangles += flat.degree(f) >= 3 ? flat.degree(f) - 2 : 0;
         if (options.binary && triangles > std::numeric_limits<std::uint32_t>::max())
             failWrite(path, "binary STL cannot hold more than 4294967295 triangles");
     }
     if (ext == ".ply" && flat.points.size() > std::size_t(std::numeric_limits<std::int32_t>::max()))
         failWrite(path, "PLY files written by FSS cannot index more than 2147483647 vertices");
     AtomicFile file(path);
-    if (ext == ".off") writeOff(flat, file, precision);
-    else if (ext == ".obj") writeObj(flat, file, precision);
-    else if (ext == ".ply") writePly(flat, file, options.binary, precision);
-    else writeStl(flat, file, options.binary, precision);
+    if (ext == ".off")
+        writeOff(flat, file, precision);
+    else if (ext == ".obj")
+        writeObj(flat, file, precision);
+    else if (ext == ".ply")
+        writePly(flat, file, options.binary, precision);
+    else
+        writeStl(flat, file, options.binary, precision);
     file.commit();
 }
 

@@ -61,7 +61,8 @@ void expectIoError(const fs::path& path, std::initializer_list<std::string> part
     } catch (const IoError& e) {
         const std::string what = e.what();
         EXPECT_NE(what.find(path.filename().string()), std::string::npos) << what;
-        for (const std::string& part : parts) EXPECT_NE(what.find(part), std::string::npos) << what << "\n  lacks: " << part;
+        for (const std::string& part : parts)
+            EXPECT_NE(what.find(part), std::string::npos) << what << "\n  lacks: " << part;
         EXPECT_EQ(what.back(), '.') << what;
     } catch (const std::exception& e) {
         ADD_FAILURE() << "wrong exception type: " << e.what();
@@ -78,7 +79,8 @@ void expectBadText(const std::string& name, const std::string& text, std::initia
 
 std::vector<Point3> positions(const Mesh& m) {
     std::vector<Point3> p;
-    for (VertexIndex v : m.vertices()) p.push_back(m.point(v));
+    for (VertexIndex v : m.vertices())
+        p.push_back(m.point(v));
     return p;
 }
 
@@ -89,7 +91,8 @@ std::vector<std::array<Point3, 3>> faceCorners(const Mesh& m) {
     for (FaceIndex f : m.faces()) {
         std::array<Point3, 3> c;
         std::size_t i = 0;
-        for (VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m)) c[i++ % 3] = m.point(v);
+        for (VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m))
+            c[i++ % 3] = m.point(v);
         EXPECT_EQ(i, 3u);
         std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
         faces.push_back(c);
@@ -97,7 +100,9 @@ std::vector<std::array<Point3, 3>> faceCorners(const Mesh& m) {
     return faces;
 }
 
-double relativeError(double a, double b) { return std::abs(a - b) / std::max(1.0, std::max(std::abs(a), std::abs(b))); }
+double relativeError(double a, double b) {
+    return std::abs(a - b) / std::max(1.0, std::max(std::abs(a), std::abs(b)));
+}
 
 double maxRelativeError(const Point3& a, const Point3& b) {
     return std::max({relativeError(a.x(), b.x()), relativeError(a.y(), b.y()), relativeError(a.z(), b.z())});
@@ -109,7 +114,9 @@ double toFloat(double v) {
     volatile float f = static_cast<float>(v);
     return f;
 }
-Point3 asFloat(const Point3& p) { return {toFloat(p.x()), toFloat(p.y()), toFloat(p.z())}; }
+Point3 asFloat(const Point3& p) {
+    return {toFloat(p.x()), toFloat(p.y()), toFloat(p.z())};
+}
 
 double area(const Mesh& m) {
     double a = 0;
@@ -138,7 +145,8 @@ bool hasRepair(const ReadReport& r, const std::string& sentence) {
 
 std::string joined(const std::vector<std::string>& v) {
     std::string s;
-    for (const auto& x : v) s += "[" + x + "] ";
+    for (const auto& x : v)
+        s += "[" + x + "] ";
     return s;
 }
 
@@ -149,13 +157,17 @@ Mesh makeOctahedron(bool withGarbage = true) {
     VertexIndex dummy;
     if (withGarbage) dummy = m.add_vertex(Point3(9, 9, 9));
     const double a = 1.0 / 3.0, b = std::sqrt(2.0), c = 12345.678901234567;
-    const std::array<VertexIndex, 6> v = {
-        m.add_vertex(Point3(a, 0.1, -1e-7)), m.add_vertex(Point3(-b, 0.2, 0.3)),
-        m.add_vertex(Point3(0.15, c / 1e4, 0.25)),  m.add_vertex(Point3(0.1, -std::exp(1.0), 0.2)),
-        m.add_vertex(Point3(0.05, 0.1, 2.0 / 7.0 + 1)), m.add_vertex(Point3(-0.1, 0.1, -1e3 * std::acos(-1.0)))};
+    const std::array<VertexIndex, 6> v = {m.add_vertex(Point3(a, 0.1, -1e-7)),
+                                          m.add_vertex(Point3(-b, 0.2, 0.3)),
+                                          m.add_vertex(Point3(0.15, c / 1e4, 0.25)),
+                                          m.add_vertex(Point3(0.1, -std::exp(1.0), 0.2)),
+                                          m.add_vertex(Point3(0.05, 0.1, 2.0 / 7.0 + 1)),
+                                          m.add_vertex(Point3(-0.1, 0.1, -1e3 * std::acos(-1.0)))};
     // +x, -x, +y, -y, +z, -z: faces oriented outwards.
-    const int faces[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
-    for (const auto& f : faces) m.add_face(v[std::size_t(f[0])], v[std::size_t(f[1])], v[std::size_t(f[2])]);
+    const int faces[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                             {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    for (const auto& f : faces)
+        m.add_face(v[std::size_t(f[0])], v[std::size_t(f[1])], v[std::size_t(f[2])]);
     if (withGarbage) m.remove_vertex(dummy);
     return m;
 }
@@ -164,7 +176,9 @@ struct FormatCase {
     std::string ext;
     bool binary;
 };
-std::string caseName(const FormatCase& c) { return c.ext.substr(1) + (c.binary ? "_binary" : "_ascii"); }
+std::string caseName(const FormatCase& c) {
+    return c.ext.substr(1) + (c.binary ? "_binary" : "_ascii");
+}
 
 const std::vector<FormatCase> kAllFormats = {{".off", false}, {".obj", false}, {".ply", false},
                                              {".ply", true},  {".stl", false}, {".stl", true}};
@@ -181,31 +195,36 @@ void checkRoundTrip(const Mesh& mesh, const FormatCase& fc, const std::string& s
     EXPECT_EQ(report.binary, fc.binary);
     EXPECT_TRUE(report.repairs.empty()) << joined(report.repairs);
     EXPECT_TRUE(CGAL::is_valid_polygon_mesh(back));
-    ASSERT_EQ(back.number_of_vertices(), mesh.number_of_vertices());  // STL: corners merged back
+    ASSERT_EQ(back.number_of_vertices(), mesh.number_of_vertices()); // STL: corners merged back
     ASSERT_EQ(back.number_of_faces(), mesh.number_of_faces());
     EXPECT_EQ(report.soup.points, mesh.number_of_vertices());
     EXPECT_EQ(report.soup.polygons, mesh.number_of_faces());
 
     const bool stl = fc.ext == ".stl";
-    if (!stl) {  // vertex order is kept
+    if (!stl) { // vertex order is kept
         const auto a = positions(mesh), b = positions(back);
         for (std::size_t i = 0; i < a.size(); ++i) {
-            if (fc.binary) ASSERT_EQ(a[i], b[i]) << "vertex " << i;
-            else ASSERT_LE(maxRelativeError(a[i], b[i]), 1e-12) << "vertex " << i;
+            if (fc.binary)
+                ASSERT_EQ(a[i], b[i]) << "vertex " << i;
+            else
+                ASSERT_LE(maxRelativeError(a[i], b[i]), 1e-12) << "vertex " << i;
         }
     }
     // Face order and corners are kept in every format.
     auto fa = faceCorners(mesh);
     const auto fb = faceCorners(back);
-    if (stl && fc.binary)  // STL stores floats: compare with the float-rounded corners, exactly
+    if (stl && fc.binary) // STL stores floats: compare with the float-rounded corners, exactly
         for (auto& c : fa) {
-            for (Point3& p : c) p = asFloat(p);
+            for (Point3& p : c)
+                p = asFloat(p);
             std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
         }
     for (std::size_t f = 0; f < fa.size(); ++f)
         for (std::size_t j = 0; j < 3; ++j) {
-            if (fc.binary) ASSERT_EQ(fa[f][j], fb[f][j]) << "face " << f;
-            else ASSERT_LE(maxRelativeError(fa[f][j], fb[f][j]), 1e-12) << "face " << f;
+            if (fc.binary)
+                ASSERT_EQ(fa[f][j], fb[f][j]) << "face " << f;
+            else
+                ASSERT_LE(maxRelativeError(fa[f][j], fb[f][j]), 1e-12) << "face " << f;
         }
 }
 
@@ -239,12 +258,14 @@ TEST(MeshIo, RoundTripsHandMadeMeshInEveryFormat) {
     const Mesh mesh = makeOctahedron();
     ASSERT_TRUE(mesh.has_garbage());
     ASSERT_EQ(mesh.number_of_vertices(), 6u);
-    for (const FormatCase& fc : kAllFormats) checkRoundTrip(mesh, fc, "octahedron");
+    for (const FormatCase& fc : kAllFormats)
+        checkRoundTrip(mesh, fc, "octahedron");
 }
 
 TEST(MeshIo, RoundTripsFandiskInEveryFormat) {
     const Mesh mesh = fss::readMesh(fss::test::meshPath("fandisk.off"));
-    for (const FormatCase& fc : kAllFormats) checkRoundTrip(mesh, fc, "fandisk");
+    for (const FormatCase& fc : kAllFormats)
+        checkRoundTrip(mesh, fc, "fandisk");
 }
 
 TEST(MeshIo, AsciiFilesUseSeventeenSignificantDigits) {
@@ -259,11 +280,13 @@ TEST(MeshIo, AsciiFilesUseSeventeenSignificantDigits) {
 
 TEST(MeshIo, RoundTripsPlyFaceQualityAndScanId) {
     Mesh mesh = makeOctahedron();
-    auto quality = mesh.add_property_map<FaceIndex, float>(fss::props::faceQuality, fss::kInputFaceQuality).first;
+    auto quality =
+        mesh.add_property_map<FaceIndex, float>(fss::props::faceQuality, fss::kInputFaceQuality).first;
     auto scan = mesh.add_property_map<FaceIndex, std::int32_t>(fss::props::faceScanId, -1).first;
     const float qs[8] = {0.1f, fss::kInputFaceQuality, -3.5f, 1e-20f, 7.0f, 0.333333343f, 2.5e9f, 0.0f};
-    const std::int32_t ids[8] = {-1, 0, 7, std::numeric_limits<std::int32_t>::max(),
-                                 std::numeric_limits<std::int32_t>::min(), 3, 3, 12};
+    const std::int32_t ids[8] = {
+        -1, 0, 7, std::numeric_limits<std::int32_t>::max(), std::numeric_limits<std::int32_t>::min(),
+        3,  3, 12};
     std::size_t i = 0;
     for (FaceIndex f : mesh.faces()) {
         quality[f] = qs[i];
@@ -349,7 +372,8 @@ TEST(MeshIo, ReadsBigEndianPlyAndSkipsUnknownElementsAndProperties) {
                       "element face 2\r\nproperty list uchar uint vertex_indices\r\n"
                       "property list uchar float texcoord\r\nproperty float quality\r\nend_header\n";
     const double xyz[4][3] = {{0, 0, 0}, {1.0 / 3, 0, 0}, {0, 1e-300, 0}, {0, 0, -7.25}};
-    for (const auto& p : xyz) ply += be(p[0]) + be(p[1]) + be(p[2]) + be(std::uint8_t(200));
+    for (const auto& p : xyz)
+        ply += be(p[0]) + be(p[1]) + be(p[2]) + be(std::uint8_t(200));
     ply += be(std::uint8_t(2)) + be(1.5f) + be(2.5f);
     const std::uint32_t faces[2][3] = {{0, 2, 1}, {0, 1, 3}};
     for (const auto& f : faces) {
@@ -397,12 +421,13 @@ TEST(MeshIo, TriangulatesQuadsAndNonConvexPolygons) {
     // A 3x3 grid of unit quads.
     std::string off = "OFF\n16 9 0\n";
     for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i) off += std::to_string(i) + " " + std::to_string(j) + " 0\n";
+        for (int i = 0; i < 4; ++i)
+            off += std::to_string(i) + " " + std::to_string(j) + " 0\n";
     for (int j = 0; j < 3; ++j)
         for (int i = 0; i < 3; ++i) {
             const int a = 4 * j + i;
-            off += "4 " + std::to_string(a) + " " + std::to_string(a + 1) + " " + std::to_string(a + 5) + " " +
-                   std::to_string(a + 4) + "\n";
+            off += "4 " + std::to_string(a) + " " + std::to_string(a + 1) + " " + std::to_string(a + 5) +
+                   " " + std::to_string(a + 4) + "\n";
         }
     const fs::path p = fss::test::tmpPath("quads.off");
     writeFile(p, off);
@@ -411,7 +436,8 @@ TEST(MeshIo, TriangulatesQuadsAndNonConvexPolygons) {
     EXPECT_EQ(m.number_of_faces(), 18u);
     EXPECT_EQ(m.number_of_vertices(), 16u);
     EXPECT_EQ(report.soup.nonTriangles, 9u);
-    EXPECT_EQ(report.repairs, std::vector<std::string>{"triangulated 9 polygons with more than three corners into 18 triangles"});
+    EXPECT_EQ(report.repairs, std::vector<std::string>{
+                                  "triangulated 9 polygons with more than three corners into 18 triangles"});
     EXPECT_NEAR(area(m), 9.0, 1e-12);
     EXPECT_TRUE(CGAL::is_valid_polygon_mesh(m));
 
@@ -419,18 +445,20 @@ TEST(MeshIo, TriangulatesQuadsAndNonConvexPolygons) {
     // octagon with a collinear corner: fans from the first corner would overlap or leave the polygon.
     const fs::path obj = fss::test::tmpPath("lshape.obj");
     auto v = [](double x, double y) {
-        return "v " + std::to_string(x) + " " + std::to_string(y) + " " + std::to_string(0.5 * x + 0.25 * y) + "\n";
+        return "v " + std::to_string(x) + " " + std::to_string(y) + " " + std::to_string(0.5 * x + 0.25 * y) +
+               "\n";
     };
     std::string text = v(0, 0) + v(0, 2) + v(1, 2) + v(1, 1) + v(2, 1) + v(2, 0) + "f 4 5 6 1 2 3\n";
     // Octagon: a U shape, 10 units^2: (10,0) (13,0) (13,3) (12,3) (12,1) (11,1) (11,3) (10,3) with a
     // collinear extra corner at (11.5, 0).
-    text += v(10, 0) + v(11.5, 0) + v(13, 0) + v(13, 3) + v(12, 3) + v(12, 1) + v(11, 1) + v(11, 3) + v(10, 3);
-    text += "f 15 14 13 12 11 10 9 8 7\n";  // clockwise too
+    text +=
+        v(10, 0) + v(11.5, 0) + v(13, 0) + v(13, 3) + v(12, 3) + v(12, 1) + v(11, 1) + v(11, 3) + v(10, 3);
+    text += "f 15 14 13 12 11 10 9 8 7\n"; // clockwise too
     writeFile(obj, text);
     m = fss::readMesh(obj, &report);
     EXPECT_EQ(report.soup.nonTriangles, 2u);
     EXPECT_EQ(m.number_of_faces(), 4u + 7u);
-    const double tilt = std::sqrt(1 + 0.25 + 0.0625);  // area scale of the plane z = x/2 + y/4
+    const double tilt = std::sqrt(1 + 0.25 + 0.0625); // area scale of the plane z = x/2 + y/4
     EXPECT_NEAR(area(m), (3.0 + 7.0) * tilt, 1e-12);
     // Every triangle keeps the polygon's orientation (normal towards -z after the clockwise input).
     for (FaceIndex f : m.faces()) {
@@ -445,18 +473,20 @@ TEST(MeshIo, OrientsInconsistentSoupAndReportsIt) {
     // A tetrahedron with outward faces except one; try the flipped face first and last (the repair keeps
     // the majority's orientation either way).
     const std::string points = "4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
-    for (const std::string faces : {"3 0 1 2\n3 0 1 3\n3 1 2 3\n3 0 3 2\n", "3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 2 3\n"}) {
+    for (const std::string faces :
+         {"3 0 1 2\n3 0 1 3\n3 1 2 3\n3 0 3 2\n", "3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 2 3\n"}) {
         const fs::path p = fss::test::tmpPath("flipped.off");
         writeFile(p, "OFF\n" + points + faces);
         ReadReport report;
         const Mesh m = fss::readMesh(p, &report);
-        EXPECT_EQ(report.repairs, std::vector<std::string>{"reoriented 1 polygon to match the orientation of their neighbours"});
+        EXPECT_EQ(report.repairs, std::vector<std::string>{
+                                      "reoriented 1 polygon to match the orientation of their neighbours"});
         EXPECT_TRUE(CGAL::is_valid_polygon_mesh(m));
         EXPECT_TRUE(CGAL::is_closed(m));
         EXPECT_EQ(m.number_of_vertices(), 4u);
         EXPECT_EQ(m.number_of_faces(), 4u);
         EXPECT_EQ(report.soup.nonManifoldEdges, 0u);
-        EXPECT_NEAR(signedVolume(m), 1.0 / 6, 1e-15);  // the three outward faces win
+        EXPECT_NEAR(signedVolume(m), 1.0 / 6, 1e-15); // the three outward faces win
         expectIoError(p, {"not a valid oriented manifold mesh", "repair is disabled"}, {.repair = false});
     }
 }
@@ -487,7 +517,8 @@ TEST(MeshIo, CountsAndRepairsBowTieVertex) {
     const Mesh m = fss::readMesh(p, &report);
     EXPECT_EQ(report.soup.nonManifoldVertices, 1u);
     EXPECT_EQ(report.soup.nonManifoldEdges, 0u);
-    EXPECT_EQ(report.repairs, std::vector<std::string>{"duplicated 1 non-manifold vertex to make the mesh manifold"});
+    EXPECT_EQ(report.repairs,
+              std::vector<std::string>{"duplicated 1 non-manifold vertex to make the mesh manifold"});
     EXPECT_TRUE(CGAL::is_valid_polygon_mesh(m));
     EXPECT_EQ(m.number_of_faces(), 2u);
     EXPECT_EQ(m.number_of_vertices(), 6u);
@@ -506,14 +537,15 @@ TEST(MeshIo, MergesDuplicatesAndRemovesDegenerateAndIsolatedElements) {
     EXPECT_EQ(report.soup.points, 9u);
     EXPECT_EQ(report.soup.polygons, 6u);
     EXPECT_EQ(report.soup.duplicatePoints, 2u);
-    EXPECT_EQ(report.soup.degeneratePolygons, 2u);  // repeated corner + zero area
+    EXPECT_EQ(report.soup.degeneratePolygons, 2u); // repeated corner + zero area
     EXPECT_TRUE(hasRepair(report, "merged 2 duplicate points")) << joined(report.repairs);
-    EXPECT_TRUE(hasRepair(report, "removed 1 degenerate polygon with repeated corners")) << joined(report.repairs);
+    EXPECT_TRUE(hasRepair(report, "removed 1 degenerate polygon with repeated corners"))
+        << joined(report.repairs);
     EXPECT_TRUE(hasRepair(report, "removed 1 duplicate triangle")) << joined(report.repairs);
     EXPECT_TRUE(hasRepair(report, "removed 1 isolated point that no polygon uses")) << joined(report.repairs);
     EXPECT_TRUE(CGAL::is_valid_polygon_mesh(m));
-    EXPECT_EQ(m.number_of_faces(), 4u);     // the square, the zero-area sliver (kept) and 1-7-2
-    EXPECT_EQ(m.number_of_vertices(), 6u);  // 0 1 2 5 7 8
+    EXPECT_EQ(m.number_of_faces(), 4u);    // the square, the zero-area sliver (kept) and 1-7-2
+    EXPECT_EQ(m.number_of_vertices(), 6u); // 0 1 2 5 7 8
 }
 
 TEST(MeshIo, DetectsFormatByContentAndCaseInsensitiveExtension) {
@@ -526,11 +558,14 @@ TEST(MeshIo, DetectsFormatByContentAndCaseInsensitiveExtension) {
         EXPECT_EQ(m.number_of_faces(), 12946u) << name;
     }
     const Mesh octa = makeOctahedron();
-    const std::vector<std::pair<FormatCase, std::string>> sniffed = {
-        {{".ply", false}, "ply"}, {{".ply", true}, "ply"}, {{".stl", false}, "stl"},
-        {{".stl", true}, "stl"},  {{".obj", false}, "obj"}};
+    const std::vector<std::pair<FormatCase, std::string>> sniffed = {{{".ply", false}, "ply"},
+                                                                     {{".ply", true}, "ply"},
+                                                                     {{".stl", false}, "stl"},
+                                                                     {{".stl", true}, "stl"},
+                                                                     {{".obj", false}, "obj"}};
     for (const auto& [fc, format] : sniffed) {
-        const fs::path real = fss::test::tmpPath("sniff" + fc.ext), disguised = fss::test::tmpPath("sniff_" + caseName(fc) + ".dat");
+        const fs::path real = fss::test::tmpPath("sniff" + fc.ext),
+                       disguised = fss::test::tmpPath("sniff_" + caseName(fc) + ".dat");
         fss::writeMesh(octa, real, {.binary = fc.binary});
         writeFile(disguised, readFile(real));
         ReadReport report;
@@ -573,7 +608,7 @@ TEST(MeshIoErrors, MissingUnreadableAndEmptyFiles) {
     const fs::path locked = fss::test::tmpPath("locked.off");
     fs::copy_file(fss::test::meshPath("tetrahedron.off"), locked, fs::copy_options::overwrite_existing);
     fs::permissions(locked, fs::perms::none);
-    if (!std::ifstream(locked)) {  // root can read anything: only check where permissions apply
+    if (!std::ifstream(locked)) { // root can read anything: only check where permissions apply
         expectIoError(locked, {"cannot be opened"});
     }
     fs::permissions(locked, fs::perms::owner_all);
@@ -586,16 +621,19 @@ TEST(MeshIoErrors, TruncatedFiles) {
                   {"announces 2 faces but the file ends after 1", "truncated"});
     expectBadText("short_face_line.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n",
                   {"line 6", "face 0 announces 3 corners but lists 2"});
-    expectBadText("short_vertex.obj", "v 0 0 0\nv 1 0\n", {"line 2", "expected 3 coordinates for vertex 1 but found 2"});
-    expectBadText("short.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                               "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
-                               "0 0 0\n1 0 0\n",
+    expectBadText("short_vertex.obj", "v 0 0 0\nv 1 0\n",
+                  {"line 2", "expected 3 coordinates for vertex 1 but found 2"});
+    expectBadText("short.ply",
+                  "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                  "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                  "0 0 0\n1 0 0\n",
                   {"truncated"});
     expectBadText("no_end_header.ply", "ply\nformat ascii 1.0\nelement vertex 3\n", {"end_header"});
     expectBadText("short.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n",
                   {"truncated"});
     expectBadText("no_endsolid.stl",
-                  "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n",
+                  "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 "
+                  "0\nendloop\nendfacet\n",
                   {"endsolid", "truncated"});
 
     const Mesh octa = makeOctahedron();
@@ -610,19 +648,22 @@ TEST(MeshIoErrors, TruncatedFiles) {
 
 TEST(MeshIoErrors, HugeHeaderCountsFailFastWithoutAllocating) {
     expectBadText("huge.off", "OFF\n2000000000 2000000000 0\n0 0 0\n", {"2000000000 vertices", "truncated"});
-    expectBadText("huge.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000000\n"
-                              "property double x\nproperty double y\nproperty double z\nelement face 1\n"
-                              "property list uchar int vertex_indices\nend_header\n" + std::string(100, '\0'),
+    expectBadText("huge.ply",
+                  "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000000\n"
+                  "property double x\nproperty double y\nproperty double z\nelement face 1\n"
+                  "property list uchar int vertex_indices\nend_header\n" +
+                      std::string(100, '\0'),
                   {"4000000000000 vertex elements", "truncated"});
     std::string stl(84, ' ');
     const std::uint32_t n = 0xffffffffu;
-    std::memcpy(stl.data() + 80, &n, 4);  // little endian on our platforms
+    std::memcpy(stl.data() + 80, &n, 4); // little endian on our platforms
     expectBadText("huge.stl", stl, {"4294967295 triangles", "truncated"});
     expectBadText("huge_face.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n1000000000 0 1 2\n",
                   {"face 0 announces 1000000000 corners but lists 3"});
     // A binary PLY face list announcing more indices than the file holds.
-    std::string ply = "ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
-                      "property float z\nelement face 1\nproperty list int int vertex_indices\nend_header\n";
+    std::string ply =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list int int vertex_indices\nend_header\n";
     const std::int32_t big = 2000000000;
     ply.append(reinterpret_cast<const char*>(&big), 4);
     ply += std::string(8, '\0');
@@ -634,13 +675,15 @@ TEST(MeshIoErrors, UnknownFormatAndGarbage) {
     expectBadText("mystery", "12 34 56\n", {"not recognised", "no extension"});
     std::mt19937 rng(7);
     std::string junk(3000, '\0');
-    for (char& c : junk) c = static_cast<char>(rng());
+    for (char& c : junk)
+        c = static_cast<char>(rng());
     expectBadText("junk.bin", junk, {"not recognised"});
     expectBadText("junk.off", junk, {"OFF header"});
     expectBadText("junk.obj", junk, {"line "});
     expectBadText("junk.ply", junk, {"'ply'"});
     expectBadText("junk.stl", junk, {"binary STL"});
-    expectBadText("words.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nhello 1 2 3\nf 1 2 3\n", {"line 4", "unknown OBJ statement 'hello'"});
+    expectBadText("words.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nhello 1 2 3\nf 1 2 3\n",
+                  {"line 4", "unknown OBJ statement 'hello'"});
     expectBadText("words.off", "OFF\n3 1 0\n0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n",
                   {"line 4", "expected a coordinate of vertex 1 but found 'zero'"});
     expectBadText("trailing.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n",
@@ -649,20 +692,25 @@ TEST(MeshIoErrors, UnknownFormatAndGarbage) {
     expectBadText("binary.off", "OFF BINARY\n", {"binary OFF"});
     expectBadText("nofaces.off", "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n", {"contains no faces"});
     expectBadText("nofaces.obj", "v 0 0 0\nv 1 0 0\n", {"contains no faces"});
-    expectBadText("noface.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-                                "property float z\nend_header\n0 0 0\n",
+    expectBadText("noface.ply",
+                  "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                  "property float z\nend_header\n0 0 0\n",
                   {"no 'face' element"});
 }
 
 TEST(MeshIoErrors, NanAndInfiniteCoordinates) {
-    expectBadText("nan.off", "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n", {"line 4", "vertex 1", "NaN or infinite"});
-    expectBadText("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 -inf 0\nf 1 2 3\n", {"line 3", "vertex 2", "NaN or infinite"});
+    expectBadText("nan.off", "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n",
+                  {"line 4", "vertex 1", "NaN or infinite"});
+    expectBadText("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 -inf 0\nf 1 2 3\n",
+                  {"line 3", "vertex 2", "NaN or infinite"});
     expectBadText("overflow.obj", "v 0 0 0\nv 1e999 0 0\nv 0 1 0\nf 1 2 3\n", {"line 2", "NaN or infinite"});
-    expectBadText("nan.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex NaN 0 0\nvertex 0 1 0\n"
-                             "endloop\nendfacet\nendsolid x\n",
+    expectBadText("nan.stl",
+                  "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex NaN 0 0\nvertex 0 1 0\n"
+                  "endloop\nendfacet\nendsolid x\n",
                   {"line 5", "NaN or infinite"});
-    std::string ply = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    std::string ply =
+        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
     const float coords[9] = {0, 0, 0, 1, 0, std::numeric_limits<float>::quiet_NaN(), 0, 1, 0};
     ply.append(reinterpret_cast<const char*>(coords), sizeof coords);
     const std::uint8_t three = 3;
@@ -675,7 +723,7 @@ TEST(MeshIoErrors, NanAndInfiniteCoordinates) {
     fss::writeMesh(makeOctahedron(), stl, {.binary = true});
     std::string bytes = readFile(stl);
     const float inf = std::numeric_limits<float>::infinity();
-    std::memcpy(bytes.data() + 84 + 50 * 3 + 12 + 4, &inf, 4);  // triangle 3, first corner, y
+    std::memcpy(bytes.data() + 84 + 50 * 3 + 12 + 4, &inf, 4); // triangle 3, first corner, y
     writeFile(stl, bytes);
     expectIoError(stl, {"triangle 3 has a NaN or infinite coordinate"});
 }
@@ -688,14 +736,19 @@ TEST(MeshIoErrors, FacesIndexingMissingVerticesOrWithTooFewCorners) {
     expectBadText("bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 7\n",
                   {"line 5", "face 1 uses vertex 7", "only 3 vertices"});
     expectBadText("zero_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", {"face 0 uses vertex index 0"});
-    expectBadText("bad_relative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n", {"relative vertex index -4"});
-    const std::string plyHeader = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
-                                  "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n";
-    expectBadText("bad_index.ply", plyHeader + pts + "3 0 1 2\n3 2 1 4\n", {"line 15", "face 1 uses vertex index 4"});
-    expectBadText("two_corners.off", "OFF\n4 1 0\n" + pts + "2 0 1\n", {"face 0 has 2 corners", "at least 3"});
+    expectBadText("bad_relative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n",
+                  {"relative vertex index -4"});
+    const std::string plyHeader =
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n";
+    expectBadText("bad_index.ply", plyHeader + pts + "3 0 1 2\n3 2 1 4\n",
+                  {"line 15", "face 1 uses vertex index 4"});
+    expectBadText("two_corners.off", "OFF\n4 1 0\n" + pts + "2 0 1\n",
+                  {"face 0 has 2 corners", "at least 3"});
     expectBadText("two_corners.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n", {"face 0 has 2 corners"});
     expectBadText("two_corners.ply", plyHeader + pts + "3 0 1 2\n2 1 3\n", {"face 1 has 2 corners"});
-    expectBadText("too_many_values.ply", plyHeader + pts + "3 0 1 2 7\n3 0 1 3\n", {"more values than the header"});
+    expectBadText("too_many_values.ply", plyHeader + pts + "3 0 1 2 7\n3 0 1 3\n",
+                  {"more values than the header"});
 }
 
 TEST(MeshIoErrors, NothingLeftAfterRepair) {
@@ -717,7 +770,8 @@ TEST(MeshIoWrite, ReplacesAtomicallyAndReportsFailures) {
     fs::create_directories(folder);
     auto entries = [&] {
         std::vector<std::string> names;
-        for (const auto& e : fs::directory_iterator(folder)) names.push_back(e.path().filename().string());
+        for (const auto& e : fs::directory_iterator(folder))
+            names.push_back(e.path().filename().string());
         std::sort(names.begin(), names.end());
         return names;
     };
@@ -772,7 +826,7 @@ TEST(MeshIoFuzz, CorruptedFilesLoadValidMeshesOrThrowIoError) {
     auto s = mesh.add_property_map<FaceIndex, std::int32_t>(fss::props::faceScanId, 3).first;
     (void)q;
     (void)s;
-    std::vector<std::pair<std::string, std::string>> originals;  // extension, bytes
+    std::vector<std::pair<std::string, std::string>> originals; // extension, bytes
     for (const FormatCase& fc : kAllFormats) {
         const fs::path p = fss::test::tmpPath("fuzz_source_" + caseName(fc) + fc.ext);
         fss::writeMesh(mesh, p, {.binary = fc.binary});
@@ -781,8 +835,8 @@ TEST(MeshIoFuzz, CorruptedFilesLoadValidMeshesOrThrowIoError) {
 
     std::mt19937 rng(20240611);
     auto uniform = [&](std::size_t n) { return std::uniform_int_distribution<std::size_t>(0, n - 1)(rng); };
-    const std::vector<std::string> interesting = {"0",   "9",    "-",           "\n", " ",   "nan",      "1e308",
-                                                  "/",   "#",    std::string(1, '\0'), "\xff", "e", "4294967295"};
+    const std::vector<std::string> interesting = {
+        "0", "9", "-", "\n", " ", "nan", "1e308", "/", "#", std::string(1, '\0'), "\xff", "e", "4294967295"};
     std::size_t loaded = 0, rejected = 0;
     constexpr int kCasesPerFormat = 60;
     for (const auto& [ext, original] : originals) {
@@ -792,12 +846,24 @@ TEST(MeshIoFuzz, CorruptedFilesLoadValidMeshesOrThrowIoError) {
             for (int k = 0; k < mutations && !bytes.empty(); ++k) {
                 const std::size_t at = uniform(bytes.size());
                 switch (uniform(6)) {
-                case 0: bytes.resize(at); break;                                            // truncate
-                case 1: bytes[at] = static_cast<char>(uniform(256)); break;                 // flip a byte
-                case 2: bytes.insert(at, 1, static_cast<char>(uniform(256))); break;        // insert a byte
-                case 3: bytes.erase(at, 1 + uniform(16)); break;                            // delete a run
-                case 4: bytes.insert(at, interesting[uniform(interesting.size())]); break;  // plausible token
-                case 5: bytes.insert(at, bytes.substr(at, 1 + uniform(40))); break;         // repeat a run
+                case 0:
+                    bytes.resize(at);
+                    break; // truncate
+                case 1:
+                    bytes[at] = static_cast<char>(uniform(256));
+                    break; // flip a byte
+                case 2:
+                    bytes.insert(at, 1, static_cast<char>(uniform(256)));
+                    break; // insert a byte
+                case 3:
+                    bytes.erase(at, 1 + uniform(16));
+                    break; // delete a run
+                case 4:
+                    bytes.insert(at, interesting[uniform(interesting.size())]);
+                    break; // plausible token
+                case 5:
+                    bytes.insert(at, bytes.substr(at, 1 + uniform(40)));
+                    break; // repeat a run
                 }
             }
             const fs::path p = fss::test::tmpPath("fuzz" + ext);
