@@ -2,10 +2,13 @@
 /// \file mesh_io.h
 /// Reading and writing triangle meshes: OFF, OBJ, PLY (ascii / binary), STL (ascii / binary).
 ///
-/// Files are read as polygon soups. A soup that is not a valid oriented 2-manifold is repaired with CGAL's
-/// polygon-soup functions (merge duplicate points, remove degenerate polygons, orient, duplicate
-/// non-manifold vertices); polygons with more than three corners are triangulated. Everything that was
-/// changed is listed in the ReadReport, so nothing is lost silently.
+/// Files are read as polygon soups by strict parsers of our own (a truncated or corrupt file is an error
+/// with a precise message, never a silently shortened mesh). A soup that is not a valid oriented
+/// 2-manifold is repaired (merge duplicate points, remove polygons with repeated corners and duplicate
+/// triangles, orient with CGAL's orient_polygon_soup, duplicate non-manifold vertices, drop isolated
+/// points); polygons with more than three corners are triangulated (ear clipping, so non-convex planar
+/// polygons come out right). Everything that was changed is listed in the ReadReport, so nothing is lost
+/// silently. Faces keep the order of the file (a triangulated polygon's triangles take its place).
 
 #include "fss/mesh.h"
 
@@ -17,13 +20,20 @@
 namespace fss {
 
 /// Topological facts about the polygon soup as it was in the file, before any repair.
+/// The topology counts (edges, vertices) identify geometrically equal points and ignore polygons with
+/// repeated corners, i.e. they describe the surface the file means. STL stores every triangle's corners
+/// separately: its identical corners are merged while reading and are not counted as duplicates.
 struct SoupStats {
     std::size_t points = 0;               ///< points in the file
     std::size_t polygons = 0;             ///< polygons in the file
     std::size_t nonTriangles = 0;         ///< polygons with more than 3 corners
     std::size_t nonManifoldEdges = 0;     ///< undirected edges shared by more than two polygons
-    std::size_t nonManifoldVertices = 0;  ///< vertices whose polygon fan is not one disc or half-disc
-    std::size_t degeneratePolygons = 0;   ///< polygons with repeated corners or zero area
+    /// vertices whose incident polygons form more than one fan (bow-ties); the ends of a non-manifold edge
+    /// are counted in nonManifoldEdges only
+    std::size_t nonManifoldVertices = 0;
+    /// polygons with repeated corners or zero area (exactly collinear corners). Only those with repeated
+    /// corners are removed by the repair: removing a zero-area triangle from a closed mesh would open a hole.
+    std::size_t degeneratePolygons = 0;
     std::size_t duplicatePoints = 0;      ///< points geometrically equal to an earlier point
 };
 
@@ -40,30 +50,45 @@ struct ReadReport {
 
 /// Options of readMesh.
 struct ReadOptions {
-    /// Repair soups that are not a valid mesh (else such a file is an error).
+    /// Repair soups that are not a valid mesh (else such a file is an error: polygons with repeated corners,
+    /// non-manifold or inconsistently oriented polygons, points no polygon uses). Triangulating polygons
+    /// with more than three corners is always done (and reported), since a Mesh holds triangles.
     bool repair = true;
 };
 
 /// Reads a triangle mesh; the format is chosen by the extension (case-insensitive), falling back to the
-/// file's content when the extension is unknown.
+/// file's content when the extension is unknown. Ascii or binary STL is always told by the content.
+/// PLY face properties `quality` and `scan_id` are restored into props::faceQuality / props::faceScanId.
+/// \param path    the file to read
+/// \param report  when not null, receives the format, the SoupStats and one sentence per repair
+/// \param options see ReadOptions
+/// \return a valid, consistently oriented, edge-manifold triangle mesh (CGAL::is_valid_polygon_mesh)
 /// \throw IoError when the file is missing, unreadable, empty, truncated, of unknown format, contains
-///        garbage, NaN/inf coordinates, faces indexing missing vertices, or nothing is left after repair.
-///        The message names the file.
+///        garbage, NaN/inf coordinates, faces indexing missing vertices, faces with fewer than 3 corners,
+///        no faces, or nothing is left after repair (or needs repair while options.repair is false).
+///        The message is one sentence that names the file and, for text formats, the line.
 Mesh readMesh(const std::filesystem::path& path, ReadReport* report = nullptr, const ReadOptions& options = {});
 
 /// Options of writeMesh.
 struct WriteOptions {
-    bool binary = false;        ///< binary PLY / STL (ascii otherwise)
-    int precision = 17;         ///< significant digits of ascii coordinates (17 round-trips doubles)
+    bool binary = false;        ///< binary PLY / STL (ascii otherwise); binary PLY stores doubles, STL floats
+    int precision = 17;         ///< significant digits of ascii coordinates (17 round-trips doubles); 1…17
 };
 
-/// Writes a mesh; the format is chosen by the extension (.off .obj .ply .stl). PLY files also store the
-/// face properties props::faceQuality (as `quality`) and props::faceScanId (as `scan_id`) when present.
-/// The file is written to a temporary name and renamed, so a failed write never destroys an existing file.
+/// Writes a mesh; the format is chosen by the extension (.off .obj .ply .stl, case-insensitive). PLY files
+/// also store the face properties props::faceQuality (as `quality`) and props::faceScanId (as `scan_id`)
+/// when present; the other formats cannot hold them. Only valid elements are written, re-indexed
+/// contiguously in iteration order (removed elements of a mesh with garbage are skipped). STL holds
+/// triangles only: a face with more corners is written as a fan.
+/// The file is written to a temporary name in the same folder and renamed, so a failed write never
+/// destroys an existing file.
+/// \param mesh    the mesh to write
+/// \param path    the target file
+/// \param options see WriteOptions (precision is clamped to 1…17)
 /// \throw IoError naming the file when the extension is unknown or the file cannot be written.
 void writeMesh(const Mesh& mesh, const std::filesystem::path& path, const WriteOptions& options = {});
 
-/// True when the extension of \p path names a format writeMesh can write.
+/// True when the extension of \p path (case-insensitive) names a format writeMesh can write.
 bool isSupportedMeshFile(const std::filesystem::path& path);
 
 } // namespace fss
