@@ -50,6 +50,8 @@ private:
     Eigen::Vector3d viewDirection_;
 };
 
+constexpr double kMinDirectionWeight = 1e-3;
+
 std::string pixelName(int x, int y) {
     return "(" + std::to_string(x) + ", " + std::to_string(y) + ")";
 }
@@ -86,7 +88,8 @@ std::size_t DirectionField::validCount() const {
 }
 
 std::optional<DirectionSample> DirectionField::sample(const Eigen::Vector2d& pos,
-                                                      const Eigen::Vector2d& reference) const {
+                                                      const Eigen::Vector2d& reference,
+                                                      double straightBelow) const {
     if (!(pos.x() >= 0 && pos.y() >= 0 && pos.x() <= width && pos.y() <= height)) return std::nullopt;
     // The pixel containing pos decides coverage (so background stops are pixel-exact).
     const int cx = std::min(int(pos.x()), width - 1), cy = std::min(int(pos.y()), height - 1);
@@ -95,6 +98,7 @@ std::optional<DirectionSample> DirectionField::sample(const Eigen::Vector2d& pos
     const double gx = pos.x() - 0.5, gy = pos.y() - 0.5;
     const int x0 = int(std::floor(gx)), y0 = int(std::floor(gy));
     const double fx = gx - x0, fy = gy - y0;
+    const Eigen::Vector2d unitReference = reference.normalized();
     Eigen::Vector2d dir = Eigen::Vector2d::Zero();
     double aniso = 0, weight = 0;
     for (int j = 0; j < 2; ++j)
@@ -104,19 +108,29 @@ std::optional<DirectionSample> DirectionField::sample(const Eigen::Vector2d& pos
             const double w = (i ? fx : 1 - fx) * (j ? fy : 1 - fy);
             if (w <= 0) continue;
             const std::size_t k = index(x, y);
-            const Eigen::Vector2d& d = direction[k];
-            dir += (d.dot(reference) < 0 ? -w : w) * d;
+            const double a = double(anisotropy[k]);
+            Eigen::Vector2d d =
+                direction[k].dot(reference) < 0 ? Eigen::Vector2d(-direction[k]) : direction[k];
+            if (straightBelow > 0 && a < 2 * straightBelow) {
+                const double f = std::clamp((a - straightBelow) / straightBelow, 0.0, 1.0);
+                d = f * d + (1 - f) * unitReference;
+            }
+            // Well-defined directions dominate ill-defined ones; the floor keeps an all-isotropic
+            // neighbourhood (a plane, anisotropy 0) a plain bilinear average.
+            dir += (w * std::max(a, kMinDirectionWeight)) * d;
             aniso += w * double(anisotropy[k]);
             weight += w;
         }
     if (weight <= 0) {
         // pos sits exactly on the containing pixel's far edge with zero weight everywhere else.
         const std::size_t k = index(cx, cy);
+        if (straightBelow > 0 && double(anisotropy[k]) < straightBelow)
+            return DirectionSample{unitReference, double(anisotropy[k])};
         const Eigen::Vector2d& d = direction[k];
         return DirectionSample{d.dot(reference) < 0 ? Eigen::Vector2d(-d) : d, double(anisotropy[k])};
     }
     const double len = dir.norm();
-    if (!(len > 1e-9 * weight)) return std::nullopt;
+    if (!(len > 1e-12)) return std::nullopt;
     return DirectionSample{dir / len, aniso / weight};
 }
 

@@ -59,7 +59,9 @@ Polyline2 traceRibHalf(const DirectionField& field, const Eigen::Vector2d& p0, c
     const StreamlineOptions& o = options.ribTracing;
     const bool inImage = p0.x() >= 0 && p0.y() >= 0 && p0.x() <= field.width && p0.y() <= field.height;
     const std::optional<DirectionSample> s = inImage ? field.sample(p0, side) : std::nullopt;
-    if (!s || s->anisotropy < o.minAnisotropy || (o.insideRegion && !o.insideRegion(p0))) return {p0};
+    const bool undefined =
+        s && s->anisotropy < o.minAnisotropy && o.lowAnisotropy == LowAnisotropyPolicy::Stop;
+    if (!s || undefined || (o.insideRegion && !o.insideRegion(p0))) return {p0};
     const StreamlineHalf half = traceStreamlineHalf(field, p0, side, o);
     return resampleAtSpacing(half.points, options.spacing);
 }

@@ -48,12 +48,14 @@ public:
             e.reason = StreamlineStop::OutsideRegion;
             return e;
         }
-        const std::optional<DirectionSample> s = field_.sample(p, reference);
+        const bool straight = o_.lowAnisotropy == LowAnisotropyPolicy::ContinueStraight;
+        const std::optional<DirectionSample> s =
+            field_.sample(p, reference, straight ? o_.minAnisotropy : 0.0);
         if (!s) {
             e.reason = StreamlineStop::Background;
             return e;
         }
-        if (s->anisotropy < o_.minAnisotropy) {
+        if (!straight && s->anisotropy < o_.minAnisotropy) {
             e.reason = StreamlineStop::LowAnisotropy;
             return e;
         }

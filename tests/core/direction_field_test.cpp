@@ -148,18 +148,32 @@ TEST(DirectionField, SampleAlignsSignsAndInterpolatesBilinearly) {
     ASSERT_TRUE(s);
     EXPECT_NEAR(s->direction.x(), -std::cos(a0), 1e-15);
     EXPECT_NEAR(s->direction.y(), -std::sin(a0), 1e-15);
-    // Half way between the centres of columns 0 and 1: the normalised average (bisector), mean anisotropy.
+    // Half way between the centres of columns 0 and 1: bilinear weights ½, ½ times the anisotropies 1 and
+    // ½ on the aligned vectors; the anisotropy itself is the plain mean.
+    const Eigen::Vector2d d0(std::cos(a0), std::sin(a0)), d1(std::cos(a1), std::sin(a1));
     s = f.sample({1.0, 1.5}, {1, 0});
     ASSERT_TRUE(s);
-    EXPECT_NEAR(std::atan2(s->direction.y(), s->direction.x()), 0.5 * (a0 + a1), 1e-12);
+    EXPECT_NEAR((s->direction - (0.5 * d0 + 0.25 * d1).normalized()).norm(), 0.0, 1e-12);
     EXPECT_NEAR(s->anisotropy, 0.75, 1e-7);
-    // A quarter of the way: weights 3/4, 1/4 of the aligned vectors.
+    // A quarter of the way: bilinear weights ¾, ¼.
     s = f.sample({0.75, 1.5}, {1, 0});
     ASSERT_TRUE(s);
-    const Eigen::Vector2d expect = (0.75 * Eigen::Vector2d(std::cos(a0), std::sin(a0)) +
-                                    0.25 * Eigen::Vector2d(std::cos(a1), std::sin(a1)))
-                                       .normalized();
-    EXPECT_NEAR((s->direction - expect).norm(), 0.0, 1e-12);
+    EXPECT_NEAR((s->direction - (0.75 * d0 + 0.125 * d1).normalized()).norm(), 0.0, 1e-12);
+    EXPECT_NEAR(s->anisotropy, 0.875, 1e-7);
+    // Equal anisotropies: the plain normalised average, the bisector half way.
+    DirectionField g(2, 1);
+    g.setPixel(0, 0, d0, 0.3);
+    g.setPixel(1, 0, -d1, 0.3);
+    s = g.sample({1.0, 0.5}, {1, 0});
+    ASSERT_TRUE(s);
+    EXPECT_NEAR(std::atan2(s->direction.y(), s->direction.x()), 0.5 * (a0 + a1), 1e-12);
+    // Anisotropy 0 everywhere (a plane): still a plain average, never undefined.
+    g.setPixel(0, 0, d0, 0.0);
+    g.setPixel(1, 0, -d1, 0.0);
+    s = g.sample({1.0, 0.5}, {1, 0});
+    ASSERT_TRUE(s);
+    EXPECT_NEAR(std::atan2(s->direction.y(), s->direction.x()), 0.5 * (a0 + a1), 1e-12);
+    EXPECT_EQ(s->anisotropy, 0.0);
     // Invalid neighbours (column 2) are left out: between columns 1 and 2 the result is column 1's.
     s = f.sample({1.9, 1.5}, {1, 0});
     ASSERT_TRUE(s);

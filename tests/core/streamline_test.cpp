@@ -173,6 +173,33 @@ TEST(Streamline, StopsAtBackgroundBorderRegionAnisotropyAndTurns) {
     EXPECT_GT(h.points.back().y(), 40.0);
 }
 
+TEST(Streamline, ContinuesStraightThroughIsotropicRegionsWhenAsked) {
+    // Field along +x with a band 40 <= x < 60 of noise directions and anisotropy 0.01 (a flat region).
+    DirectionField f = makeField(100, 50, [](const Eigen::Vector2d&) { return Eigen::Vector2d(1, 0.02); });
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> angle(0, 2 * kPi);
+    for (int y = 0; y < 50; ++y)
+        for (int x = 40; x < 60; ++x) {
+            const double a = angle(rng);
+            f.setPixel(x, y, {std::cos(a), std::sin(a)}, 0.01);
+        }
+    StreamlineOptions o;
+    fss::StreamlineHalf h = fss::traceStreamlineHalf(f, {10.5, 20.5}, {1, 0}, o);
+    EXPECT_EQ(h.stop, StreamlineStop::LowAnisotropy);
+    EXPECT_LT(h.points.back().x(), 40.5); // bilinear anisotropy 1 → 0.01 between pixel centres 39.5 and 40.5
+    o.lowAnisotropy = fss::LowAnisotropyPolicy::ContinueStraight;
+    h = fss::traceStreamlineHalf(f, {10.5, 20.5}, {1, 0}, o);
+    EXPECT_EQ(h.stop, StreamlineStop::ImageBorder);
+    EXPECT_GT(h.points.back().x(), 100.0 - 2 * o.minStep);
+    // The field's slope 0.02 everywhere outside the band, straight across it: one straight line (the noise
+    // pixels carry the previous direction, so nothing leaks in).
+    double worst = 0;
+    for (const Eigen::Vector2d& p : h.points)
+        worst = std::max(worst, std::abs(p.y() - (20.5 + 0.02 * (p.x() - 10.5))));
+    std::printf("[ isotropic band ] crossed straight, worst deviation %.2e px\n", worst);
+    EXPECT_LT(worst, 1e-9);
+}
+
 TEST(Streamline, BadSeedsAndOptionsThrow) {
     DirectionField f = makeField(50, 50, [](const Eigen::Vector2d&) { return Eigen::Vector2d(1, 0); });
     f.setPixel(5, 5, Eigen::Vector2d::Zero());

@@ -63,13 +63,20 @@ struct DirectionField {
     std::size_t validCount() const;
 
     /// Bilinear sampling at the sub-pixel position \p pos between the four nearest pixel centres: each
-    /// neighbour's direction is first flipped to agree with \p reference (line field), invalid neighbours
-    /// and those outside the image are left out (weights renormalised), and the blend is normalised.
-    /// The anisotropy is interpolated the same way.
+    /// neighbour's direction is first flipped to agree with \p reference (line field) and weighted by its
+    /// bilinear weight times its anisotropy (floored at 10⁻³, so a well-defined direction dominates an
+    /// ill-defined neighbour while an isotropic neighbourhood is still averaged plainly); invalid
+    /// neighbours and those outside the image are left out, and the blend is normalised. The anisotropy is
+    /// the plain bilinear average over the valid neighbours.
+    /// With \p straightBelow > 0, a neighbour whose anisotropy is below straightBelow contributes the
+    /// reference direction instead of its own (linear ramp back to its own up to 2·straightBelow): a
+    /// streamline can cross an isotropic region straight without picking up its noise
+    /// (LowAnisotropyPolicy::ContinueStraight).
     /// \return std::nullopt when \p pos lies outside the image [0, width] × [0, height], when the pixel
     ///         containing \p pos is invalid, or when the blend cancels (directions ⟂ the reference).
-    /// \pre reference is non-zero (only its sign matters: the result has a non-negative dot with it).
-    std::optional<DirectionSample> sample(const Eigen::Vector2d& pos, const Eigen::Vector2d& reference) const;
+    /// \pre reference is non-zero (its sign decides the result's: a non-negative dot with it).
+    std::optional<DirectionSample> sample(const Eigen::Vector2d& pos, const Eigen::Vector2d& reference,
+                                          double straightBelow = 0) const;
 };
 
 /// Options of computeDirectionField().

@@ -37,6 +37,15 @@ enum class StreamlineStop {
     StepLimit      ///< the safety limit on the number of steps was hit
 };
 
+/// What a streamline does where the direction field's anisotropy falls below the threshold.
+enum class LowAnisotropyPolicy {
+    Stop,            ///< end the streamline there (StreamlineStop::LowAnisotropy)
+    ContinueStraight ///< keep the previous direction until the field is defined again (crosses flat
+                     ///< or umbilic regions, e.g. the planar faces beside a rounded crease): pixels
+                     ///< below minAnisotropy carry the previous direction (DirectionField::sample's
+                     ///< straightBelow)
+};
+
 /// Options of traceStreamline(). Lengths in pixels.
 struct StreamlineOptions {
     /// RK4 step: a quarter pixel resolves the bilinear field (whose values change per pixel) with an
@@ -50,6 +59,8 @@ struct StreamlineOptions {
     /// Stop where the interpolated anisotropy falls below this (0 never stops). 0.05: only where the
     /// principal directions are essentially undefined (umbilics, flat regions).
     double minAnisotropy = 0.05;
+    /// Below minAnisotropy: stop, or continue straight.
+    LowAnisotropyPolicy lowAnisotropy = LowAnisotropyPolicy::Stop;
     /// Stop when two consecutive steps turn by more than this angle, degrees. With the default step
     /// 10° per quarter pixel is a radius of curvature under 1.5 pixels: a singularity or a seam of the
     /// field, not a feature to follow.
