@@ -1,7 +1,7 @@
 #pragma once
 /// \file curvature.h
 /// Principal curvatures and directions per vertex of the reference mesh — the first step of the
-/// feature-sensitive (fishbone) grid (DESIGN.md §1; Vorsatz et al. 2000, §4 "curvature estimation").
+/// feature-sensitive (fishbone) grid (DESIGN.md §1; Vorsatz, Rössl, Kobbelt, Seidel, VMV 2000).
 ///
 /// Estimator: CGAL's `Monge_via_jet_fitting` (Cazals & Pouget 2005) on a k-ring neighbourhood that grows
 /// ring by ring until it holds enough points, so that the neighbourhood adapts to the local sampling

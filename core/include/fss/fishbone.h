@@ -1,7 +1,7 @@
 #pragma once
 /// \file fishbone.h
-/// The feature-sensitive ("fishbone") sampling grid in screen space (Vorsatz et al. 2000, §4–5;
-/// DESIGN.md §1 "Feature-sensitive (fishbone) grid").
+/// The feature-sensitive ("fishbone") sampling grid in screen space (Vorsatz, Rössl, Kobbelt, Seidel, VMV
+/// 2000; DESIGN.md §1 "Feature-sensitive (fishbone) grid").
 ///
 ///  * **Backbone**: the streamline through a picked point along one principal direction (traceBackbone),
 ///    or a hand-drawn interpolating spline (drawnBackbone), sampled every h.
@@ -104,9 +104,10 @@ struct FishboneGrid {
     std::size_t presentCount() const;
 };
 
-/// [E0, {αᵢ}] of one rib half. \pre halfRib.size() ≠ 1 would be fine; any size works: fewer than two
-/// points give an empty shape. Turning angles are exact for any edge lengths; the reconstruction
-/// (ribFromShape) is exact when every edge after the first has length h.
+/// [E0, {αᵢ}] of one rib half whose first vertex lies on the backbone (the paper's key-rib representation).
+/// Any polyline is accepted: fewer than two points give an empty shape. The turning angles are exact
+/// for any edge lengths; ribFromShape reproduces the polyline exactly (to round-off) when every edge
+/// after the first has length h, as for every rib sampled by this file's functions.
 RibShape ribShape(const Polyline2& halfRib);
 
 /// The paper's rib formula: vertices p0, p0 + G0, … from a start point, a shape [G0, {γᵢ}] and the
@@ -161,15 +162,17 @@ KeyRib drawnKeyRib(const Backbone& backbone, const Polyline2& points, const Fish
 FishboneGrid assembleFishboneGrid(const Backbone& backbone, const std::vector<Rib>& ribs, double spacing,
                                   int width = 0, int height = 0);
 
-/// Automatic mode (paper §4): backbone through \p seed on \p backboneField, then a traced rib through
-/// every backbone sample on \p ribField. Swap the two fields to swap min and max.
+/// Automatic mode (DESIGN.md §1, ribs from every backbone sample): the backbone through \p seed on
+/// \p backboneField, then a traced rib through every backbone sample on \p ribField. Swap the two
+/// fields to swap min and max. Entries outside the image are absent.
 /// \pre fields of equal size; seed on a valid pixel. \throw InvalidInputError otherwise.
 FishboneGrid automaticFishbone(const DirectionField& backboneField, const DirectionField& ribField,
                                const Eigen::Vector2d& seed, const FishboneOptions& options = {});
 
-/// Key-rib mode (paper §5): ribs only at the given key-ribs, blended ribs between neighbouring key-ribs,
-/// copies of the nearest key-rib beyond the first and last (options.extendBeyondKeyRibs) or no rows
-/// there. Key-ribs at the same row: the last one given wins.
+/// Key-rib mode (DESIGN.md §1, key-ribs and blended ribs): ribs only at the given key-ribs, blended
+/// ribs between neighbouring key-ribs, copies of the nearest key-rib beyond the first and last
+/// (options.extendBeyondKeyRibs) or no rows there. Of several key-ribs at one row the last given wins.
+/// Entries outside the image [0, width] × [0, height] are absent (width or height ≤ 0: no test).
 /// \pre at least one key-rib; every key row < backbone.samples.size(); backbone ≥ 2 samples.
 /// \throw InvalidInputError otherwise.
 FishboneGrid keyRibFishbone(const Backbone& backbone, std::vector<KeyRib> keyRibs,
