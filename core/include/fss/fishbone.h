@@ -1,0 +1,181 @@
+#pragma once
+/// \file fishbone.h
+/// The feature-sensitive ("fishbone") sampling grid in screen space (Vorsatz, Rössl, Kobbelt, Seidel, VMV
+/// 2000; DESIGN.md §1 "Feature-sensitive (fishbone) grid").
+///
+///  * **Backbone**: the streamline through a picked point along one principal direction (traceBackbone),
+///    or a hand-drawn interpolating spline (drawnBackbone), sampled every h.
+///  * **Ribs**: from every backbone sample, the streamline along the other principal direction, both ways,
+///    sampled every h (automaticFishbone / traceRib).
+///  * **Key-ribs and blended ribs**: ribs only at a few backbone samples (traced or hand-drawn); every rib
+///    in between is blended from its two neighbouring key-ribs by the paper's rule (blendRibShapes).
+///  * The rib vertices form a rows × columns matrix, FishboneGrid: row r = the rib through backbone sample
+///    r, column = index along the rib, the backbone at column `backboneColumn`. The caller casts a ray
+///    through every present vertex to make a SampleGrid (DESIGN.md §1, last step).
+///
+/// Sides: a rib's *positive* half leaves the backbone towards n = (−t.y, t.x), t the backbone's screen
+/// tangent (with y pointing down this is the right-hand side of the backbone as seen on the screen); it
+/// fills the columns above backboneColumn, the negative half those below.
+///
+/// **Rib shapes and the blending rule.** One half of a rib with vertices p0 (on the backbone), p1, …, pn
+/// and edges eᵢ = pᵢ₊₁ − pᵢ of length h is [E0, {αᵢ}]: the first edge E0 = e0 and the turning angles
+/// αᵢ = ∠(eᵢ₋₁, eᵢ), i = 1 … n−1, each the signed angle (atan2(e×e', e·e'), counter-clockwise in the
+/// (x, y) screen axes) from the previous edge direction to the next. Then, exactly,
+///     p_k = p0 + E0 + h · Σ_{i=1}^{k−1} R(θ0) (cos Σ_{j≤i} αⱼ, sin Σ_{j≤i} αⱼ),
+/// R(θ0) the rotation by the angle θ0 of E0 (the paper's formula written in E0's frame). Between key-ribs
+/// [E0, {αᵢ}] and [F0, {βᵢ}], the blended rib for t ∈ [0, 1] starts at its own backbone sample p0, has
+///     G0 = h · ((1−t)·E0 + t·F0) / |(1−t)·E0 + t·F0|,   γᵢ = (1−t)·αᵢ + t·βᵢ,
+/// and the vertices above with (G0, γ). The negative half uses the same formula with its own first edge
+/// and angles (the paper's "mirrored formula for k < 0"). Key-ribs of unequal length are blended up to
+/// the shorter one (no turning angles are invented). t = (r − a)/(b − a) for the backbone sample r
+/// between key-ribs at samples a < b (equal backbone spacing makes this the arc-length fraction).
+
+#include "fss/direction_field.h"
+#include "fss/streamline.h"
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace fss {
+
+/// Options of the fishbone construction. Lengths in pixels.
+struct FishboneOptions {
+    /// Sample spacing h along the backbone and the ribs (the grid's edge length in pixels). Must be > 0.
+    double spacing = 4.0;
+    /// Tracing of the backbone (streamline through the picked point).
+    StreamlineOptions backboneTracing{};
+    /// Tracing of the ribs (automatic mode and traced key-ribs). Its maxLength bounds each half-rib.
+    StreamlineOptions ribTracing{};
+    /// Key-rib mode: backbone samples before the first and after the last key-rib get a copy of the
+    /// nearest key-rib's shape (true) or are left out of the grid (false).
+    bool extendBeyondKeyRibs = true;
+};
+
+/// The backbone: samples every h along a streamline or a drawn spline.
+struct Backbone {
+    Polyline2 samples;         ///< consecutive samples at distance h
+    std::size_t seedIndex = 0; ///< the picked point (traced backbone) or the first drawn point
+    /// Unit screen tangent at sample r (central difference; one-sided at the ends).
+    /// \pre samples.size() ≥ 2 and r < samples.size().
+    Eigen::Vector2d tangent(std::size_t r) const;
+    /// Unit normal n = (−t.y, t.x) at sample r: the side of the ribs' positive halves.
+    Eigen::Vector2d normal(std::size_t r) const;
+    /// Index of the sample nearest to \p p (to place a key-rib at a picked point). \pre !samples.empty().
+    std::size_t nearestSample(const Eigen::Vector2d& p) const;
+};
+
+/// A rib through one backbone sample: both halves start at that sample (index 0) and continue every h.
+struct Rib {
+    Polyline2 positive; ///< towards Backbone::normal
+    Polyline2 negative; ///< the other side
+};
+
+/// A key-rib: a rib placed at backbone sample `row`.
+struct KeyRib {
+    std::size_t row = 0;
+    Rib rib;
+};
+
+/// One half of a rib in the paper's representation [E0, {αᵢ}] (see the file comment for the convention).
+struct RibShape {
+    Eigen::Vector2d firstEdge{0, 0};   ///< E0 = p1 − p0 (zero: a rib half without edges)
+    std::vector<double> turningAngles; ///< αᵢ, i = 1 … n−1, radians in (−π, π]
+    /// Number of edges n (vertices n + 1).
+    std::size_t edgeCount() const { return firstEdge.isZero() ? 0 : turningAngles.size() + 1; }
+};
+
+/// The fishbone sampling grid in screen space: rows × cols positions, row-major, with presence flags.
+struct FishboneGrid {
+    int rows = 0;
+    int cols = 0;
+    int backboneColumn = 0;              ///< the column of the backbone samples
+    double spacing = 0;                  ///< h
+    std::vector<Eigen::Vector2d> screen; ///< rows·cols sub-pixel screen positions (unused where absent)
+    std::vector<std::uint8_t> present;   ///< 1 where a rib vertex exists (and lies inside the image)
+
+    std::size_t index(int r, int c) const { return std::size_t(r) * std::size_t(cols) + std::size_t(c); }
+    bool isPresent(int r, int c) const {
+        return r >= 0 && c >= 0 && r < rows && c < cols && present[index(r, c)] != 0;
+    }
+    const Eigen::Vector2d& at(int r, int c) const { return screen[index(r, c)]; }
+    std::size_t presentCount() const;
+};
+
+/// [E0, {αᵢ}] of one rib half whose first vertex lies on the backbone (the paper's key-rib representation).
+/// Any polyline is accepted: fewer than two points give an empty shape. The turning angles are exact
+/// for any edge lengths; ribFromShape reproduces the polyline exactly (to round-off) when every edge
+/// after the first has length h, as for every rib sampled by this file's functions.
+RibShape ribShape(const Polyline2& halfRib);
+
+/// The paper's rib formula: vertices p0, p0 + G0, … from a start point, a shape [G0, {γᵢ}] and the
+/// spacing h (see the file comment). \pre h > 0. \throw InvalidInputError otherwise.
+Polyline2 ribFromShape(const Eigen::Vector2d& p0, const RibShape& shape, double h);
+
+/// The blended shape [G0, {γᵢ}] between key-rib halves \p e = [E0, {αᵢ}] (t = 0) and \p f = [F0, {βᵢ}]
+/// (t = 1): G0 = h·normalise((1−t)E0 + tF0), γᵢ = (1−t)αᵢ + tβᵢ, truncated to the shorter of the two.
+/// Either shape empty gives an empty shape.
+/// \pre t ∈ [0, 1], h > 0, (1−t)E0 + tF0 ≠ 0 (both halves on the same side of the backbone).
+/// \throw InvalidInputError when a precondition is violated.
+RibShape blendRibShapes(const RibShape& e, const RibShape& f, double t, double h);
+
+/// Blends two key-ribs into the rib starting at backbone sample \p p0 (both halves by blendRibShapes).
+/// \throw InvalidInputError as blendRibShapes.
+Rib blendRibs(const Rib& a, const Rib& b, const Eigen::Vector2d& p0, double t, double h);
+
+/// Centripetal Catmull–Rom spline through \p points (DESIGN.md §1 "drawn by hand (interpolating splines
+/// in 2D)"): passes through every point, no cusps or self-intersections within a segment (centripetal
+/// parametrisation, Yuksel et al. 2011); end tangents from reflected phantom points. Returns a dense
+/// polyline whose segments are at most \p maxSegment long, containing every input point exactly.
+/// Consecutive duplicate points are merged. \pre maxSegment > 0; points finite.
+/// \throw InvalidInputError when a precondition is violated.
+Polyline2 catmullRomSpline(const Polyline2& points, double maxSegment = 0.25);
+
+/// Traces the backbone (paper: "the streamline through the picked point along one principal direction")
+/// on \p backboneField from \p seed, both ways, and samples it every h from the seed.
+/// \pre seed on a valid pixel of the field; options valid. \throw InvalidInputError otherwise.
+Backbone traceBackbone(const DirectionField& backboneField, const Eigen::Vector2d& seed,
+                       const FishboneOptions& options = {});
+
+/// A hand-drawn backbone: a Catmull–Rom spline through \p points, sampled every h from the first point.
+/// \pre at least two distinct finite points; spacing > 0. \throw InvalidInputError otherwise.
+Backbone drawnBackbone(const Polyline2& points, const FishboneOptions& options = {});
+
+/// Traces the rib through backbone sample \p row on \p ribField, both ways, each half sampled every h
+/// from the backbone sample; a half whose start is undefined (background) is just the sample.
+/// \pre row < backbone.samples.size(), backbone has ≥ 2 samples. \throw InvalidInputError otherwise.
+Rib traceRib(const DirectionField& ribField, const Backbone& backbone, std::size_t row,
+             const FishboneOptions& options = {});
+
+/// A hand-drawn key-rib: a Catmull–Rom spline through \p points that must pass within 2h of a backbone
+/// sample; the nearest sample becomes its row, the spline is split at its point nearest to that sample,
+/// and each part (prefixed by the sample itself) is sampled every h and assigned to its side.
+/// \pre ≥ 2 distinct finite points; the spline passes within 2h of the backbone; backbone ≥ 2 samples.
+/// \throw InvalidInputError otherwise.
+KeyRib drawnKeyRib(const Backbone& backbone, const Polyline2& points, const FishboneOptions& options = {});
+
+/// Assembles ribs (one per backbone sample, ribs[r] through backbone.samples[r]) into the grid. Entries
+/// outside the image [0, width] × [0, height] are marked absent (width or height ≤ 0: no test).
+/// \pre ribs.size() == backbone.samples.size(). \throw InvalidInputError otherwise.
+FishboneGrid assembleFishboneGrid(const Backbone& backbone, const std::vector<Rib>& ribs, double spacing,
+                                  int width = 0, int height = 0);
+
+/// Automatic mode (DESIGN.md §1, ribs from every backbone sample): the backbone through \p seed on
+/// \p backboneField, then a traced rib through every backbone sample on \p ribField. Swap the two
+/// fields to swap min and max. Entries outside the image are absent.
+/// \pre fields of equal size; seed on a valid pixel. \throw InvalidInputError otherwise.
+FishboneGrid automaticFishbone(const DirectionField& backboneField, const DirectionField& ribField,
+                               const Eigen::Vector2d& seed, const FishboneOptions& options = {});
+
+/// Key-rib mode (DESIGN.md §1, key-ribs and blended ribs): ribs only at the given key-ribs, blended
+/// ribs between neighbouring key-ribs, copies of the nearest key-rib beyond the first and last
+/// (options.extendBeyondKeyRibs) or no rows there. Of several key-ribs at one row the last given wins.
+/// Entries outside the image [0, width] × [0, height] are absent (width or height ≤ 0: no test).
+/// \pre at least one key-rib; every key row < backbone.samples.size(); backbone ≥ 2 samples.
+/// \throw InvalidInputError otherwise.
+FishboneGrid keyRibFishbone(const Backbone& backbone, std::vector<KeyRib> keyRibs,
+                            const FishboneOptions& options = {}, int width = 0, int height = 0);
+
+} // namespace fss

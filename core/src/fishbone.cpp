@@ -1,0 +1,382 @@
+#include "fss/fishbone.h"
+
+#include "fss/error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <string>
+
+namespace fss {
+namespace {
+
+double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() * b.y() - a.y() * b.x();
+}
+
+Eigen::Vector2d rotate(const Eigen::Vector2d& v, double angle) {
+    const double c = std::cos(angle), s = std::sin(angle);
+    return {c * v.x() - s * v.y(), s * v.x() + c * v.y()};
+}
+
+void requireSpacing(double h) {
+    if (!(h > 0) || !std::isfinite(h))
+        throw InvalidInputError("The fishbone spacing h must be positive and finite.");
+}
+
+void requireBackbone(const Backbone& backbone) {
+    if (backbone.samples.size() < 2)
+        throw InvalidInputError(
+            "The backbone has fewer than two samples; it must be longer than the spacing h.");
+}
+
+// Closest point of a polyline to p: (segment index, parameter on it, distance).
+struct Closest {
+    std::size_t segment = 0;
+    double t = 0;
+    double distance = std::numeric_limits<double>::infinity();
+};
+Closest closestOnPolyline(const Polyline2& line, const Eigen::Vector2d& p) {
+    Closest best;
+    if (line.size() == 1) {
+        best.distance = (line[0] - p).norm();
+        return best;
+    }
+    for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+        const Eigen::Vector2d d = line[i + 1] - line[i];
+        const double len2 = d.squaredNorm();
+        const double t = len2 > 0 ? std::clamp((p - line[i]).dot(d) / len2, 0.0, 1.0) : 0.0;
+        const double dist = (line[i] + t * d - p).norm();
+        if (dist < best.distance) best = {i, t, dist};
+    }
+    return best;
+}
+
+// A rib half traced from p0 along the rib field, or just {p0} when the field is undefined there.
+Polyline2 traceRibHalf(const DirectionField& field, const Eigen::Vector2d& p0, const Eigen::Vector2d& side,
+                       const FishboneOptions& options) {
+    const StreamlineOptions& o = options.ribTracing;
+    const bool inImage = p0.x() >= 0 && p0.y() >= 0 && p0.x() <= field.width && p0.y() <= field.height;
+    const std::optional<DirectionSample> s = inImage ? field.sample(p0, side) : std::nullopt;
+    const bool undefined =
+        s && s->anisotropy < o.minAnisotropy && o.lowAnisotropy == LowAnisotropyPolicy::Stop;
+    if (!s || undefined || (o.insideRegion && !o.insideRegion(p0))) return {p0};
+    const StreamlineHalf half = traceStreamlineHalf(field, p0, side, o);
+    return resampleAtSpacing(half.points, options.spacing);
+}
+
+// Splits a dense polyline at its point nearest to p0 into two halves starting at p0.
+std::pair<Polyline2, Polyline2> splitAt(const Polyline2& line, const Closest& c, const Eigen::Vector2d& p0) {
+    Polyline2 after{p0}, before{p0};
+    after.insert(after.end(), line.begin() + std::ptrdiff_t(c.segment) + 1, line.end());
+    for (std::size_t i = c.segment + 1; i-- > 0;)
+        before.push_back(line[i]);
+    return {after, before};
+}
+
+} // namespace
+
+// ---- Backbone -------------------------------------------------------------------------------------------
+
+Eigen::Vector2d Backbone::tangent(std::size_t r) const {
+    requireBackbone(*this);
+    const std::size_t a = r == 0 ? 0 : r - 1, b = std::min(r + 1, samples.size() - 1);
+    return (samples[b] - samples[a]).normalized();
+}
+
+Eigen::Vector2d Backbone::normal(std::size_t r) const {
+    const Eigen::Vector2d t = tangent(r);
+    return {-t.y(), t.x()};
+}
+
+std::size_t Backbone::nearestSample(const Eigen::Vector2d& p) const {
+    if (samples.empty()) throw InvalidInputError("The backbone has no samples.");
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < samples.size(); ++i)
+        if ((samples[i] - p).squaredNorm() < (samples[best] - p).squaredNorm()) best = i;
+    return best;
+}
+
+std::size_t FishboneGrid::presentCount() const {
+    std::size_t n = 0;
+    for (auto p : present)
+        n += p != 0;
+    return n;
+}
+
+// ---- Rib shapes and blending ----------------------------------------------------------------------------
+
+RibShape ribShape(const Polyline2& halfRib) {
+    RibShape shape;
+    if (halfRib.size() < 2) return shape;
+    shape.firstEdge = halfRib[1] - halfRib[0];
+    for (std::size_t i = 1; i + 1 < halfRib.size(); ++i) {
+        const Eigen::Vector2d e0 = halfRib[i] - halfRib[i - 1], e1 = halfRib[i + 1] - halfRib[i];
+        shape.turningAngles.push_back(std::atan2(cross(e0, e1), e0.dot(e1)));
+    }
+    return shape;
+}
+
+Polyline2 ribFromShape(const Eigen::Vector2d& p0, const RibShape& shape, double h) {
+    requireSpacing(h);
+    Polyline2 out{p0};
+    if (shape.edgeCount() == 0) return out;
+    // p_k = p0 + G0 + h·Σ_{i=1}^{k−1} R(θ0)(cos Σ_{j≤i}γj, sin Σ_{j≤i}γj)
+    const Eigen::Vector2d unit = shape.firstEdge.normalized();
+    out.push_back(p0 + shape.firstEdge);
+    double angle = 0;
+    for (double gamma : shape.turningAngles) {
+        angle += gamma;
+        out.push_back(out.back() + h * rotate(unit, angle));
+    }
+    return out;
+}
+
+RibShape blendRibShapes(const RibShape& e, const RibShape& f, double t, double h) {
+    requireSpacing(h);
+    if (!(t >= 0 && t <= 1)) throw InvalidInputError("The rib blending parameter t must lie in [0, 1].");
+    RibShape g;
+    if (e.edgeCount() == 0 || f.edgeCount() == 0) return g;
+    const Eigen::Vector2d average = (1 - t) * e.firstEdge + t * f.firstEdge;
+    const double len = average.norm();
+    if (!(len > 1e-12 * (e.firstEdge.norm() + f.firstEdge.norm())))
+        throw InvalidInputError("Two key-ribs leave the backbone in opposite directions on the same side; "
+                                "they cannot be blended.");
+    // t = 0 and t = 1 reproduce the key-rib's first edge bit for bit when its length is h.
+    g.firstEdge = t == 0 ? e.firstEdge : t == 1 ? f.firstEdge : Eigen::Vector2d(average * (h / len));
+    const std::size_t n = std::min(e.turningAngles.size(), f.turningAngles.size());
+    g.turningAngles.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+        g.turningAngles[i] = (1 - t) * e.turningAngles[i] + t * f.turningAngles[i];
+    return g;
+}
+
+Rib blendRibs(const Rib& a, const Rib& b, const Eigen::Vector2d& p0, double t, double h) {
+    Rib r;
+    r.positive = ribFromShape(p0, blendRibShapes(ribShape(a.positive), ribShape(b.positive), t, h), h);
+    r.negative = ribFromShape(p0, blendRibShapes(ribShape(a.negative), ribShape(b.negative), t, h), h);
+    return r;
+}
+
+// ---- Hand-drawn curves ----------------------------------------------------------------------------------
+
+Polyline2 catmullRomSpline(const Polyline2& input, double maxSegment) {
+    if (!(maxSegment > 0) || !std::isfinite(maxSegment))
+        throw InvalidInputError("The spline's maximum segment length must be positive and finite.");
+    Polyline2 pts;
+    for (const Eigen::Vector2d& p : input) {
+        if (!p.allFinite()) throw InvalidInputError("A drawn curve contains a non-finite point.");
+        if (pts.empty() || (p - pts.back()).norm() > 0) pts.push_back(p);
+    }
+    if (pts.size() < 2) return pts;
+    const std::size_t n = pts.size();
+    auto point = [&](std::ptrdiff_t i) -> Eigen::Vector2d {
+        if (i < 0) return 2 * pts[0] - pts[1];
+        if (i >= std::ptrdiff_t(n)) return 2 * pts[n - 1] - pts[n - 2];
+        return pts[std::size_t(i)];
+    };
+    Polyline2 out{pts[0]};
+    for (std::size_t s = 0; s + 1 < n; ++s) {
+        const std::ptrdiff_t i = std::ptrdiff_t(s);
+        const Eigen::Vector2d P0 = point(i - 1), P1 = point(i), P2 = point(i + 1), P3 = point(i + 2);
+        // Centripetal knots: t_{k+1} = t_k + |P_{k+1} − P_k|^½.
+        const double t0 = 0, t1 = t0 + std::sqrt((P1 - P0).norm()), t2 = t1 + std::sqrt((P2 - P1).norm()),
+                     t3 = t2 + std::sqrt((P3 - P2).norm());
+        auto eval = [&](double t) { // Barry–Goldman pyramid
+            const Eigen::Vector2d A1 = ((t1 - t) * P0 + (t - t0) * P1) / (t1 - t0);
+            const Eigen::Vector2d A2 = ((t2 - t) * P1 + (t - t1) * P2) / (t2 - t1);
+            const Eigen::Vector2d A3 = ((t3 - t) * P2 + (t - t2) * P3) / (t3 - t2);
+            const Eigen::Vector2d B1 = ((t2 - t) * A1 + (t - t0) * A2) / (t2 - t0);
+            const Eigen::Vector2d B2 = ((t3 - t) * A2 + (t - t1) * A3) / (t3 - t1);
+            return Eigen::Vector2d(((t2 - t) * B1 + (t - t1) * B2) / (t2 - t1));
+        };
+        // Subdivide until every piece is at most maxSegment long.
+        std::size_t pieces = std::size_t(std::ceil((P2 - P1).norm() / maxSegment)) + 1;
+        Polyline2 segment;
+        for (;;) {
+            segment.clear();
+            for (std::size_t k = 1; k < pieces; ++k)
+                segment.push_back(eval(t1 + (t2 - t1) * double(k) / double(pieces)));
+            segment.push_back(P2); // exactly the input point
+            double longest = (segment.front() - P1).norm();
+            for (std::size_t k = 1; k < segment.size(); ++k)
+                longest = std::max(longest, (segment[k] - segment[k - 1]).norm());
+            if (longest <= maxSegment) break;
+            pieces *= 2;
+        }
+        out.insert(out.end(), segment.begin(), segment.end());
+    }
+    return out;
+}
+
+// ---- Backbone and ribs ----------------------------------------------------------------------------------
+
+Backbone traceBackbone(const DirectionField& backboneField, const Eigen::Vector2d& seed,
+                       const FishboneOptions& options) {
+    requireSpacing(options.spacing);
+    const Streamline line =
+        resampleAtSpacing(traceStreamline(backboneField, seed, options.backboneTracing), options.spacing);
+    Backbone b;
+    b.samples = line.points;
+    b.seedIndex = line.seedIndex;
+    return b;
+}
+
+Backbone drawnBackbone(const Polyline2& points, const FishboneOptions& options) {
+    requireSpacing(options.spacing);
+    const Polyline2 dense = catmullRomSpline(points);
+    if (dense.size() < 2) throw InvalidInputError("A drawn backbone needs at least two distinct points.");
+    Backbone b;
+    b.samples = resampleAtSpacing(dense, options.spacing);
+    b.seedIndex = 0;
+    requireBackbone(b);
+    return b;
+}
+
+Rib traceRib(const DirectionField& ribField, const Backbone& backbone, std::size_t row,
+             const FishboneOptions& options) {
+    requireSpacing(options.spacing);
+    requireBackbone(backbone);
+    if (row >= backbone.samples.size())
+        throw InvalidInputError("The rib's backbone sample " + std::to_string(row) +
+                                " does not exist (the backbone has " +
+                                std::to_string(backbone.samples.size()) + " samples).");
+    const Eigen::Vector2d p0 = backbone.samples[row], n = backbone.normal(row);
+    Rib rib;
+    rib.positive = traceRibHalf(ribField, p0, n, options);
+    rib.negative = traceRibHalf(ribField, p0, -n, options);
+    return rib;
+}
+
+KeyRib drawnKeyRib(const Backbone& backbone, const Polyline2& points, const FishboneOptions& options) {
+    requireSpacing(options.spacing);
+    requireBackbone(backbone);
+    const Polyline2 dense = catmullRomSpline(points);
+    if (dense.size() < 2) throw InvalidInputError("A drawn key-rib needs at least two distinct points.");
+    KeyRib key;
+    Closest best;
+    for (std::size_t r = 0; r < backbone.samples.size(); ++r) {
+        const Closest c = closestOnPolyline(dense, backbone.samples[r]);
+        if (c.distance < best.distance) {
+            best = c;
+            key.row = r;
+        }
+    }
+    if (best.distance > 2 * options.spacing)
+        throw InvalidInputError("The drawn key-rib does not cross the backbone (it passes " +
+                                std::to_string(best.distance) + " pixels from the nearest backbone sample).");
+    const Eigen::Vector2d p0 = backbone.samples[key.row], n = backbone.normal(key.row);
+    auto [after, before] = splitAt(dense, best, p0);
+    Polyline2 a = resampleAtSpacing(after, options.spacing), b = resampleAtSpacing(before, options.spacing);
+    // Side of each part: its first edge against the backbone normal (the other part takes the other side).
+    const double sa = a.size() > 1 ? (a[1] - p0).dot(n) : 0.0, sb = b.size() > 1 ? (b[1] - p0).dot(n) : 0.0;
+    const bool aPositive = sa != 0 ? sa > 0 : sb < 0;
+    key.rib.positive = aPositive ? std::move(a) : std::move(b);
+    key.rib.negative = aPositive ? std::move(b) : std::move(a);
+    return key;
+}
+
+// ---- Grids ----------------------------------------------------------------------------------------------
+
+FishboneGrid assembleFishboneGrid(const Backbone& backbone, const std::vector<Rib>& ribs, double spacing,
+                                  int width, int height) {
+    requireSpacing(spacing);
+    if (ribs.size() != backbone.samples.size())
+        throw InvalidInputError("A fishbone grid needs exactly one rib per backbone sample.");
+    std::size_t neg = 0, pos = 0;
+    for (const Rib& r : ribs) {
+        neg = std::max(neg, r.negative.empty() ? 0 : r.negative.size() - 1);
+        pos = std::max(pos, r.positive.empty() ? 0 : r.positive.size() - 1);
+    }
+    FishboneGrid g;
+    g.rows = int(ribs.size());
+    g.cols = int(neg + 1 + pos);
+    g.backboneColumn = int(neg);
+    g.spacing = spacing;
+    g.screen.assign(std::size_t(g.rows) * std::size_t(g.cols), Eigen::Vector2d::Zero());
+    g.present.assign(g.screen.size(), 0);
+    const bool clip = width > 0 && height > 0;
+    auto put = [&](int r, int c, const Eigen::Vector2d& p) {
+        const std::size_t i = g.index(r, c);
+        g.screen[i] = p;
+        g.present[i] =
+            p.allFinite() && (!clip || (p.x() >= 0 && p.y() >= 0 && p.x() <= width && p.y() <= height));
+    };
+    for (int r = 0; r < g.rows; ++r) {
+        const Rib& rib = ribs[std::size_t(r)];
+        put(r, g.backboneColumn, backbone.samples[std::size_t(r)]);
+        for (std::size_t k = 1; k < rib.positive.size(); ++k)
+            put(r, g.backboneColumn + int(k), rib.positive[k]);
+        for (std::size_t k = 1; k < rib.negative.size(); ++k)
+            put(r, g.backboneColumn - int(k), rib.negative[k]);
+    }
+    return g;
+}
+
+FishboneGrid automaticFishbone(const DirectionField& backboneField, const DirectionField& ribField,
+                               const Eigen::Vector2d& seed, const FishboneOptions& options) {
+    if (backboneField.width != ribField.width || backboneField.height != ribField.height)
+        throw InvalidInputError("The backbone and rib direction fields must have the same size.");
+    const Backbone backbone = traceBackbone(backboneField, seed, options);
+    requireBackbone(backbone);
+    std::vector<Rib> ribs;
+    ribs.reserve(backbone.samples.size());
+    for (std::size_t r = 0; r < backbone.samples.size(); ++r)
+        ribs.push_back(traceRib(ribField, backbone, r, options));
+    return assembleFishboneGrid(backbone, ribs, options.spacing, ribField.width, ribField.height);
+}
+
+FishboneGrid keyRibFishbone(const Backbone& backbone, std::vector<KeyRib> keyRibs,
+                            const FishboneOptions& options, int width, int height) {
+    requireSpacing(options.spacing);
+    requireBackbone(backbone);
+    if (keyRibs.empty()) throw InvalidInputError("The key-rib mode needs at least one key-rib.");
+    for (const KeyRib& k : keyRibs)
+        if (k.row >= backbone.samples.size())
+            throw InvalidInputError("A key-rib sits at backbone sample " + std::to_string(k.row) +
+                                    ", but the backbone has only " + std::to_string(backbone.samples.size()) +
+                                    " samples.");
+    // Sorted by row; of several key-ribs on one row the last given wins.
+    std::stable_sort(keyRibs.begin(), keyRibs.end(),
+                     [](const KeyRib& a, const KeyRib& b) { return a.row < b.row; });
+    std::vector<KeyRib> keys;
+    for (KeyRib& k : keyRibs) {
+        if (!keys.empty() && keys.back().row == k.row)
+            keys.back() = std::move(k);
+        else
+            keys.push_back(std::move(k));
+    }
+
+    const double h = options.spacing;
+    const std::size_t first = options.extendBeyondKeyRibs ? 0 : keys.front().row;
+    const std::size_t last = options.extendBeyondKeyRibs ? backbone.samples.size() - 1 : keys.back().row;
+    Backbone part;
+    part.samples.assign(backbone.samples.begin() + std::ptrdiff_t(first),
+                        backbone.samples.begin() + std::ptrdiff_t(last) + 1);
+    part.seedIndex =
+        backbone.seedIndex >= first && backbone.seedIndex <= last ? backbone.seedIndex - first : 0;
+    std::vector<Rib> ribs;
+    ribs.reserve(part.samples.size());
+    std::size_t next = 0; // first key with row ≥ r
+    for (std::size_t r = first; r <= last; ++r) {
+        while (next < keys.size() && keys[next].row < r)
+            ++next;
+        const Eigen::Vector2d& p0 = backbone.samples[r];
+        if (next < keys.size() && keys[next].row == r) {
+            ribs.push_back(keys[next].rib);
+        } else if (next == 0) {
+            ribs.push_back(blendRibs(keys.front().rib, keys.front().rib, p0, 0.0, h));
+        } else if (next == keys.size()) {
+            ribs.push_back(blendRibs(keys.back().rib, keys.back().rib, p0, 0.0, h));
+        } else {
+            const KeyRib& a = keys[next - 1];
+            const KeyRib& b = keys[next];
+            const double t = double(r - a.row) / double(b.row - a.row);
+            ribs.push_back(blendRibs(a.rib, b.rib, p0, t, h));
+        }
+    }
+    return assembleFishboneGrid(part, ribs, h, width, height);
+}
+
+} // namespace fss
