@@ -167,6 +167,7 @@ void Camera::fitClippingRange(const Eigen::AlignedBox3d& box) {
 void Camera::zoom(double factor) {
     if (!(factor > 0) || !std::isfinite(factor))
         throw InvalidInputError("The zoom factor " + fmt(factor) + " is not a finite positive number.");
+    if (factor == 1.0) return;  // exactly: no rounding of the view angle
     if (parallel)
         parallelScale /= factor;
     else

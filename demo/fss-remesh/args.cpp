@@ -30,7 +30,7 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
             std::cout << help();
             return false;
         }
-        if (a.size() > 2 && a.rfind("--", 0) == 0) {
+        if (a.size() > 1 && a[0] == '-') {
             std::string name = a, value;
             bool hasInlineValue = false;
             if (auto eq = a.find('='); eq != std::string::npos) {

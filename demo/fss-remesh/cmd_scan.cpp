@@ -78,7 +78,7 @@ std::unique_ptr<MeshRenderer> makeRenderer(const std::string& kind, std::string&
     }
     try {
         auto gpu = std::make_unique<render::GpuMeshRenderer>();
-        used = "gpu (" + gpu->rasterizer().glRenderer() + ")";
+        used = "gpu";
         return gpu;
     } catch (const Error& e) {
         if (kind == "gpu") throw;
@@ -164,6 +164,8 @@ int runScan(const std::vector<std::string>& args) {
     std::unique_ptr<MeshRenderer> renderer = makeRenderer(rendererKind, rendererUsed);
     renderer->setMesh(reference);
     const ScanResult result = scanPatch(reference, *renderer, reference, *renderer, params);
+    if (auto* gpu = dynamic_cast<render::GpuMeshRenderer*>(renderer.get()))
+        rendererUsed = "gpu (" + gpu->rasterizer().glRenderer() + ")";
     writeMesh(result.patch.mesh, outPath, WriteOptions{.binary = false});
 
     if (json) {
