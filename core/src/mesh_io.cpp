@@ -1616,9 +1616,11 @@ Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOpt
             quantity(split, "polygon with more than three corners", "polygons with more than three corners") +
             " into " + quantity(triangles.size() - (polys.size() - split), "triangle", "triangles"));
         if (fanned)
-            report.repairs.push_back("triangulated " + quantity(fanned, "polygon", "polygons") +
-                                     " as a simple fan because it is self-intersecting or too large to "
-                                     "triangulate carefully, so its triangles may overlap");
+            report.repairs.push_back(
+                "triangulated " +
+                quantity(fanned, "polygon as a simple fan because it is",
+                         "polygons as simple fans because they are") +
+                " self-intersecting or too large to triangulate carefully, so the triangles may overlap");
         polys = std::move(triangles);
         origin = std::move(triangleOrigin);
         changed = true;
