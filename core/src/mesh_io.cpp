@@ -5,7 +5,6 @@
 #include "fss/error.h"
 
 #include <CGAL/Polygon_mesh_processing/orient_polygon_soup.h>
-#include <CGAL/boost/graph/Euler_operations.h>
 #include <CGAL/boost/graph/iterator.h>
 
 #include <boost/container/small_vector.hpp>
@@ -1320,8 +1319,11 @@ constexpr std::size_t kMaxEarClippingCorners = 10000;
 
 /// Triangulates one polygon by ear clipping in the plane of its dominant normal axis (exact orientation
 /// tests on the projected coordinates), keeping its orientation; falls back to a fan when no ear is left
-/// (self-intersecting or zero-area polygons).
-void triangulatePolygon(const std::vector<Point3>& pts, const Polygon& poly, std::vector<Polygon>& out) {
+/// (self-intersecting or zero-area polygons) or when `budget` (point tests left for the whole file, which
+/// bounds the time an adversarial file can take) runs out. Returns false when it fell back to a fan for a
+/// polygon with area (whose triangles may then overlap).
+bool triangulatePolygon(const std::vector<Point3>& pts, const Polygon& poly, std::vector<Polygon>& out,
+                        std::size_t& budget) {
     const std::size_t n = poly.size();
     auto fan = [&](const std::vector<std::size_t>& ids) {
         for (std::size_t i = 1; i + 1 < ids.size(); ++i)
@@ -1341,9 +1343,13 @@ void triangulatePolygon(const std::vector<Point3>& pts, const Polygon& poly, std
     std::size_t axis = 0;
     for (std::size_t k = 1; k < 3; ++k)
         if (std::abs(normal[k]) > std::abs(normal[axis])) axis = k;
-    if (normal[axis] == 0.0 || !std::isfinite(normal[axis]) || n > kMaxEarClippingCorners) {
+    if (normal[axis] == 0.0 || !std::isfinite(normal[axis])) { // zero area: any triangulation will do
         fan(remaining);
-        return;
+        return true;
+    }
+    if (n > kMaxEarClippingCorners) {
+        fan(remaining);
+        return false;
     }
     // Dropping the dominant axis and keeping the cyclic order of the other two preserves the sign of the
     // projected area: the polygon turns left in 2D exactly when normal[axis] > 0.
@@ -1357,10 +1363,15 @@ void triangulatePolygon(const std::vector<Point3>& pts, const Polygon& poly, std
     std::size_t i = 0, failures = 0;
     while (remaining.size() > 3) {
         const std::size_t m = remaining.size();
+        if (budget < m) {
+            fan(remaining);
+            return false;
+        }
         i %= m;
         const std::size_t ia = remaining[(i + m - 1) % m], ib = remaining[i], ic = remaining[(i + 1) % m];
         const Kernel::Point_2 &a = p2[ia], &b = p2[ib], &c = p2[ic];
         bool ear = CGAL::orientation(a, b, c) == convex;
+        budget -= ear ? m : 1; // an emptiness test costs m point tests
         for (std::size_t k = 0; ear && k < m; ++k) {
             const std::size_t id = remaining[k];
             if (id == ia || id == ib || id == ic) continue;
@@ -1377,12 +1388,13 @@ void triangulatePolygon(const std::vector<Point3>& pts, const Polygon& poly, std
             failures = 0;
         } else if (++failures > m) {
             fan(remaining);
-            return;
+            return false;
         } else {
             ++i;
         }
     }
     out.push_back({poly[remaining[0]], poly[remaining[1]], poly[remaining[2]]});
+    return true;
 }
 
 /// Records which polygons orient_polygon_soup reversed.
@@ -1446,6 +1458,76 @@ bool removeDuplicateTriangles(std::vector<Polygon>& polys, std::vector<std::size
     origin.resize(kept);
     report.repairs.push_back("removed " + quantity(duplicates, "duplicate triangle", "duplicate triangles"));
     return true;
+}
+
+/// Builds the halfedge structure of a triangle soup that analyseTopology accepts (no repeated corners,
+/// manifold, consistently oriented) directly: CGAL::Euler::add_face looks every new edge up around its
+/// vertex, which is quadratic in the valence (a fan apex of a finely segmented cylinder cap). Vertices keep
+/// the order of the used points and faces the order of the triangles. std::nullopt if the soup is not such.
+std::optional<Mesh> buildTriangleMesh(const std::vector<Point3>& points, const std::vector<char>& used,
+                                      const std::vector<Polygon>& triangles) {
+    const std::size_t nf = triangles.size();
+    Mesh mesh;
+    mesh.reserve(Mesh::size_type(points.size()), Mesh::size_type(nf * 3 / 2 + 3), Mesh::size_type(nf));
+    std::vector<VertexIndex> vertex(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i)
+        if (used[i]) vertex[i] = mesh.add_vertex(points[i]);
+
+    // Corner c = 3f + j owns the halfedge from corner j to corner j + 1 of triangle f. Bucket the corners
+    // by the smaller end of their edge (counting sort); an edge's two halfedges meet in one bucket.
+    auto from = [&](std::size_t c) { return triangles[c / 3][c % 3]; };
+    auto to = [&](std::size_t c) { return triangles[c / 3][(c % 3 + 1) % 3]; };
+    std::vector<std::size_t> start(points.size() + 1, 0);
+    for (std::size_t c = 0; c < 3 * nf; ++c)
+        ++start[std::min(from(c), to(c)) + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    std::vector<std::size_t> bucket(3 * nf), fill(start.begin(), start.end() - 1);
+    for (std::size_t c = 0; c < 3 * nf; ++c)
+        bucket[fill[std::min(from(c), to(c))]++] = c;
+
+    std::vector<HalfedgeIndex> halfedge(3 * nf);
+    std::vector<HalfedgeIndex> borderFrom(points.size());       // the border halfedge leaving a point
+    std::vector<std::pair<HalfedgeIndex, std::size_t>> borders; // border halfedge, the point it ends at
+    for (std::size_t v = 0; v < points.size(); ++v) {
+        const auto begin = bucket.begin() + std::ptrdiff_t(start[v]),
+                   end = bucket.begin() + std::ptrdiff_t(start[v + 1]);
+        auto other = [&](std::size_t c) { return std::max(from(c), to(c)); };
+        std::sort(begin, end, [&](std::size_t a, std::size_t b) { return other(a) < other(b); });
+        for (auto it = begin; it != end;) {
+            const std::size_t c = *it;
+            const HalfedgeIndex h = mesh.add_edge(), o = mesh.opposite(h);
+            mesh.set_target(h, vertex[to(c)]);
+            mesh.set_target(o, vertex[from(c)]);
+            halfedge[c] = h;
+            if (it + 1 != end && other(*(it + 1)) == other(c)) {
+                const std::size_t d = *(it + 1);
+                if (from(d) != to(c) || (it + 2 != end && other(*(it + 2)) == other(c))) return std::nullopt;
+                halfedge[d] = o;
+                it += 2;
+            } else {
+                if (borderFrom[to(c)] != HalfedgeIndex()) return std::nullopt;
+                borderFrom[to(c)] = o;
+                borders.emplace_back(o, from(c));
+                ++it;
+            }
+        }
+    }
+    for (std::size_t f = 0; f < nf; ++f) {
+        const FaceIndex face = mesh.add_face();
+        mesh.set_halfedge(face, halfedge[3 * f]);
+        for (std::size_t j = 0; j < 3; ++j) {
+            mesh.set_face(halfedge[3 * f + j], face);
+            mesh.set_next(halfedge[3 * f + j], halfedge[3 * f + (j + 1) % 3]);
+            mesh.set_halfedge(vertex[triangles[f][(j + 1) % 3]], halfedge[3 * f + j]);
+        }
+    }
+    // Border halfedges follow each other around holes; a border vertex points to its incoming one.
+    for (const auto& [h, end] : borders) {
+        if (borderFrom[end] == HalfedgeIndex()) return std::nullopt;
+        mesh.set_next(h, borderFrom[end]);
+        mesh.set_halfedge(vertex[end], h);
+    }
+    return mesh;
 }
 
 /// Turns the soup into a valid triangle mesh, repairing (and reporting) what must be repaired.
@@ -1515,13 +1597,16 @@ Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOpt
         std::vector<Polygon> triangles;
         std::vector<std::size_t> triangleOrigin;
         triangles.reserve(polys.size());
-        std::size_t split = 0;
+        std::size_t split = 0, fanned = 0, corners = 0;
+        for (const Polygon& p : polys)
+            corners += p.size();
+        std::size_t budget = 10'000'000 + 64 * corners; // generous for real polygons, bounded for any file
         for (std::size_t f = 0; f < polys.size(); ++f) {
             const std::size_t before = triangles.size();
             if (polys[f].size() == 3) {
                 triangles.push_back(std::move(polys[f]));
             } else {
-                triangulatePolygon(soup.points, polys[f], triangles);
+                if (!triangulatePolygon(soup.points, polys[f], triangles, budget)) ++fanned;
                 ++split;
             }
             triangleOrigin.insert(triangleOrigin.end(), triangles.size() - before, origin[f]);
@@ -1530,6 +1615,12 @@ Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOpt
             "triangulated " +
             quantity(split, "polygon with more than three corners", "polygons with more than three corners") +
             " into " + quantity(triangles.size() - (polys.size() - split), "triangle", "triangles"));
+        if (fanned)
+            report.repairs.push_back(
+                "triangulated " +
+                quantity(fanned, "polygon as a simple fan because it is",
+                         "polygons as simple fans because they are") +
+                " self-intersecting or too large to triangulate carefully, so the triangles may overlap");
         polys = std::move(triangles);
         origin = std::move(triangleOrigin);
         changed = true;
@@ -1599,34 +1690,22 @@ Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOpt
                                  " that no polygon uses");
 
     // 6. Build: vertices in file order, faces in polygon order (so face properties keep their order).
-    Mesh mesh;
-    mesh.reserve(Mesh::size_type(soup.points.size()), Mesh::size_type(polys.size() * 3 / 2 + 3),
-                 Mesh::size_type(polys.size()));
-    std::vector<VertexIndex> vertex(soup.points.size());
-    for (std::size_t i = 0; i < soup.points.size(); ++i)
-        if (used[i]) vertex[i] = mesh.add_vertex(soup.points[i]);
-    std::vector<FaceIndex> faces(polys.size());
-    std::array<VertexIndex, 3> corners;
-    for (std::size_t f = 0; f < polys.size(); ++f) {
-        for (std::size_t j = 0; j < 3; ++j)
-            corners[j] = vertex[polys[f][j]];
-        faces[f] = CGAL::Euler::add_face(corners, mesh);
-        if (faces[f] == Mesh::null_face())
-            src.fail("face " + std::to_string(origin[f]) + " could not be added to the mesh");
-    }
+    std::optional<Mesh> built = buildTriangleMesh(soup.points, used, polys);
+    if (!built) src.fail("its polygons could not be assembled into a mesh (an internal error of FSS)");
+    Mesh& mesh = *built;
     if (!soup.quality.empty()) {
         auto map = mesh.add_property_map<FaceIndex, float>(props::faceQuality, kInputFaceQuality).first;
         for (std::size_t f = 0; f < polys.size(); ++f)
-            map[faces[f]] = soup.quality[origin[f]];
+            map[FaceIndex(Mesh::size_type(f))] = soup.quality[origin[f]];
         report.hasFaceQuality = true;
     }
     if (!soup.scanId.empty()) {
         auto map = mesh.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1).first;
         for (std::size_t f = 0; f < polys.size(); ++f)
-            map[faces[f]] = soup.scanId[origin[f]];
+            map[FaceIndex(Mesh::size_type(f))] = soup.scanId[origin[f]];
         report.hasScanId = true;
     }
-    return mesh;
+    return std::move(mesh);
 }
 
 // =====================================================================================================
