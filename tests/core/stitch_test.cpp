@@ -1,0 +1,289 @@
+// Stitching: the invariants of DESIGN.md §5 after zippering patches into flat grids and spheres.
+// Patches are built here as a scan would: a regular grid of pixel centres unprojected onto an analytic
+// surface (plane, sphere), quads split along one diagonal, oriented towards the camera.
+#include "fss/error.h"
+#include "fss/shapes.h"
+#include "fss/stitch.h"
+
+#include <CGAL/Polygon_mesh_processing/measure.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <set>
+#include <unordered_map>
+
+namespace PMP = CGAL::Polygon_mesh_processing;
+using fss::Camera;
+using fss::FaceIndex;
+using fss::Mesh;
+using fss::Point3;
+using fss::VertexIndex;
+using Vec3 = Eigen::Vector3d;
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+Vec3 vec(const Point3& p) { return {p.x(), p.y(), p.z()}; }
+
+// ---- analytic surfaces: the nearest hit of a view ray
+using Surface = std::function<std::optional<Vec3>(const fss::Ray&)>;
+
+Surface planeZ0() {
+    return [](const fss::Ray& r) -> std::optional<Vec3> {
+        if (std::abs(r.direction.z()) < 1e-12) return std::nullopt;
+        const double t = -r.origin.z() / r.direction.z();
+        if (t <= 0) return std::nullopt;
+        Vec3 p = r.origin + t * r.direction;
+        p.z() = 0.0; // exactly on the plane
+        return p;
+    };
+}
+
+[[maybe_unused]] Surface sphere(double radius) {
+    return [radius](const fss::Ray& r) -> std::optional<Vec3> {
+        const double b = r.origin.dot(r.direction), c = r.origin.squaredNorm() - radius * radius;
+        const double disc = b * b - c;
+        if (disc < 0) return std::nullopt;
+        const double t = -b - std::sqrt(disc);
+        if (t <= 0) return std::nullopt;
+        const Vec3 p = r.origin + t * r.direction;
+        return p * (radius / p.norm());
+    };
+}
+
+// A scan patch: samples at the centres of the pixels (x, y) for which `mask` holds, on `surface`;
+// quads of four samples become two triangles (same diagonal everywhere), facing the camera; triangles
+// seen more obliquely than maxAngleDeg are dropped (as the scan's sampling-angle test does).
+Mesh makePatch(const Camera& cam, const std::function<bool(int, int)>& mask, const Surface& surface,
+               std::int32_t scanId = 1, double maxAngleDeg = 75.0) {
+    const int W = cam.width, H = cam.height;
+    std::vector<std::optional<Vec3>> pts(std::size_t(W) * std::size_t(H));
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x)
+            if (mask(x, y)) pts[std::size_t(y) * std::size_t(W) + std::size_t(x)] = surface(cam.ray(x + 0.5, y + 0.5));
+    Mesh m;
+    std::vector<VertexIndex> vid(pts.size());
+    auto vertex = [&](int x, int y) {
+        const std::size_t i = std::size_t(y) * std::size_t(W) + std::size_t(x);
+        if (vid[i] == VertexIndex()) vid[i] = m.add_vertex(Point3(pts[i]->x(), pts[i]->y(), pts[i]->z()));
+        return vid[i];
+    };
+    auto quality = m.add_property_map<FaceIndex, float>(fss::props::faceQuality, 0.f).first;
+    auto sid = m.add_property_map<FaceIndex, std::int32_t>(fss::props::faceScanId, -1).first;
+    auto addTri = [&](int x0, int y0, int x1, int y1, int x2, int y2) {
+        const auto& a = pts[std::size_t(y0) * std::size_t(W) + std::size_t(x0)];
+        const auto& b = pts[std::size_t(y1) * std::size_t(W) + std::size_t(x1)];
+        const auto& c = pts[std::size_t(y2) * std::size_t(W) + std::size_t(x2)];
+        if (!a || !b || !c) return;
+        const Vec3 n = (*b - *a).cross(*c - *a).normalized();
+        const Vec3 toEye = (cam.eye - (*a + *b + *c) / 3.0).normalized();
+        const double cosA = n.dot(toEye);
+        if (cosA < std::cos(maxAngleDeg * kDeg)) return;
+        const FaceIndex f = m.add_face(vertex(x0, y0), vertex(x1, y1), vertex(x2, y2));
+        ASSERT_NE(f, Mesh::null_face());
+        quality[f] = float(1.0 - cosA);
+        sid[f] = scanId;
+    };
+    for (int y = 0; y + 1 < H; ++y)
+        for (int x = 0; x + 1 < W; ++x) {
+            addTri(x, y, x, y + 1, x + 1, y);
+            addTri(x + 1, y, x, y + 1, x + 1, y + 1);
+        }
+    return m;
+}
+
+// ---- invariants
+std::size_t boundaryLoops(const Mesh& m) {
+    std::set<std::uint32_t> seen;
+    std::size_t loops = 0;
+    for (auto h : m.halfedges()) {
+        if (!m.is_border(h) || seen.count(std::uint32_t(h))) continue;
+        ++loops;
+        auto g = h;
+        do {
+            seen.insert(std::uint32_t(g));
+            g = m.next(g);
+        } while (g != h);
+    }
+    return loops;
+}
+
+std::size_t nonManifoldVertices(const Mesh& m) {
+    std::unordered_map<std::uint32_t, int> incoming;
+    for (auto h : m.halfedges()) ++incoming[std::uint32_t(m.target(h))];
+    std::size_t bad = 0;
+    for (auto v : m.vertices()) {
+        if (m.halfedge(v) == Mesh::null_halfedge()) {
+            ++bad; // isolated
+            continue;
+        }
+        int n = 0, borders = 0;
+        for (auto h : CGAL::halfedges_around_target(m.halfedge(v), m)) {
+            ++n;
+            borders += m.is_border(h);
+        }
+        if (n != incoming[std::uint32_t(v)] || borders > 1) ++bad;
+    }
+    return bad;
+}
+
+std::size_t degenerateFaces(const Mesh& m) {
+    std::size_t n = 0;
+    for (auto f : m.faces()) {
+        auto h = m.halfedge(f);
+        if (CGAL::collinear(m.point(m.source(h)), m.point(m.target(h)), m.point(m.target(m.next(h))))) ++n;
+    }
+    return n;
+}
+
+// All faces of a patch scanned by `cam` face it: counter-clockwise after projection (y flipped).
+std::size_t facesNotFacing(const Mesh& m, const Camera& cam, const std::set<std::uint32_t>& only) {
+    std::size_t n = 0;
+    for (auto f : m.faces()) {
+        if (!only.empty() && !only.count(std::uint32_t(f))) continue;
+        auto h = m.halfedge(f);
+        const Vec3 a = cam.project(vec(m.point(m.source(h)))), b = cam.project(vec(m.point(m.target(h)))),
+                   c = cam.project(vec(m.point(m.target(m.next(h)))));
+        const double o = (b.x() - a.x()) * (-(c.y() - a.y())) - (-(b.y() - a.y())) * (c.x() - a.x());
+        if (!(o > 0)) ++n;
+    }
+    return n;
+}
+
+struct Invariants {
+    bool closed;
+    std::size_t loops;
+};
+
+void expectValid(const Mesh& m, const Invariants& inv, bool checkSelfIntersections = true) {
+    ASSERT_TRUE(m.is_valid(false));
+    ASSERT_TRUE(CGAL::is_triangle_mesh(m));
+    EXPECT_EQ(CGAL::is_closed(m), inv.closed);
+    EXPECT_EQ(boundaryLoops(m), inv.loops);
+    EXPECT_EQ(nonManifoldVertices(m), 0u);
+    EXPECT_EQ(degenerateFaces(m), 0u);
+    if (checkSelfIntersections) {
+        EXPECT_FALSE(PMP::does_self_intersect(m));
+    }
+}
+
+using FaceKey = std::array<std::array<double, 3>, 3>;
+FaceKey faceKey(const Mesh& m, FaceIndex f) {
+    FaceKey k;
+    int i = 0;
+    for (auto v : CGAL::vertices_around_face(m.halfedge(f), m)) {
+        const auto& p = m.point(v);
+        k[std::size_t(i++)] = {p.x(), p.y(), p.z()};
+    }
+    std::rotate(k.begin(), std::min_element(k.begin(), k.end()), k.end()); // same cyclic order
+    return k;
+}
+
+std::string reportText(const fss::StitchReport& r) {
+    std::ostringstream os;
+    os << "stitched " << r.componentsStitched << " skipped " << r.componentsSkipped << " removed " << r.facesRemoved
+       << " added " << r.facesAdded << " seam edges " << r.seamEdges << " seam faces " << r.seamFaces
+       << " min angle " << r.seamMinAngleDeg << " frac>=25 " << r.seamFracMinAngleAbove25 << " collapses "
+       << r.collapses << " flips " << r.flips << " trimmed " << r.patchFacesTrimmed << " time " << r.seconds;
+    for (const auto& s : r.skipped) os << "\n  " << s;
+    return os.str();
+}
+
+// A camera looking straight down at the z = 0 plane, its image rotated by `rollDeg`.
+Camera downCamera(double cx, double cy, double height, double rollDeg, int res) {
+    Camera c;
+    c.eye = {cx, cy, height};
+    c.focal = {cx, cy, 0};
+    c.up = {std::sin(rollDeg * kDeg), std::cos(rollDeg * kDeg), 0};
+    c.viewAngleDeg = 40;
+    c.width = c.height = res;
+    c.nearPlane = 0.1;
+    c.farPlane = 100;
+    return c;
+}
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------------
+TEST(Stitch, PatchInsideFlatGrid) {
+    Mesh grid = fss::shapes::grid(20, 20, 1.0);
+    const Mesh before = grid;
+    const Camera cam = downCamera(10.3, 9.8, 30, 7.0, 96);
+    auto mask = [](int x, int y) { return x >= 30 && x < 66 && y >= 32 && y < 64; };
+    const Mesh patch = makePatch(cam, mask, planeZ0());
+    ASSERT_GT(patch.number_of_faces(), 1000u);
+
+    const fss::StitchReport r = fss::stitchPatch(grid, patch, cam);
+    SCOPED_TRACE(reportText(r));
+    EXPECT_EQ(r.componentsStitched, 1);
+    EXPECT_EQ(r.componentsSkipped, 0);
+    EXPECT_EQ(r.patchFacesTrimmed, 0u);
+    expectValid(grid, {false, 1});
+    EXPECT_NEAR(PMP::area(grid), 400.0, 400.0 * 1e-9);
+    for (auto v : grid.vertices()) EXPECT_EQ(grid.point(v).z(), 0.0);
+    for (auto f : grid.faces()) EXPECT_GT(PMP::face_area(f, grid), 0.0);
+    EXPECT_EQ(facesNotFacing(grid, cam, {}), 0u);
+
+    // Faces away from the patch footprint keep index, vertices and positions.
+    double xmin = 1e9, xmax = -1e9, ymin = 1e9, ymax = -1e9;
+    for (auto v : patch.vertices()) {
+        xmin = std::min(xmin, patch.point(v).x());
+        xmax = std::max(xmax, patch.point(v).x());
+        ymin = std::min(ymin, patch.point(v).y());
+        ymax = std::max(ymax, patch.point(v).y());
+    }
+    std::size_t far = 0;
+    for (auto f : before.faces()) {
+        bool away = true;
+        for (auto v : CGAL::vertices_around_face(before.halfedge(f), before)) {
+            const auto& p = before.point(v);
+            if (p.x() > xmin - 2 && p.x() < xmax + 2 && p.y() > ymin - 2 && p.y() < ymax + 2) away = false;
+        }
+        if (!away) continue;
+        ++far;
+        ASSERT_FALSE(grid.is_removed(f));
+        EXPECT_EQ(faceKey(grid, f), faceKey(before, f));
+    }
+    EXPECT_GT(far, 300u);
+
+    // The patch's interior faces (two rings away from its boundary) are in the mesh as they were.
+    std::set<FaceKey> result;
+    for (auto f : grid.faces()) result.insert(faceKey(grid, f));
+    std::set<std::uint32_t> nearBorder;
+    for (auto v : patch.vertices())
+        if (patch.is_border(v))
+            for (auto w : CGAL::vertices_around_target(patch.halfedge(v), patch)) {
+                nearBorder.insert(std::uint32_t(w));
+                for (auto x : CGAL::vertices_around_target(patch.halfedge(w), patch)) nearBorder.insert(std::uint32_t(x));
+            }
+    std::size_t interior = 0, found = 0;
+    for (auto f : patch.faces()) {
+        bool inner = true;
+        for (auto v : CGAL::vertices_around_face(patch.halfedge(f), patch))
+            if (nearBorder.count(std::uint32_t(v))) inner = false;
+        if (!inner) continue;
+        ++interior;
+        found += result.count(faceKey(patch, f));
+    }
+    EXPECT_GT(interior, 1000u);
+    EXPECT_EQ(found, interior);
+
+    // Face properties: patch faces carry the scan id, the others the input's.
+    auto sid = grid.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId);
+    ASSERT_TRUE(sid.second);
+    std::size_t scanned = 0;
+    for (auto f : grid.faces()) scanned += sid.first[f] == 1;
+    EXPECT_GE(scanned, patch.number_of_faces());
+    EXPECT_GT(r.seamEdges, 100u);
+    EXPECT_GT(r.seamMinAngleDeg, 0.0);
+    std::printf("flat grid: %s\n", reportText(r).c_str());
+}
