@@ -443,7 +443,7 @@ private:
                 const bool border = !directed.count(dirKey(std::uint32_t(q), std::uint32_t(p)));
                 if (border) {
                     pedgeIndex_[dirKey(std::uint32_t(p), std::uint32_t(q))] = int(pedges_.size());
-                    pedges_.push_back({p, q, {}, {}});
+                    pedges_.push_back({p, q, t[std::size_t((k + 2) % 3)], {}, {}});
                     boundary_.insert(p);
                 }
                 if (border || p < q) {
@@ -888,6 +888,12 @@ private:
                     }
                 });
                 if (best < 0) continue;
+                {
+                    // The patch triangle on that edge must stay a fan of counter-clockwise triangles.
+                    const auto& pe = pedges_[std::size_t(best)];
+                    const Point2 A = L_uvOfPatch(pe.a), B = L_uvOfPatch(pe.b), C = L_uvOfPatch(pe.opposite);
+                    if (!leftTurn(A, l.uv, C) || !leftTurn(l.uv, B, C)) continue;
+                }
                 pedges_[std::size_t(best)].splits.push_back({bestS, int(i)});
                 l.chain = true;
                 l.patchA = pedges_[std::size_t(best)].a;
@@ -1139,13 +1145,16 @@ private:
     // ---- step 3c: the faces of the result (local ids)
     // Triangulates a polygon whose corners lie on the edges of one patch triangle (ear clipping, best
     // smallest angle first, exact orientation tests).
-    bool triangulatePolygon(std::vector<int> poly, float q, std::int32_t sid) {
+    // `edges` holds for every corner the triangle edges it lies on (bit k: edge k); a diagonal between two
+    // corners on the same edge would leave a triangle of collinear points, so it is never cut.
+    bool triangulatePolygon(std::vector<int> poly, std::vector<unsigned> edges, float q, std::int32_t sid) {
         while (poly.size() > 3) {
             int best = -1;
             double bestAngle = -1;
             const std::size_t n = poly.size();
             for (std::size_t i = 0; i < n; ++i) {
                 const int a = poly[(i + n - 1) % n], b = poly[i], c = poly[(i + 1) % n];
+                if (edges[(i + n - 1) % n] & edges[(i + 1) % n]) continue;
                 const Point2 &A = L_[std::size_t(a)].uv, &B = L_[std::size_t(b)].uv, &C = L_[std::size_t(c)].uv;
                 if (!leftTurn(A, B, C)) continue;
                 bool empty = true;
@@ -1165,6 +1174,7 @@ private:
             const std::size_t i = std::size_t(best);
             newFaces_.push_back({{poly[(i + n - 1) % n], poly[i], poly[(i + 1) % n]}, q, sid});
             poly.erase(poly.begin() + std::ptrdiff_t(i));
+            edges.erase(edges.begin() + std::ptrdiff_t(i));
         }
         if (!leftTurn(L_[std::size_t(poly[0])].uv, L_[std::size_t(poly[1])].uv, L_[std::size_t(poly[2])].uv)) return false;
         newFaces_.push_back({{poly[0], poly[1], poly[2]}, q, sid});
@@ -1202,19 +1212,22 @@ private:
         for (int f : faces_) {
             const auto& t = P_.tri[std::size_t(f)];
             std::vector<int> poly;
+            std::vector<unsigned> edges;
             for (int k = 0; k < 3; ++k) {
                 const int p = t[std::size_t(k)], q = t[std::size_t((k + 1) % 3)];
                 poly.push_back(localOfPatch(p));
+                edges.push_back((1u << k) | (1u << ((k + 2) % 3)));
                 auto it = pedgeIndex_.find(dirKey(std::uint32_t(p), std::uint32_t(q)));
                 if (it != pedgeIndex_.end()) {
                     const auto& line = pedges_[std::size_t(it->second)].line;
                     poly.insert(poly.end(), line.begin() + 1, line.end() - 1);
+                    edges.insert(edges.end(), line.size() - 2, 1u << k);
                 }
             }
             const float q = P_.hasQuality ? P_.quality[std::size_t(f)] : kInputFaceQuality;
             const std::int32_t sid = P_.hasScanId ? P_.scanId[std::size_t(f)] : -1;
             const std::size_t before = newFaces_.size();
-            if (!triangulatePolygon(poly, q, sid)) {
+            if (!triangulatePolygon(poly, edges, q, sid)) {
                 for (int v : t) bad.push_back(v);
                 continue;
             }
@@ -1602,6 +1615,17 @@ private:
         // No new self-intersections among the local faces.
         std::vector<std::pair<FaceIndex, FaceIndex>> pairs;
         PMP::self_intersections(S.faces(), S, std::back_inserter(pairs));
+        if (std::getenv("FSS_STITCH_DEBUG"))
+            for (const auto& [f, g] : pairs) {
+                std::fprintf(stderr, "  intersect kept %d %d\n", int(loc.star.kept[f]), int(loc.star.kept[g]));
+                for (FaceIndex x : {f, g}) {
+                    for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(x), S)) {
+                        const int id = loc.lid[v];
+                        std::fprintf(stderr, "    v%u lid %d pa %d pb %d kind %d p %.17g %.17g %.17g uv %.17g %.17g\n", std::uint32_t(v), id, id >= 0 ? L_[std::size_t(id)].patchA : -9, id >= 0 ? L_[std::size_t(id)].patchB : -9, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, S.point(v).x(), S.point(v).y(), S.point(v).z(), loc.uv[v].x(), loc.uv[v].y());
+                    }
+                }
+                break;
+            }
         for (const auto& [f, g] : pairs) {
             if (!loc.star.kept[f]) badFace(f);
             if (!loc.star.kept[g]) badFace(g);
@@ -1705,7 +1729,8 @@ private:
 
     // ---- component
     struct PEdge {
-        int a, b; // patch vertices, interior on the left of a → b
+        int a, b;     // patch vertices, interior on the left of a → b
+        int opposite; // third vertex of the patch triangle on this edge
         std::vector<std::pair<double, int>> splits;
         std::vector<int> line;
     };

@@ -287,3 +287,249 @@ TEST(Stitch, PatchInsideFlatGrid) {
     EXPECT_GT(r.seamMinAngleDeg, 0.0);
     std::printf("flat grid: %s\n", reportText(r).c_str());
 }
+
+namespace {
+
+// A camera at `distance` from the origin looking at it from direction `from`.
+Camera orbitCamera(const Vec3& from, double distance, int res, double angleDeg = 30.0) {
+    Camera c;
+    c.eye = from.normalized() * distance;
+    c.focal = {0, 0, 0};
+    const Vec3 f = -from.normalized();
+    c.up = std::abs(f.z()) < 0.9 ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
+    c.viewAngleDeg = angleDeg;
+    c.width = c.height = res;
+    c.nearPlane = 0.1;
+    c.farPlane = 100;
+    return c;
+}
+
+std::function<bool(int, int)> disk(double cx, double cy, double r) {
+    return [=](int x, int y) { return (x + 0.5 - cx) * (x + 0.5 - cx) + (y + 0.5 - cy) * (y + 0.5 - cy) <= r * r; };
+}
+
+// Largest distance of an edge midpoint of a sphere mesh from the sphere: the discretisation error.
+double sphereSag(const Mesh& m, double radius) {
+    double sag = 0;
+    for (auto e : m.edges()) {
+        const Vec3 a = vec(m.point(m.source(m.halfedge(e)))), b = vec(m.point(m.target(m.halfedge(e))));
+        sag = std::max(sag, radius - (0.5 * (a + b)).norm());
+    }
+    return sag;
+}
+
+void expectOnSphere(const Mesh& m, double radius, double tolerance) {
+    double worst = 0;
+    for (auto v : m.vertices()) worst = std::max(worst, std::abs(vec(m.point(v)).norm() - radius));
+    EXPECT_LE(worst, tolerance);
+}
+
+// Everything of a Surface_mesh that a caller could observe, including garbage and free slots.
+void expectBitIdentical(const Mesh& a, const Mesh& b) {
+    ASSERT_EQ(a.num_vertices(), b.num_vertices());
+    ASSERT_EQ(a.num_halfedges(), b.num_halfedges());
+    ASSERT_EQ(a.num_faces(), b.num_faces());
+    ASSERT_EQ(a.number_of_removed_vertices(), b.number_of_removed_vertices());
+    ASSERT_EQ(a.number_of_removed_faces(), b.number_of_removed_faces());
+    ASSERT_EQ(a.number_of_removed_edges(), b.number_of_removed_edges());
+    ASSERT_EQ(a.properties<VertexIndex>(), b.properties<VertexIndex>());
+    ASSERT_EQ(a.properties<FaceIndex>(), b.properties<FaceIndex>());
+    ASSERT_EQ(a.properties<fss::HalfedgeIndex>(), b.properties<fss::HalfedgeIndex>());
+    ASSERT_EQ(a.properties<fss::EdgeIndex>(), b.properties<fss::EdgeIndex>());
+    for (std::size_t i = 0; i < a.num_vertices(); ++i) {
+        const VertexIndex v(static_cast<Mesh::size_type>(i));
+        ASSERT_EQ(a.is_removed(v), b.is_removed(v));
+        ASSERT_EQ(a.point(v), b.point(v));
+        ASSERT_EQ(a.halfedge(v), b.halfedge(v));
+    }
+    for (std::size_t i = 0; i < a.num_halfedges(); ++i) {
+        const fss::HalfedgeIndex h(static_cast<Mesh::size_type>(i));
+        ASSERT_EQ(a.next(h), b.next(h));
+        ASSERT_EQ(a.target(h), b.target(h));
+        ASSERT_EQ(a.face(h), b.face(h));
+    }
+    auto qa = a.property_map<FaceIndex, float>(fss::props::faceQuality);
+    auto qb = b.property_map<FaceIndex, float>(fss::props::faceQuality);
+    for (std::size_t i = 0; i < a.num_faces(); ++i) {
+        const FaceIndex f(static_cast<Mesh::size_type>(i));
+        ASSERT_EQ(a.is_removed(f), b.is_removed(f));
+        ASSERT_EQ(a.halfedge(f), b.halfedge(f));
+        if (qa.second) {
+            ASSERT_EQ(qa.first[f], qb.first[f]);
+        }
+    }
+}
+
+double sumArea(const Mesh& m) { return PMP::area(m); }
+
+} // namespace
+
+TEST(Stitch, SphereChainedPatchesStayClosed) {
+    Mesh m = fss::shapes::icosphere(3, 1.0);
+    const double sag = sphereSag(m, 1.0);
+    const Vec3 dirs[] = {{0, 0, 1}, {1, 0.2, 0.3}, {-0.3, 1, 0.1}, {0.2, -0.4, -1}, {-1, -0.5, 0.4}, {0.6, 0.6, 0.5}};
+    double minAngle = 180, frac = 0;
+    int n = 0;
+    for (const Vec3& d : dirs) {
+        const Camera cam = orbitCamera(d, 4.0, 128);
+        const Mesh patch = makePatch(cam, disk(60, 66, 24), sphere(1.0), n + 1);
+        const fss::StitchReport r = fss::stitchPatch(m, patch, cam);
+        SCOPED_TRACE(reportText(r));
+        EXPECT_EQ(r.componentsStitched, 1);
+        EXPECT_EQ(r.componentsSkipped, 0);
+        expectValid(m, {true, 0});
+        expectOnSphere(m, 1.0, sag * 1.0001);
+        minAngle = std::min(minAngle, r.seamMinAngleDeg);
+        frac += r.seamFracMinAngleAbove25;
+        ++n;
+    }
+    EXPECT_GT(PMP::volume(m), 0.0);
+    std::printf("sphere chained: %d patches, seam min angle %.2f deg, mean frac >= 25 deg %.3f, faces %zu\n", n,
+                minAngle, frac / n, std::size_t(m.number_of_faces()));
+}
+
+TEST(Stitch, PatchOverlappingAnEarlierPatch) {
+    Mesh grid = fss::shapes::grid(20, 20, 1.0);
+    const Camera a = downCamera(8.0, 9.0, 30, 7.0, 96);
+    const Camera b = downCamera(12.0, 11.0, 26, -11.0, 96);
+    auto rect = [](int x0, int y0, int x1, int y1) {
+        return [=](int x, int y) { return x >= x0 && x < x1 && y >= y0 && y < y1; };
+    };
+    const fss::StitchReport ra = fss::stitchPatch(grid, makePatch(a, rect(30, 30, 62, 62), planeZ0(), 1), a);
+    EXPECT_EQ(ra.componentsStitched, 1);
+    const fss::StitchReport rb = fss::stitchPatch(grid, makePatch(b, rect(28, 30, 66, 70), planeZ0(), 2), b);
+    SCOPED_TRACE(reportText(rb));
+    EXPECT_EQ(rb.componentsStitched, 1);
+    EXPECT_EQ(rb.componentsSkipped, 0);
+    expectValid(grid, {false, 1});
+    EXPECT_NEAR(sumArea(grid), 400.0, 400.0 * 1e-9);
+    for (auto v : grid.vertices()) EXPECT_EQ(grid.point(v).z(), 0.0);
+    // Both scans are present: the second covers part of the first.
+    auto sid = grid.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId).first;
+    std::map<int, std::size_t> count;
+    for (auto f : grid.faces()) ++count[sid[f]];
+    EXPECT_GT(count[1], 300u);
+    EXPECT_GT(count[2], 1500u);
+    EXPECT_EQ(facesNotFacing(grid, b, {}), 0u);
+}
+
+TEST(Stitch, PatchWithHoleKeepsTheMeshInsideTheHole) {
+    Mesh grid = fss::shapes::grid(20, 20, 1.0);
+    const Mesh before = grid;
+    const Camera cam = downCamera(10.0, 10.0, 30, 4.0, 96);
+    // A ring: 40 × 40 pixels minus the middle 20 × 20 (about 4.5 mesh edges wide).
+    auto ring = [](int x, int y) {
+        const bool outer = x >= 28 && x < 68 && y >= 28 && y < 68;
+        const bool inner = x >= 38 && x < 58 && y >= 38 && y < 58;
+        return outer && !inner;
+    };
+    const Mesh patch = makePatch(cam, ring, planeZ0());
+    ASSERT_EQ(boundaryLoops(patch), 2u);
+    const fss::StitchReport r = fss::stitchPatch(grid, patch, cam);
+    SCOPED_TRACE(reportText(r));
+    EXPECT_EQ(r.componentsStitched, 1);
+    expectValid(grid, {false, 1});
+    EXPECT_NEAR(sumArea(grid), 400.0, 400.0 * 1e-9);
+    // Original faces in the middle of the hole are untouched.
+    const Vec3 c = cam.unproject(48, 48, 0.5);
+    const double k = cam.pixelFootprint(Vec3(c.x(), c.y(), 0));
+    std::size_t untouched = 0;
+    for (auto f : before.faces()) {
+        bool middle = true;
+        for (auto v : CGAL::vertices_around_face(before.halfedge(f), before)) {
+            const auto& p = before.point(v);
+            if (std::abs(p.x() - 10.0) > 5 * k || std::abs(p.y() - 10.0) > 5 * k) middle = false;
+        }
+        if (!middle) continue;
+        ++untouched;
+        ASSERT_FALSE(grid.is_removed(f));
+        EXPECT_EQ(faceKey(grid, f), faceKey(before, f));
+    }
+    EXPECT_GE(untouched, 2u);
+}
+
+TEST(Stitch, PatchWithTwoComponents) {
+    Mesh grid = fss::shapes::grid(20, 20, 1.0);
+    const Camera cam = downCamera(10.0, 10.0, 30, 3.0, 96);
+    auto two = [](int x, int y) {
+        return (x >= 20 && x < 44 && y >= 25 && y < 70) || (x >= 52 && x < 76 && y >= 30 && y < 60);
+    };
+    const Mesh patch = makePatch(cam, two, planeZ0());
+    const fss::StitchReport r = fss::stitchPatch(grid, patch, cam);
+    SCOPED_TRACE(reportText(r));
+    EXPECT_EQ(r.componentsStitched, 2);
+    EXPECT_EQ(r.componentsSkipped, 0);
+    EXPECT_EQ(r.patchFacesTrimmed, 0u);
+    expectValid(grid, {false, 1});
+    EXPECT_NEAR(sumArea(grid), 400.0, 400.0 * 1e-9);
+}
+
+TEST(Stitch, PatchReachingTheMeshBorderIsTrimmed) {
+    Mesh grid = fss::shapes::grid(12, 12, 1.0);
+    // Looking at the corner (0, 0): the scan sees past two borders of the grid.
+    const Camera cam = downCamera(1.5, 2.0, 25, 6.0, 96);
+    const Mesh patch = makePatch(cam, [](int x, int y) { return x >= 8 && x < 80 && y >= 10 && y < 85; }, planeZ0());
+    const fss::StitchReport r = fss::stitchPatch(grid, patch, cam);
+    SCOPED_TRACE(reportText(r));
+    EXPECT_EQ(r.componentsStitched, 1);
+    EXPECT_GT(r.patchFacesTrimmed, 0u);
+    expectValid(grid, {false, 1});
+    EXPECT_NEAR(sumArea(grid), 144.0, 144.0 * 1e-9);
+    for (auto v : grid.vertices()) {
+        const auto& p = grid.point(v);
+        EXPECT_TRUE(p.x() >= 0 && p.x() <= 12 && p.y() >= 0 && p.y() <= 12 && p.z() == 0.0);
+    }
+    auto sid = grid.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId).first;
+    std::size_t scanned = 0;
+    for (auto f : grid.faces()) scanned += sid[f] == 1;
+    EXPECT_GT(scanned, patch.number_of_faces() / 4);
+}
+
+TEST(Stitch, PatchPastTheSilhouetteIsTrimmed) {
+    Mesh m = fss::shapes::icosphere(3, 1.0);
+    const double sag = sphereSag(m, 1.0);
+    const Camera cam = orbitCamera({0.3, -1, 0.5}, 4.0, 96);
+    // The whole image: the patch reaches the sphere's silhouette, where the mesh is seen edge-on.
+    const Mesh patch = makePatch(cam, [](int, int) { return true; }, sphere(1.0), 1, 85.0);
+    const fss::StitchReport r = fss::stitchPatch(m, patch, cam);
+    SCOPED_TRACE(reportText(r));
+    EXPECT_EQ(r.componentsStitched, 1);
+    EXPECT_GT(r.patchFacesTrimmed, 0u);
+    expectValid(m, {true, 0});
+    expectOnSphere(m, 1.0, sag * 1.0001);
+}
+
+TEST(Stitch, FailureLeavesTheMeshBitIdentical) {
+    Mesh m = fss::shapes::icosphere(3, 1.0);
+    // Make the mesh carry garbage and face properties first, as it will in a session.
+    const Camera first = orbitCamera({0, 0, 1}, 4.0, 96);
+    fss::stitchPatch(m, makePatch(first, disk(48, 48, 15), sphere(1.0), 1), first);
+    ASSERT_TRUE(m.has_garbage());
+    const Mesh before = m;
+
+    const Camera cam = orbitCamera({0.2, 0.3, 1}, 4.0, 96);
+    const Mesh patch = makePatch(cam, disk(40, 50, 20), sphere(1.0), 2);
+    fss::StitchOptions o;
+    o.failValidationForTesting = true;
+    try {
+        fss::stitchPatch(m, patch, cam, o);
+        FAIL() << "a forced validation failure must throw";
+    } catch (const fss::InvalidInputError& e) {
+        EXPECT_NE(std::string(e.what()).find("forced"), std::string::npos) << e.what();
+    }
+    expectBitIdentical(m, before);
+
+    // A patch beside the mesh: nothing to stitch to.
+    const Camera away = orbitCamera({0, 0, 1}, 4.0, 96);
+    EXPECT_THROW(fss::stitchPatch(m, makePatch(away, disk(5, 5, 4), planeZ0()), away), fss::InvalidInputError);
+    expectBitIdentical(m, before);
+
+    // Invalid input.
+    Camera bad = cam;
+    bad.width = 0;
+    EXPECT_THROW(fss::stitchPatch(m, patch, bad), fss::InvalidInputError);
+    EXPECT_THROW(fss::stitchPatch(m, Mesh(), cam), fss::InvalidInputError);
+    const std::vector<std::uint32_t> wrongSize(10, 0);
+    EXPECT_THROW(fss::stitchPatch(m, patch, cam, {}, wrongSize), fss::InvalidInputError);
+    expectBitIdentical(m, before);
+}
