@@ -57,6 +57,8 @@ using Vec3 = Eigen::Vector3d;
 
 constexpr std::uint32_t kNone = 0xFFFFFFFFu;
 constexpr double kDeg = std::numbers::pi / 180.0;
+// Normals of pieces of one planar face agree to rounding; a flip between such pieces keeps the surface.
+constexpr double kCoplanar = 1e-4 * kDeg;
 
 Vec3 toVec(const Point3& p) { return {p.x(), p.y(), p.z()}; }
 Point3 toPoint(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
@@ -382,6 +384,8 @@ struct LFace {
     std::array<int, 3> v;
     float quality;
     std::int32_t scanId;
+    bool patchSide; // a patch face (or a piece of one); else a piece of a mesh face outside the patch
+    Vec3 planeNormal{0, 0, 0}; // pieces outside: unit normal of the mesh face they lie in
 };
 
 // ---------------------------------------------------------------------------------------------------
@@ -1001,7 +1005,21 @@ private:
         for (const auto& pe : pedges_) constrain(pe.line);
         if (cdt.number_of_vertices() != inserted) {
             for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v)
-                if (v->info().id < 0) addNear(bad, v->point());
+                if (v->info().id < 0) {
+                    addNear(bad, v->point());
+                    if (std::getenv("FSS_STITCH_DEBUG")) {
+                        std::fprintf(stderr, "  extra vertex at %.17g %.17g\n", v->point().x(), v->point().y());
+                        const CdtVertex vv = v;
+                        auto ec = cdt.incident_edges(vv), end = ec;
+                        do {
+                            if (cdt.is_constrained(*ec)) {
+                                const CdtVertex w = ec->first->vertex(ec->first->ccw(ec->second)) == vv ? ec->first->vertex(ec->first->cw(ec->second)) : ec->first->vertex(ec->first->ccw(ec->second));
+                                const int id = w->info().id;
+                                std::fprintf(stderr, "    to lid %d kind %d uv %.17g %.17g\n", id, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, w->point().x(), w->point().y());
+                            }
+                        } while (++ec != end);
+                    }
+                }
             return fail(a, "it or the mesh under it overlaps itself in the scan's view", std::move(bad));
         }
         for (std::size_t k = 0; k < subEdges_.size(); ++k) {
@@ -1172,12 +1190,12 @@ private:
             }
             if (best < 0) return false;
             const std::size_t i = std::size_t(best);
-            newFaces_.push_back({{poly[(i + n - 1) % n], poly[i], poly[(i + 1) % n]}, q, sid});
+            newFaces_.push_back({{poly[(i + n - 1) % n], poly[i], poly[(i + 1) % n]}, q, sid, true});
             poly.erase(poly.begin() + std::ptrdiff_t(i));
             edges.erase(edges.begin() + std::ptrdiff_t(i));
         }
         if (!leftTurn(L_[std::size_t(poly[0])].uv, L_[std::size_t(poly[1])].uv, L_[std::size_t(poly[2])].uv)) return false;
-        newFaces_.push_back({{poly[0], poly[1], poly[2]}, q, sid});
+        newFaces_.push_back({{poly[0], poly[1], poly[2]}, q, sid, true});
         return true;
     }
     bool assemble(Cdt& cdt, Attempt& a) {
@@ -1203,8 +1221,10 @@ private:
             replaced_.push_back(region_[r]);
             const float q = curHasQuality_ ? curQuality_[region_[r]] : kInputFaceQuality;
             const std::int32_t sid = curHasScanId_ ? curScanId_[region_[r]] : -1;
+            const Vec3 n = normalOf(toVec(M_.point(vs[0])), toVec(M_.point(vs[1])), toVec(M_.point(vs[2]))).normalized();
             for (CdtFace f : pieces[r])
-                if (f->info().inside == 0) newFaces_.push_back({{f->vertex(0)->info().id, f->vertex(1)->info().id, f->vertex(2)->info().id}, q, sid});
+                if (f->info().inside == 0)
+                    newFaces_.push_back({{f->vertex(0)->info().id, f->vertex(1)->info().id, f->vertex(2)->info().id}, q, sid, false, n});
         }
         // Patch faces, the boundary ones re-triangulated over the seam vertices of their edges.
         double patchArea = 0;
@@ -1262,6 +1282,8 @@ private:
         Mesh::Property_map<VertexIndex, bool> locked;
         Mesh::Property_map<FaceIndex, float> quality;
         Mesh::Property_map<FaceIndex, std::int32_t> scanId;
+        Mesh::Property_map<FaceIndex, bool> patchSide;
+        Mesh::Property_map<FaceIndex, Vec3> planeNormal; // outside pieces: normal of their mesh face
         std::set<std::pair<std::uint32_t, std::uint32_t>> seam;
     };
     static std::pair<std::uint32_t, std::uint32_t> seamKey(VertexIndex a, VertexIndex b) {
@@ -1320,6 +1342,8 @@ private:
         loc.locked = S.add_property_map<VertexIndex, bool>("v:locked", false).first;
         loc.quality = S.add_property_map<FaceIndex, float>("f:q", kInputFaceQuality).first;
         loc.scanId = S.add_property_map<FaceIndex, std::int32_t>("f:s", -1).first;
+        loc.patchSide = S.add_property_map<FaceIndex, bool>("f:patch", false).first;
+        loc.planeNormal = S.add_property_map<FaceIndex, Vec3>("f:plane", Vec3(0, 0, 0)).first;
         // Border edges around the replaced faces before (must be the same after: no new holes).
         const auto bordersBefore = bordersAround(loc);
         // Map local ids to S vertices.
@@ -1371,6 +1395,8 @@ private:
             loc.star.kept[g] = false;
             loc.quality[g] = newFaces_[i].quality;
             loc.scanId[g] = newFaces_[i].scanId;
+            loc.patchSide[g] = newFaces_[i].patchSide;
+            loc.planeNormal[g] = newFaces_[i].planeNormal;
         }
         if (!bad.empty()) return fail(a, "its seam would not be manifold", std::move(bad));
         for (VertexIndex v : S.vertices()) {
@@ -1448,7 +1474,14 @@ private:
                 if (!leftTurn(loc.uv[b], loc.uv[p], loc.uv[q])) return false;
                 if (CGAL::collinear(S.point(b), S.point(p), S.point(q))) return false;
                 const Vec3 n0 = normalOf(pt(S, a), pt(S, p), pt(S, q)), n1 = normalOf(pt(S, b), pt(S, p), pt(S, q));
-                if (angleBetween(n0, n1) > maxTurn) return false;
+                if (loc.patchSide[f]) {
+                    if (angleBetween(n0, n1) > maxTurn) return false;
+                } else {
+                    // A piece of a mesh face outside the patch may not leave that face's plane (any more
+                    // than it already does at a patch vertex).
+                    const Vec3& n = loc.planeNormal[f];
+                    if (angleBetween(n1, n) > std::max(angleBetween(n0, n), kCoplanar)) return false;
+                }
                 newMin = std::min(newMin, minAngle(pt(S, b), pt(S, p), pt(S, q)));
             }
             if (newMin < oldMin) return false;
@@ -1514,7 +1547,12 @@ private:
             if (CGAL::collinear(S.point(x), S.point(z2), S.point(z1)) || CGAL::collinear(S.point(z2), S.point(y), S.point(z1))) continue;
             const Vec3 X = pt(S, x), Y = pt(S, y), Z1 = pt(S, z1), Z2 = pt(S, z2);
             const Vec3 o1 = normalOf(X, Y, Z1), o2 = normalOf(Y, X, Z2), n1 = normalOf(X, Z2, Z1), n2 = normalOf(Z2, Y, Z1);
-            if (std::max({angleBetween(o1, n1), angleBetween(o1, n2), angleBetween(o2, n1), angleBetween(o2, n2)}) > maxTurn) continue;
+            // Outside the patch a flip may not change the surface (the pieces must be coplanar); on the
+            // patch side it may not turn a normal more than maxNormalChangeDeg.
+            const bool patchSide = loc.patchSide[S.face(h)];
+            if (patchSide != loc.patchSide[S.face(o)]) continue;
+            const double turn = std::max({angleBetween(o1, n1), angleBetween(o1, n2), angleBetween(o2, n1), angleBetween(o2, n2)});
+            if (turn > (patchSide ? maxTurn : kCoplanar)) continue;
             const double oldMin = std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2));
             const double newMin = std::min(minAngle(X, Z2, Z1), minAngle(Z2, Y, Z1));
             const int devOld = valenceCost(x, 0) + valenceCost(y, 0) + valenceCost(z1, 0) + valenceCost(z2, 0);
@@ -1661,6 +1699,10 @@ private:
                 } else if (!freshIndex.count(std::uint32_t(v))) {
                     freshIndex[std::uint32_t(v)] = std::uint32_t(plan.freshPositions.size());
                     plan.freshPositions.push_back(pt(S, v));
+                    if (std::getenv("FSS_STITCH_DEBUG") && std::abs(pt(S, v).norm() - 1.0) > 0.0177) {
+                        const int id = loc.lid[v];
+                        std::fprintf(stderr, "  off-sphere fresh vertex lid %d kind %d |p| %g\n", id, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, pt(S, v).norm());
+                    }
                 }
             }
         // Face order: growth order over the faces expressed in the rehearsal mesh after the removals.
@@ -1699,6 +1741,19 @@ private:
             plan.quality.push_back(loc.quality[sfaces[i]]);
             plan.scanId.push_back(loc.scanId[sfaces[i]]);
         }
+        if (std::getenv("FSS_STITCH_DEBUG_DEEP"))
+            for (std::size_t i = 0; i < faces.size(); ++i) {
+                const auto& fv = faces[i];
+                const Kernel::Triangle_3 t(S.point(fv[0]), S.point(fv[1]), S.point(fv[2]));
+                const double d = 1.0 - std::sqrt(CGAL::squared_distance(Point3(0, 0, 0), t));
+                if (d > 0.0178) {
+                    std::fprintf(stderr, "  deep face %.5f patchSide %d\n", d, int(loc.patchSide[sfaces[i]]));
+                    for (VertexIndex v : fv) {
+                        const int id = loc.lid[v];
+                        std::fprintf(stderr, "    lid %d kind %d |p| %.5f\n", id, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, pt(S, v).norm());
+                    }
+                }
+            }
         // Seam figures.
         plan.seamEdges = loc.seam.size();
         std::unordered_set<std::uint32_t> seamVerts;
