@@ -407,6 +407,7 @@ public:
         if (!preTrim(a)) return a;
         buildLocalVertices();
         snap();
+        pruneEdgeSnaps();
         if (!computeCrossings(a)) return a;
         Cdt cdt;
         std::vector<CdtVertex> vh;
@@ -797,6 +798,14 @@ private:
     }
     void snap() {
         const double cell = 2.0 * h2_;
+        // Snapping distances are a fraction of the local edge lengths on both sides, so that snapped
+        // points keep their order and no triangle folds.
+        std::vector<double> regionEdgeMin(L_.size(), std::numeric_limits<double>::infinity());
+        for (const auto& re : redges_) {
+            const double l = std::sqrt(dist2(L_[std::size_t(re.u)].uv, L_[std::size_t(re.w)].uv));
+            for (int v : {re.u, re.w}) regionEdgeMin[std::size_t(v)] = std::min(regionEdgeMin[std::size_t(v)], l);
+        }
+        const double ratio = O_.collapseEdgeRatio;
         // Rule 1: a patch boundary vertex close to a mesh vertex becomes that vertex.
         {
             BucketGrid grid(cell, L_.size());
@@ -812,7 +821,7 @@ private:
                 const Point2 uv = L_[std::size_t(lid)].uv;
                 grid.query(grown(uv.bbox(), r), [&](int i) {
                     const double d = std::sqrt(dist2(uv, L_[std::size_t(i)].uv));
-                    if (d < r) cands.push_back({d, v, i});
+                    if (d < std::min(r, ratio * regionEdgeMin[std::size_t(i)])) cands.push_back({d, v, i});
                 });
             }
             std::sort(cands.begin(), cands.end(), [](const Cand& x, const Cand& y) {
@@ -848,8 +857,9 @@ private:
                 double bestD = r, bestS = 0;
                 grid.query(grown(uv.bbox(), r), [&](int i) {
                     double s;
-                    const double d = segmentDistance(uv, L_[std::size_t(redges_[std::size_t(i)].u)].uv, L_[std::size_t(redges_[std::size_t(i)].w)].uv, s);
-                    if (d < bestD && s > 1e-3 && s < 1 - 1e-3) {
+                    const Point2 &U = L_[std::size_t(redges_[std::size_t(i)].u)].uv, &W = L_[std::size_t(redges_[std::size_t(i)].w)].uv;
+                    const double d = segmentDistance(uv, U, W, s);
+                    if (d < bestD && d < ratio * std::sqrt(dist2(U, W)) && s > 1e-3 && s < 1 - 1e-3) {
                         bestD = d;
                         best = i;
                         bestS = s;
@@ -884,7 +894,7 @@ private:
                     const double len = std::sqrt(dist2(A, B));
                     double s;
                     const double d = segmentDistance(l.uv, A, B, s);
-                    const double rel = d / (O_.collapseEdgeRatio * len);
+                    const double rel = d / (ratio * std::min(len, regionEdgeMin[i]));
                     if (rel < bestRel && s > 1e-3 && s < 1 - 1e-3) {
                         bestRel = rel;
                         best = e;
@@ -903,6 +913,29 @@ private:
                 l.patchA = pedges_[std::size_t(best)].a;
                 l.patchB = pedges_[std::size_t(best)].b;
             }
+        }
+    }
+    // Mesh vertices snapped onto a patch boundary edge must leave the patch triangle on it a fan of
+    // counter-clockwise triangles: keep them greedily in order along the edge.
+    void pruneEdgeSnaps() {
+        for (auto& pe : pedges_) {
+            if (pe.splits.empty()) continue;
+            std::sort(pe.splits.begin(), pe.splits.end());
+            const Point2 B = L_uvOfPatch(pe.b), C = L_uvOfPatch(pe.opposite);
+            Point2 prev = L_uvOfPatch(pe.a);
+            std::vector<std::pair<double, int>> kept;
+            for (const auto& sp : pe.splits) {
+                LVert& l = L_[std::size_t(sp.second)];
+                if (leftTurn(prev, l.uv, C) && leftTurn(l.uv, B, C) &&
+                    (kept.empty() || lineParam(l.uv, prev, B) > 0)) {
+                    kept.push_back(sp);
+                    prev = l.uv;
+                } else {
+                    l.chain = false;
+                    l.patchA = l.patchB = -1;
+                }
+            }
+            pe.splits.swap(kept);
         }
     }
     // Polyline (local ids) of a region edge or a patch boundary edge with its splits, sorted.
@@ -1163,39 +1196,75 @@ private:
     // ---- step 3c: the faces of the result (local ids)
     // Triangulates a polygon whose corners lie on the edges of one patch triangle (ear clipping, best
     // smallest angle first, exact orientation tests).
-    // `edges` holds for every corner the triangle edges it lies on (bit k: edge k); a diagonal between two
-    // corners on the same edge would leave a triangle of collinear points, so it is never cut.
-    bool triangulatePolygon(std::vector<int> poly, std::vector<unsigned> edges, float q, std::int32_t sid) {
-        while (poly.size() > 3) {
-            int best = -1;
-            double bestAngle = -1;
-            const std::size_t n = poly.size();
-            for (std::size_t i = 0; i < n; ++i) {
-                const int a = poly[(i + n - 1) % n], b = poly[i], c = poly[(i + 1) % n];
-                if (edges[(i + n - 1) % n] & edges[(i + 1) % n]) continue;
-                const Point2 &A = L_[std::size_t(a)].uv, &B = L_[std::size_t(b)].uv, &C = L_[std::size_t(c)].uv;
-                if (!leftTurn(A, B, C)) continue;
-                bool empty = true;
-                for (std::size_t j = 0; j < n && empty; ++j) {
-                    const int d = poly[j];
-                    if (d == a || d == b || d == c) continue;
-                    if (inTriangle(L_[std::size_t(d)].uv, A, B, C)) empty = false;
+    // Triangulates a polygon whose corners lie on the edges of one patch triangle, maximising the
+    // smallest angle (dynamic programming over the polygon's chains; exact orientation tests).
+    // `edges` holds for every corner the triangle edges it lies on (bit k: edge k): a diagonal between
+    // two corners on the same edge would leave a triangle of collinear points, so it is never used.
+    bool triangulatePolygon(const std::vector<int>& poly, const std::vector<unsigned>& edges, float q,
+                            std::int32_t sid) {
+        const std::size_t n = poly.size();
+        auto P = [&](std::size_t i) -> const Point2& { return L_[std::size_t(poly[i])].uv; };
+        auto X = [&](std::size_t i) -> const Vec3& { return L_[std::size_t(poly[i])].pos; };
+        if (n == 3) {
+            if (!leftTurn(P(0), P(1), P(2))) return false;
+            newFaces_.push_back({{poly[0], poly[1], poly[2]}, q, sid, true});
+            return true;
+        }
+        // diagonal[i][j]: the segment i–j lies inside the polygon and does not run along a triangle edge.
+        std::vector<char> diagonal(n * n, 0);
+        for (std::size_t i = 0; i < n; ++i)
+            for (std::size_t j = i + 1; j < n; ++j) {
+                if (j == i + 1 || (i == 0 && j == n - 1)) {
+                    diagonal[i * n + j] = diagonal[j * n + i] = 1;
+                    continue;
                 }
-                if (!empty) continue;
-                const double ang = minAngle(L_[std::size_t(a)].pos, L_[std::size_t(b)].pos, L_[std::size_t(c)].pos);
-                if (ang > bestAngle) {
-                    bestAngle = ang;
-                    best = int(i);
+                if (edges[i] & edges[j]) continue;
+                // Inside the cone of the polygon's corner at i.
+                const Point2 &pi = P(i), &prev = P((i + n - 1) % n), &next = P((i + 1) % n), &pj = P(j);
+                const bool convex = CGAL::orientation(prev, pi, next) != CGAL::RIGHT_TURN;
+                const bool inCone = convex ? (leftTurn(pi, next, pj) && leftTurn(prev, pi, pj))
+                                           : !(CGAL::orientation(pi, next, pj) != CGAL::LEFT_TURN &&
+                                               CGAL::orientation(prev, pi, pj) != CGAL::LEFT_TURN);
+                if (!inCone) continue;
+                bool clear = true;
+                const Segment2 d(pi, pj);
+                for (std::size_t e = 0; e < n && clear; ++e) {
+                    const std::size_t f = (e + 1) % n;
+                    if (e == i || e == j || f == i || f == j) continue;
+                    if (CGAL::do_intersect(d, Segment2(P(e), P(f)))) clear = false;
+                }
+                if (clear) diagonal[i * n + j] = diagonal[j * n + i] = 1;
+            }
+        // best[i][j]: best smallest angle triangulating the chain i..j closed by i–j (i < j).
+        const double none = -1;
+        std::vector<double> best(n * n, none);
+        std::vector<std::size_t> split(n * n, 0);
+        for (std::size_t i = 0; i + 1 < n; ++i) best[i * n + i + 1] = 4; // an edge: nothing to do
+        for (std::size_t len = 2; len < n; ++len)
+            for (std::size_t i = 0; i + len < n; ++i) {
+                const std::size_t j = i + len;
+                if (!diagonal[i * n + j]) continue;
+                for (std::size_t k = i + 1; k < j; ++k) {
+                    const double left = best[i * n + k], right = best[k * n + j];
+                    if (left < 0 || right < 0 || !leftTurn(P(i), P(k), P(j))) continue;
+                    const double v = std::min({left, right, minAngle(X(i), X(k), X(j))});
+                    if (v > best[i * n + j]) {
+                        best[i * n + j] = v;
+                        split[i * n + j] = k;
+                    }
                 }
             }
-            if (best < 0) return false;
-            const std::size_t i = std::size_t(best);
-            newFaces_.push_back({{poly[(i + n - 1) % n], poly[i], poly[(i + 1) % n]}, q, sid, true});
-            poly.erase(poly.begin() + std::ptrdiff_t(i));
-            edges.erase(edges.begin() + std::ptrdiff_t(i));
+        if (best[n - 1] < 0) return false;
+        std::vector<std::pair<std::size_t, std::size_t>> stack{{0, n - 1}};
+        while (!stack.empty()) {
+            const auto [i, j] = stack.back();
+            stack.pop_back();
+            if (j == i + 1) continue;
+            const std::size_t k = split[i * n + j];
+            newFaces_.push_back({{poly[i], poly[k], poly[j]}, q, sid, true});
+            stack.push_back({i, k});
+            stack.push_back({k, j});
         }
-        if (!leftTurn(L_[std::size_t(poly[0])].uv, L_[std::size_t(poly[1])].uv, L_[std::size_t(poly[2])].uv)) return false;
-        newFaces_.push_back({{poly[0], poly[1], poly[2]}, q, sid, true});
         return true;
     }
     bool assemble(Cdt& cdt, Attempt& a) {
@@ -1248,6 +1317,12 @@ private:
             const std::int32_t sid = P_.hasScanId ? P_.scanId[std::size_t(f)] : -1;
             const std::size_t before = newFaces_.size();
             if (!triangulatePolygon(poly, edges, q, sid)) {
+                if (std::getenv("FSS_STITCH_DEBUG")) {
+                    std::fprintf(stderr, "  polygon failed:");
+                    for (std::size_t k = 0; k < poly.size(); ++k)
+                        std::fprintf(stderr, " [lid %d kind %d e%u %.6f %.6f]", poly[k], int(L_[std::size_t(poly[k])].kind), edges[k], L_[std::size_t(poly[k])].uv.x(), L_[std::size_t(poly[k])].uv.y());
+                    std::fprintf(stderr, "\n");
+                }
                 for (int v : t) bad.push_back(v);
                 continue;
             }
