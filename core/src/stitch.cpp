@@ -405,6 +405,7 @@ public:
         if (!setupComponent(a)) return a;
         if (!findRegion(a)) return a;
         if (!preTrim(a)) return a;
+        if (!splitRegion(a)) return a;
         buildLocalVertices();
         snap();
         pruneEdgeSnaps();
@@ -711,6 +712,124 @@ private:
             if (!inside) bad.push_back(v);
         }
         if (!bad.empty()) return fail(a, "it reaches past the visible part of the mesh", std::move(bad));
+        return true;
+    }
+
+    // ---- step 1c: seam faces (near the patch boundary: re-triangulated in the view) and faces under the
+    // patch (removed whole, whatever their orientation, so folds under the patch go too)
+    bool insidePatch(const Point2& p) {
+        bool in = false;
+        compGrid_.query(p.bbox(), [&](int i) {
+            if (in) return;
+            const Triangle2 t = patchTriangle(faces_[std::size_t(i)]);
+            in = inTriangle(p, t[0], t[1], t[2]);
+        });
+        return in;
+    }
+    // Do the interiors of two (counter-clockwise) faces overlap in the view? Separating-axis test on
+    // their edges with exact orientations: disjoint interiors iff one triangle lies on the closed outer
+    // side of an edge of the other.
+    bool interiorsOverlap(FaceIndex f, FaceIndex g) {
+        const Triangle2 s = faceTriangle(f), t = faceTriangle(g);
+        for (const auto& [x, y] : {std::pair{&s, &t}, std::pair{&t, &s}})
+            for (int k = 0; k < 3; ++k) {
+                const Point2 &p = (*x)[k], &q = (*x)[(k + 1) % 3];
+                if (CGAL::orientation(p, q, (*y)[0]) != CGAL::LEFT_TURN && CGAL::orientation(p, q, (*y)[1]) != CGAL::LEFT_TURN &&
+                    CGAL::orientation(p, q, (*y)[2]) != CGAL::LEFT_TURN)
+                    return false;
+            }
+        return true;
+    }
+    bool splitRegion(Attempt& a) {
+        BucketGrid segments(2.0 * h2_, pedges_.size());
+        for (std::size_t i = 0; i < pedges_.size(); ++i)
+            segments.insert(int(i), bboxOf(P_.uv[std::size_t(pedges_[i].a)], P_.uv[std::size_t(pedges_[i].b)]));
+        const double reach2 = margin_ * margin_; // the snapping distance
+        std::vector<FaceIndex> seam;
+        std::vector<FaceIndex> stack;
+        std::unordered_set<std::uint32_t> isSeam, isInterior;
+        for (FaceIndex f : region_) {
+            const Triangle2 t = faceTriangle(f);
+            bool near = false;
+            segments.query(grown(t.bbox(), margin_), [&](int i) {
+                if (near) return;
+                const Segment2 e(P_.uv[std::size_t(pedges_[std::size_t(i)].a)], P_.uv[std::size_t(pedges_[std::size_t(i)].b)]);
+                near = CGAL::do_intersect(t, e) || CGAL::squared_distance(t, e) <= reach2;
+            });
+            if (near) {
+                seam.push_back(f);
+                isSeam.insert(std::uint32_t(f));
+            } else if (insidePatch(CGAL::centroid(t))) {
+                isInterior.insert(std::uint32_t(f));
+                stack.push_back(f);
+            }
+        }
+        std::vector<int> bad;
+        // Folds: front-facing faces overlapping in the view (a step of the mesh seen obliquely). Under the
+        // patch they are simply replaced; where the patch boundary crosses them there is no height field
+        // to cut, so the patch is cut back around every fold that reaches its boundary.
+        {
+            std::vector<int> parent(region_.size());
+            for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = int(i);
+            auto find = [&](int x) {
+                while (parent[std::size_t(x)] != x) x = parent[std::size_t(x)] = parent[std::size_t(parent[std::size_t(x)])];
+                return x;
+            };
+            std::vector<char> folded(region_.size(), 0);
+            for (std::size_t i = 0; i < region_.size(); ++i) {
+                const Triangle2 t = faceTriangle(region_[i]);
+                regionGrid_.query(t.bbox(), [&](int j) {
+                    if (j <= int(i)) return;
+                    if (!interiorsOverlap(region_[i], region_[std::size_t(j)])) return;
+                    folded[i] = folded[std::size_t(j)] = 1;
+                    parent[std::size_t(find(j))] = find(int(i));
+                });
+            }
+            std::unordered_map<int, bool> clusterAtSeam;
+            for (std::size_t i = 0; i < region_.size(); ++i)
+                if (folded[i] && isSeam.count(std::uint32_t(region_[i]))) clusterAtSeam[find(int(i))] = true;
+            for (std::size_t i = 0; i < region_.size(); ++i) {
+                if (!folded[i] || !clusterAtSeam.count(find(int(i)))) continue;
+                const Triangle2 t = faceTriangle(region_[i]);
+                const double r = margin_ + h2_;
+                compGrid_.query(grown(t.bbox(), r), [&](int k) {
+                    const Triangle2 p = patchTriangle(faces_[std::size_t(k)]);
+                    if (CGAL::do_intersect(t, p) || CGAL::squared_distance(t, p) <= r * r)
+                        for (int v : P_.tri[std::size_t(faces_[std::size_t(k)])]) bad.push_back(v);
+                });
+            }
+            if (!bad.empty()) return fail(a, "the mesh under its boundary folds over itself in the scan's view", std::move(bad));
+        }
+        // Faces connected to the interior ones, away from the seam, lying under the patch in the view.
+        while (!stack.empty()) {
+            const FaceIndex f = stack.back();
+            stack.pop_back();
+            interior_.push_back(f);
+            for (HalfedgeIndex h : CGAL::halfedges_around_face(M_.halfedge(f), M_)) {
+                const FaceIndex g = M_.face(M_.opposite(h));
+                if (g == Mesh::null_face()) {
+                    addNear(bad, vproj(M_.target(h)).uv); // the mesh's border under the patch
+                    continue;
+                }
+                if (isSeam.count(std::uint32_t(g)) || isInterior.count(std::uint32_t(g))) continue;
+                bool under = true;
+                for (VertexIndex v : CGAL::vertices_around_face(M_.halfedge(g), M_)) {
+                    const VProj& p = vproj(v);
+                    if (!p.ok || !insidePatch(p.uv)) under = false;
+                }
+                if (!under) {
+                    addNear(bad, vproj(M_.target(h)).uv); // a face reaching out without a seam: a fold, a hole
+                    continue;
+                }
+                isInterior.insert(std::uint32_t(g));
+                stack.push_back(g);
+            }
+        }
+        if (!bad.empty()) return fail(a, "the mesh under it folds or has a hole in the scan's view", std::move(bad));
+        region_ = std::move(seam);
+        regionIndex_.clear();
+        for (std::size_t i = 0; i < region_.size(); ++i) regionIndex_[std::uint32_t(region_[i])] = int(i);
+        if (region_.empty()) return fail(a, "no visible face of the mesh lies under its boundary");
         return true;
     }
 
@@ -1042,6 +1161,14 @@ private:
                     addNear(bad, v->point());
                     if (std::getenv("FSS_STITCH_DEBUG")) {
                         std::fprintf(stderr, "  extra vertex at %.17g %.17g\n", v->point().x(), v->point().y());
+                        for (FaceIndex f : region_) {
+                            const Triangle2 t = faceTriangle(f);
+                            if (!inTriangle(v->point(), t[0], t[1], t[2])) continue;
+                            const auto vs = faceVertices(f);
+                            const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
+                            const double c = normalOf(A, B, C).normalized().dot(V_.towardsViewer((A + B + C) / 3.0));
+                            std::fprintf(stderr, "    in face %u cos %.3f depth %.5f sid %d\n", std::uint32_t(f), c, V_.camera().viewDepth((A+B+C)/3.0), curHasScanId_ ? curScanId_[f] : -9);
+                        }
                         const CdtVertex vv = v;
                         auto ec = cdt.incident_edges(vv), end = ec;
                         do {
@@ -1149,44 +1276,21 @@ private:
     // ---- step 3b: the patch must lie strictly over the region, on the same sheet
     bool checkCoverage(Cdt& cdt, const std::vector<CdtVertex>& vh, Attempt& a) {
         std::vector<int> bad;
-        for (auto f = cdt.all_faces_begin(); f != cdt.all_faces_end(); ++f)
-            if (f->info().inside == 1 && (cdt.is_infinite(f) || f->info().region < 0)) {
-                for (int k = 0; k < 3; ++k)
-                    if (!cdt.is_infinite(f->vertex(k))) addBad(bad, f->vertex(k)->info().id);
-                if (!cdt.is_infinite(f)) addNear(bad, CGAL::centroid(cdt.triangle(f)));
-            }
-        std::unordered_set<std::uint32_t> inRegion;
-        for (FaceIndex f : region_) inRegion.insert(std::uint32_t(f));
         for (std::size_t i = 0; i < L_.size(); ++i) {
             const LVert& l = L_[i];
-            if (!l.alive) continue;
+            if (!l.alive || !l.chain) continue;
             const CdtVertex v = vh[i];
-            bool touchesInside = false, uncovered = false;
+            bool uncovered = false;
             auto fc = cdt.incident_faces(v), end = fc;
             do {
                 if (cdt.is_infinite(fc) || fc->info().region < 0) uncovered = true;
-                if (fc->info().inside == 1) touchesInside = true;
             } while (++fc != end);
-            if (l.chain && uncovered && l.kind != LVert::Region) {
-                addBad(bad, int(i));
-                if (std::getenv("FSS_STITCH_DEBUG")) std::fprintf(stderr, "  uncovered chain vertex %zu kind %d at %g %g\n", i, int(l.kind), l.uv.x(), l.uv.y());
-            }
-            if (l.kind == LVert::Region && !l.chain && touchesInside) {
-                // A mesh vertex under the patch goes: every face around it must be in the region.
-                const VertexIndex cv(l.cur);
-                for (FaceIndex g : CGAL::faces_around_target(M_.halfedge(cv), M_))
-                    if (g == Mesh::null_face() || !inRegion.count(std::uint32_t(g))) {
-                        addNear(bad, l.uv);
-                        break;
-                    }
-            }
+            // Around a seam vertex inside mesh faces or on mesh edges, the seam faces must surround it.
+            if (uncovered && l.kind != LVert::Region) addBad(bad, int(i));
             if (l.kind == LVert::PatchBoundary && !uncovered) {
                 // The patch must lie on the surface under it (not on an occluder or another sheet).
                 const FaceIndex f = region_[std::size_t(v->face()->info().region)];
-                if (gapTo(l.pos, f) > O_.maxGapRatio * (longestEdge(f) + h3_)) {
-                    addBad(bad, int(i));
-                    if (std::getenv("FSS_STITCH_DEBUG")) std::fprintf(stderr, "  gap %g at vertex %zu\n", gapTo(l.pos, f), i);
-                }
+                if (gapTo(l.pos, f) > O_.maxGapRatio * (longestEdge(f) + h3_)) addBad(bad, int(i));
             }
         }
         if (!bad.empty()) return fail(a, "it reaches past the visible, stitchable part of the mesh", std::move(bad));
@@ -1194,8 +1298,6 @@ private:
     }
 
     // ---- step 3c: the faces of the result (local ids)
-    // Triangulates a polygon whose corners lie on the edges of one patch triangle (ear clipping, best
-    // smallest angle first, exact orientation tests).
     // Triangulates a polygon whose corners lie on the edges of one patch triangle, maximising the
     // smallest angle (dynamic programming over the polygon's chains; exact orientation tests).
     // `edges` holds for every corner the triangle edges it lies on (bit k: edge k): a diagonal between
@@ -1268,6 +1370,7 @@ private:
         return true;
     }
     bool assemble(Cdt& cdt, Attempt& a) {
+        replaced_ = interior_;
         // Region faces: unchanged when they are exactly one outside triangle, else replaced by their
         // outside triangles.
         std::vector<std::vector<CdtFace>> pieces(region_.size());
@@ -1718,12 +1821,19 @@ private:
             if (!loc.star.kept[f])
                 for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(f), S))
                     if (loc.star.cur[v] == kNone && S.is_border(v)) badFace(f);
-        if (std::getenv("FSS_STITCH_DEBUG") && bordersAround(loc) != bordersBefore) {
-            for (auto e : bordersAround(loc)) if (!bordersBefore.count(e)) std::fprintf(stderr, "  new border %u %u\n", e.first, e.second);
-            for (auto e : bordersBefore) if (!bordersAround(loc).count(e)) std::fprintf(stderr, "  lost border %u %u\n", e.first, e.second);
-            for (VertexIndex v : S.vertices()) if (S.is_border(v)) { int id = loc.lid[v]; std::fprintf(stderr, "  border v %u cur %u lid %d kind %d\n", std::uint32_t(v), loc.star.cur[v], id, id >= 0 ? int(L_[std::size_t(id)].kind) : -1); }
+        const auto bordersAfter = bordersAround(loc);
+        if (bordersAfter != bordersBefore) {
+            // Locate the difference (a hole of the mesh under the patch, an edge left dangling).
+            for (const auto* set : {&bordersAfter, &bordersBefore})
+                for (const auto& e : *set)
+                    if (!(set == &bordersAfter ? bordersBefore : bordersAfter).count(e)) {
+                        Point2 uv;
+                        double w;
+                        if (e.first != kNone && e.second != kNone && V_.project(0.5 * (toVec(M_.point(VertexIndex(e.first))) + toVec(M_.point(VertexIndex(e.second)))), uv, w))
+                            addNear(bad, uv);
+                    }
         }
-        if (!bad.empty() || bordersAround(loc) != bordersBefore)
+        if (!bad.empty() || bordersAfter != bordersBefore)
             return fail(a, "it would open or close a hole in the mesh", std::move(bad));
         // No new self-intersections among the local faces.
         std::vector<std::pair<FaceIndex, FaceIndex>> pairs;
@@ -1886,7 +1996,8 @@ private:
     bool fallbackBuilt_ = false;
     std::vector<FaceIndex> fallback_;
     BucketGrid fallbackGrid_;
-    std::vector<FaceIndex> region_;
+    std::vector<FaceIndex> region_;   // faces re-triangulated in the view (near the seam)
+    std::vector<FaceIndex> interior_; // faces under the patch, removed whole
     std::unordered_map<std::uint32_t, int> regionIndex_;
     BucketGrid regionGrid_;
 
