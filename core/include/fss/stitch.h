@@ -1,0 +1,106 @@
+#pragma once
+/// \file stitch.h
+/// Stitching (mesh zippering, Turk & Levoy 1994, as modified by Vorsatz et al., VMV 2000): a scanned patch
+/// replaces the part of the current mesh it covers in the scan's view.
+///
+/// In the scan camera's view the problem is two-dimensional. The current mesh's faces under the patch
+/// (front-facing, not grazing) are projected; the patch's boundary vertices and edges are inserted into
+/// that projected triangulation as constraints (a constrained Delaunay triangulation performs the paper's
+/// face / edge splits and edge flips); where a patch boundary edge crosses a mesh edge the new vertex lies
+/// *on that mesh edge in 3D*, so the geometry outside the patch does not move. The faces inside the patch
+/// boundary are removed, the patch is glued in sharing the boundary vertices, and the seam is optimised by
+/// collapsing short edges and flipping edges (never flipping a face in the view, folding the surface or
+/// moving a vertex). Every change is checked on the touched region before the mesh is modified.
+
+#include "fss/camera.h"
+#include "fss/mesh.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace fss {
+
+/// Options of stitchPatch. The defaults suit regular scans of 1 sample per pixel.
+struct StitchOptions {
+    /// Rings of vertices around the seam that the seam optimisation may change.
+    int seamRings = 2;
+    /// Collapse short seam edges and flip edges for quality after gluing.
+    bool optimiseSeam = true;
+    /// Seam edges shorter than this × the patch's median edge length are collapsed. The same fraction of
+    /// the local patch edge length (in pixels) is the distance within which a patch boundary vertex is
+    /// snapped onto a mesh vertex or edge, and a mesh vertex onto a patch boundary edge.
+    double collapseEdgeRatio = 0.3;
+    /// Current-mesh faces seen at a larger angle between normal and view ray (degrees) are not stitched to;
+    /// the patch is trimmed away from them.
+    double maxViewAngleDeg = 85.0;
+    /// A seam collapse or flip may turn no face normal by more than this (degrees): no folds.
+    double maxNormalChangeDeg = 20.0;
+    /// A patch boundary vertex whose distance to the current surface along its view ray exceeds this × (the
+    /// longest edge of the face under it + the patch's median edge length) is trimmed: the patch does not
+    /// belong to that surface there (an occluder, another sheet).
+    double maxGapRatio = 1.0;
+    /// Rounds of trimming a component (removing the patch faces at places that cannot be stitched safely)
+    /// before it is skipped.
+    int maxTrimRounds = 16;
+    /// Components (or pieces left by trimming) with fewer faces are dropped and reported.
+    std::size_t minComponentFaces = 1;
+    /// Call collect_garbage() on the mesh at the end (renumbers all indices, O(mesh)). When false the
+    /// removed elements stay as garbage that later additions reuse.
+    bool collectGarbage = false;
+    /// Test hook: makes the final check of every component fail, to exercise the strong guarantee.
+    bool failValidationForTesting = false;
+};
+
+/// What stitchPatch did.
+struct StitchReport {
+    std::size_t facesRemoved = 0;      ///< faces of the current mesh replaced
+    std::size_t facesAdded = 0;        ///< faces added (patch faces, re-triangulated pieces around the seam)
+    std::size_t seamEdges = 0;         ///< edges of the final seam (patch boundary ↔ old mesh)
+    double seamLength = 0;             ///< 3D length of the seam
+    double seamMinAngleDeg = 180;      ///< smallest angle of the faces touching the seam (180 when none)
+    double seamFracMinAngleAbove25 = 1; ///< fraction of those faces whose smallest angle is ≥ 25°
+    std::size_t seamFaces = 0;         ///< number of faces touching the seam
+    int componentsStitched = 0;        ///< patch components (or pieces of them after trimming) glued in
+    int componentsSkipped = 0;         ///< components left out, each with a sentence in `skipped`
+    std::size_t patchFacesTrimmed = 0; ///< patch faces dropped so that the rest could be stitched
+    std::size_t collapses = 0;         ///< seam edge collapses performed
+    std::size_t flips = 0;             ///< seam edge flips performed
+    std::vector<std::string> skipped;  ///< one sentence per skipped component
+    double seconds = 0;                ///< wall time
+};
+
+/// Zippers \p patch into \p current (DESIGN.md §1 "Stitch", §6).
+///
+/// \param current  the mesh being remeshed; a valid, consistently oriented, edge- and vertex-manifold
+///                 triangle mesh (it may have boundary and garbage).
+/// \param patch    the scan's patch: triangles facing \p scanCamera, edge-manifold, possibly with holes and
+///                 several components; face properties props::faceQuality / props::faceScanId are copied
+///                 into \p current when present (and created there with kInputFaceQuality / -1 for the
+///                 existing faces).
+/// \param scanCamera the camera of the scan that produced the patch.
+/// \param options  see StitchOptions.
+/// \param faceIds  optional ID buffer of \p current from \p scanCamera (width × height, row 0 at the top,
+///                 FrameBuffers::kNoFace for background): finds the faces under the patch in time
+///                 proportional to the patch. When empty, the faces are found by projecting all faces of
+///                 \p current (O(mesh)).
+///
+/// Each patch component is stitched on its own: the region under it is re-triangulated in the view, the
+/// result is validated (edge- and vertex-manifold, consistently oriented, no degenerate faces, no new
+/// self-intersections among the touched faces and their neighbours, every face facing the camera, border
+/// edges and so boundary loops unchanged, closed stays closed) and only then applied. Where a component
+/// cannot be stitched safely (it reaches past a silhouette, the current mesh's border, a grazing face or
+/// another sheet), its patch faces there are trimmed; a component that cannot be made stitchable is
+/// skipped and reported. Faces of \p current that do not touch the patch's view footprint keep their
+/// indices, vertices and positions. Removed elements are left as garbage (see StitchOptions::collectGarbage).
+///
+/// \return what was done, with seam quality figures.
+/// \throw InvalidInputError when the camera, the patch or the ID buffer is invalid, or when no component
+///        could be stitched (the sentence gives the first reason). Strong guarantee: every check runs before
+///        \p current is modified, so on any exception \p current is unchanged.
+StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCamera,
+                         const StitchOptions& options = {}, std::span<const std::uint32_t> faceIds = {});
+
+} // namespace fss

@@ -1,0 +1,2216 @@
+// Stitching a scanned patch into the current mesh (DESIGN.md §1 "Stitch", §6).
+//
+// Per patch component:
+//  1. region     current faces under the component's view footprint: front-facing, not grazing, on the
+//                sheet the patch lies on (seeds = faces under the patch vertices with the smallest depth
+//                gap, grown over faces whose projection meets the component's projection);
+//  2. insert     snap patch boundary vertices onto nearby mesh vertices / edges and mesh vertices onto
+//                nearby patch boundary edges (no slivers), compute the crossings of patch boundary edges
+//                with mesh edges (3D position on the mesh edge, perspective-correct), and build a
+//                constrained Delaunay triangulation of all these edges in the view;
+//  3. cut, glue  flood-fill the triangulation: which mesh face each triangle lies in, inside or outside
+//                the patch. Mesh faces cut by the seam are replaced by their outside triangles (lifted
+//                into the plane of the mesh face, so the surface outside does not move); the patch's
+//                boundary triangles are re-triangulated over the seam vertices of their edges;
+//  4. optimise   on a local copy (the star of the replaced faces): collapse short edges, flip edges for
+//                minimum angle and valence; never flip a face in the view, fold, or move a vertex;
+//  5. check      on the local copy (manifold, oriented, no degenerate faces, every new face facing the
+//                camera, border edges unchanged, no self-intersections), then replay the exact sequence of
+//                edits on a fresh local copy (it must succeed), and only then edit the mesh itself.
+// A problem that can be located (the patch reaching past a silhouette, a border, a grazing face, another
+// sheet; a degenerate contact; a failed check) trims the patch faces there and the component is retried.
+
+#include "fss/stitch.h"
+
+#include "fss/error.h"
+
+#include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Triangulation_face_base_with_info_2.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+#include <CGAL/boost/graph/Euler_operations.h>
+#include <CGAL/boost/graph/helpers.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+
+namespace fss {
+namespace {
+
+namespace PMP = CGAL::Polygon_mesh_processing;
+using Point2 = Kernel::Point_2;
+using Triangle2 = Kernel::Triangle_2;
+using Segment2 = Kernel::Segment_2;
+using Vec3 = Eigen::Vector3d;
+
+constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+constexpr double kDeg = std::numbers::pi / 180.0;
+// Normals of pieces of one planar face agree to rounding; a flip between such pieces keeps the surface.
+constexpr double kCoplanar = 1e-4 * kDeg;
+
+Vec3 toVec(const Point3& p) { return {p.x(), p.y(), p.z()}; }
+Point3 toPoint(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {
+    if (a > b) std::swap(a, b);
+    return (std::uint64_t(a) << 32) | b;
+}
+std::uint64_t dirKey(std::uint32_t a, std::uint32_t b) { return (std::uint64_t(a) << 32) | b; }
+
+bool leftTurn(const Point2& a, const Point2& b, const Point2& c) {
+    return CGAL::orientation(a, b, c) == CGAL::LEFT_TURN;
+}
+// Closed containment of p in the counter-clockwise triangle abc (exact).
+bool inTriangle(const Point2& p, const Point2& a, const Point2& b, const Point2& c) {
+    return CGAL::orientation(a, b, p) != CGAL::RIGHT_TURN && CGAL::orientation(b, c, p) != CGAL::RIGHT_TURN &&
+           CGAL::orientation(c, a, p) != CGAL::RIGHT_TURN;
+}
+double area2(const Point2& a, const Point2& b, const Point2& c) {
+    return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+}
+double dist2(const Point2& a, const Point2& b) { return CGAL::squared_distance(a, b); }
+// Parameter of the projection of p onto the line ab (0 at a, 1 at b).
+double lineParam(const Point2& p, const Point2& a, const Point2& b) {
+    const double dx = b.x() - a.x(), dy = b.y() - a.y();
+    const double l2 = dx * dx + dy * dy;
+    return l2 > 0 ? ((p.x() - a.x()) * dx + (p.y() - a.y()) * dy) / l2 : 0.0;
+}
+double segmentDistance(const Point2& p, const Point2& a, const Point2& b, double& t) {
+    t = lineParam(p, a, b);
+    const double tc = std::clamp(t, 0.0, 1.0);
+    const Point2 q(a.x() + tc * (b.x() - a.x()), a.y() + tc * (b.y() - a.y()));
+    return std::sqrt(dist2(p, q));
+}
+CGAL::Bbox_2 bboxOf(const Point2& a, const Point2& b) { return a.bbox() + b.bbox(); }
+CGAL::Bbox_2 bboxOf(const Point2& a, const Point2& b, const Point2& c) { return a.bbox() + b.bbox() + c.bbox(); }
+CGAL::Bbox_2 grown(const CGAL::Bbox_2& b, double r) {
+    return {b.xmin() - r, b.ymin() - r, b.xmax() + r, b.ymax() + r};
+}
+
+// Smallest corner angle of a 3D triangle (radians); 0 for degenerate ones.
+double minAngle(const Vec3& a, const Vec3& b, const Vec3& c) {
+    const Vec3 e[3] = {b - a, c - b, a - c};
+    double best = std::numbers::pi;
+    for (int i = 0; i < 3; ++i) {
+        const Vec3 u = -e[(i + 2) % 3], v = e[i];
+        const double nu = u.norm(), nv = v.norm();
+        if (!(nu > 0) || !(nv > 0)) return 0;
+        best = std::min(best, std::atan2(u.cross(v).norm(), u.dot(v)));
+    }
+    return best;
+}
+Vec3 normalOf(const Vec3& a, const Vec3& b, const Vec3& c) { return (b - a).cross(c - a); }
+double angleBetween(const Vec3& n1, const Vec3& n2) { return std::atan2(n1.cross(n2).norm(), n1.dot(n2)); }
+
+
+// ---------------------------------------------------------------------------------------------------
+// The scan's view: projection to a 2D plane where front-facing triangles are counter-clockwise.
+// uv = (screen x, −screen y); the screen's y axis points down.
+class View {
+public:
+    explicit View(const Camera& c) : cam_(c), vp_(c.viewProjectionMatrix()), dir_(c.viewDirection()) {}
+
+    // False for points behind the eye (or not finite).
+    bool project(const Vec3& p, Point2& uv, double& w) const {
+        const Eigen::Vector4d clip = vp_ * p.homogeneous();
+        w = clip.w();
+        if (!(w > 0) || !clip.allFinite()) return false;
+        const double sx = (clip.x() / w + 1.0) * 0.5 * cam_.width;
+        const double sy = (1.0 - clip.y() / w) * 0.5 * cam_.height;
+        if (!std::isfinite(sx) || !std::isfinite(sy)) return false;
+        uv = Point2(sx, -sy);
+        return true;
+    }
+    // Unit vector from p towards the viewer.
+    Vec3 towardsViewer(const Vec3& p) const {
+        return cam_.parallel ? Vec3(-dir_) : Vec3((cam_.eye - p).normalized());
+    }
+    // The view ray through p.
+    void rayThrough(const Vec3& p, Vec3& origin, Vec3& direction) const {
+        if (cam_.parallel) {
+            origin = p;
+            direction = dir_;
+        } else {
+            origin = cam_.eye;
+            direction = (p - cam_.eye).normalized();
+        }
+    }
+    // 3D parameter along an edge from u (clip w = wu) to w (clip w = ww) of the point whose projection is
+    // at 2D parameter s along the projected edge (perspective-correct: 1/w is affine on the screen).
+    static double perspectiveParam(double s, double wu, double ww) {
+        const double a = s / ww, b = (1.0 - s) / wu;
+        const double t = a / (a + b);
+        return std::isfinite(t) ? std::clamp(t, 0.0, 1.0) : s;
+    }
+    const Camera& camera() const { return cam_; }
+
+private:
+    Camera cam_;
+    Eigen::Matrix4d vp_;
+    Vec3 dir_;
+};
+
+// ---------------------------------------------------------------------------------------------------
+// Uniform bucket grid over 2D boxes; queries report each id once.
+class BucketGrid {
+public:
+    BucketGrid() = default;
+    BucketGrid(double cell, std::size_t ids) : inv_(1.0 / cell), stamp_(ids, 0) {}
+
+    void insert(int id, const CGAL::Bbox_2& b) {
+        forCells(b, [&](std::uint64_t key) { cells_[key].push_back(id); });
+    }
+    template <class F> void query(const CGAL::Bbox_2& b, F&& f) {
+        ++current_;
+        forCells(b, [&](std::uint64_t key) {
+            auto it = cells_.find(key);
+            if (it == cells_.end()) return;
+            for (int id : it->second)
+                if (stamp_[std::size_t(id)] != current_) {
+                    stamp_[std::size_t(id)] = current_;
+                    f(id);
+                }
+        });
+    }
+
+private:
+    template <class F> void forCells(const CGAL::Bbox_2& b, F&& f) const {
+        const auto x0 = std::int64_t(std::floor(b.xmin() * inv_)), x1 = std::int64_t(std::floor(b.xmax() * inv_));
+        const auto y0 = std::int64_t(std::floor(b.ymin() * inv_)), y1 = std::int64_t(std::floor(b.ymax() * inv_));
+        for (std::int64_t x = x0; x <= x1; ++x)
+            for (std::int64_t y = y0; y <= y1; ++y)
+                f((std::uint64_t(std::uint32_t(x)) << 32) | std::uint32_t(y));
+    }
+    double inv_ = 1.0;
+    std::unordered_map<std::uint64_t, std::vector<int>> cells_;
+    std::vector<unsigned> stamp_;
+    unsigned current_ = 0;
+};
+
+// ---------------------------------------------------------------------------------------------------
+// The patch, projected once.
+struct PatchData {
+    std::vector<Vec3> pos;
+    std::vector<Point2> uv;
+    std::vector<double> w;
+    std::vector<std::array<int, 3>> tri; // counter-clockwise in the view
+    std::vector<float> quality;
+    std::vector<std::int32_t> scanId;
+    bool hasQuality = false, hasScanId = false;
+};
+
+// ---------------------------------------------------------------------------------------------------
+// Removes face f like CGAL::Euler::remove_face, but keeps the vertices for which keep(v) is true when
+// they become isolated (they are reused by the faces added next).
+template <class Keep> void removeFaceKeeping(Mesh& m, FaceIndex f, const Keep& keep) {
+    HalfedgeIndex h = m.halfedge(f);
+    const HalfedgeIndex end = h;
+    do {
+        CGAL::internal::set_border(h, m);
+        const HalfedgeIndex nh = m.next(h);
+        const bool hBorder = m.is_border(m.opposite(h));
+        const bool nhBorder = m.is_border(m.opposite(nh));
+        if (hBorder && nhBorder && m.next(m.opposite(nh)) == m.opposite(h)) {
+            const VertexIndex v = m.target(h);
+            if (keep(v))
+                m.set_halfedge(v, Mesh::null_halfedge());
+            else
+                m.remove_vertex(v);
+            if (h != end) m.remove_edge(m.edge(h));
+        } else {
+            if (nhBorder) {
+                CGAL::internal::set_vertex_halfedge(m.opposite(m.next(m.opposite(nh))), m);
+                CGAL::internal::remove_tip(h, m);
+            }
+            if (hBorder) {
+                CGAL::internal::set_vertex_halfedge(m.opposite(m.next(h)), m);
+                CGAL::internal::remove_tip(m.prev(m.opposite(h)), m);
+                if (h != end) m.remove_edge(m.edge(h));
+            }
+        }
+        h = nh;
+    } while (h != end);
+    m.remove_face(f);
+    if (m.is_border(m.opposite(h))) m.remove_edge(m.edge(h));
+}
+
+// ---------------------------------------------------------------------------------------------------
+// A vertex of a plan: an existing vertex of the current mesh or the k-th new one.
+struct PlanVertex {
+    std::uint32_t index = 0;
+    bool fresh = false;
+};
+
+// Everything needed to apply one component's stitch to the mesh, computed without touching it.
+struct Plan {
+    std::vector<FaceIndex> removed;                  // faces of the current mesh replaced (in this order)
+    std::vector<VertexIndex> reused;                 // vertices of removed faces that new faces use
+    std::vector<Vec3> freshPositions;                // new vertices, added in this order
+    std::vector<std::array<PlanVertex, 3>> faces;    // new faces, added in this order
+    std::vector<float> quality;
+    std::vector<std::int32_t> scanId;
+    std::size_t seamEdges = 0;
+    double seamLength = 0;
+    std::vector<double> seamFaceMinAngles;           // degrees, one per face touching the seam
+    std::size_t collapses = 0, flips = 0;
+};
+
+struct Attempt {
+    bool ok = false;
+    std::string reason;   // why not (without the component's name), when !ok
+    std::vector<int> bad; // patch vertices near the problem: trim there and retry
+    Plan plan;
+};
+
+// Applies the edits of a plan to a mesh whose vertices are addressed through `vertexOf` (current
+// vertices → vertices of m) and whose faces through `faceOf`. Returns false when a face cannot be added.
+template <class VertexOf, class FaceOf, class OnFace>
+bool replay(Mesh& m, const Plan& plan, const VertexOf& vertexOf, const FaceOf& faceOf, const OnFace& onFace) {
+    std::vector<VertexIndex> fresh;
+    fresh.reserve(plan.freshPositions.size());
+    for (const Vec3& p : plan.freshPositions) fresh.push_back(m.add_vertex(toPoint(p)));
+    std::unordered_set<std::uint32_t> keep;
+    for (VertexIndex v : plan.reused) keep.insert(std::uint32_t(vertexOf(v)));
+    for (FaceIndex f : plan.removed)
+        removeFaceKeeping(m, faceOf(f), [&](VertexIndex v) { return keep.count(std::uint32_t(v)) > 0; });
+    for (std::size_t i = 0; i < plan.faces.size(); ++i) {
+        std::array<VertexIndex, 3> vs;
+        for (int k = 0; k < 3; ++k) {
+            const PlanVertex& pv = plan.faces[i][std::size_t(k)];
+            vs[std::size_t(k)] = pv.fresh ? fresh[pv.index] : vertexOf(VertexIndex(pv.index));
+        }
+        const FaceIndex f = m.add_face(vs[0], vs[1], vs[2]);
+        if (f == Mesh::null_face()) return false;
+        onFace(i, f);
+    }
+    return true;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// The star of a set of faces of the current mesh (all faces sharing a vertex with them), copied into a
+// small local mesh on which the stitch is built, optimised, checked and rehearsed.
+struct Star {
+    Mesh S;
+    std::unordered_map<std::uint32_t, VertexIndex> fromCurrent;  // current vertex → S vertex
+    std::unordered_map<std::uint32_t, FaceIndex> faceFromCurrent; // current face → S face
+    Mesh::Property_map<VertexIndex, std::uint32_t> cur;          // S vertex → current vertex (kNone: new)
+    Mesh::Property_map<FaceIndex, bool> kept;                    // face of the current mesh that stays
+    std::vector<VertexIndex> full; // S vertices whose whole star is in S (vertices of the replaced faces)
+};
+
+bool buildStar(const Mesh& M, const std::vector<FaceIndex>& replaced, Star& st) {
+    st.cur = st.S.add_property_map<VertexIndex, std::uint32_t>("v:cur", kNone).first;
+    st.kept = st.S.add_property_map<FaceIndex, bool>("f:kept", true).first;
+    std::vector<FaceIndex> faces;
+    std::unordered_set<std::uint32_t> seenFace, seenVertex;
+    std::vector<VertexIndex> centre;
+    for (FaceIndex f : replaced)
+        for (VertexIndex v : CGAL::vertices_around_face(M.halfedge(f), M))
+            if (seenVertex.insert(std::uint32_t(v)).second) centre.push_back(v);
+    for (VertexIndex v : centre)
+        for (FaceIndex f : CGAL::faces_around_target(M.halfedge(v), M))
+            if (f != Mesh::null_face() && seenFace.insert(std::uint32_t(f)).second) faces.push_back(f);
+    auto vertexOf = [&](VertexIndex v) {
+        auto [it, fresh] = st.fromCurrent.try_emplace(std::uint32_t(v));
+        if (fresh) {
+            it->second = st.S.add_vertex(M.point(v));
+            st.cur[it->second] = std::uint32_t(v);
+        }
+        return it->second;
+    };
+    for (FaceIndex f : faces) {
+        std::array<VertexIndex, 3> vs;
+        int k = 0;
+        for (VertexIndex v : CGAL::vertices_around_face(M.halfedge(f), M)) {
+            if (k == 3) return false;
+            vs[std::size_t(k++)] = vertexOf(v);
+        }
+        if (k != 3) return false;
+        const FaceIndex g = st.S.add_face(vs[0], vs[1], vs[2]);
+        if (g == Mesh::null_face()) return false;
+        st.faceFromCurrent[std::uint32_t(f)] = g;
+    }
+    for (VertexIndex v : centre) {
+        const VertexIndex s = st.fromCurrent.at(std::uint32_t(v));
+        // The whole umbrella must have been copied (else the mesh is not vertex-manifold here).
+        if (st.S.degree(s) != M.degree(v) || st.S.is_border(s) != M.is_border(v)) return false;
+        st.full.push_back(s);
+    }
+    return true;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Constrained Delaunay triangulation of the view.
+struct CdtFaceInfo {
+    int region = -1;       // index of the region face the triangle lies in
+    std::int8_t inside = -1; // 1 inside the patch, 0 outside, -1 unknown
+};
+struct CdtVertexInfo {
+    int id = -1; // local vertex id; -1 for a vertex the triangulation made itself
+};
+using CdtVb = CGAL::Triangulation_vertex_base_with_info_2<CdtVertexInfo, Kernel>;
+using CdtFb = CGAL::Triangulation_face_base_with_info_2<CdtFaceInfo, Kernel,
+                                                        CGAL::Constrained_triangulation_face_base_2<Kernel>>;
+using CdtTds = CGAL::Triangulation_data_structure_2<CdtVb, CdtFb>;
+using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Kernel, CdtTds, CGAL::Exact_predicates_tag>;
+using CdtVertex = Cdt::Vertex_handle;
+using CdtFace = Cdt::Face_handle;
+
+// A vertex of the local problem.
+struct LVert {
+    enum Kind : std::uint8_t { Region, PatchBoundary, Crossing, PatchInterior };
+    Kind kind = Region;
+    std::uint32_t cur = kNone; // Region: the current-mesh vertex
+    int patchA = -1, patchB = -1; // the patch vertex it stands for, or the patch boundary edge it lies on
+    bool alive = true;         // false for patch boundary vertices merged into a region vertex
+    bool chain = false;        // lies on the patch boundary (a seam vertex)
+    Vec3 pos{0, 0, 0};
+    Point2 uv{0, 0};
+};
+
+// A face of the stitched result in local vertex ids.
+struct LFace {
+    std::array<int, 3> v;
+    float quality;
+    std::int32_t scanId;
+    bool patchSide; // a patch face (or a piece of one); else a piece of a mesh face outside the patch
+    Vec3 planeNormal{0, 0, 0}; // pieces outside: unit normal of the mesh face they lie in
+};
+
+// ---------------------------------------------------------------------------------------------------
+class ComponentStitcher {
+public:
+    ComponentStitcher(const Mesh& m, const PatchData& p, const View& view, const StitchOptions& o,
+                      std::span<const std::uint32_t> ids, const std::vector<int>& faces, bool hasQuality,
+                      bool hasScanId)
+        : M_(m), P_(p), V_(view), O_(o), ids_(ids), faces_(faces), curHasQuality_(hasQuality),
+          curHasScanId_(hasScanId) {
+        if (hasQuality) curQuality_ = M_.property_map<FaceIndex, float>(props::faceQuality).first;
+        if (hasScanId) curScanId_ = M_.property_map<FaceIndex, std::int32_t>(props::faceScanId).first;
+    }
+
+    Attempt run() {
+        Attempt a;
+        if (!setupComponent(a)) return a;
+        if (!findRegion(a)) return a;
+        if (!preTrim(a)) return a;
+        if (!splitRegion(a)) return a;
+        buildLocalVertices();
+        snap();
+        pruneEdgeSnaps();
+        if (!computeCrossings(a)) return a;
+        Cdt cdt;
+        std::vector<CdtVertex> vh;
+        if (!triangulate(cdt, vh, a)) return a;
+        if (!classify(cdt, vh, a)) return a;
+        if (!checkCoverage(cdt, vh, a)) return a;
+        if (!assemble(cdt, a)) return a;
+        if (!buildAndOptimise(a)) return a;
+        a.ok = true;
+        return a;
+    }
+
+private:
+    // ---- results of the steps
+    bool fail(Attempt& a, std::string reason, std::vector<int> bad = {}) {
+        a.ok = false;
+        a.reason = std::move(reason);
+        std::sort(bad.begin(), bad.end());
+        bad.erase(std::unique(bad.begin(), bad.end()), bad.end());
+        bad.erase(std::remove(bad.begin(), bad.end(), -1), bad.end());
+        a.bad = std::move(bad);
+        return false;
+    }
+
+    // ---- step 0: the component's boundary, sizes and a grid over its triangles
+    bool setupComponent(Attempt& a) {
+        std::unordered_set<std::uint64_t> directed;
+        for (int f : faces_) {
+            const auto& t = P_.tri[std::size_t(f)];
+            for (int k = 0; k < 3; ++k) directed.insert(dirKey(std::uint32_t(t[std::size_t(k)]), std::uint32_t(t[std::size_t((k + 1) % 3)])));
+        }
+        std::vector<double> len2, len3;
+        for (int f : faces_) {
+            const auto& t = P_.tri[std::size_t(f)];
+            for (int k = 0; k < 3; ++k) {
+                const int p = t[std::size_t(k)], q = t[std::size_t((k + 1) % 3)];
+                vertexFaces_[p].push_back(f);
+                const bool border = !directed.count(dirKey(std::uint32_t(q), std::uint32_t(p)));
+                if (border) {
+                    pedgeIndex_[dirKey(std::uint32_t(p), std::uint32_t(q))] = int(pedges_.size());
+                    pedges_.push_back({p, q, t[std::size_t((k + 2) % 3)], {}, {}});
+                    boundary_.insert(p);
+                }
+                if (border || p < q) {
+                    len2.push_back(std::sqrt(dist2(P_.uv[std::size_t(p)], P_.uv[std::size_t(q)])));
+                    len3.push_back((P_.pos[std::size_t(p)] - P_.pos[std::size_t(q)]).norm());
+                }
+            }
+        }
+        if (pedges_.empty()) return fail(a, "it has no boundary in the scan's view (it would cover the whole view)");
+        auto median = [](std::vector<double> v) {
+            std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+            return v[v.size() / 2];
+        };
+        h2_ = median(len2);
+        h3_ = median(len3);
+        if (!(h2_ > 0) || !(h3_ > 0)) return fail(a, "its triangles have no extent in the scan's view");
+        for (const auto& e : pedges_) {
+            const double l = std::sqrt(dist2(P_.uv[std::size_t(e.a)], P_.uv[std::size_t(e.b)]));
+            for (int v : {e.a, e.b}) {
+                auto [it, fresh] = snapRadius_.try_emplace(v, l);
+                if (!fresh) it->second = std::min(it->second, l);
+            }
+        }
+        for (auto& [v, r] : snapRadius_) {
+            r *= O_.collapseEdgeRatio;
+            margin_ = std::max(margin_, r);
+        }
+        margin_ *= 1.01;
+        compBox_ = CGAL::Bbox_2();
+        for (const auto& [v, fs] : vertexFaces_) compBox_ += P_.uv[std::size_t(v)].bbox();
+        compGrid_ = BucketGrid(2.0 * h2_, faces_.size());
+        for (std::size_t i = 0; i < faces_.size(); ++i) compGrid_.insert(int(i), triBox(faces_[i]));
+        return true;
+    }
+    CGAL::Bbox_2 triBox(int f) const {
+        const auto& t = P_.tri[std::size_t(f)];
+        return bboxOf(P_.uv[std::size_t(t[0])], P_.uv[std::size_t(t[1])], P_.uv[std::size_t(t[2])]);
+    }
+    Triangle2 patchTriangle(int f) const {
+        const auto& t = P_.tri[std::size_t(f)];
+        return {P_.uv[std::size_t(t[0])], P_.uv[std::size_t(t[1])], P_.uv[std::size_t(t[2])]};
+    }
+    // Patch vertices of the component near a point of the view (for trimming there).
+    std::vector<int> patchVerticesNear(const Point2& q, double radius) {
+        std::vector<int> out;
+        const CGAL::Bbox_2 box = grown(q.bbox(), radius);
+        compGrid_.query(box, [&](int i) {
+            if (CGAL::do_overlap(box, triBox(faces_[std::size_t(i)])))
+                for (int v : P_.tri[std::size_t(faces_[std::size_t(i)])]) out.push_back(v);
+        });
+        return out;
+    }
+    void addNear(std::vector<int>& bad, const Point2& q) {
+        auto near = patchVerticesNear(q, 1.5 * h2_);
+        bad.insert(bad.end(), near.begin(), near.end());
+    }
+    // Patch vertices to trim for a problem at local vertex i.
+    void addBad(std::vector<int>& bad, int i) {
+        const LVert& l = L_[std::size_t(i)];
+        if (l.patchA >= 0 || l.patchB >= 0) {
+            bad.push_back(l.patchA);
+            bad.push_back(l.patchB);
+        } else {
+            addNear(bad, l.uv);
+        }
+    }
+
+    // ---- the current mesh in the view (cached per vertex / face)
+    struct VProj {
+        Point2 uv;
+        double w = 0;
+        bool ok = false;
+    };
+    const VProj& vproj(VertexIndex v) {
+        auto [it, fresh] = vcache_.try_emplace(std::uint32_t(v));
+        if (fresh) it->second.ok = V_.project(toVec(M_.point(v)), it->second.uv, it->second.w);
+        return it->second;
+    }
+    // Triangle face, in front of the eye, counter-clockwise in the view and not grazing.
+    bool acceptable(FaceIndex f) {
+        auto [it, fresh] = accept_.try_emplace(std::uint32_t(f), false);
+        if (!fresh) return it->second;
+        const HalfedgeIndex h = M_.halfedge(f);
+        if (M_.next(M_.next(M_.next(h))) != h) return false;
+        const VertexIndex a = M_.source(h), b = M_.target(h), c = M_.target(M_.next(h));
+        const VProj &pa = vproj(a), &pb = vproj(b), &pc = vproj(c);
+        if (!pa.ok || !pb.ok || !pc.ok || !leftTurn(pa.uv, pb.uv, pc.uv)) return false;
+        const Vec3 A = toVec(M_.point(a)), B = toVec(M_.point(b)), C = toVec(M_.point(c));
+        const Vec3 n = normalOf(A, B, C);
+        if (!(n.norm() > 0)) return false;
+        const double cosView = n.normalized().dot(V_.towardsViewer((A + B + C) / 3.0));
+        it->second = cosView >= std::cos(O_.maxViewAngleDeg * kDeg);
+        return it->second;
+    }
+    std::array<VertexIndex, 3> faceVertices(FaceIndex f) const {
+        const HalfedgeIndex h = M_.halfedge(f);
+        return {M_.source(h), M_.target(h), M_.target(M_.next(h))};
+    }
+    Triangle2 faceTriangle(FaceIndex f) {
+        const auto v = faceVertices(f);
+        return {vproj(v[0]).uv, vproj(v[1]).uv, vproj(v[2]).uv};
+    }
+    // Distance from patch vertex point p to the plane of face f along p's view ray.
+    double gapTo(const Vec3& p, FaceIndex f) const {
+        const auto v = faceVertices(f);
+        const Vec3 A = toVec(M_.point(v[0])), B = toVec(M_.point(v[1])), C = toVec(M_.point(v[2]));
+        const Vec3 n = normalOf(A, B, C);
+        Vec3 o, d;
+        V_.rayThrough(p, o, d);
+        const double den = n.dot(d);
+        if (!(std::abs(den) > 0)) return std::numeric_limits<double>::infinity();
+        const Vec3 q = o + d * (n.dot(A - o) / den);
+        return (p - q).norm();
+    }
+    double longestEdge(FaceIndex f) const {
+        const auto v = faceVertices(f);
+        double l = 0;
+        for (int k = 0; k < 3; ++k)
+            l = std::max(l, std::sqrt(CGAL::squared_distance(M_.point(v[std::size_t(k)]), M_.point(v[std::size_t((k + 1) % 3)]))));
+        return l;
+    }
+    // Does face f meet the component in the view, or come closer to it than snapping can move things?
+    bool meetsComponent(FaceIndex f) {
+        const Triangle2 t = faceTriangle(f);
+        const double r2 = margin_ * margin_;
+        bool hit = false;
+        compGrid_.query(grown(t.bbox(), margin_), [&](int i) {
+            if (hit) return;
+            const Triangle2 p = patchTriangle(faces_[std::size_t(i)]);
+            hit = CGAL::do_intersect(t, p) || CGAL::squared_distance(t, p) <= r2;
+        });
+        return hit;
+    }
+
+    // ---- step 1: the region under the component
+    void candidatesAt(const Point2& uv, std::vector<FaceIndex>& out) {
+        out.clear();
+        if (!ids_.empty()) {
+            const int W = V_.camera().width, H = V_.camera().height;
+            const int px = int(std::floor(uv.x())), py = int(std::floor(-uv.y()));
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int x = px + dx, y = py + dy;
+                    if (x < 0 || y < 0 || x >= W || y >= H) continue;
+                    const std::uint32_t id = ids_[std::size_t(y) * std::size_t(W) + std::size_t(x)];
+                    if (id == kNone) continue;
+                    const FaceIndex f(id);
+                    if (!M_.has_valid_index(f) || M_.is_removed(f)) continue;
+                    if (std::find(out.begin(), out.end(), f) == out.end()) out.push_back(f);
+                }
+            return;
+        }
+        if (!fallbackBuilt_) buildFallback();
+        fallbackGrid_.query(uv.bbox(), [&](int i) { out.push_back(fallback_[std::size_t(i)]); });
+    }
+    // O(mesh): all faces whose view bounding box meets the component's.
+    void buildFallback() {
+        fallbackBuilt_ = true;
+        const CGAL::Bbox_2 box = grown(compBox_, 2.0 * h2_);
+        std::vector<CGAL::Bbox_2> boxes;
+        for (FaceIndex f : M_.faces()) {
+            const HalfedgeIndex h = M_.halfedge(f);
+            Point2 uv[3];
+            double w;
+            bool ok = true;
+            int k = 0;
+            for (VertexIndex v : CGAL::vertices_around_face(h, M_)) {
+                if (k == 3 || !V_.project(toVec(M_.point(v)), uv[k], w)) {
+                    ok = false;
+                    break;
+                }
+                ++k;
+            }
+            if (!ok || k != 3) continue;
+            const CGAL::Bbox_2 fb = bboxOf(uv[0], uv[1], uv[2]);
+            if (!CGAL::do_overlap(fb, box) || !leftTurn(uv[0], uv[1], uv[2])) continue;
+            fallback_.push_back(f);
+            boxes.push_back(fb);
+        }
+        const double cell = std::max(4.0 * h2_, std::max(box.xmax() - box.xmin(), box.ymax() - box.ymin()) / 64.0);
+        fallbackGrid_ = BucketGrid(cell, fallback_.size());
+        for (std::size_t i = 0; i < fallback_.size(); ++i) fallbackGrid_.insert(int(i), boxes[i]);
+    }
+    bool findRegion(Attempt& a) {
+        // Seeds: under every boundary vertex and a sample of the interior, the acceptable face containing
+        // the vertex in the view whose plane is nearest to it along the view ray.
+        std::vector<int> samples(boundary_.begin(), boundary_.end());
+        std::sort(samples.begin(), samples.end());
+        {
+            std::vector<int> interior;
+            for (const auto& [v, fs] : vertexFaces_)
+                if (!boundary_.count(v)) interior.push_back(v);
+            std::sort(interior.begin(), interior.end());
+            const std::size_t stride = std::max<std::size_t>(1, interior.size() / 2048);
+            for (std::size_t i = 0; i < interior.size(); i += stride) samples.push_back(interior[i]);
+        }
+        std::vector<FaceIndex> seeds, cands;
+        for (int pass = 0; pass < 2 && seeds.empty(); ++pass) {
+            if (pass == 1) {
+                if (ids_.empty()) break;
+                ids_ = {}; // the ID buffer found nothing valid (stale after earlier components): fall back
+            }
+            for (int v : samples) {
+                const Point2& uv = P_.uv[std::size_t(v)];
+                candidatesAt(uv, cands);
+                FaceIndex best;
+                double bestGap = std::numeric_limits<double>::infinity();
+                for (FaceIndex f : cands) {
+                    if (!acceptable(f)) continue;
+                    const Triangle2 t = faceTriangle(f);
+                    if (!inTriangle(uv, t[0], t[1], t[2])) continue;
+                    const double g = gapTo(P_.pos[std::size_t(v)], f);
+                    if (g < bestGap) {
+                        bestGap = g;
+                        best = f;
+                    }
+                }
+                if (best != FaceIndex()) seeds.push_back(best);
+            }
+        }
+        if (seeds.empty()) return fail(a, "no visible face of the mesh lies under it in the scan's view");
+        // Grow over faces sharing a vertex, keeping the acceptable ones that meet the component in the view.
+        std::unordered_set<std::uint32_t> visited;
+        std::vector<FaceIndex> stack;
+        for (FaceIndex f : seeds)
+            if (visited.insert(std::uint32_t(f)).second) stack.push_back(f);
+        while (!stack.empty()) {
+            const FaceIndex f = stack.back();
+            stack.pop_back();
+            if (!acceptable(f) || !meetsComponent(f)) continue;
+            regionIndex_[std::uint32_t(f)] = int(region_.size());
+            region_.push_back(f);
+            for (VertexIndex v : faceVertices(f))
+                for (FaceIndex g : CGAL::faces_around_target(M_.halfedge(v), M_))
+                    if (g != Mesh::null_face() && visited.insert(std::uint32_t(g)).second) stack.push_back(g);
+        }
+        if (region_.empty()) return fail(a, "no visible face of the mesh lies under it in the scan's view");
+        return true;
+    }
+
+    // ---- step 1b: every patch vertex must lie over the region (else trim there)
+    bool preTrim(Attempt& a) {
+        double edge = 0;
+        for (FaceIndex f : region_) {
+            const Triangle2 t = faceTriangle(f);
+            edge += std::sqrt(dist2(t[0], t[1]));
+        }
+        edge /= double(region_.size());
+        regionGrid_ = BucketGrid(std::max(2.0 * h2_, edge), region_.size());
+        for (std::size_t i = 0; i < region_.size(); ++i) regionGrid_.insert(int(i), faceTriangle(region_[i]).bbox());
+        std::vector<int> bad;
+        for (const auto& [v, fs] : vertexFaces_) {
+            const Point2& uv = P_.uv[std::size_t(v)];
+            bool inside = false;
+            regionGrid_.query(uv.bbox(), [&](int i) {
+                if (inside) return;
+                const Triangle2 t = faceTriangle(region_[std::size_t(i)]);
+                inside = inTriangle(uv, t[0], t[1], t[2]);
+            });
+            if (!inside) bad.push_back(v);
+        }
+        if (!bad.empty()) return fail(a, "it reaches past the visible part of the mesh", std::move(bad));
+        return true;
+    }
+
+    // ---- step 1c: seam faces (near the patch boundary: re-triangulated in the view) and faces under the
+    // patch (removed whole, whatever their orientation, so folds under the patch go too)
+    bool insidePatch(const Point2& p) {
+        bool in = false;
+        compGrid_.query(p.bbox(), [&](int i) {
+            if (in) return;
+            const Triangle2 t = patchTriangle(faces_[std::size_t(i)]);
+            in = inTriangle(p, t[0], t[1], t[2]);
+        });
+        return in;
+    }
+    // Do the interiors of two (counter-clockwise) faces overlap in the view? Separating-axis test on
+    // their edges with exact orientations: disjoint interiors iff one triangle lies on the closed outer
+    // side of an edge of the other.
+    bool interiorsOverlap(FaceIndex f, FaceIndex g) {
+        const Triangle2 s = faceTriangle(f), t = faceTriangle(g);
+        for (const auto& [x, y] : {std::pair{&s, &t}, std::pair{&t, &s}})
+            for (int k = 0; k < 3; ++k) {
+                const Point2 &p = (*x)[k], &q = (*x)[(k + 1) % 3];
+                if (CGAL::orientation(p, q, (*y)[0]) != CGAL::LEFT_TURN && CGAL::orientation(p, q, (*y)[1]) != CGAL::LEFT_TURN &&
+                    CGAL::orientation(p, q, (*y)[2]) != CGAL::LEFT_TURN)
+                    return false;
+            }
+        return true;
+    }
+    bool splitRegion(Attempt& a) {
+        BucketGrid segments(2.0 * h2_, pedges_.size());
+        for (std::size_t i = 0; i < pedges_.size(); ++i)
+            segments.insert(int(i), bboxOf(P_.uv[std::size_t(pedges_[i].a)], P_.uv[std::size_t(pedges_[i].b)]));
+        const double reach2 = margin_ * margin_; // the snapping distance
+        std::vector<FaceIndex> seam;
+        std::vector<FaceIndex> stack;
+        std::unordered_set<std::uint32_t> isSeam, isInterior;
+        for (FaceIndex f : region_) {
+            const Triangle2 t = faceTriangle(f);
+            bool near = false;
+            segments.query(grown(t.bbox(), margin_), [&](int i) {
+                if (near) return;
+                const Segment2 e(P_.uv[std::size_t(pedges_[std::size_t(i)].a)], P_.uv[std::size_t(pedges_[std::size_t(i)].b)]);
+                near = CGAL::do_intersect(t, e) || CGAL::squared_distance(t, e) <= reach2;
+            });
+            if (near) {
+                seam.push_back(f);
+                isSeam.insert(std::uint32_t(f));
+            } else if (insidePatch(CGAL::centroid(t))) {
+                isInterior.insert(std::uint32_t(f));
+                stack.push_back(f);
+            }
+        }
+        std::vector<int> bad;
+        // Folds: front-facing faces overlapping in the view (a step of the mesh seen obliquely). Under the
+        // patch they are simply replaced; where the patch boundary crosses them there is no height field
+        // to cut, so the patch is cut back around every fold that reaches its boundary.
+        {
+            std::vector<int> parent(region_.size());
+            for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = int(i);
+            auto find = [&](int x) {
+                while (parent[std::size_t(x)] != x) x = parent[std::size_t(x)] = parent[std::size_t(parent[std::size_t(x)])];
+                return x;
+            };
+            std::vector<char> folded(region_.size(), 0);
+            for (std::size_t i = 0; i < region_.size(); ++i) {
+                const Triangle2 t = faceTriangle(region_[i]);
+                regionGrid_.query(t.bbox(), [&](int j) {
+                    if (j <= int(i)) return;
+                    if (!interiorsOverlap(region_[i], region_[std::size_t(j)])) return;
+                    folded[i] = folded[std::size_t(j)] = 1;
+                    parent[std::size_t(find(j))] = find(int(i));
+                });
+            }
+            std::unordered_map<int, bool> clusterAtSeam;
+            for (std::size_t i = 0; i < region_.size(); ++i)
+                if (folded[i] && isSeam.count(std::uint32_t(region_[i]))) clusterAtSeam[find(int(i))] = true;
+            for (std::size_t i = 0; i < region_.size(); ++i) {
+                if (!folded[i] || !clusterAtSeam.count(find(int(i)))) continue;
+                const Triangle2 t = faceTriangle(region_[i]);
+                const double r = margin_ + h2_;
+                compGrid_.query(grown(t.bbox(), r), [&](int k) {
+                    const Triangle2 p = patchTriangle(faces_[std::size_t(k)]);
+                    if (CGAL::do_intersect(t, p) || CGAL::squared_distance(t, p) <= r * r)
+                        for (int v : P_.tri[std::size_t(faces_[std::size_t(k)])]) bad.push_back(v);
+                });
+            }
+            if (!bad.empty()) return fail(a, "the mesh under its boundary folds over itself in the scan's view", std::move(bad));
+        }
+        // Faces connected to the interior ones, away from the seam, lying under the patch in the view.
+        while (!stack.empty()) {
+            const FaceIndex f = stack.back();
+            stack.pop_back();
+            interior_.push_back(f);
+            for (HalfedgeIndex h : CGAL::halfedges_around_face(M_.halfedge(f), M_)) {
+                const FaceIndex g = M_.face(M_.opposite(h));
+                if (g == Mesh::null_face()) {
+                    addNear(bad, vproj(M_.target(h)).uv); // the mesh's border under the patch
+                    continue;
+                }
+                if (isSeam.count(std::uint32_t(g)) || isInterior.count(std::uint32_t(g))) continue;
+                bool under = true;
+                for (VertexIndex v : CGAL::vertices_around_face(M_.halfedge(g), M_)) {
+                    const VProj& p = vproj(v);
+                    if (!p.ok || !insidePatch(p.uv)) under = false;
+                }
+                if (!under) {
+                    addNear(bad, vproj(M_.target(h)).uv); // a face reaching out without a seam: a fold, a hole
+                    continue;
+                }
+                isInterior.insert(std::uint32_t(g));
+                stack.push_back(g);
+            }
+        }
+        if (!bad.empty()) return fail(a, "the mesh under it folds or has a hole in the scan's view", std::move(bad));
+        region_ = std::move(seam);
+        regionIndex_.clear();
+        for (std::size_t i = 0; i < region_.size(); ++i) regionIndex_[std::uint32_t(region_[i])] = int(i);
+        if (region_.empty()) return fail(a, "no visible face of the mesh lies under its boundary");
+        return true;
+    }
+
+    // ---- step 2: local vertices, snapping, crossings
+    int addLocal(LVert l) {
+        L_.push_back(l);
+        return int(L_.size()) - 1;
+    }
+    int regionVertex(VertexIndex v) {
+        auto [it, fresh] = lidOfCurrent_.try_emplace(std::uint32_t(v), -1);
+        if (fresh) {
+            LVert l;
+            l.kind = LVert::Region;
+            l.cur = std::uint32_t(v);
+            l.pos = toVec(M_.point(v));
+            l.uv = vproj(v).uv;
+            it->second = addLocal(l);
+        }
+        return it->second;
+    }
+    void buildLocalVertices() {
+        for (FaceIndex f : region_) {
+            const HalfedgeIndex h0 = M_.halfedge(f);
+            HalfedgeIndex h = h0;
+            do {
+                regionVertex(M_.target(h));
+                h = M_.next(h);
+            } while (h != h0);
+        }
+        for (FaceIndex f : region_) {
+            const HalfedgeIndex h0 = M_.halfedge(f);
+            HalfedgeIndex h = h0;
+            do {
+                const EdgeIndex e = M_.edge(h);
+                if (!redgeIndex_.count(std::uint32_t(e))) {
+                    const HalfedgeIndex he = M_.halfedge(e);
+                    redgeIndex_[std::uint32_t(e)] = int(redges_.size());
+                    redges_.push_back({regionVertex(M_.source(he)), regionVertex(M_.target(he)), e, {}, {}});
+                }
+                h = M_.next(h);
+            } while (h != h0);
+        }
+        std::vector<int> bverts(boundary_.begin(), boundary_.end());
+        std::sort(bverts.begin(), bverts.end());
+        for (int v : bverts) {
+            LVert l;
+            l.kind = LVert::PatchBoundary;
+            l.patchA = v;
+            l.chain = true;
+            l.pos = P_.pos[std::size_t(v)];
+            l.uv = P_.uv[std::size_t(v)];
+            lidOfPatch_[v] = addLocal(l);
+        }
+    }
+    // Would the patch faces around patch vertex v stay counter-clockwise if v moved to uv?
+    bool patchStaysValid(int v, const Point2& uv) const {
+        for (int f : vertexFaces_.at(v)) {
+            const auto& t = P_.tri[std::size_t(f)];
+            Point2 q[3];
+            for (int k = 0; k < 3; ++k) q[k] = t[std::size_t(k)] == v ? uv : L_uvOfPatch(t[std::size_t(k)]);
+            if (!leftTurn(q[0], q[1], q[2])) return false;
+        }
+        return true;
+    }
+    // Current view position of a patch vertex (moved by snapping when on the boundary).
+    Point2 L_uvOfPatch(int v) const {
+        auto it = lidOfPatch_.find(v);
+        return it == lidOfPatch_.end() ? P_.uv[std::size_t(v)] : L_[std::size_t(it->second)].uv;
+    }
+    // Lift a point at 2D parameter s of region edge re onto the 3D mesh edge.
+    void liftOnEdge(int re, double s, Vec3& pos, Point2& uv) {
+        const int u = redges_[std::size_t(re)].u, w = redges_[std::size_t(re)].w;
+        const VProj &pu = vproj(VertexIndex(L_[std::size_t(u)].cur)), &pw = vproj(VertexIndex(L_[std::size_t(w)].cur));
+        const double t = View::perspectiveParam(s, pu.w, pw.w);
+        pos = L_[std::size_t(u)].pos + t * (L_[std::size_t(w)].pos - L_[std::size_t(u)].pos);
+        double wq;
+        if (!V_.project(pos, uv, wq)) uv = Point2(pu.uv.x() + s * (pw.uv.x() - pu.uv.x()), pu.uv.y() + s * (pw.uv.y() - pu.uv.y()));
+    }
+    // A region edge may be split when both its faces are region faces (never a border edge).
+    bool splittable(int re) const {
+        const HalfedgeIndex h = M_.halfedge(redges_[std::size_t(re)].edge);
+        for (HalfedgeIndex g : {h, M_.opposite(h)})
+            if (M_.is_border(g) || !regionIndex_.count(std::uint32_t(M_.face(g)))) return false;
+        return true;
+    }
+    void snap() {
+        const double cell = 2.0 * h2_;
+        // Snapping distances are a fraction of the local edge lengths on both sides, so that snapped
+        // points keep their order and no triangle folds.
+        std::vector<double> regionEdgeMin(L_.size(), std::numeric_limits<double>::infinity());
+        for (const auto& re : redges_) {
+            const double l = std::sqrt(dist2(L_[std::size_t(re.u)].uv, L_[std::size_t(re.w)].uv));
+            for (int v : {re.u, re.w}) regionEdgeMin[std::size_t(v)] = std::min(regionEdgeMin[std::size_t(v)], l);
+        }
+        const double ratio = O_.collapseEdgeRatio;
+        // Rule 1: a patch boundary vertex close to a mesh vertex becomes that vertex.
+        {
+            BucketGrid grid(cell, L_.size());
+            for (std::size_t i = 0; i < L_.size(); ++i)
+                if (L_[i].kind == LVert::Region) grid.insert(int(i), L_[i].uv.bbox());
+            struct Cand {
+                double d;
+                int patch, lid;
+            };
+            std::vector<Cand> cands;
+            for (const auto& [v, lid] : lidOfPatch_) {
+                const double r = snapRadius_.at(v);
+                const Point2 uv = L_[std::size_t(lid)].uv;
+                grid.query(grown(uv.bbox(), r), [&](int i) {
+                    const double d = std::sqrt(dist2(uv, L_[std::size_t(i)].uv));
+                    if (d < std::min(r, ratio * regionEdgeMin[std::size_t(i)])) cands.push_back({d, v, i});
+                });
+            }
+            std::sort(cands.begin(), cands.end(), [](const Cand& x, const Cand& y) {
+                return x.d != y.d ? x.d < y.d : (x.patch != y.patch ? x.patch < y.patch : x.lid < y.lid);
+            });
+            std::unordered_set<int> usedPatch, usedRegion;
+            for (const Cand& c : cands) {
+                if (usedPatch.count(c.patch) || usedRegion.count(c.lid)) continue;
+                if (!patchStaysValid(c.patch, L_[std::size_t(c.lid)].uv)) continue;
+                usedPatch.insert(c.patch);
+                usedRegion.insert(c.lid);
+                const int old = lidOfPatch_.at(c.patch);
+                L_[std::size_t(old)].alive = false;
+                lidOfPatch_[c.patch] = c.lid;
+                L_[std::size_t(c.lid)].patchA = c.patch;
+                L_[std::size_t(c.lid)].chain = true;
+            }
+        }
+        // Rule 2: a patch boundary vertex close to a mesh edge moves onto it (an edge split).
+        {
+            BucketGrid grid(cell, redges_.size());
+            for (std::size_t i = 0; i < redges_.size(); ++i)
+                grid.insert(int(i), bboxOf(L_[std::size_t(redges_[i].u)].uv, L_[std::size_t(redges_[i].w)].uv));
+            std::vector<int> verts;
+            for (const auto& [v, lid] : lidOfPatch_)
+                if (L_[std::size_t(lid)].kind == LVert::PatchBoundary) verts.push_back(v);
+            std::sort(verts.begin(), verts.end());
+            for (int v : verts) {
+                const int lid = lidOfPatch_.at(v);
+                const double r = snapRadius_.at(v);
+                const Point2 uv = L_[std::size_t(lid)].uv;
+                int best = -1;
+                double bestD = r, bestS = 0;
+                grid.query(grown(uv.bbox(), r), [&](int i) {
+                    double s;
+                    const Point2 &U = L_[std::size_t(redges_[std::size_t(i)].u)].uv, &W = L_[std::size_t(redges_[std::size_t(i)].w)].uv;
+                    const double d = segmentDistance(uv, U, W, s);
+                    if (d < bestD && d < ratio * std::sqrt(dist2(U, W)) && s > 1e-3 && s < 1 - 1e-3) {
+                        bestD = d;
+                        best = i;
+                        bestS = s;
+                    }
+                });
+                if (best < 0 || !splittable(best)) continue;
+                Vec3 pos;
+                Point2 q;
+                liftOnEdge(best, bestS, pos, q);
+                if (!patchStaysValid(v, q)) continue;
+                LVert& l = L_[std::size_t(lid)];
+                l.pos = pos;
+                l.uv = q;
+                onEdge_[lid] = best;
+                redges_[std::size_t(best)].splits.push_back({lineParam(q, L_[std::size_t(redges_[std::size_t(best)].u)].uv, L_[std::size_t(redges_[std::size_t(best)].w)].uv), lid});
+            }
+        }
+        // Rule 3: a mesh vertex close to a patch boundary edge splits that edge.
+        {
+            BucketGrid grid(cell, pedges_.size());
+            for (std::size_t i = 0; i < pedges_.size(); ++i) grid.insert(int(i), bboxOf(L_uvOfPatch(pedges_[i].a), L_uvOfPatch(pedges_[i].b)));
+            for (std::size_t i = 0; i < L_.size(); ++i) {
+                LVert& l = L_[i];
+                if (l.kind != LVert::Region || l.chain) continue;
+                int best = -1;
+                double bestRel = 1, bestS = 0;
+                grid.query(grown(l.uv.bbox(), O_.collapseEdgeRatio * 4.0 * h2_), [&](int e) {
+                    const auto& pe = pedges_[std::size_t(e)];
+                    const int la = lidOfPatch_.at(pe.a), lb = lidOfPatch_.at(pe.b);
+                    if (la == int(i) || lb == int(i)) return;
+                    const Point2 &A = L_[std::size_t(la)].uv, &B = L_[std::size_t(lb)].uv;
+                    const double len = std::sqrt(dist2(A, B));
+                    double s;
+                    const double d = segmentDistance(l.uv, A, B, s);
+                    const double rel = d / (ratio * std::min(len, regionEdgeMin[i]));
+                    if (rel < bestRel && s > 1e-3 && s < 1 - 1e-3) {
+                        bestRel = rel;
+                        best = e;
+                        bestS = s;
+                    }
+                });
+                if (best < 0) continue;
+                {
+                    // The patch triangle on that edge must stay a fan of counter-clockwise triangles.
+                    const auto& pe = pedges_[std::size_t(best)];
+                    const Point2 A = L_uvOfPatch(pe.a), B = L_uvOfPatch(pe.b), C = L_uvOfPatch(pe.opposite);
+                    if (!leftTurn(A, l.uv, C) || !leftTurn(l.uv, B, C)) continue;
+                }
+                pedges_[std::size_t(best)].splits.push_back({bestS, int(i)});
+                l.chain = true;
+                l.patchA = pedges_[std::size_t(best)].a;
+                l.patchB = pedges_[std::size_t(best)].b;
+            }
+        }
+    }
+    // Mesh vertices snapped onto a patch boundary edge must leave the patch triangle on it a fan of
+    // counter-clockwise triangles: keep them greedily in order along the edge.
+    void pruneEdgeSnaps() {
+        for (auto& pe : pedges_) {
+            if (pe.splits.empty()) continue;
+            std::sort(pe.splits.begin(), pe.splits.end());
+            const Point2 B = L_uvOfPatch(pe.b), C = L_uvOfPatch(pe.opposite);
+            Point2 prev = L_uvOfPatch(pe.a);
+            std::vector<std::pair<double, int>> kept;
+            for (const auto& sp : pe.splits) {
+                LVert& l = L_[std::size_t(sp.second)];
+                if (leftTurn(prev, l.uv, C) && leftTurn(l.uv, B, C) &&
+                    (kept.empty() || lineParam(l.uv, prev, B) > 0)) {
+                    kept.push_back(sp);
+                    prev = l.uv;
+                } else {
+                    l.chain = false;
+                    l.patchA = l.patchB = -1;
+                }
+            }
+            pe.splits.swap(kept);
+        }
+    }
+    // Polyline (local ids) of a region edge or a patch boundary edge with its splits, sorted.
+    static std::vector<int> polyline(int from, int to, std::vector<std::pair<double, int>> splits) {
+        std::sort(splits.begin(), splits.end());
+        std::vector<int> out{from};
+        for (const auto& s : splits)
+            if (s.second != out.back()) out.push_back(s.second);
+        if (to != out.back()) out.push_back(to);
+        return out;
+    }
+    bool computeCrossings(Attempt& a) {
+        struct Sub {
+            int p, q, owner;
+        };
+        std::vector<Sub> rsubs, psubs;
+        for (std::size_t i = 0; i < redges_.size(); ++i) {
+            const auto pl = polyline(redges_[i].u, redges_[i].w, redges_[i].splits);
+            for (std::size_t k = 0; k + 1 < pl.size(); ++k) rsubs.push_back({pl[k], pl[k + 1], int(i)});
+        }
+        for (std::size_t i = 0; i < pedges_.size(); ++i) {
+            const auto pl = polyline(lidOfPatch_.at(pedges_[i].a), lidOfPatch_.at(pedges_[i].b), pedges_[i].splits);
+            for (std::size_t k = 0; k + 1 < pl.size(); ++k) psubs.push_back({pl[k], pl[k + 1], int(i)});
+        }
+        BucketGrid grid(2.0 * h2_, rsubs.size());
+        for (std::size_t i = 0; i < rsubs.size(); ++i) grid.insert(int(i), bboxOf(L_[std::size_t(rsubs[i].p)].uv, L_[std::size_t(rsubs[i].q)].uv));
+        std::vector<int> bad;
+        for (const Sub& ps : psubs) {
+            const Point2 P = L_[std::size_t(ps.p)].uv, Q = L_[std::size_t(ps.q)].uv;
+            grid.query(bboxOf(P, Q), [&](int ri) {
+                const Sub& rs = rsubs[std::size_t(ri)];
+                if (rs.p == ps.p || rs.p == ps.q || rs.q == ps.p || rs.q == ps.q) return;
+                const Point2 R = L_[std::size_t(rs.p)].uv, S = L_[std::size_t(rs.q)].uv;
+                const auto o1 = CGAL::orientation(P, Q, R), o2 = CGAL::orientation(P, Q, S);
+                const auto o3 = CGAL::orientation(R, S, P), o4 = CGAL::orientation(R, S, Q);
+                if (o1 != CGAL::COLLINEAR && o2 != CGAL::COLLINEAR && o3 != CGAL::COLLINEAR && o4 != CGAL::COLLINEAR) {
+                    if (o1 == o2 || o3 == o4) return; // no crossing
+                    // Proper crossing: intersection in the view, then lifted onto the 3D mesh edge.
+                    const double d = area2(Point2(0, 0), Point2(Q.x() - P.x(), Q.y() - P.y()), Point2(S.x() - R.x(), S.y() - R.y()));
+                    const double t = area2(Point2(0, 0), Point2(R.x() - P.x(), R.y() - P.y()), Point2(S.x() - R.x(), S.y() - R.y())) / d;
+                    const Point2 X(P.x() + t * (Q.x() - P.x()), P.y() + t * (Q.y() - P.y()));
+                    auto& re = redges_[std::size_t(rs.owner)];
+                    const double s = std::clamp(lineParam(X, L_[std::size_t(re.u)].uv, L_[std::size_t(re.w)].uv), 0.0, 1.0);
+                    LVert l;
+                    l.kind = LVert::Crossing;
+                    l.chain = true;
+                    auto& pe = pedges_[std::size_t(ps.owner)];
+                    l.patchA = pe.a;
+                    l.patchB = pe.b;
+                    liftOnEdge(rs.owner, s, l.pos, l.uv);
+                    const int id = addLocal(l);
+                    re.splits.push_back({lineParam(l.uv, L_[std::size_t(re.u)].uv, L_[std::size_t(re.w)].uv), id});
+                    pe.splits.push_back({lineParam(l.uv, L_uvOfPatch(pe.a), L_uvOfPatch(pe.b)), id});
+                    return;
+                }
+                if (CGAL::do_intersect(Segment2(P, Q), Segment2(R, S))) {
+                    // A contact that snapping did not resolve: trim the patch there.
+                    bad.push_back(pedges_[std::size_t(ps.owner)].a);
+                    bad.push_back(pedges_[std::size_t(ps.owner)].b);
+                }
+            });
+        }
+        if (!bad.empty()) return fail(a, "its boundary touches mesh edges in a degenerate way", std::move(bad));
+        for (auto& re : redges_) re.line = polyline(re.u, re.w, re.splits);
+        for (auto& pe : pedges_) pe.line = polyline(lidOfPatch_.at(pe.a), lidOfPatch_.at(pe.b), pe.splits);
+        return true;
+    }
+
+    // ---- step 2b: the constrained triangulation of the view
+    bool triangulate(Cdt& cdt, std::vector<CdtVertex>& vh, Attempt& a) {
+        vh.assign(L_.size(), CdtVertex());
+        std::vector<int> order;
+        for (std::size_t i = 0; i < L_.size(); ++i)
+            if (L_[i].alive) order.push_back(int(i));
+        std::vector<int> bad;
+        CdtFace hint;
+        std::size_t inserted = 0;
+        for (int i : order) {
+            const CdtVertex v = cdt.insert(L_[std::size_t(i)].uv, hint);
+            if (v->info().id >= 0) {
+                addBad(bad, i);
+                addBad(bad, v->info().id);
+                continue;
+            }
+            ++inserted;
+            v->info().id = i;
+            vh[std::size_t(i)] = v;
+            hint = v->face();
+        }
+        if (!bad.empty()) return fail(a, "some of its boundary vertices coincide with mesh vertices in the view", std::move(bad));
+        auto constrain = [&](const std::vector<int>& line) {
+            for (std::size_t k = 0; k + 1 < line.size(); ++k) {
+                const std::size_t p = std::size_t(line[k]), q = std::size_t(line[k + 1]);
+                subEdges_.push_back({line[k], line[k + 1]});
+                cdt.insert_constraint(vh[p], vh[q]);
+            }
+        };
+        for (const auto& re : redges_) constrain(re.line);
+        const std::size_t regionSubs = subEdges_.size();
+        for (const auto& pe : pedges_) constrain(pe.line);
+        if (cdt.number_of_vertices() != inserted) {
+            for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v)
+                if (v->info().id < 0) {
+                    addNear(bad, v->point());
+                    if (std::getenv("FSS_STITCH_DEBUG")) {
+                        std::fprintf(stderr, "  extra vertex at %.17g %.17g\n", v->point().x(), v->point().y());
+                        for (FaceIndex f : region_) {
+                            const Triangle2 t = faceTriangle(f);
+                            if (!inTriangle(v->point(), t[0], t[1], t[2])) continue;
+                            const auto vs = faceVertices(f);
+                            const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
+                            const double c = normalOf(A, B, C).normalized().dot(V_.towardsViewer((A + B + C) / 3.0));
+                            std::fprintf(stderr, "    in face %u cos %.3f depth %.5f sid %d\n", std::uint32_t(f), c, V_.camera().viewDepth((A+B+C)/3.0), curHasScanId_ ? curScanId_[f] : -9);
+                        }
+                        const CdtVertex vv = v;
+                        auto ec = cdt.incident_edges(vv), end = ec;
+                        do {
+                            if (cdt.is_constrained(*ec)) {
+                                const CdtVertex w = ec->first->vertex(ec->first->ccw(ec->second)) == vv ? ec->first->vertex(ec->first->cw(ec->second)) : ec->first->vertex(ec->first->ccw(ec->second));
+                                const int id = w->info().id;
+                                std::fprintf(stderr, "    to lid %d kind %d uv %.17g %.17g\n", id, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, w->point().x(), w->point().y());
+                            }
+                        } while (++ec != end);
+                    }
+                }
+            return fail(a, "it or the mesh under it overlaps itself in the scan's view", std::move(bad));
+        }
+        for (std::size_t k = 0; k < subEdges_.size(); ++k) {
+            const auto [p, q] = subEdges_[k];
+            CdtFace f;
+            int i;
+            if (!cdt.is_edge(vh[std::size_t(p)], vh[std::size_t(q)], f, i)) {
+                addBad(bad, p);
+                addBad(bad, q);
+                continue;
+            }
+            (k < regionSubs ? regionSub_ : patchSub_).insert(edgeKey(std::uint32_t(p), std::uint32_t(q)));
+        }
+        if (!bad.empty()) return fail(a, "its boundary passes exactly through mesh vertices in the view", std::move(bad));
+        return true;
+    }
+    // The triangle to the left of the directed edge p → q of the triangulation.
+    static CdtFace leftOf(const Cdt& cdt, CdtVertex p, CdtVertex q) {
+        CdtFace f;
+        int i;
+        cdt.is_edge(p, q, f, i);
+        return f->vertex(f->ccw(i)) == p ? f : f->neighbor(i);
+    }
+    std::uint64_t keyOf(CdtFace f, int i) const {
+        return edgeKey(std::uint32_t(f->vertex(f->ccw(i))->info().id), std::uint32_t(f->vertex(f->cw(i))->info().id));
+    }
+    // ---- step 3a: which region face and which side of the patch boundary every triangle lies in
+    bool classify(Cdt& cdt, const std::vector<CdtVertex>& vh, Attempt& a) {
+        std::vector<int> bad;
+        std::vector<CdtFace> stack;
+        for (std::size_t r = 0; r < region_.size(); ++r) {
+            const auto vs = faceVertices(region_[r]);
+            double covered = 0;
+            for (int k = 0; k < 3; ++k) {
+                const int u = lidOfCurrent_.at(std::uint32_t(vs[std::size_t(k)]));
+                const HalfedgeIndex he = M_.halfedge(vs[std::size_t(k)], vs[std::size_t((k + 1) % 3)]);
+                const auto& re = redges_[std::size_t(redgeIndex_.at(std::uint32_t(M_.edge(he))))];
+                std::vector<int> line = re.line;
+                if (line.front() != u) std::reverse(line.begin(), line.end());
+                for (std::size_t j = 0; j + 1 < line.size(); ++j) {
+                    const CdtFace f = leftOf(cdt, vh[std::size_t(line[j])], vh[std::size_t(line[j + 1])]);
+                    if (f->info().region == int(r)) continue;
+                    if (f->info().region >= 0 || cdt.is_infinite(f)) {
+                        addNear(bad, L_[std::size_t(line[j])].uv);
+                        continue;
+                    }
+                    stack.push_back(f);
+                    while (!stack.empty()) {
+                        const CdtFace g = stack.back();
+                        stack.pop_back();
+                        if (g->info().region == int(r)) continue;
+                        if (g->info().region >= 0 || cdt.is_infinite(g)) {
+                            addNear(bad, L_[std::size_t(line[j])].uv);
+                            stack.clear();
+                            break;
+                        }
+                        g->info().region = int(r);
+                        covered += area2(g->vertex(0)->point(), g->vertex(1)->point(), g->vertex(2)->point());
+                        for (int e = 0; e < 3; ++e)
+                            if (!regionSub_.count(keyOf(g, e))) stack.push_back(g->neighbor(e));
+                    }
+                }
+            }
+            const Triangle2 t = faceTriangle(region_[r]);
+            const double full = area2(t[0], t[1], t[2]);
+            if (std::abs(covered - full) > 1e-7 * full) addNear(bad, CGAL::centroid(t));
+        }
+        if (!bad.empty()) return fail(a, "the mesh under it overlaps itself in the scan's view", std::move(bad));
+        // Inside / outside of the patch: the interior lies to the left of every boundary edge.
+        std::vector<std::pair<CdtFace, std::int8_t>> fill;
+        for (const auto& pe : pedges_)
+            for (std::size_t j = 0; j + 1 < pe.line.size(); ++j) {
+                const CdtVertex s = vh[std::size_t(pe.line[j])], t = vh[std::size_t(pe.line[j + 1])];
+                fill.emplace_back(leftOf(cdt, s, t), std::int8_t(1));
+                fill.emplace_back(leftOf(cdt, t, s), std::int8_t(0));
+            }
+        while (!fill.empty()) {
+            const auto [f, side] = fill.back();
+            fill.pop_back();
+            if (f->info().inside == side) continue;
+            if (f->info().inside >= 0) {
+                if (!cdt.is_infinite(f)) addNear(bad, CGAL::centroid(cdt.triangle(f)));
+                else bad.push_back(-1);
+                continue;
+            }
+            f->info().inside = side;
+            for (int e = 0; e < 3; ++e)
+                if (!patchSub_.count(keyOf(f, e))) fill.emplace_back(f->neighbor(e), side);
+        }
+        if (!bad.empty()) return fail(a, "it overlaps itself in the scan's view", std::move(bad));
+        return true;
+    }
+
+    // ---- step 3b: the patch must lie strictly over the region, on the same sheet
+    bool checkCoverage(Cdt& cdt, const std::vector<CdtVertex>& vh, Attempt& a) {
+        std::vector<int> bad;
+        for (std::size_t i = 0; i < L_.size(); ++i) {
+            const LVert& l = L_[i];
+            if (!l.alive || !l.chain) continue;
+            const CdtVertex v = vh[i];
+            bool uncovered = false;
+            auto fc = cdt.incident_faces(v), end = fc;
+            do {
+                if (cdt.is_infinite(fc) || fc->info().region < 0) uncovered = true;
+            } while (++fc != end);
+            // Around a seam vertex inside mesh faces or on mesh edges, the seam faces must surround it.
+            if (uncovered && l.kind != LVert::Region) addBad(bad, int(i));
+            if (l.kind == LVert::PatchBoundary && !uncovered) {
+                // The patch must lie on the surface under it (not on an occluder or another sheet).
+                const FaceIndex f = region_[std::size_t(v->face()->info().region)];
+                if (gapTo(l.pos, f) > O_.maxGapRatio * (longestEdge(f) + h3_)) addBad(bad, int(i));
+            }
+        }
+        if (!bad.empty()) return fail(a, "it reaches past the visible, stitchable part of the mesh", std::move(bad));
+        return true;
+    }
+
+    // ---- step 3c: the faces of the result (local ids)
+    // Triangulates a polygon whose corners lie on the edges of one patch triangle, maximising the
+    // smallest angle (dynamic programming over the polygon's chains; exact orientation tests).
+    // `edges` holds for every corner the triangle edges it lies on (bit k: edge k): a diagonal between
+    // two corners on the same edge would leave a triangle of collinear points, so it is never used.
+    bool triangulatePolygon(const std::vector<int>& poly, const std::vector<unsigned>& edges, float q,
+                            std::int32_t sid) {
+        const std::size_t n = poly.size();
+        auto P = [&](std::size_t i) -> const Point2& { return L_[std::size_t(poly[i])].uv; };
+        auto X = [&](std::size_t i) -> const Vec3& { return L_[std::size_t(poly[i])].pos; };
+        if (n == 3) {
+            if (!leftTurn(P(0), P(1), P(2))) return false;
+            newFaces_.push_back({{poly[0], poly[1], poly[2]}, q, sid, true});
+            return true;
+        }
+        // diagonal[i][j]: the segment i–j lies inside the polygon and does not run along a triangle edge.
+        std::vector<char> diagonal(n * n, 0);
+        for (std::size_t i = 0; i < n; ++i)
+            for (std::size_t j = i + 1; j < n; ++j) {
+                if (j == i + 1 || (i == 0 && j == n - 1)) {
+                    diagonal[i * n + j] = diagonal[j * n + i] = 1;
+                    continue;
+                }
+                if (edges[i] & edges[j]) continue;
+                // Inside the cone of the polygon's corner at i.
+                const Point2 &pi = P(i), &prev = P((i + n - 1) % n), &next = P((i + 1) % n), &pj = P(j);
+                const bool convex = CGAL::orientation(prev, pi, next) != CGAL::RIGHT_TURN;
+                const bool inCone = convex ? (leftTurn(pi, next, pj) && leftTurn(prev, pi, pj))
+                                           : !(CGAL::orientation(pi, next, pj) != CGAL::LEFT_TURN &&
+                                               CGAL::orientation(prev, pi, pj) != CGAL::LEFT_TURN);
+                if (!inCone) continue;
+                bool clear = true;
+                const Segment2 d(pi, pj);
+                for (std::size_t e = 0; e < n && clear; ++e) {
+                    const std::size_t f = (e + 1) % n;
+                    if (e == i || e == j || f == i || f == j) continue;
+                    if (CGAL::do_intersect(d, Segment2(P(e), P(f)))) clear = false;
+                }
+                if (clear) diagonal[i * n + j] = diagonal[j * n + i] = 1;
+            }
+        // best[i][j]: best smallest angle triangulating the chain i..j closed by i–j (i < j).
+        const double none = -1;
+        std::vector<double> best(n * n, none);
+        std::vector<std::size_t> split(n * n, 0);
+        for (std::size_t i = 0; i + 1 < n; ++i) best[i * n + i + 1] = 4; // an edge: nothing to do
+        for (std::size_t len = 2; len < n; ++len)
+            for (std::size_t i = 0; i + len < n; ++i) {
+                const std::size_t j = i + len;
+                if (!diagonal[i * n + j]) continue;
+                for (std::size_t k = i + 1; k < j; ++k) {
+                    const double left = best[i * n + k], right = best[k * n + j];
+                    if (left < 0 || right < 0 || !leftTurn(P(i), P(k), P(j))) continue;
+                    const double v = std::min({left, right, minAngle(X(i), X(k), X(j))});
+                    if (v > best[i * n + j]) {
+                        best[i * n + j] = v;
+                        split[i * n + j] = k;
+                    }
+                }
+            }
+        if (best[n - 1] < 0) return false;
+        std::vector<std::pair<std::size_t, std::size_t>> stack{{0, n - 1}};
+        while (!stack.empty()) {
+            const auto [i, j] = stack.back();
+            stack.pop_back();
+            if (j == i + 1) continue;
+            const std::size_t k = split[i * n + j];
+            newFaces_.push_back({{poly[i], poly[k], poly[j]}, q, sid, true});
+            stack.push_back({i, k});
+            stack.push_back({k, j});
+        }
+        return true;
+    }
+    bool assemble(Cdt& cdt, Attempt& a) {
+        replaced_ = interior_;
+        // Region faces: unchanged when they are exactly one outside triangle, else replaced by their
+        // outside triangles.
+        std::vector<std::vector<CdtFace>> pieces(region_.size());
+        double insideArea = 0;
+        for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
+            if (f->info().region >= 0) pieces[std::size_t(f->info().region)].push_back(f);
+            if (f->info().inside == 1) insideArea += area2(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point());
+        }
+        for (std::size_t r = 0; r < region_.size(); ++r) {
+            const auto vs = faceVertices(region_[r]);
+            bool changed = pieces[r].size() != 1 || pieces[r][0]->info().inside != 0;
+            if (!changed)
+                for (int k = 0; k < 3; ++k) {
+                    const int lid = pieces[r][0]->vertex(k)->info().id;
+                    if (L_[std::size_t(lid)].kind != LVert::Region ||
+                        std::find(vs.begin(), vs.end(), VertexIndex(L_[std::size_t(lid)].cur)) == vs.end())
+                        changed = true;
+                }
+            if (!changed) continue;
+            replaced_.push_back(region_[r]);
+            const float q = curHasQuality_ ? curQuality_[region_[r]] : kInputFaceQuality;
+            const std::int32_t sid = curHasScanId_ ? curScanId_[region_[r]] : -1;
+            const Vec3 n = normalOf(toVec(M_.point(vs[0])), toVec(M_.point(vs[1])), toVec(M_.point(vs[2]))).normalized();
+            for (CdtFace f : pieces[r])
+                if (f->info().inside == 0)
+                    newFaces_.push_back({{f->vertex(0)->info().id, f->vertex(1)->info().id, f->vertex(2)->info().id}, q, sid, false, n});
+        }
+        // Patch faces, the boundary ones re-triangulated over the seam vertices of their edges.
+        double patchArea = 0;
+        std::vector<int> bad;
+        for (int f : faces_) {
+            const auto& t = P_.tri[std::size_t(f)];
+            std::vector<int> poly;
+            std::vector<unsigned> edges;
+            for (int k = 0; k < 3; ++k) {
+                const int p = t[std::size_t(k)], q = t[std::size_t((k + 1) % 3)];
+                poly.push_back(localOfPatch(p));
+                edges.push_back((1u << k) | (1u << ((k + 2) % 3)));
+                auto it = pedgeIndex_.find(dirKey(std::uint32_t(p), std::uint32_t(q)));
+                if (it != pedgeIndex_.end()) {
+                    const auto& line = pedges_[std::size_t(it->second)].line;
+                    poly.insert(poly.end(), line.begin() + 1, line.end() - 1);
+                    edges.insert(edges.end(), line.size() - 2, 1u << k);
+                }
+            }
+            const float q = P_.hasQuality ? P_.quality[std::size_t(f)] : kInputFaceQuality;
+            const std::int32_t sid = P_.hasScanId ? P_.scanId[std::size_t(f)] : -1;
+            const std::size_t before = newFaces_.size();
+            if (!triangulatePolygon(poly, edges, q, sid)) {
+                if (std::getenv("FSS_STITCH_DEBUG")) {
+                    std::fprintf(stderr, "  polygon failed:");
+                    for (std::size_t k = 0; k < poly.size(); ++k)
+                        std::fprintf(stderr, " [lid %d kind %d e%u %.6f %.6f]", poly[k], int(L_[std::size_t(poly[k])].kind), edges[k], L_[std::size_t(poly[k])].uv.x(), L_[std::size_t(poly[k])].uv.y());
+                    std::fprintf(stderr, "\n");
+                }
+                for (int v : t) bad.push_back(v);
+                continue;
+            }
+            for (std::size_t i = before; i < newFaces_.size(); ++i) {
+                const auto& nf = newFaces_[i].v;
+                patchArea += area2(L_[std::size_t(nf[0])].uv, L_[std::size_t(nf[1])].uv, L_[std::size_t(nf[2])].uv);
+            }
+        }
+        if (!bad.empty()) return fail(a, "some of its boundary triangles cannot be joined to the seam", std::move(bad));
+        if (std::abs(patchArea - insideArea) > 1e-6 * insideArea)
+            return fail(a, "it overlaps itself in the scan's view");
+        return true;
+    }
+    int localOfPatch(int p) {
+        auto it = lidOfPatch_.find(p);
+        if (it != lidOfPatch_.end()) return it->second;
+        LVert l;
+        l.kind = LVert::PatchInterior;
+        l.patchA = p;
+        l.pos = P_.pos[std::size_t(p)];
+        l.uv = P_.uv[std::size_t(p)];
+        const int id = addLocal(l);
+        lidOfPatch_[p] = id;
+        return id;
+    }
+
+    // ---- steps 4 + 5: local mesh, seam optimisation, checks, rehearsal
+    struct Local {
+        Star star;
+        Mesh::Property_map<VertexIndex, int> lid;
+        Mesh::Property_map<VertexIndex, Point2> uv;
+        Mesh::Property_map<VertexIndex, bool> locked;
+        Mesh::Property_map<FaceIndex, float> quality;
+        Mesh::Property_map<FaceIndex, std::int32_t> scanId;
+        Mesh::Property_map<FaceIndex, bool> patchSide;
+        Mesh::Property_map<FaceIndex, Vec3> planeNormal; // outside pieces: normal of their mesh face
+        std::set<std::pair<std::uint32_t, std::uint32_t>> seam;
+    };
+    static std::pair<std::uint32_t, std::uint32_t> seamKey(VertexIndex a, VertexIndex b) {
+        return std::minmax(std::uint32_t(a), std::uint32_t(b));
+    }
+    // Adds faces in an order that grows from the hole's border (each face next to what is there).
+    static std::vector<std::size_t> growthOrder(const std::vector<std::array<VertexIndex, 3>>& faces, const Mesh& m) {
+        std::unordered_map<std::uint64_t, std::size_t> byEdge;
+        for (std::size_t i = 0; i < faces.size(); ++i)
+            for (int k = 0; k < 3; ++k)
+                byEdge[dirKey(std::uint32_t(faces[i][std::size_t(k)]), std::uint32_t(faces[i][std::size_t((k + 1) % 3)]))] = i;
+        std::vector<std::size_t> order;
+        std::vector<char> done(faces.size(), 0);
+        std::deque<std::size_t> queue;
+        for (std::size_t i = 0; i < faces.size(); ++i)
+            for (int k = 0; k < 3 && !done[i]; ++k) {
+                const VertexIndex a = faces[i][std::size_t(k)], b = faces[i][std::size_t((k + 1) % 3)];
+                if (!m.has_valid_index(a) || !m.has_valid_index(b) || m.is_removed(a) || m.is_removed(b)) continue;
+                const auto h = m.halfedge(a, b);
+                if (h != Mesh::null_halfedge() && m.is_border(h)) {
+                    done[i] = 1;
+                    queue.push_back(i);
+                }
+            }
+        auto drain = [&] {
+            while (!queue.empty()) {
+                const std::size_t i = queue.front();
+                queue.pop_front();
+                order.push_back(i);
+                for (int k = 0; k < 3; ++k) {
+                    auto it = byEdge.find(dirKey(std::uint32_t(faces[i][std::size_t((k + 1) % 3)]), std::uint32_t(faces[i][std::size_t(k)])));
+                    if (it != byEdge.end() && !done[it->second]) {
+                        done[it->second] = 1;
+                        queue.push_back(it->second);
+                    }
+                }
+            }
+        };
+        drain();
+        for (std::size_t i = 0; i < faces.size(); ++i)
+            if (!done[i]) {
+                done[i] = 1;
+                queue.push_back(i);
+                drain();
+            }
+        return order;
+    }
+
+    bool buildAndOptimise(Attempt& a) {
+        Local loc;
+        Mesh& S = loc.star.S;
+        if (!buildStar(M_, replaced_, loc.star))
+            return fail(a, "the mesh is not manifold near its seam");
+        loc.lid = S.add_property_map<VertexIndex, int>("v:lid", -1).first;
+        loc.uv = S.add_property_map<VertexIndex, Point2>("v:uv", Point2(0, 0)).first;
+        loc.locked = S.add_property_map<VertexIndex, bool>("v:locked", false).first;
+        loc.quality = S.add_property_map<FaceIndex, float>("f:q", kInputFaceQuality).first;
+        loc.scanId = S.add_property_map<FaceIndex, std::int32_t>("f:s", -1).first;
+        loc.patchSide = S.add_property_map<FaceIndex, bool>("f:patch", false).first;
+        loc.planeNormal = S.add_property_map<FaceIndex, Vec3>("f:plane", Vec3(0, 0, 0)).first;
+        // Border edges around the replaced faces before (must be the same after: no new holes).
+        const auto bordersBefore = bordersAround(loc);
+        // Map local ids to S vertices.
+        std::vector<VertexIndex> sv(L_.size());
+        std::unordered_set<std::uint32_t> reusedCur;
+        for (const LFace& f : newFaces_)
+            for (int id : f.v)
+                if (L_[std::size_t(id)].kind == LVert::Region) reusedCur.insert(L_[std::size_t(id)].cur);
+        for (std::size_t i = 0; i < L_.size(); ++i) {
+            const LVert& l = L_[i];
+            if (!l.alive) continue;
+            if (l.kind == LVert::Region) {
+                auto it = loc.star.fromCurrent.find(l.cur);
+                if (it == loc.star.fromCurrent.end()) continue; // a region vertex of no replaced face
+                sv[i] = it->second;
+            }
+        }
+        // Fresh vertices are created on use, in order.
+        std::vector<std::array<VertexIndex, 3>> faceVs;
+        std::vector<Vec3> freshPos;
+        for (const LFace& f : newFaces_) {
+            std::array<VertexIndex, 3> vs;
+            for (int k = 0; k < 3; ++k) {
+                const int id = f.v[std::size_t(k)];
+                if (sv[std::size_t(id)] == VertexIndex()) {
+                    if (L_[std::size_t(id)].kind == LVert::Region)
+                        return fail(a, "internal error: a seam vertex is missing from the local mesh");
+                    sv[std::size_t(id)] = S.add_vertex(toPoint(L_[std::size_t(id)].pos));
+                }
+                vs[std::size_t(k)] = sv[std::size_t(id)];
+            }
+            faceVs.push_back(vs);
+        }
+        for (std::size_t i = 0; i < L_.size(); ++i)
+            if (sv[i] != VertexIndex()) {
+                loc.lid[sv[i]] = int(i);
+                loc.uv[sv[i]] = L_[i].uv;
+            }
+        for (FaceIndex f : replaced_)
+            removeFaceKeeping(S, loc.star.faceFromCurrent.at(std::uint32_t(f)),
+                              [&](VertexIndex v) { return reusedCur.count(loc.star.cur[v]) > 0; });
+        std::vector<int> bad;
+        for (std::size_t i : growthOrder(faceVs, S)) {
+            const FaceIndex g = S.add_face(faceVs[i][0], faceVs[i][1], faceVs[i][2]);
+            if (g == Mesh::null_face()) {
+                for (int id : newFaces_[i].v) addBad(bad, id);
+                continue;
+            }
+            loc.star.kept[g] = false;
+            loc.quality[g] = newFaces_[i].quality;
+            loc.scanId[g] = newFaces_[i].scanId;
+            loc.patchSide[g] = newFaces_[i].patchSide;
+            loc.planeNormal[g] = newFaces_[i].planeNormal;
+        }
+        if (!bad.empty()) return fail(a, "its seam would not be manifold", std::move(bad));
+        for (VertexIndex v : S.vertices()) {
+            bool lockedV = S.is_border(v);
+            for (FaceIndex f : CGAL::faces_around_target(S.halfedge(v), S))
+                if (f == Mesh::null_face() || loc.star.kept[f]) lockedV = true;
+            loc.locked[v] = lockedV || S.halfedge(v) == Mesh::null_halfedge();
+        }
+        for (const auto& pe : pedges_)
+            for (std::size_t j = 0; j + 1 < pe.line.size(); ++j)
+                loc.seam.insert(seamKey(sv[std::size_t(pe.line[j])], sv[std::size_t(pe.line[j + 1])]));
+
+        if (O_.optimiseSeam) optimise(loc, a.plan);
+        if (!validate(loc, bordersBefore, a)) return false;
+        return extractPlan(loc, a);
+    }
+
+    // Border edges (pairs of current-mesh vertices) incident to the vertices of the replaced faces.
+    std::set<std::pair<std::uint32_t, std::uint32_t>> bordersAround(Local& loc) const {
+        std::set<std::pair<std::uint32_t, std::uint32_t>> out;
+        const Mesh& S = loc.star.S;
+        for (VertexIndex v : loc.star.full) {
+            if (S.is_removed(v) || S.halfedge(v) == Mesh::null_halfedge()) continue;
+            for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(v), S))
+                for (HalfedgeIndex g : {h, S.opposite(h)})
+                    if (S.is_border(g)) out.insert(std::minmax(loc.star.cur[S.source(g)], loc.star.cur[S.target(g)]));
+        }
+        return out;
+    }
+
+    // Seam neighbourhood: vertices within seamRings rings of the seam, over new faces.
+    std::unordered_set<std::uint32_t> seamNeighbourhood(Local& loc) const {
+        const Mesh& S = loc.star.S;
+        std::unordered_set<std::uint32_t> inside;
+        std::vector<VertexIndex> ring;
+        for (const auto& [a, b] : loc.seam)
+            for (std::uint32_t v : {a, b})
+                if (inside.insert(v).second) ring.push_back(VertexIndex(v));
+        for (int r = 0; r < O_.seamRings; ++r) {
+            std::vector<VertexIndex> next;
+            for (VertexIndex v : ring)
+                for (VertexIndex w : CGAL::vertices_around_target(S.halfedge(v), S))
+                    if (inside.insert(std::uint32_t(w)).second) next.push_back(w);
+            ring.swap(next);
+        }
+        return inside;
+    }
+    Vec3 pt(const Mesh& S, VertexIndex v) const { return toVec(S.point(v)); }
+
+    void optimise(Local& loc, Plan& plan) {
+        Mesh& S = loc.star.S;
+        const double maxTurn = O_.maxNormalChangeDeg * kDeg;
+        const double shortEdge = O_.collapseEdgeRatio * h3_;
+        auto isNewFace = [&](FaceIndex f) { return f != Mesh::null_face() && !loc.star.kept[f]; };
+        auto removable = [&](VertexIndex v) {
+            const int id = loc.lid[v];
+            return !loc.locked[v] && id >= 0 && L_[std::size_t(id)].kind != LVert::Region;
+        };
+        // -- collapses: remove a into b
+        auto tryCollapse = [&](VertexIndex a, VertexIndex b, double& score) -> bool {
+            if (!removable(a)) return false;
+            const bool seamA = seamVertex(loc, a), seamB = seamVertex(loc, b);
+            if (seamA && seamB && !loc.seam.count(seamKey(a, b))) return false;
+            const HalfedgeIndex h = S.halfedge(a, b);
+            if (h == Mesh::null_halfedge() || !isNewFace(S.face(h)) || !isNewFace(S.face(S.opposite(h)))) return false;
+            if (!CGAL::Euler::does_satisfy_link_condition(S.edge(h), S)) return false;
+            double oldMin = std::numbers::pi, newMin = std::numbers::pi;
+            for (HalfedgeIndex g : CGAL::halfedges_around_target(S.halfedge(a), S)) {
+                const FaceIndex f = S.face(g);
+                if (!isNewFace(f)) return false;
+                // g ends at a, so the face is (a, target(next(g)), source(g)) counter-clockwise.
+                const VertexIndex p = S.target(S.next(g)), q = S.source(g);
+                oldMin = std::min(oldMin, minAngle(pt(S, a), pt(S, p), pt(S, q)));
+                if (p == b || q == b) continue;
+                if (!leftTurn(loc.uv[b], loc.uv[p], loc.uv[q])) return false;
+                if (CGAL::collinear(S.point(b), S.point(p), S.point(q))) return false;
+                const Vec3 n0 = normalOf(pt(S, a), pt(S, p), pt(S, q)), n1 = normalOf(pt(S, b), pt(S, p), pt(S, q));
+                if (loc.patchSide[f]) {
+                    if (angleBetween(n0, n1) > maxTurn) return false;
+                } else {
+                    // A piece of a mesh face outside the patch may not leave that face's plane (any more
+                    // than it already does at a patch vertex).
+                    const Vec3& n = loc.planeNormal[f];
+                    if (angleBetween(n1, n) > std::max(angleBetween(n0, n), kCoplanar)) return false;
+                }
+                newMin = std::min(newMin, minAngle(pt(S, b), pt(S, p), pt(S, q)));
+            }
+            if (newMin < oldMin) return false;
+            score = newMin;
+            return true;
+        };
+        for (int pass = 0; pass < 4; ++pass) {
+            const auto near = seamNeighbourhood(loc);
+            std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
+            for (EdgeIndex e : S.edges()) {
+                const HalfedgeIndex h = S.halfedge(e);
+                const VertexIndex a = S.source(h), b = S.target(h);
+                if (!near.count(std::uint32_t(a)) && !near.count(std::uint32_t(b))) continue;
+                const double len = (pt(S, a) - pt(S, b)).norm();
+                if (len < shortEdge) cands.push_back({len, {a, b}});
+            }
+            std::sort(cands.begin(), cands.end());
+            std::size_t done = 0;
+            for (const auto& c : cands) {
+                const auto [a, b] = c.second;
+                if (S.is_removed(a) || S.is_removed(b)) continue;
+                double s1 = -1, s2 = -1;
+                const bool ok1 = tryCollapse(a, b, s1), ok2 = tryCollapse(b, a, s2);
+                if (!ok1 && !ok2) continue;
+                const VertexIndex from = (ok1 && (!ok2 || s1 >= s2)) ? a : b, to = from == a ? b : a;
+                collapse(loc, from, to);
+                ++done;
+            }
+            plan.collapses += done;
+            if (done == 0) break;
+        }
+        // -- flips: raise the smallest angle, valence towards 6
+        const auto near = seamNeighbourhood(loc);
+        auto valenceCost = [&](VertexIndex v, int delta) {
+            const int target = S.is_border(v) ? 4 : 6;
+            return std::abs(int(S.degree(v)) + delta - target);
+        };
+        std::deque<EdgeIndex> queue;
+        std::unordered_set<std::uint32_t> queued;
+        for (EdgeIndex e : S.edges()) {
+            const HalfedgeIndex h = S.halfedge(e);
+            if (near.count(std::uint32_t(S.source(h))) && near.count(std::uint32_t(S.target(h)))) {
+                queue.push_back(e);
+                queued.insert(std::uint32_t(e));
+            }
+        }
+        std::size_t flips = 0;
+        const std::size_t maxFlips = 20 * queue.size() + 100;
+        while (!queue.empty() && flips < maxFlips) {
+            const EdgeIndex e = queue.front();
+            queue.pop_front();
+            queued.erase(std::uint32_t(e));
+            if (S.is_removed(e)) continue;
+            const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
+            if (!isNewFace(S.face(h)) || !isNewFace(S.face(o))) continue;
+            const VertexIndex x = S.source(h), y = S.target(h), z1 = S.target(S.next(h)), z2 = S.target(S.next(o));
+            if (!near.count(std::uint32_t(x)) || !near.count(std::uint32_t(y))) continue;
+            if (loc.seam.count(seamKey(x, y)) || z1 == z2) continue;
+            if (S.degree(x) <= 3 || S.degree(y) <= 3) continue;
+            if (S.halfedge(z1, z2) != Mesh::null_halfedge()) continue;
+            // New faces (x, z2, z1) and (z2, y, z1).
+            if (!leftTurn(loc.uv[x], loc.uv[z2], loc.uv[z1]) || !leftTurn(loc.uv[z2], loc.uv[y], loc.uv[z1])) continue;
+            if (CGAL::collinear(S.point(x), S.point(z2), S.point(z1)) || CGAL::collinear(S.point(z2), S.point(y), S.point(z1))) continue;
+            const Vec3 X = pt(S, x), Y = pt(S, y), Z1 = pt(S, z1), Z2 = pt(S, z2);
+            const Vec3 o1 = normalOf(X, Y, Z1), o2 = normalOf(Y, X, Z2), n1 = normalOf(X, Z2, Z1), n2 = normalOf(Z2, Y, Z1);
+            // Outside the patch a flip may not change the surface (the pieces must be coplanar); on the
+            // patch side it may not turn a normal more than maxNormalChangeDeg.
+            const bool patchSide = loc.patchSide[S.face(h)];
+            if (patchSide != loc.patchSide[S.face(o)]) continue;
+            const double turn = std::max({angleBetween(o1, n1), angleBetween(o1, n2), angleBetween(o2, n1), angleBetween(o2, n2)});
+            if (turn > (patchSide ? maxTurn : kCoplanar)) continue;
+            const double oldMin = std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2));
+            const double newMin = std::min(minAngle(X, Z2, Z1), minAngle(Z2, Y, Z1));
+            const int devOld = valenceCost(x, 0) + valenceCost(y, 0) + valenceCost(z1, 0) + valenceCost(z2, 0);
+            const int devNew = valenceCost(x, -1) + valenceCost(y, -1) + valenceCost(z1, 1) + valenceCost(z2, 1);
+            // Score: smallest angle in degrees minus 3° per unit of valence deviation.
+            const double gain = (newMin - oldMin) / kDeg - 3.0 * double(devNew - devOld);
+            if (!(gain > 0.5) || newMin < std::min(oldMin, 20.0 * kDeg)) continue;
+            CGAL::Euler::flip_edge(h, S);
+            ++flips;
+            for (HalfedgeIndex g : {S.next(h), S.prev(h), S.next(o), S.prev(o)}) {
+                const EdgeIndex ge = S.edge(g);
+                if (queued.insert(std::uint32_t(ge)).second) queue.push_back(ge);
+            }
+        }
+        plan.flips += flips;
+    }
+    bool seamVertex(const Local& loc, VertexIndex v) const {
+        const std::uint32_t i = std::uint32_t(v);
+        auto it = loc.seam.lower_bound({i, 0});
+        if (it != loc.seam.end() && it->first == i) return true;
+        for (const auto& e : loc.seam)
+            if (e.second == i) return true;
+        return false;
+    }
+    // Collapses edge (from, to) so that `to` survives with its position and data.
+    void collapse(Local& loc, VertexIndex from, VertexIndex to) {
+        Mesh& S = loc.star.S;
+        const HalfedgeIndex h = S.halfedge(from, to);
+        const EdgeIndex e = S.edge(h);
+        const VertexIndex v0 = S.source(S.halfedge(e)), v1 = S.target(S.halfedge(e));
+        const VertexIndex kept = CGAL::Euler::collapse_edge(e, S);
+        (void)kept;
+        if (v1 != to) {
+            // The descriptor of `from` survived: give it the data of `to`.
+            S.point(v1) = S.point(to);
+            loc.lid[v1] = loc.lid[to];
+            loc.uv[v1] = loc.uv[to];
+            loc.locked[v1] = loc.locked[to];
+            loc.star.cur[v1] = loc.star.cur[to];
+        }
+        std::set<std::pair<std::uint32_t, std::uint32_t>> seam;
+        for (auto [a, b] : loc.seam) {
+            if (a == std::uint32_t(v0)) a = std::uint32_t(v1);
+            if (b == std::uint32_t(v0)) b = std::uint32_t(v1);
+            if (a != b) seam.insert(std::minmax(a, b));
+        }
+        loc.seam.swap(seam);
+    }
+
+    bool validate(Local& loc, const std::set<std::pair<std::uint32_t, std::uint32_t>>& bordersBefore, Attempt& a) {
+        Mesh& S = loc.star.S;
+        std::vector<int> bad;
+        auto badFace = [&](FaceIndex f) {
+            Point2 c(0, 0);
+            double x = 0, y = 0;
+            for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(f), S)) {
+                x += loc.uv[v].x() / 3.0;
+                y += loc.uv[v].y() / 3.0;
+            }
+            c = Point2(x, y);
+            addNear(bad, c);
+        };
+        if (!S.is_valid(false)) return fail(a, "internal error: the local mesh is not valid");
+        // Faces: not degenerate, facing the camera.
+        for (FaceIndex f : S.faces()) {
+            if (loc.star.kept[f]) continue;
+            const HalfedgeIndex h = S.halfedge(f);
+            const VertexIndex p = S.source(h), q = S.target(h), r = S.target(S.next(h));
+            if (CGAL::collinear(S.point(p), S.point(q), S.point(r)) || !leftTurn(loc.uv[p], loc.uv[q], loc.uv[r])) badFace(f);
+        }
+        if (!bad.empty()) return fail(a, "it would create degenerate or back-facing faces", std::move(bad));
+        // Vertices: manifold (one umbrella) and no new border.
+        std::unordered_map<std::uint32_t, int> incoming;
+        for (HalfedgeIndex h : S.halfedges()) ++incoming[std::uint32_t(S.target(h))];
+        for (VertexIndex v : S.vertices()) {
+            if (S.halfedge(v) == Mesh::null_halfedge()) continue;
+            int n = 0, borders = 0;
+            for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(v), S)) {
+                ++n;
+                borders += S.is_border(h);
+            }
+            if (n != incoming[std::uint32_t(v)] || borders > 1) {
+                addNear(bad, loc.uv[v]);
+            }
+        }
+        if (!bad.empty()) return fail(a, "it would create a non-manifold vertex", std::move(bad));
+        for (FaceIndex f : S.faces())
+            if (!loc.star.kept[f])
+                for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(f), S))
+                    if (loc.star.cur[v] == kNone && S.is_border(v)) badFace(f);
+        const auto bordersAfter = bordersAround(loc);
+        if (bordersAfter != bordersBefore) {
+            // Locate the difference (a hole of the mesh under the patch, an edge left dangling).
+            for (const auto* set : {&bordersAfter, &bordersBefore})
+                for (const auto& e : *set)
+                    if (!(set == &bordersAfter ? bordersBefore : bordersAfter).count(e)) {
+                        Point2 uv;
+                        double w;
+                        if (e.first != kNone && e.second != kNone && V_.project(0.5 * (toVec(M_.point(VertexIndex(e.first))) + toVec(M_.point(VertexIndex(e.second)))), uv, w))
+                            addNear(bad, uv);
+                    }
+        }
+        if (!bad.empty() || bordersAfter != bordersBefore)
+            return fail(a, "it would open or close a hole in the mesh", std::move(bad));
+        // No new self-intersections among the local faces.
+        std::vector<std::pair<FaceIndex, FaceIndex>> pairs;
+        PMP::self_intersections(S.faces(), S, std::back_inserter(pairs));
+        if (std::getenv("FSS_STITCH_DEBUG"))
+            for (const auto& [f, g] : pairs) {
+                std::fprintf(stderr, "  intersect kept %d %d\n", int(loc.star.kept[f]), int(loc.star.kept[g]));
+                for (FaceIndex x : {f, g}) {
+                    for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(x), S)) {
+                        const int id = loc.lid[v];
+                        std::fprintf(stderr, "    v%u lid %d pa %d pb %d kind %d p %.17g %.17g %.17g uv %.17g %.17g\n", std::uint32_t(v), id, id >= 0 ? L_[std::size_t(id)].patchA : -9, id >= 0 ? L_[std::size_t(id)].patchB : -9, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, S.point(v).x(), S.point(v).y(), S.point(v).z(), loc.uv[v].x(), loc.uv[v].y());
+                    }
+                }
+                break;
+            }
+        for (const auto& [f, g] : pairs) {
+            if (!loc.star.kept[f]) badFace(f);
+            if (!loc.star.kept[g]) badFace(g);
+        }
+        if (!bad.empty()) return fail(a, "it would make the mesh intersect itself", std::move(bad));
+        if (O_.failValidationForTesting) return fail(a, "its final check was forced to fail for testing");
+        return true;
+    }
+
+    bool extractPlan(Local& loc, Attempt& a) {
+        Mesh& S = loc.star.S;
+        Plan& plan = a.plan;
+        plan.removed = replaced_;
+        // Vertices: current ones stay themselves, new ones are numbered in order of use.
+        std::unordered_map<std::uint32_t, std::uint32_t> freshIndex;
+        std::vector<std::array<VertexIndex, 3>> faces;
+        std::vector<FaceIndex> sfaces;
+        for (FaceIndex f : S.faces())
+            if (!loc.star.kept[f]) {
+                const HalfedgeIndex h = S.halfedge(f);
+                faces.push_back({S.source(h), S.target(h), S.target(S.next(h))});
+                sfaces.push_back(f);
+            }
+        std::unordered_set<std::uint32_t> reused;
+        // Order faces for growth in the rehearsal mesh: build it first (same star, same removals).
+        Star rehearsal;
+        if (!buildStar(M_, replaced_, rehearsal)) return fail(a, "internal error: the star could not be rebuilt");
+        for (const auto& fv : faces)
+            for (VertexIndex v : fv) {
+                const std::uint32_t c = loc.star.cur[v];
+                if (c != kNone) {
+                    if (reused.insert(c).second) plan.reused.push_back(VertexIndex(c));
+                } else if (!freshIndex.count(std::uint32_t(v))) {
+                    freshIndex[std::uint32_t(v)] = std::uint32_t(plan.freshPositions.size());
+                    plan.freshPositions.push_back(pt(S, v));
+                    if (std::getenv("FSS_STITCH_DEBUG") && std::abs(pt(S, v).norm() - 1.0) > 0.0177) {
+                        const int id = loc.lid[v];
+                        std::fprintf(stderr, "  off-sphere fresh vertex lid %d kind %d |p| %g\n", id, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, pt(S, v).norm());
+                    }
+                }
+            }
+        // Face order: growth order over the faces expressed in the rehearsal mesh after the removals.
+        std::vector<std::array<PlanVertex, 3>> pf;
+        for (const auto& fv : faces) {
+            std::array<PlanVertex, 3> p;
+            for (int k = 0; k < 3; ++k) {
+                const VertexIndex v = fv[std::size_t(k)];
+                const std::uint32_t c = loc.star.cur[v];
+                p[std::size_t(k)] = c != kNone ? PlanVertex{c, false} : PlanVertex{freshIndex.at(std::uint32_t(v)), true};
+            }
+            pf.push_back(p);
+        }
+        // Rehearse: add fresh vertices, remove the replaced faces, add the faces in growth order.
+        std::vector<VertexIndex> fresh;
+        for (const Vec3& p : plan.freshPositions) fresh.push_back(rehearsal.S.add_vertex(toPoint(p)));
+        std::unordered_set<std::uint32_t> keep;
+        for (VertexIndex v : plan.reused) keep.insert(std::uint32_t(rehearsal.fromCurrent.at(std::uint32_t(v))));
+        for (FaceIndex f : replaced_)
+            removeFaceKeeping(rehearsal.S, rehearsal.faceFromCurrent.at(std::uint32_t(f)),
+                              [&](VertexIndex v) { return keep.count(std::uint32_t(v)) > 0; });
+        std::vector<std::array<VertexIndex, 3>> rf;
+        for (const auto& p : pf) {
+            std::array<VertexIndex, 3> r;
+            for (int k = 0; k < 3; ++k)
+                r[std::size_t(k)] = p[std::size_t(k)].fresh ? fresh[p[std::size_t(k)].index]
+                                                             : rehearsal.fromCurrent.at(p[std::size_t(k)].index);
+            rf.push_back(r);
+        }
+        const auto order = growthOrder(rf, rehearsal.S);
+        for (std::size_t i : order)
+            if (rehearsal.S.add_face(rf[i][0], rf[i][1], rf[i][2]) == Mesh::null_face())
+                return fail(a, "internal error: the stitch could not be rehearsed");
+        for (std::size_t i : order) {
+            plan.faces.push_back(pf[i]);
+            plan.quality.push_back(loc.quality[sfaces[i]]);
+            plan.scanId.push_back(loc.scanId[sfaces[i]]);
+        }
+        if (std::getenv("FSS_STITCH_DEBUG_DEEP"))
+            for (std::size_t i = 0; i < faces.size(); ++i) {
+                const auto& fv = faces[i];
+                const Kernel::Triangle_3 t(S.point(fv[0]), S.point(fv[1]), S.point(fv[2]));
+                const double d = 1.0 - std::sqrt(CGAL::squared_distance(Point3(0, 0, 0), t));
+                if (d > 0.0178) {
+                    std::fprintf(stderr, "  deep face %.5f patchSide %d\n", d, int(loc.patchSide[sfaces[i]]));
+                    for (VertexIndex v : fv) {
+                        const int id = loc.lid[v];
+                        std::fprintf(stderr, "    lid %d kind %d |p| %.5f\n", id, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, pt(S, v).norm());
+                    }
+                }
+            }
+        // Seam figures.
+        plan.seamEdges = loc.seam.size();
+        std::unordered_set<std::uint32_t> seamVerts;
+        for (const auto& [p, q] : loc.seam) {
+            plan.seamLength += (pt(S, VertexIndex(p)) - pt(S, VertexIndex(q))).norm();
+            seamVerts.insert(p);
+            seamVerts.insert(q);
+        }
+        for (std::size_t i = 0; i < faces.size(); ++i) {
+            const auto& fv = faces[i];
+            if (!seamVerts.count(std::uint32_t(fv[0])) && !seamVerts.count(std::uint32_t(fv[1])) && !seamVerts.count(std::uint32_t(fv[2])))
+                continue;
+            plan.seamFaceMinAngles.push_back(minAngle(pt(S, fv[0]), pt(S, fv[1]), pt(S, fv[2])) / kDeg);
+        }
+        return true;
+    }
+
+    // ---- inputs
+    const Mesh& M_;
+    const PatchData& P_;
+    const View& V_;
+    const StitchOptions& O_;
+    std::span<const std::uint32_t> ids_;
+    const std::vector<int>& faces_;
+    bool curHasQuality_, curHasScanId_;
+    Mesh::Property_map<FaceIndex, float> curQuality_;
+    Mesh::Property_map<FaceIndex, std::int32_t> curScanId_;
+
+    // ---- component
+    struct PEdge {
+        int a, b;     // patch vertices, interior on the left of a → b
+        int opposite; // third vertex of the patch triangle on this edge
+        std::vector<std::pair<double, int>> splits;
+        std::vector<int> line;
+    };
+    struct REdge {
+        int u, w; // local ids of the mesh edge's halfedge source and target
+        EdgeIndex edge;
+        std::vector<std::pair<double, int>> splits;
+        std::vector<int> line;
+    };
+    std::unordered_map<int, std::vector<int>> vertexFaces_;
+    std::unordered_set<int> boundary_;
+    std::vector<PEdge> pedges_;
+    std::unordered_map<std::uint64_t, int> pedgeIndex_;
+    std::unordered_map<int, double> snapRadius_;
+    double h2_ = 0, h3_ = 0;
+    double margin_ = 0; // largest snapping distance in the view
+    CGAL::Bbox_2 compBox_;
+    BucketGrid compGrid_;
+
+    // ---- current mesh
+    std::unordered_map<std::uint32_t, VProj> vcache_;
+    std::unordered_map<std::uint32_t, bool> accept_;
+    bool fallbackBuilt_ = false;
+    std::vector<FaceIndex> fallback_;
+    BucketGrid fallbackGrid_;
+    std::vector<FaceIndex> region_;   // faces re-triangulated in the view (near the seam)
+    std::vector<FaceIndex> interior_; // faces under the patch, removed whole
+    std::unordered_map<std::uint32_t, int> regionIndex_;
+    BucketGrid regionGrid_;
+
+    // ---- local problem
+    std::vector<LVert> L_;
+    std::unordered_map<std::uint32_t, int> lidOfCurrent_;
+    std::unordered_map<int, int> lidOfPatch_;
+    std::unordered_map<int, int> onEdge_;
+    std::vector<REdge> redges_;
+    std::unordered_map<std::uint32_t, int> redgeIndex_;
+    std::vector<std::pair<int, int>> subEdges_;
+    std::unordered_set<std::uint64_t> regionSub_, patchSub_;
+    std::vector<FaceIndex> replaced_;
+    std::vector<LFace> newFaces_;
+};
+
+// ---------------------------------------------------------------------------------------------------
+PatchData readPatch(const Mesh& patch, const View& view, std::size_t& dropped) {
+    PatchData P;
+    std::unordered_map<std::uint32_t, int> index;
+    for (VertexIndex v : patch.vertices()) {
+        const Vec3 p = toVec(patch.point(v));
+        if (!p.allFinite()) throw InvalidInputError("The patch has a vertex with a non-finite coordinate.");
+        index[std::uint32_t(v)] = int(P.pos.size());
+        P.pos.push_back(p);
+        Point2 uv;
+        double w = 0;
+        if (!view.project(p, uv, w)) uv = Point2(std::numeric_limits<double>::quiet_NaN(), 0);
+        P.uv.push_back(uv);
+        P.w.push_back(w);
+    }
+    auto q = patch.property_map<FaceIndex, float>(props::faceQuality);
+    auto s = patch.property_map<FaceIndex, std::int32_t>(props::faceScanId);
+    P.hasQuality = q.second;
+    P.hasScanId = s.second;
+    for (FaceIndex f : patch.faces()) {
+        std::array<int, 3> t;
+        int k = 0;
+        for (VertexIndex v : CGAL::vertices_around_face(patch.halfedge(f), patch)) {
+            if (k == 3) throw InvalidInputError("The patch has a face that is not a triangle.");
+            t[std::size_t(k++)] = index.at(std::uint32_t(v));
+        }
+        if (k != 3) throw InvalidInputError("The patch has a face that is not a triangle.");
+        const Point2 &a = P.uv[std::size_t(t[0])], &b = P.uv[std::size_t(t[1])], &c = P.uv[std::size_t(t[2])];
+        if (std::isnan(a.x()) || std::isnan(b.x()) || std::isnan(c.x()) || !leftTurn(a, b, c)) {
+            ++dropped;
+            continue;
+        }
+        P.tri.push_back(t);
+        P.quality.push_back(q.second ? q.first[f] : kInputFaceQuality);
+        P.scanId.push_back(s.second ? s.first[f] : -1);
+    }
+    return P;
+}
+
+// Components of patch faces connected through vertices, largest first.
+std::vector<std::vector<int>> components(const PatchData& P, const std::vector<int>& faces) {
+    std::unordered_map<int, int> parent;
+    auto find = [&](int x) {
+        auto it = parent.try_emplace(x, x).first;
+        while (it->second != x) {
+            auto& px = parent[it->second];
+            it->second = px;
+            x = it->second;
+            it = parent.find(x);
+        }
+        return x;
+    };
+    for (int f : faces) {
+        const auto& t = P.tri[std::size_t(f)];
+        const int a = find(t[0]), b = find(t[1]), c = find(t[2]);
+        parent[b] = a;
+        parent[find(c)] = a;
+    }
+    std::unordered_map<int, std::size_t> which;
+    std::vector<std::vector<int>> out;
+    for (int f : faces) {
+        const int r = find(P.tri[std::size_t(f)][0]);
+        auto [it, fresh] = which.try_emplace(r, out.size());
+        if (fresh) out.emplace_back();
+        out[it->second].push_back(f);
+    }
+    std::stable_sort(out.begin(), out.end(), [](const auto& x, const auto& y) { return x.size() > y.size(); });
+    return out;
+}
+
+} // namespace
+
+StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCamera, const StitchOptions& options,
+                         std::span<const std::uint32_t> faceIds) {
+    const auto start = std::chrono::steady_clock::now();
+    scanCamera.validate();
+    if (patch.number_of_faces() == 0) throw InvalidInputError("The patch has no faces.");
+    if (!faceIds.empty() && faceIds.size() != std::size_t(scanCamera.width) * std::size_t(scanCamera.height))
+        throw InvalidInputError("The ID buffer has " + std::to_string(faceIds.size()) + " pixels but the scan camera's image has " +
+                                std::to_string(std::size_t(scanCamera.width) * std::size_t(scanCamera.height)) + ".");
+    if (!(options.collapseEdgeRatio >= 0 && options.collapseEdgeRatio < 0.5) || options.seamRings < 0 ||
+        !(options.maxViewAngleDeg > 0 && options.maxViewAngleDeg < 90) || !(options.maxNormalChangeDeg >= 0) ||
+        !(options.maxGapRatio > 0) || options.maxTrimRounds < 0)
+        throw InvalidInputError("The stitch options are out of range (collapseEdgeRatio in [0, 0.5), seamRings >= 0, "
+                                "maxViewAngleDeg in (0, 90), maxNormalChangeDeg >= 0, maxGapRatio > 0, maxTrimRounds >= 0).");
+
+    const View view(scanCamera);
+    StitchReport report;
+    std::size_t dropped = 0;
+    const PatchData P = readPatch(patch, view, dropped);
+    if (dropped > 0)
+        report.skipped.push_back(std::to_string(dropped) + " patch faces were behind the camera or not facing it and were left out.");
+    report.patchFacesTrimmed += dropped;
+
+    std::vector<int> all(P.tri.size());
+    for (std::size_t i = 0; i < all.size(); ++i) all[i] = int(i);
+    struct Work {
+        std::vector<int> faces;
+        int name;    // number of the original component (1-based)
+        int rounds;  // trim rounds used
+    };
+    std::deque<Work> work;
+    {
+        int n = 0;
+        for (auto& c : components(P, all)) work.push_back({std::move(c), ++n, 0});
+    }
+    const int componentCount = int(work.size());
+    std::string firstReason;
+    auto skip = [&](const Work& w, const std::string& why) {
+        ++report.componentsSkipped;
+        report.patchFacesTrimmed += w.faces.size();
+        const std::string s = "Patch component " + std::to_string(w.name) + " (" + std::to_string(w.faces.size()) +
+                              " faces) was not stitched: " + why + ".";
+        report.skipped.push_back(s);
+        if (firstReason.empty()) firstReason = why;
+    };
+
+    bool propsReady = false;
+    std::size_t seamFacesAbove25 = 0;
+    while (!work.empty()) {
+        Work w = std::move(work.front());
+        work.pop_front();
+        if (w.faces.size() < options.minComponentFaces) {
+            skip(w, "it has fewer than " + std::to_string(options.minComponentFaces) + " faces");
+            continue;
+        }
+        const bool curQ = current.property_map<FaceIndex, float>(props::faceQuality).second;
+        const bool curS = current.property_map<FaceIndex, std::int32_t>(props::faceScanId).second;
+        ComponentStitcher stitcher(current, P, view, options, faceIds, w.faces, curQ, curS);
+        Attempt a = stitcher.run();
+        if (std::getenv("FSS_STITCH_DEBUG"))
+            std::fprintf(stderr, "stitch: component %d round %d (%zu faces): %s (%zu bad)\n", w.name, w.rounds,
+                         w.faces.size(), a.ok ? "ok" : a.reason.c_str(), a.bad.size());
+        if (!a.ok) {
+            if (a.bad.empty() || w.rounds >= options.maxTrimRounds) {
+                skip(w, a.reason);
+                continue;
+            }
+            // Trim the faces around the problem and retry what is left (it may fall apart).
+            std::unordered_set<int> bad(a.bad.begin(), a.bad.end());
+            std::vector<int> rest;
+            for (int f : w.faces) {
+                const auto& t = P.tri[std::size_t(f)];
+                if (!bad.count(t[0]) && !bad.count(t[1]) && !bad.count(t[2])) rest.push_back(f);
+            }
+            if (rest.size() == w.faces.size()) {
+                skip(w, a.reason);
+                continue;
+            }
+            report.patchFacesTrimmed += w.faces.size() - rest.size();
+            if (rest.empty()) {
+                ++report.componentsSkipped;
+                const std::string why = a.reason;
+                report.skipped.push_back("Patch component " + std::to_string(w.name) + " was trimmed away: " + why + ".");
+                if (firstReason.empty()) firstReason = why;
+                continue;
+            }
+            for (auto& c : components(P, rest)) work.push_front({std::move(c), w.name, w.rounds + 1});
+            continue;
+        }
+        // Apply: every check has passed on the local copy and the rehearsal succeeded.
+        if (!propsReady) {
+            if (P.hasQuality) current.add_property_map<FaceIndex, float>(props::faceQuality, kInputFaceQuality);
+            if (P.hasScanId) current.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1);
+            propsReady = true;
+        }
+        auto q = current.property_map<FaceIndex, float>(props::faceQuality);
+        auto s = current.property_map<FaceIndex, std::int32_t>(props::faceScanId);
+        const Plan& plan = a.plan;
+        const bool applied = replay(
+            current, plan, [](VertexIndex v) { return v; }, [](FaceIndex f) { return f; },
+            [&](std::size_t i, FaceIndex f) {
+                if (q.second) q.first[f] = plan.quality[i];
+                if (s.second) s.first[f] = plan.scanId[i];
+            });
+        if (!applied) throw Error("Internal error: a rehearsed stitch could not be applied to the mesh.");
+        ++report.componentsStitched;
+        report.facesRemoved += plan.removed.size();
+        report.facesAdded += plan.faces.size();
+        report.seamEdges += plan.seamEdges;
+        report.seamLength += plan.seamLength;
+        report.collapses += plan.collapses;
+        report.flips += plan.flips;
+        for (double ang : plan.seamFaceMinAngles) {
+            report.seamMinAngleDeg = std::min(report.seamMinAngleDeg, ang);
+            seamFacesAbove25 += ang >= 25.0;
+        }
+        report.seamFaces += plan.seamFaceMinAngles.size();
+    }
+    report.seamFracMinAngleAbove25 = report.seamFaces ? double(seamFacesAbove25) / double(report.seamFaces) : 1.0;
+    if (report.componentsStitched == 0)
+        throw InvalidInputError("No part of the patch could be stitched" +
+                                (componentCount > 1 ? " (" + std::to_string(componentCount) + " components)" : std::string()) +
+                                ": " + (firstReason.empty() ? std::string("it is empty") : firstReason) + ".");
+    if (options.collectGarbage) current.collect_garbage();
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return report;
+}
+
+} // namespace fss
