@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 
 namespace fss {
@@ -44,6 +45,28 @@ struct RayFactory {
         return Ray{camera.parallel ? a : camera.eye, (b - a).normalized()};
     }
 };
+
+/// The ray's hit on face \p f (Möller–Trumbore, inclusive edges with a tiny tolerance), if any. The fast
+/// path of the hinted ray cast: a rib vertex lies in the pixel whose centre shows \p f, so most rays hit
+/// it; the rest go to RayCaster::intersect (local search, AABB fallback).
+std::optional<Eigen::Vector3d> hitOnFace(const Mesh& mesh, FaceIndex f, const Ray& ray) {
+    const HalfedgeIndex h = mesh.halfedge(f);
+    auto P = [&](VertexIndex v) {
+        const Point3& p = mesh.point(v);
+        return Eigen::Vector3d(p.x(), p.y(), p.z());
+    };
+    const Eigen::Vector3d a = P(mesh.source(h)), b = P(mesh.target(h)), c = P(mesh.target(mesh.next(h)));
+    const Eigen::Vector3d e1 = b - a, e2 = c - a, pv = ray.direction.cross(e2);
+    const double det = e1.dot(pv);
+    if (std::abs(det) < 1e-14 * e1.norm() * e2.norm()) return std::nullopt; // ray in the plane: let the caster decide
+    const Eigen::Vector3d tv = ray.origin - a;
+    const double u = tv.dot(pv) / det;
+    const Eigen::Vector3d qv = tv.cross(e1);
+    const double v = ray.direction.dot(qv) / det, t = e2.dot(qv) / det;
+    constexpr double eps = 1e-12;
+    if (u < -eps || v < -eps || u + v > 1 + eps || t < 0) return std::nullopt;
+    return ray.origin + t * ray.direction;
+}
 
 } // namespace
 
@@ -134,7 +157,35 @@ SampleGrid rayCastFishbone(const FishboneGrid& fishbone, const FrameBuffers& ref
             const int py = std::clamp(int(std::floor(p.y())), 0, h - 1);
             const std::uint32_t id = referenceBuffers.faceAt(px, py);
             const FaceIndex hint = (id != FrameBuffers::kNoFace && id < faceCount) ? FaceIndex(id) : Mesh::null_face();
-            const SurfacePoint hit = caster.intersect(rays(p.x(), p.y()), hint, search);
+            const Ray ray = rays(p.x(), p.y());
+            if (hint != Mesh::null_face() && !search.verifyUnoccluded) {
+                if (const std::optional<Eigen::Vector3d> q = hitOnFace(reference, hint, ray)) {
+                    ++local;
+                    setSampleOnSurface(s, reference, camera, hint, *q, options);
+                    continue;
+                }
+                // The faces under the 8 neighbouring pixels (the vertex is near its pixel's border, or the
+                // faces are smaller than a pixel): nearest hit among them.
+                std::optional<Eigen::Vector3d> best;
+                FaceIndex bestFace;
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const int x = px + dx, y = py + dy;
+                        if ((dx == 0 && dy == 0) || x < 0 || y < 0 || x >= w || y >= h) continue;
+                        const std::uint32_t nid = referenceBuffers.faceAt(x, y);
+                        if (nid == FrameBuffers::kNoFace || nid >= faceCount || nid == id) continue;
+                        if (const auto q = hitOnFace(reference, FaceIndex(nid), ray);
+                            q && (!best || (*q - ray.origin).squaredNorm() < (*best - ray.origin).squaredNorm())) {
+                            best = q;
+                            bestFace = FaceIndex(nid);
+                        }
+                    }
+                if (best) {
+                    setSampleOnSurface(s, reference, camera, bestFace, *best, options);
+                    continue;
+                }
+            }
+            const SurfacePoint hit = caster.intersect(ray, hint, search);
             if (!hit) continue;
             if (hint != Mesh::null_face() && hit.face == hint) ++local;
             setSampleOnSurface(s, reference, camera, hit.face, hit.point, options);
@@ -181,6 +232,11 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
     FishboneScanResult result;
     FishboneOptions options = fb.tracing;
     options.spacing = h;
+    // Unbounded tracing: a backbone at most the image diagonal long each way, a rib half at most half of it
+    // (a line field can close on itself, and a rib circling a feature many times is no sampling grid).
+    const double diagonal = std::hypot(double(params.camera.width), double(params.camera.height));
+    if (!std::isfinite(options.backboneTracing.maxLength)) options.backboneTracing.maxLength = diagonal;
+    if (!std::isfinite(options.ribTracing.maxLength)) options.ribTracing.maxLength = 0.5 * diagonal;
 
     // Per-reference precomputation (cached by the caller).
     progress.report(0.0, "curvature");

@@ -82,7 +82,8 @@ struct FishboneParams {
     std::vector<Polyline2> drawnKeyRibs;          ///< key-rib mode: hand-drawn key-ribs (splines)
     Polyline2 drawnBackbone;                      ///< hand-drawn backbone (≥ 2 points) instead of seed
     /// Tracing options (its spacing is replaced by `spacing`). The default continues straight across
-    /// isotropic regions, which CAD meshes' flat faces need.
+    /// isotropic regions, which CAD meshes' flat faces need. An unbounded (infinite) maxLength becomes the
+    /// image diagonal for the backbone (each way) and half of it for each rib half.
     FishboneOptions tracing = defaultTracing();
     /// A traced backbone needs the seed's interpolated anisotropy to reach this (else the principal
     /// directions are undefined there: flat or umbilic region).
@@ -132,8 +133,10 @@ struct FishboneScanResult {
 };
 
 /// Casts a ray from the eye through every present vertex of \p fishbone (Camera::ray of the buffers'
-/// camera) onto \p reference: the face of \p referenceBuffers under the vertex's pixel is the hint of
-/// RayCaster::intersect (local search, AABB fallback). Returns a SampleGrid of the same rows × cols whose
+/// camera) onto \p reference: the face of \p referenceBuffers under the vertex's pixel is the first guess
+/// (then the faces under the 8 neighbouring pixels, nearest hit), and RayCaster::intersect with that hint
+/// (local search, AABB fallback) answers the rest. As RayCaster's hinted query, a guess is trusted to be
+/// unoccluded unless `search.verifyUnoccluded` (then every ray goes through the caster). Returns a SampleGrid of the same rows × cols whose
 /// sample (r, c) has screen = the rib vertex and the rest from setSampleOnSurface; absent vertices and
 /// misses are not hit. \p hintHits (optional) receives how many hits lie on the hint face itself.
 /// \pre \p caster holds \p reference and \p referenceBuffers were rendered from it.
