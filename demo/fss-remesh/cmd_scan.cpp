@@ -1,10 +1,12 @@
 // fss-remesh scan MESH -o OUT [--view V | --camera ...] [--parallel] [--resolution W[xH]] [--zoom F]
 //                  [--lasso "x,y;x,y;..."] [--erode N] [--dilate N] [--json] ...
+//                  [--fishbone "seed=X,Y[;dir=min|max][;h=PIXELS][;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...]"]
 #include "args.h"
 #include "commands.h"
 
 #include "fss/camera.h"
 #include "fss/error.h"
+#include "fss/fishbone_scan.h"
 #include "fss/mesh_io.h"
 #include "fss/render/gpu_mesh_renderer.h"
 #include "fss/scan_pipeline.h"
@@ -13,6 +15,7 @@
 
 #include <iostream>
 #include <memory>
+#include <optional>
 
 namespace fss::cli {
 namespace {
@@ -71,6 +74,69 @@ Lasso parseLasso(const std::string& text, int w, int h) {
     return lasso;
 }
 
+// "x,y|x,y|..." (normalised) → pixels.
+std::vector<Eigen::Vector2d> parsePointList(const std::string& key, const std::string& text, int w, int h) {
+    std::vector<Eigen::Vector2d> points;
+    std::size_t start = 0;
+    while (start <= text.size()) {
+        const auto bar = text.find('|', start);
+        const std::string item = text.substr(start, bar == std::string::npos ? std::string::npos : bar - start);
+        const std::vector<double> xy = parseDoubleList("--fishbone " + key, item);
+        if (xy.size() != 2)
+            throw UsageError("Each point of the --fishbone key '" + key +
+                             "' needs two numbers x,y (normalised 0..1), not '" + item + "'.");
+        points.emplace_back(xy[0] * w, xy[1] * h);
+        if (bar == std::string::npos) break;
+        start = bar + 1;
+    }
+    return points;
+}
+
+// "seed=X,Y[;dir=min|max][;h=PIXELS][;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...]", points normalised.
+FishboneParams parseFishbone(const std::string& text, int w, int h) {
+    FishboneParams fb;
+    bool haveSeed = false;
+    std::size_t start = 0;
+    while (start <= text.size()) {
+        const auto semi = text.find(';', start);
+        const std::string item = text.substr(start, semi == std::string::npos ? std::string::npos : semi - start);
+        if (!item.empty()) {
+            const auto eq = item.find('=');
+            if (eq == std::string::npos)
+                throw UsageError("The --fishbone item '" + item + "' is not of the form key=value.");
+            const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
+            if (key == "seed") {
+                const std::vector<Eigen::Vector2d> p = parsePointList(key, value, w, h);
+                if (p.size() != 1)
+                    throw UsageError("The --fishbone seed must be one point x,y (normalised 0..1).");
+                fb.seed = p.front();
+                haveSeed = true;
+            } else if (key == "dir") {
+                if (value == "min") fb.direction = PrincipalDirection::Min;
+                else if (value == "max") fb.direction = PrincipalDirection::Max;
+                else throw UsageError("The --fishbone direction '" + value + "' is not one of min, max.");
+            } else if (key == "h") {
+                fb.spacing = parseDouble("--fishbone h", value);
+            } else if (key == "keyribs") {
+                fb.keyRibs = parsePointList(key, value, w, h);
+            } else if (key == "backbone") {
+                fb.drawnBackbone = parsePointList(key, value, w, h);
+            } else {
+                throw UsageError("The --fishbone key '" + key + "' is not one of seed, dir, h, keyribs, backbone.");
+            }
+        }
+        if (semi == std::string::npos) break;
+        start = semi + 1;
+    }
+    if (!haveSeed && fb.drawnBackbone.empty())
+        throw UsageError("The --fishbone spec needs a seed=X,Y or a backbone=X,Y|X,Y|....");
+    if (!fb.drawnBackbone.empty() && fb.drawnBackbone.size() < 2)
+        throw UsageError("The --fishbone backbone needs at least two points.");
+    if (fb.keyRibs.size() == 1)
+        throw UsageError("The --fishbone keyribs need at least two points to blend between.");
+    return fb;
+}
+
 std::unique_ptr<MeshRenderer> makeRenderer(const std::string& kind, std::string& used) {
     if (kind == "cpu") {
         used = "cpu";
@@ -88,12 +154,67 @@ std::unique_ptr<MeshRenderer> makeRenderer(const std::string& kind, std::string&
     }
 }
 
+int runFishboneScan(const Mesh& reference, MeshRenderer& renderer, std::string rendererUsed, const ScanParams& params,
+                    const FishboneParams& fishbone, const std::string& meshPath, const std::string& outPath, bool json) {
+    FishboneCache cache;
+    const FishboneScanResult result = scanFishbonePatch(reference, renderer, reference, renderer, params, fishbone, cache);
+    if (auto* gpu = dynamic_cast<render::GpuMeshRenderer*>(&renderer))
+        rendererUsed = "gpu (" + gpu->rasterizer().glRenderer() + ")";
+    writeMesh(result.patch.mesh, outPath, WriteOptions{.binary = false});
+    const FishboneCounts& c = result.counts;
+    const FishboneTimings& t = result.timings;
+    if (json) {
+        const TriangulateReport& tr = result.patch.report;
+        nlohmann::json j;
+        j["input"] = meshPath;
+        j["output"] = outPath;
+        j["renderer"] = rendererUsed;
+        j["grid"] = "fishbone";
+        j["resolution"] = {params.camera.width, params.camera.height};
+        j["fishbone"] = {{"direction", fishbone.direction == PrincipalDirection::Min ? "min" : "max"},
+                         {"h_pixels", fishbone.spacing},
+                         {"key_ribs", fishbone.keyRibs.size()},
+                         {"drawn_backbone", !fishbone.drawnBackbone.empty()}};
+        j["counts"] = {{"rows", c.rows},
+                       {"cols", c.cols},
+                       {"rib_vertices", c.ribVertices},
+                       {"covered", c.covered},
+                       {"front_facing", c.frontFacing},
+                       {"on_hint_face", c.onHintFace},
+                       {"after_lasso", c.afterLasso},
+                       {"after_quality", c.afterQuality},
+                       {"after_morphology", c.afterMorphology},
+                       {"patch_vertices", result.patch.mesh.number_of_vertices()},
+                       {"patch_faces", result.patch.mesh.number_of_faces()},
+                       {"dropped_flipped", tr.flipped},
+                       {"dropped_back_facing", tr.backFacing},
+                       {"dropped_long_edges", tr.longEdges},
+                       {"dropped_grazing", tr.grazing},
+                       {"dropped_non_manifold", tr.nonManifoldTriangles}};
+        j["timings_s"] = {{"curvature", t.curvature},          {"ray_caster_build", t.rayCasterBuild},
+                          {"render_reference", t.renderReference}, {"direction_field", t.directionField},
+                          {"tracing", t.tracing},              {"ray_casting", t.rayCasting},
+                          {"masks", t.masks},                  {"triangulate", t.triangulate},
+                          {"total", t.total}};
+        std::cout << j.dump(2) << "\n";
+    } else {
+        std::cout << "fishbone-scanned " << meshPath << " at " << params.camera.width << "x" << params.camera.height
+                  << " (" << rendererUsed << "): " << c.rows << " ribs x " << c.cols << " columns, " << c.covered
+                  << " samples -> patch of " << result.patch.mesh.number_of_vertices() << " vertices, "
+                  << result.patch.mesh.number_of_faces() << " faces in " << t.total << " s, written to " << outPath
+                  << "\n";
+    }
+    return 0;
+}
+
 } // namespace
 
 int runScan(const std::vector<std::string>& args) {
     std::string meshPath, outPath, view = "iso", cameraText, resolution = "256", zoom = "1", lassoText, erodeText = "1",
                                    dilateText = "1", rendererKind = "auto", scanIdText = "0", maxEdge = "3",
                                    maxAngle = "80", margin = "0.1";
+    std::string fishboneText;
+    bool haveFishbone = false;
     bool haveView = false, haveCamera = false, haveLasso = false, parallel = false, json = false, force = false;
     ArgParser p("fss-remesh scan", "Scan MESH from a camera: render it off-screen, turn every covered pixel into a "
                                    "sample on the surface, mask the samples and triangulate the pixel grid into a "
@@ -112,6 +233,14 @@ int runScan(const std::vector<std::string>& args) {
     p.option("--lasso", "\"x,y;x,y;...\"",
              "Keep only samples inside this polygon, in normalised image coordinates (0,0 top-left, 1,1 "
              "bottom-right). Self-intersecting polygons use the non-zero winding rule.", &lassoText, &haveLasso);
+    p.option("--fishbone", "SPEC",
+             "Feature-sensitive (fishbone) grid instead of the pixel grid: \"seed=X,Y[;dir=min|max][;h=PIXELS]"
+             "[;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...]\". seed: a point on a curved feature; the backbone is "
+             "traced through it along the min (default) or max curvature direction, ribs along the other; h: "
+             "sample spacing in pixels (default 4); keyribs: ribs only at the backbone samples nearest these points "
+             "(at least two), blended in between; backbone: a hand-drawn backbone through these points instead of "
+             "the seed. Points in normalised image coordinates as for --lasso. --max-edge-footprints is "
+             "multiplied by h.", &fishboneText, &haveFishbone);
     p.option("--erode", "N", "Erosion radius in samples (default 1; 0 = none).", &erodeText);
     p.option("--dilate", "N", "Dilation radius after the erosion (default 1); never re-admits rejected samples.",
              &dilateText);
@@ -127,7 +256,8 @@ int runScan(const std::vector<std::string>& args) {
              &rendererKind);
     p.flag("--json", "Print a JSON report: counts and the timing of each stage.", &json);
     p.epilog("examples:\n  fss-remesh scan fandisk.off -o patch.ply --view iso --resolution 512\n"
-             "  fss-remesh scan fandisk.off -o patch.ply --view +x --lasso \"0.2,0.2;0.8,0.2;0.5,0.9\" --erode 2");
+             "  fss-remesh scan fandisk.off -o patch.ply --view +x --lasso \"0.2,0.2;0.8,0.2;0.5,0.9\" --erode 2\n"
+             "  fss-remesh scan fandisk.off -o patch.ply --renderer cpu --fishbone \"seed=0.4,0.55;dir=min;h=3\"");
     if (!p.parse(args)) return 0;
 
     if (outPath.empty()) throw UsageError("'fss-remesh scan' needs an output file: -o OUT.");
@@ -160,9 +290,13 @@ int runScan(const std::vector<std::string>& args) {
     params.camera.zoom(zoomFactor);
     if (haveLasso) params.lasso = parseLasso(lassoText, w, h);
 
+    std::optional<FishboneParams> fishbone;
+    if (haveFishbone) fishbone = parseFishbone(fishboneText, w, h);
+
     std::string rendererUsed;
     std::unique_ptr<MeshRenderer> renderer = makeRenderer(rendererKind, rendererUsed);
     renderer->setMesh(reference);
+    if (fishbone) return runFishboneScan(reference, *renderer, rendererUsed, params, *fishbone, meshPath, outPath, json);
     const ScanResult result = scanPatch(reference, *renderer, reference, *renderer, params);
     if (auto* gpu = dynamic_cast<render::GpuMeshRenderer*>(renderer.get()))
         rendererUsed = "gpu (" + gpu->rasterizer().glRenderer() + ")";

@@ -1,0 +1,125 @@
+// Issue 5, deliverable 7: a fishbone scan costs at most 2x a regular scan with the same number of samples.
+//
+// Per mesh (fandisk, 13k faces; a 100k-face torus), one GPU renderer (head-less) for both scans:
+//  * fishbone: scanFishbonePatch at 512² with h = 2 pixels (automatic mode, seed on a curved region);
+//  * regular:  scanPatch with the same camera at the resolution whose covered-pixel count equals the
+//    fishbone's sample count (calibrated once before timing: covered ∝ resolution²).
+// Both scans run alternately in the same loop; counters: fishbone_ms, regular_ms, ratio =
+// fishbone_ms / regular_ms, the two sample counts, and the stage times of the fishbone scan. Curvature and
+// the AABB tree are per-reference precomputations (cached in FishboneCache, as the Session keeps them):
+// measured once before the loop and reported as curvature_ms / aabb_ms, not in fishbone_ms.
+#include "fss/fishbone_scan.h"
+#include "fss/mesh_io.h"
+#include "fss/render/gpu_mesh_renderer.h"
+#include "fss/scan_pipeline.h"
+#include "fss/shapes.h"
+
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <string>
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+struct Scene {
+    fss::Mesh mesh;
+    fss::Camera camera;
+    Eigen::Vector2d seed;
+};
+
+Eigen::AlignedBox3d bbox(const fss::Mesh& m) {
+    Eigen::AlignedBox3d b;
+    for (auto v : m.vertices()) b.extend(Eigen::Vector3d(m.point(v).x(), m.point(v).y(), m.point(v).z()));
+    return b;
+}
+
+Scene makeScene(int which) {
+    Scene s;
+    if (which == 0) {
+        s.mesh = fss::readMesh(std::string(FSS_BENCH_MESH_DIR) + "/fandisk.off");
+        s.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(s.mesh), 512, 512);
+        s.seed = {0.4 * 512, 0.55 * 512}; // on fandisk's curved middle feature (as the CLI test)
+    } else {
+        s.mesh = fss::shapes::torus(250, 200, 1.0, 0.35);
+        s.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(s.mesh), 512, 512);
+        const Eigen::Vector3d p = 1.35 * Eigen::Vector3d(1, 1, 0).normalized(); // outer equator, facing the eye
+        const Eigen::Vector3d q = s.camera.project(p);
+        s.seed = {q.x(), q.y()};
+    }
+    return s;
+}
+
+void BM_FishboneVsRegular(benchmark::State& state) {
+    const Scene scene = makeScene(int(state.range(0)));
+    fss::render::GpuMeshRenderer renderer;
+    renderer.setMesh(scene.mesh);
+    fss::FishboneCache cache;
+    auto t = Clock::now();
+    cache.curvature(scene.mesh);
+    const double curvatureMs = msSince(t);
+    t = Clock::now();
+    cache.rayCaster(scene.mesh);
+    const double aabbMs = msSince(t);
+
+    fss::ScanParams fishParams;
+    fishParams.camera = scene.camera;
+    fss::FishboneParams fb;
+    fb.seed = scene.seed;
+    fb.spacing = 2.0;
+    const fss::FishboneScanResult probe = fss::scanFishbonePatch(scene.mesh, renderer, scene.mesh, renderer, fishParams, fb, cache);
+    const std::size_t fishSamples = probe.counts.covered;
+
+    // Calibrate the regular scan's resolution to the same number of samples.
+    fss::ScanParams regParams;
+    regParams.camera = scene.camera;
+    const fss::ScanResult full = fss::scanPatch(scene.mesh, renderer, scene.mesh, renderer, regParams);
+    const int res = std::max(8, int(std::lround(512.0 * std::sqrt(double(fishSamples) / double(full.counts.covered)))));
+    regParams.camera.width = regParams.camera.height = res;
+
+    double fishMs = 0, regMs = 0, dirMs = 0, traceMs = 0, castMs = 0, renderMs = 0, maskMs = 0, triMs = 0;
+    std::size_t regSamples = 0;
+    for (auto _ : state) {
+        t = Clock::now();
+        const fss::FishboneScanResult f = fss::scanFishbonePatch(scene.mesh, renderer, scene.mesh, renderer, fishParams, fb, cache);
+        fishMs += msSince(t);
+        t = Clock::now();
+        const fss::ScanResult r = fss::scanPatch(scene.mesh, renderer, scene.mesh, renderer, regParams);
+        regMs += msSince(t);
+        regSamples = r.counts.covered;
+        renderMs += f.timings.renderReference * 1e3;
+        dirMs += f.timings.directionField * 1e3;
+        traceMs += f.timings.tracing * 1e3;
+        castMs += f.timings.rayCasting * 1e3;
+        maskMs += f.timings.masks * 1e3;
+        triMs += f.timings.triangulate * 1e3;
+        benchmark::DoNotOptimize(f.patch.mesh.number_of_faces());
+        benchmark::DoNotOptimize(r.patch.mesh.number_of_faces());
+    }
+    const double n = double(state.iterations());
+    state.counters["fishbone_ms"] = fishMs / n;
+    state.counters["regular_ms"] = regMs / n;
+    state.counters["ratio"] = fishMs / regMs;
+    state.counters["fish_samples"] = double(fishSamples);
+    state.counters["reg_samples"] = double(regSamples);
+    state.counters["reg_res"] = res;
+    state.counters["f_render_ms"] = renderMs / n;
+    state.counters["f_dirfield_ms"] = dirMs / n;
+    state.counters["f_trace_ms"] = traceMs / n;
+    state.counters["f_raycast_ms"] = castMs / n;
+    state.counters["f_masks_ms"] = maskMs / n;
+    state.counters["f_tri_ms"] = triMs / n;
+    state.counters["curvature_ms"] = curvatureMs;
+    state.counters["aabb_ms"] = aabbMs;
+    state.SetLabel(state.range(0) == 0 ? "fandisk" : "torus 100k");
+}
+
+} // namespace
+
+BENCHMARK(BM_FishboneVsRegular)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(10);
+
+BENCHMARK_MAIN();

@@ -1,0 +1,163 @@
+#pragma once
+/// \file fishbone_scan.h
+/// One feature-sensitive ("fishbone") scan from camera to patch (DESIGN.md §1, "Feature-sensitive
+/// (fishbone) grid", last paragraph; Vorsatz, Rössl, Kobbelt, Seidel, VMV 2000): render the *reference*
+/// mesh from the scan camera, build the screen direction fields of its principal curvature directions,
+/// trace (or take the drawn) backbone and ribs into a FishboneGrid, cast a ray from the eye through every
+/// rib vertex onto the reference surface — the ID buffer's face under the vertex is the first guess, a
+/// local search around it finishes, the AABB tree is the fallback — and then mask and triangulate the
+/// resulting SampleGrid exactly like a regular scan (scan_pipeline.h): lasso, sampling quality against the
+/// current mesh, erosion and dilation, triangulateGrid (screen-flipped quads, i.e. crossing ribs, are
+/// dropped). The patch is stitched like any other.
+///
+/// Principal curvatures and the reference's AABB tree depend only on the reference mesh: they live in a
+/// caller-owned FishboneCache, computed on the first scan and reused by every later one (the Session
+/// keeps it with the reference).
+
+#include "fss/curvature.h"
+#include "fss/direction_field.h"
+#include "fss/fishbone.h"
+#include "fss/raycast.h"
+#include "fss/scan_pipeline.h"
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <vector>
+
+namespace fss {
+
+/// What a fishbone scan precomputes once per reference mesh: principal curvatures (estimateCurvature) and
+/// the reference's RayCaster. Owned by the caller; it references the mesh given to get(), which must stay
+/// alive and unchanged while the cache holds it (call clear() before changing or destroying it).
+class FishboneCache {
+public:
+    FishboneCache();
+    ~FishboneCache();
+    FishboneCache(FishboneCache&&) noexcept;
+    FishboneCache& operator=(FishboneCache&&) noexcept;
+
+    /// Curvature of \p reference, estimated on the first call for this mesh (options used then) and cached.
+    /// A different mesh (other object or other vertex / face count) replaces the cache.
+    /// \throw as estimateCurvature (the cache is left as it was).
+    const CurvatureField& curvature(const Mesh& reference, const CurvatureOptions& options = {},
+                                    const Progress& progress = {});
+    /// RayCaster (AABB tree) of \p reference, built on the first call for this mesh and cached.
+    /// \throw as RayCaster's constructor.
+    const RayCaster& rayCaster(const Mesh& reference);
+    /// True when the RayCaster of \p reference is already built.
+    bool hasRayCaster(const Mesh& reference) const;
+    /// Seconds the curvature estimate took when it was computed (0 before).
+    double curvatureSeconds() const { return curvatureSeconds_; }
+    /// Seconds the AABB tree took when it was built (0 before).
+    double rayCasterSeconds() const { return rayCasterSeconds_; }
+    /// True when the curvature of \p reference is already cached.
+    bool hasCurvature(const Mesh& reference) const;
+    /// Forgets everything (the mesh is no longer referenced).
+    void clear();
+
+private:
+    bool holds(const Mesh& reference) const;
+    void bind(const Mesh& reference);
+    const Mesh* mesh_ = nullptr;
+    std::size_t vertices_ = 0, faces_ = 0;
+    std::optional<CurvatureField> curvature_;
+    std::unique_ptr<RayCaster> caster_;
+    double curvatureSeconds_ = 0, rayCasterSeconds_ = 0;
+};
+
+/// How the fishbone grid of a scan is built. Positions in pixels of the scan image (camera.h).
+///
+/// Modes: **automatic** (a traced backbone through `seed`, a traced rib through every backbone sample);
+/// **key-rib** (`keyRibs` and/or `drawnKeyRibs` non-empty: ribs traced only at the backbone samples nearest
+/// the key-rib points, or drawn; blended ribs in between, fishbone.h keyRibFishbone); the backbone is
+/// traced through `seed` or, when `drawnBackbone` is given, the spline through its points.
+struct FishboneParams {
+    std::optional<Eigen::Vector2d> seed;          ///< picked point of a traced backbone
+    PrincipalDirection direction = PrincipalDirection::Min; ///< the backbone's direction; ribs the other
+    double spacing = 4.0;                         ///< h: sample spacing in pixels, in [0.5, min(W, H)/4]
+    std::vector<Eigen::Vector2d> keyRibs;         ///< key-rib mode: traced key-ribs at these points (≥ 2)
+    std::vector<Polyline2> drawnKeyRibs;          ///< key-rib mode: hand-drawn key-ribs (splines)
+    Polyline2 drawnBackbone;                      ///< hand-drawn backbone (≥ 2 points) instead of seed
+    /// Tracing options (its spacing is replaced by `spacing`). The default continues straight across
+    /// isotropic regions, which CAD meshes' flat faces need. An unbounded (infinite) maxLength becomes the
+    /// image diagonal for the backbone (each way) and half of it for each rib half.
+    FishboneOptions tracing = defaultTracing();
+    /// A traced backbone needs the seed's interpolated anisotropy to reach this (else the principal
+    /// directions are undefined there: flat or umbilic region).
+    double minSeedAnisotropy = 0.1;
+    /// Local search of the hinted ray casts.
+    LocalSearchOptions raycast{};
+
+    /// Tracing with LowAnisotropyPolicy::ContinueStraight for the backbone and the ribs.
+    static FishboneOptions defaultTracing();
+};
+
+/// Wall-clock seconds of each stage of scanFishbonePatch.
+struct FishboneTimings {
+    double curvature = 0;       ///< curvature estimate (0 when the cache held it)
+    double rayCasterBuild = 0;  ///< AABB tree of the reference (0 when the cache held it)
+    double renderReference = 0; ///< render + read-back of the reference
+    double renderCurrent = 0;   ///< render of the current mesh (0 when it is the reference)
+    double directionField = 0;  ///< the screen direction field(s)
+    double tracing = 0;         ///< backbone, ribs, grid assembly
+    double rayCasting = 0;      ///< rib vertex → ray → sample
+    double masks = 0;           ///< lasso + quality mask + morphology
+    double triangulate = 0;
+    double total = 0;           ///< everything, including the cached stages when computed here
+};
+
+/// Sample counts after each stage of scanFishbonePatch.
+struct FishboneCounts {
+    int rows = 0, cols = 0;          ///< grid size (rows = ribs)
+    std::size_t ribVertices = 0;     ///< present entries of the fishbone grid
+    std::size_t covered = 0;         ///< rays that hit the reference
+    std::size_t frontFacing = 0;     ///< of those, on front-facing faces
+    std::size_t onHintFace = 0;      ///< hits on the ID buffer's face under the rib vertex itself
+    std::size_t afterLasso = 0;
+    std::size_t afterQuality = 0;
+    std::size_t afterMorphology = 0;
+};
+
+/// The result of a fishbone scan: the screen grid, the SampleGrid with its masks, the patch, and the
+/// current mesh's buffers from the scan camera (for the stitcher).
+struct FishboneScanResult {
+    FishboneGrid fishbone;
+    SampleGrid grid;
+    Patch patch;
+    FrameBuffers currentBuffers;
+    FishboneCounts counts;
+    FishboneTimings timings;
+};
+
+/// Casts a ray from the eye through every present vertex of \p fishbone (Camera::ray of the buffers'
+/// camera) onto \p reference: the face of \p referenceBuffers under the vertex's pixel is the first guess
+/// (then the faces under the 8 neighbouring pixels, nearest hit), and RayCaster::intersect with that hint
+/// (local search, AABB fallback) answers the rest. As RayCaster's hinted query, a guess is trusted to be
+/// unoccluded unless `search.verifyUnoccluded` (then every ray goes through the caster). Returns a SampleGrid of the same rows × cols whose
+/// sample (r, c) has screen = the rib vertex and the rest from setSampleOnSurface; absent vertices and
+/// misses are not hit. \p hintHits (optional) receives how many hits lie on the hint face itself.
+/// \pre \p caster holds \p reference and \p referenceBuffers were rendered from it.
+/// \throw InvalidInputError when the buffers' sizes do not match their camera.
+SampleGrid rayCastFishbone(const FishboneGrid& fishbone, const FrameBuffers& referenceBuffers,
+                           const Mesh& reference, const RayCaster& caster, const ScanOptions& options = {},
+                           const LocalSearchOptions& search = {}, std::size_t* hintHits = nullptr);
+
+/// Runs one fishbone scan (see the file comment); parallel to scanPatch, with the same renderer contract
+/// (\p referenceRenderer holds \p reference, \p currentRenderer \p current; pass the same renderer and
+/// `current == reference` for the first scan, which skips the quality mask). Triangulation accepts edges
+/// up to `params.triangulate.maxEdgeFootprints · h` footprints (grid edges are h pixels long).
+/// \throw InvalidInputError with one sentence when: the camera, lasso or radii are invalid (as scanPatch);
+///        h is not in [0.5, min(W, H)/4]; neither a seed nor a drawn backbone is given; the seed lies
+///        outside the image, on the background, or on a flat / isotropic region; fewer than two key-ribs
+///        are given in key-rib mode, or two fall on one backbone sample, or one lies farther than 2h from
+///        the backbone; the backbone has fewer than two samples; or nothing is left to triangulate.
+///        CancelledError through \p progress.
+FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& referenceRenderer, const Mesh& current,
+                                     MeshRenderer& currentRenderer, const ScanParams& params,
+                                     const FishboneParams& fishbone, FishboneCache& cache,
+                                     const Progress& progress = {});
+
+} // namespace fss

@@ -1,0 +1,380 @@
+#include "fss/fishbone_scan.h"
+
+#include "fss/error.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <string>
+
+namespace fss {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::string fmt(double x) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.3g", x);
+    return buf;
+}
+
+std::string point(const Eigen::Vector2d& p) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "(%.1f, %.1f)", p.x(), p.y());
+    return buf;
+}
+
+/// Rays through sub-pixel screen positions with the inverse view-projection computed once (Camera::ray
+/// rebuilds and inverts the matrices per call). Same formula as Camera::ray.
+struct RayFactory {
+    Eigen::Matrix4d inverse;
+    const Camera& camera;
+    explicit RayFactory(const Camera& c) : inverse(c.viewProjectionMatrix().inverse()), camera(c) {}
+    Eigen::Vector3d unproject(double sx, double sy, double depth) const {
+        const Eigen::Vector4d ndc(2.0 * sx / camera.width - 1.0, 1.0 - 2.0 * sy / camera.height,
+                                  2.0 * depth - 1.0, 1.0);
+        const Eigen::Vector4d w = inverse * ndc;
+        return w.head<3>() / w.w();
+    }
+    Ray operator()(double sx, double sy) const {
+        const Eigen::Vector3d a = unproject(sx, sy, 0.0), b = unproject(sx, sy, 1.0);
+        return Ray{camera.parallel ? a : camera.eye, (b - a).normalized()};
+    }
+};
+
+/// The ray's hit on face \p f (Möller–Trumbore, inclusive edges with a tiny tolerance), if any. The fast
+/// path of the hinted ray cast: a rib vertex lies in the pixel whose centre shows \p f, so most rays hit
+/// it; the rest go to RayCaster::intersect (local search, AABB fallback).
+std::optional<Eigen::Vector3d> hitOnFace(const Mesh& mesh, FaceIndex f, const Ray& ray) {
+    const HalfedgeIndex h = mesh.halfedge(f);
+    auto P = [&](VertexIndex v) {
+        const Point3& p = mesh.point(v);
+        return Eigen::Vector3d(p.x(), p.y(), p.z());
+    };
+    const Eigen::Vector3d a = P(mesh.source(h)), b = P(mesh.target(h)), c = P(mesh.target(mesh.next(h)));
+    const Eigen::Vector3d e1 = b - a, e2 = c - a, pv = ray.direction.cross(e2);
+    const double det = e1.dot(pv);
+    if (std::abs(det) < 1e-14 * e1.norm() * e2.norm()) return std::nullopt; // ray in the plane: let the caster decide
+    const Eigen::Vector3d tv = ray.origin - a;
+    const double u = tv.dot(pv) / det;
+    const Eigen::Vector3d qv = tv.cross(e1);
+    const double v = ray.direction.dot(qv) / det, t = e2.dot(qv) / det;
+    constexpr double eps = 1e-12;
+    if (u < -eps || v < -eps || u + v > 1 + eps || t < 0) return std::nullopt;
+    return ray.origin + t * ray.direction;
+}
+
+} // namespace
+
+// ---- FishboneCache --------------------------------------------------------------------------------------
+
+FishboneCache::FishboneCache() = default;
+FishboneCache::~FishboneCache() = default;
+FishboneCache::FishboneCache(FishboneCache&&) noexcept = default;
+FishboneCache& FishboneCache::operator=(FishboneCache&&) noexcept = default;
+
+bool FishboneCache::holds(const Mesh& reference) const {
+    return mesh_ == &reference && vertices_ == reference.number_of_vertices() &&
+           faces_ == reference.number_of_faces();
+}
+
+void FishboneCache::bind(const Mesh& reference) {
+    if (holds(reference)) return;
+    clear();
+    mesh_ = &reference;
+    vertices_ = reference.number_of_vertices();
+    faces_ = reference.number_of_faces();
+}
+
+bool FishboneCache::hasCurvature(const Mesh& reference) const { return holds(reference) && curvature_; }
+
+bool FishboneCache::hasRayCaster(const Mesh& reference) const { return holds(reference) && caster_; }
+
+const CurvatureField& FishboneCache::curvature(const Mesh& reference, const CurvatureOptions& options,
+                                               const Progress& progress) {
+    if (holds(reference) && curvature_) return *curvature_;
+    const auto t = Clock::now();
+    CurvatureField field = estimateCurvature(reference, options, progress);
+    bind(reference);
+    curvature_ = std::move(field);
+    curvatureSeconds_ = secondsSince(t);
+    return *curvature_;
+}
+
+const RayCaster& FishboneCache::rayCaster(const Mesh& reference) {
+    if (holds(reference) && caster_) return *caster_;
+    const auto t = Clock::now();
+    auto caster = std::make_unique<RayCaster>(reference);
+    bind(reference);
+    caster_ = std::move(caster);
+    rayCasterSeconds_ = secondsSince(t);
+    return *caster_;
+}
+
+void FishboneCache::clear() {
+    mesh_ = nullptr;
+    vertices_ = faces_ = 0;
+    curvature_.reset();
+    caster_.reset();
+    curvatureSeconds_ = rayCasterSeconds_ = 0;
+}
+
+FishboneOptions FishboneParams::defaultTracing() {
+    FishboneOptions o;
+    o.backboneTracing.lowAnisotropy = LowAnisotropyPolicy::ContinueStraight;
+    o.ribTracing.lowAnisotropy = LowAnisotropyPolicy::ContinueStraight;
+    return o;
+}
+
+// ---- Ray casting ----------------------------------------------------------------------------------------
+
+SampleGrid rayCastFishbone(const FishboneGrid& fishbone, const FrameBuffers& referenceBuffers,
+                           const Mesh& reference, const RayCaster& caster, const ScanOptions& options,
+                           const LocalSearchOptions& search, std::size_t* hintHits) {
+    const Camera& camera = referenceBuffers.camera;
+    const int w = camera.width, h = camera.height;
+    const std::size_t n = std::size_t(w) * std::size_t(h);
+    if (referenceBuffers.faceId.size() != n)
+        throw InvalidInputError("The scan buffers hold " + std::to_string(referenceBuffers.faceId.size()) +
+                                " face ids instead of " + std::to_string(n) + ".");
+    SampleGrid grid(fishbone.rows, fishbone.cols);
+    grid.camera = camera;
+    grid.scanId = options.scanId;
+    const RayFactory rays(camera);
+    const std::size_t faceCount = reference.number_of_faces() + reference.number_of_removed_faces();
+    std::size_t local = 0;
+    for (int r = 0; r < fishbone.rows; ++r)
+        for (int c = 0; c < fishbone.cols; ++c) {
+            Sample& s = grid.at(r, c);
+            if (!fishbone.isPresent(r, c)) continue;
+            const Eigen::Vector2d& p = fishbone.at(r, c);
+            s.screen = p;
+            const int px = std::clamp(int(std::floor(p.x())), 0, w - 1);
+            const int py = std::clamp(int(std::floor(p.y())), 0, h - 1);
+            const std::uint32_t id = referenceBuffers.faceAt(px, py);
+            const FaceIndex hint = (id != FrameBuffers::kNoFace && id < faceCount) ? FaceIndex(id) : Mesh::null_face();
+            const Ray ray = rays(p.x(), p.y());
+            if (hint != Mesh::null_face() && !search.verifyUnoccluded) {
+                if (const std::optional<Eigen::Vector3d> q = hitOnFace(reference, hint, ray)) {
+                    ++local;
+                    setSampleOnSurface(s, reference, camera, hint, *q, options);
+                    continue;
+                }
+                // The faces under the 8 neighbouring pixels (the vertex is near its pixel's border, or the
+                // faces are smaller than a pixel): nearest hit among them.
+                std::optional<Eigen::Vector3d> best;
+                FaceIndex bestFace;
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const int x = px + dx, y = py + dy;
+                        if ((dx == 0 && dy == 0) || x < 0 || y < 0 || x >= w || y >= h) continue;
+                        const std::uint32_t nid = referenceBuffers.faceAt(x, y);
+                        if (nid == FrameBuffers::kNoFace || nid >= faceCount || nid == id) continue;
+                        if (const auto q = hitOnFace(reference, FaceIndex(nid), ray);
+                            q && (!best || (*q - ray.origin).squaredNorm() < (*best - ray.origin).squaredNorm())) {
+                            best = q;
+                            bestFace = FaceIndex(nid);
+                        }
+                    }
+                if (best) {
+                    setSampleOnSurface(s, reference, camera, bestFace, *best, options);
+                    continue;
+                }
+            }
+            const SurfacePoint hit = caster.intersect(ray, hint, search);
+            if (!hit) continue;
+            if (hint != Mesh::null_face() && hit.face == hint) ++local;
+            setSampleOnSurface(s, reference, camera, hit.face, hit.point, options);
+        }
+    if (hintHits) *hintHits = local;
+    return grid;
+}
+
+// ---- The scan -------------------------------------------------------------------------------------------
+
+FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& referenceRenderer, const Mesh& current,
+                                     MeshRenderer& currentRenderer, const ScanParams& params,
+                                     const FishboneParams& fb, FishboneCache& cache, const Progress& progress) {
+    const auto start = Clock::now();
+    params.camera.validate();
+    if (params.erodeRadius < 0 || params.dilateRadius < 0)
+        throw InvalidInputError("The erosion and dilation radii must not be negative.");
+    if (params.lasso) validateLasso(*params.lasso);
+    const double h = fb.spacing;
+    const double maxH = std::min(params.camera.width, params.camera.height) / 4.0;
+    if (!std::isfinite(h) || h < 0.5 || h > maxH)
+        throw InvalidInputError("The fishbone spacing h = " + fmt(h) + " pixels is outside [0.5, " + fmt(maxH) +
+                                "] for a " + std::to_string(params.camera.width) + "x" +
+                                std::to_string(params.camera.height) + " scan.");
+    const bool drawnBackbone = !fb.drawnBackbone.empty();
+    if (!drawnBackbone && !fb.seed)
+        throw InvalidInputError("A fishbone scan needs a seed point or a drawn backbone.");
+    if (drawnBackbone && fb.drawnBackbone.size() < 2)
+        throw InvalidInputError("A drawn backbone needs at least two points.");
+    const std::size_t keyRibCount = fb.keyRibs.size() + fb.drawnKeyRibs.size();
+    const bool keyRibMode = keyRibCount > 0;
+    if (keyRibMode && keyRibCount < 2)
+        throw InvalidInputError("Key-rib mode needs at least two key-ribs to blend between, " +
+                                std::to_string(keyRibCount) + " given.");
+    auto insideImage = [&](const Eigen::Vector2d& p) {
+        return std::isfinite(p.x()) && std::isfinite(p.y()) && p.x() >= 0 && p.y() >= 0 &&
+               p.x() < params.camera.width && p.y() < params.camera.height;
+    };
+    if (fb.seed && !drawnBackbone && !insideImage(*fb.seed))
+        throw InvalidInputError("The fishbone seed " + point(*fb.seed) + " lies outside the " +
+                                std::to_string(params.camera.width) + "x" +
+                                std::to_string(params.camera.height) + " scan image.");
+
+    FishboneScanResult result;
+    FishboneOptions options = fb.tracing;
+    options.spacing = h;
+    // Unbounded tracing: a backbone at most the image diagonal long each way, a rib half at most half of it
+    // (a line field can close on itself, and a rib circling a feature many times is no sampling grid).
+    const double diagonal = std::hypot(double(params.camera.width), double(params.camera.height));
+    if (!std::isfinite(options.backboneTracing.maxLength)) options.backboneTracing.maxLength = diagonal;
+    if (!std::isfinite(options.ribTracing.maxLength)) options.ribTracing.maxLength = 0.5 * diagonal;
+
+    // Per-reference precomputation (cached by the caller).
+    progress.report(0.0, "curvature");
+    const bool needFields = !drawnBackbone || !keyRibMode || !fb.keyRibs.empty();
+    const CurvatureField* curvature = nullptr;
+    if (needFields) {
+        const bool cached = cache.hasCurvature(reference);
+        curvature = &cache.curvature(reference, {}, progress);
+        if (!cached) result.timings.curvature = cache.curvatureSeconds();
+    }
+    const bool casterCached = cache.hasRayCaster(reference);
+    const RayCaster& caster = cache.rayCaster(reference);
+    if (!casterCached) result.timings.rayCasterBuild = cache.rayCasterSeconds();
+
+    progress.report(0.1, "render reference");
+    auto t = Clock::now();
+    const FrameBuffers buffers = referenceRenderer.render(params.camera);
+    result.timings.renderReference = secondsSince(t);
+    if (buffers.coveredCount() == 0) throw InvalidInputError("The scan camera sees no part of the mesh.");
+    const int W = buffers.width(), H = buffers.height();
+
+    const bool currentIsReference = (&current == &reference);
+    if (!currentIsReference) {
+        progress.report(0.2, "render current");
+        t = Clock::now();
+        result.currentBuffers = currentRenderer.render(buffers.camera);
+        result.timings.renderCurrent = secondsSince(t);
+    } else {
+        result.currentBuffers = buffers;
+    }
+
+    // Direction fields: the backbone's (traced backbone) and the ribs' (automatic or traced key-ribs).
+    progress.report(0.3, "direction field");
+    t = Clock::now();
+    DirectionField backboneField, ribField;
+    if (!drawnBackbone) {
+        const int sx = int(std::floor(fb.seed->x())), sy = int(std::floor(fb.seed->y()));
+        if (!buffers.covered(sx, sy))
+            throw InvalidInputError("The fishbone seed " + point(*fb.seed) +
+                                    " lies on the background; pick a point on the surface.");
+        backboneField = computeDirectionField(reference, *curvature, buffers,
+                                              {fb.direction});
+    }
+    if (!keyRibMode || !fb.keyRibs.empty())
+        ribField = computeDirectionField(reference, *curvature, buffers,
+                                         {otherDirection(fb.direction)});
+    result.timings.directionField = secondsSince(t);
+
+    progress.report(0.4, "tracing");
+    t = Clock::now();
+    Backbone backbone;
+    if (drawnBackbone) {
+        backbone = fss::drawnBackbone(fb.drawnBackbone, options);
+    } else {
+        const std::optional<DirectionSample> at = backboneField.sample(*fb.seed, Eigen::Vector2d(1, 0));
+        if (!at || at->anisotropy < fb.minSeedAnisotropy)
+            throw InvalidInputError("The fishbone seed " + point(*fb.seed) +
+                                    " lies on a flat or isotropic region where no principal direction is "
+                                    "defined; pick a point on a curved feature.");
+        backbone = traceBackbone(backboneField, *fb.seed, options);
+    }
+    if (backbone.samples.size() < 2)
+        throw InvalidInputError("The fishbone backbone has fewer than two samples; pick a point on a longer "
+                                "feature or reduce h.");
+    if (!keyRibMode) {
+        std::vector<Rib> ribs;
+        ribs.reserve(backbone.samples.size());
+        for (std::size_t r = 0; r < backbone.samples.size(); ++r) ribs.push_back(traceRib(ribField, backbone, r, options));
+        result.fishbone = assembleFishboneGrid(backbone, ribs, h, W, H);
+    } else {
+        std::vector<KeyRib> keys;
+        std::vector<std::uint8_t> used(backbone.samples.size(), 0);
+        auto claim = [&](std::size_t row, const std::string& what) {
+            if (used[row])
+                throw InvalidInputError("Two key-ribs fall on the same backbone sample (" + what +
+                                        "); place them farther apart.");
+            used[row] = 1;
+        };
+        for (const Eigen::Vector2d& p : fb.keyRibs) {
+            const std::size_t row = backbone.nearestSample(p);
+            const double d = (backbone.samples[row] - p).norm();
+            if (d > 2 * h)
+                throw InvalidInputError("The key-rib point " + point(p) + " lies " + fmt(d) +
+                                        " pixels from the backbone, farther than 2h = " + fmt(2 * h) + ".");
+            claim(row, point(p));
+            keys.push_back(KeyRib{row, traceRib(ribField, backbone, row, options)});
+        }
+        for (const Polyline2& drawn : fb.drawnKeyRibs) {
+            KeyRib k = drawnKeyRib(backbone, drawn, options);
+            claim(k.row, "a drawn key-rib");
+            keys.push_back(std::move(k));
+        }
+        result.fishbone = keyRibFishbone(backbone, std::move(keys), options, W, H);
+    }
+    result.timings.tracing = secondsSince(t);
+    result.counts.rows = result.fishbone.rows;
+    result.counts.cols = result.fishbone.cols;
+    result.counts.ribVertices = result.fishbone.presentCount();
+
+    progress.report(0.6, "ray casting");
+    t = Clock::now();
+    result.grid = rayCastFishbone(result.fishbone, buffers, reference, caster, params.scan, fb.raycast,
+                                  &result.counts.onHintFace);
+    result.timings.rayCasting = secondsSince(t);
+    result.counts.covered = result.grid.hitCount();
+    result.counts.frontFacing = result.grid.admissibleCount();
+    if (result.counts.frontFacing == 0)
+        throw InvalidInputError("No rib vertex of the fishbone lands on the front of the surface.");
+
+    progress.report(0.7, "masks");
+    t = Clock::now();
+    if (params.lasso) applyLasso(result.grid, *params.lasso);
+    result.counts.afterLasso = result.grid.admissibleCount();
+    if (result.counts.afterLasso == 0) throw InvalidInputError("The lasso selects no part of the fishbone grid.");
+    if (!currentIsReference) applyQualityMask(result.grid, current, result.currentBuffers, params.quality);
+    result.counts.afterQuality = result.grid.admissibleCount();
+    erode(result.grid, params.erodeRadius);
+    dilate(result.grid, params.dilateRadius);
+    removeUntriangulatableSamples(result.grid);
+    result.counts.afterMorphology = result.grid.validCount();
+    result.timings.masks = secondsSince(t);
+
+    progress.report(0.85, "triangulate");
+    t = Clock::now();
+    TriangulateOptions tri = params.triangulate;
+    tri.maxEdgeFootprints *= std::max(1.0, h);
+    result.patch = triangulateGrid(result.grid, tri);
+    result.timings.triangulate = secondsSince(t);
+    if (result.patch.mesh.number_of_faces() == 0) {
+        if (result.counts.afterQuality == 0)
+            throw InvalidInputError("Every sample of this scan is worse than the mesh already there, so nothing "
+                                    "would change (use force-replace to override).");
+        throw InvalidInputError("Nothing is left to triangulate after the masks; enlarge the lasso, reduce the "
+                                "erosion or reduce h.");
+    }
+    result.timings.total = secondsSince(start);
+    progress.report(1.0, "done");
+    return result;
+}
+
+} // namespace fss

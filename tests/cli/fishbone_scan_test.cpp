@@ -1,0 +1,82 @@
+// fss-remesh scan --fishbone: a feature-sensitive patch of fandisk from the command line (JSON counts and
+// stage timings, the patch on the reference), and one clear sentence for each malformed --fishbone spec.
+#include "run_process.h"
+#include "test_data.h"
+
+#include "fss/mesh_io.h"
+#include "fss/metrics.h"
+
+#include <nlohmann/json.hpp>
+
+#include <gtest/gtest.h>
+
+using fss::test::meshPath;
+using fss::test::tmpPath;
+
+namespace {
+
+fss::test::ProcessResult remesh(const std::vector<std::string>& args) {
+    return fss::test::runProcess(fss::test::remeshExe(), args, tmpPath("cli_fishbone"));
+}
+
+void expectCleanFailure(const fss::test::ProcessResult& r, const std::string& mustMention) {
+    EXPECT_EQ(r.signal, 0) << "crashed with signal " << r.signal << "; stderr: " << r.err;
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_EQ(fss::test::countLines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(mustMention), std::string::npos) << "expected '" << mustMention << "' in: " << r.err;
+}
+
+const std::string kFandisk = meshPath("fandisk.off").string();
+
+} // namespace
+
+TEST(CliFishbone, FishboneScanOfFandisk) {
+    const auto out = tmpPath("cli_fishbone/fandisk_fishbone.ply");
+    const auto r = remesh({"scan", kFandisk, "-o", out.string(), "--renderer", "cpu", "--fishbone",
+                           "seed=0.4,0.55;dir=min;h=3", "--json"});
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j.at("grid"), "fishbone");
+    EXPECT_EQ(j.at("fishbone").at("h_pixels").get<double>(), 3.0);
+    const auto& c = j.at("counts");
+    EXPECT_GT(c.at("rows").get<int>(), 20);
+    EXPECT_GT(c.at("rib_vertices").get<int>(), 1000);
+    EXPECT_GT(c.at("patch_faces").get<int>(), 500);
+    for (const char* stage : {"curvature", "direction_field", "tracing", "ray_casting", "masks", "triangulate", "total"})
+        EXPECT_GT(j.at("timings_s").at(stage).get<double>(), 0.0) << stage;
+
+    const fss::Mesh patch = fss::readMesh(out);
+    EXPECT_EQ(patch.number_of_faces(), c.at("patch_faces").get<std::size_t>());
+    const fss::Mesh ref = fss::readMesh(kFandisk);
+    const fss::Metrics m = fss::computeMetrics(patch, {.selfIntersections = false, .reference = &ref});
+    EXPECT_EQ(m.nonManifoldVertices, 0u);
+    EXPECT_LE(*m.hausdorffToRefRel, 0.01); // chords of h = 3 pixels (a 1-pixel grid: 0.0025)
+
+    // Key-rib mode and a hand-drawn backbone work too.
+    const auto drawn = remesh({"scan", kFandisk, "-o", out.string(), "--renderer", "cpu", "--fishbone",
+                               "backbone=0.3,0.5|0.4,0.55|0.5,0.6;h=3"});
+    EXPECT_EQ(drawn.exitCode, 0) << drawn.err;
+    const auto keys = remesh({"scan", kFandisk, "-o", out.string(), "--renderer", "cpu", "--fishbone",
+                              "backbone=0.3,0.5|0.4,0.55|0.5,0.6;h=3;keyribs=0.32,0.51|0.48,0.59"});
+    EXPECT_EQ(keys.exitCode, 0) << keys.err;
+}
+
+TEST(CliFishbone, MalformedSpecsFailWithOneSentence) {
+    const auto out = tmpPath("cli_fishbone/bad.ply").string();
+    auto scan = [&](const std::string& spec) {
+        return remesh({"scan", kFandisk, "-o", out, "--renderer", "cpu", "--fishbone", spec});
+    };
+    expectCleanFailure(scan(""), "needs a seed=X,Y or a backbone");
+    expectCleanFailure(scan("seed=0.5"), "needs two numbers x,y");
+    expectCleanFailure(scan("seed=a,b"), "--fishbone");
+    expectCleanFailure(scan("seed=0.4,0.55;dir=sideways"), "'sideways' is not one of min, max");
+    expectCleanFailure(scan("seed=0.4,0.55;colour=red"), "key 'colour' is not one of");
+    expectCleanFailure(scan("seed0.4,0.55"), "is not of the form key=value");
+    expectCleanFailure(scan("seed=0.4,0.55;h=0"), "spacing h = 0 pixels is outside");
+    expectCleanFailure(scan("seed=0.4,0.55;h=1000"), "spacing h = 1e+03 pixels is outside");
+    expectCleanFailure(scan("seed=0.4,0.55;keyribs=0.4,0.5"), "at least two points");
+    expectCleanFailure(scan("backbone=0.4,0.5"), "at least two points");
+    expectCleanFailure(scan("seed=0.02,0.02"), "lies on the background");
+    expectCleanFailure(scan("seed=0.5,0.5"), "flat or isotropic region");
+    expectCleanFailure(scan("seed=0.4,0.55;keyribs=0.4,0.45|0.4,0.65"), "pixels from the backbone, farther than 2h");
+}
