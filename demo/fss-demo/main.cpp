@@ -1,0 +1,156 @@
+// fss-demo: the FSS demo application (a main window around VtkView).
+//
+//   fss-demo [--view V] [--colormap C] [MESH]
+//   fss-demo --screenshot FILE.png [--view iso|+x|-x|+y|-y|+z|-z] [--colormap none|angle|valence]
+//            [--size WxH] [MESH]
+//
+// Without MESH the bundled default mesh (CGAL's fandisk) is opened. --screenshot renders the window to
+// FILE and exits: 0 on success, 1 with one sentence on stderr when it failed, 2 for a wrong command line.
+#include "main_window.h"
+
+#include <fss/camera.h>
+#include <fss/error.h>
+#include <fss/mesh_io.h>
+#include <fss/widgets/vtk_view.h>
+
+#include <QApplication>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <string>
+
+namespace {
+
+const char* const kUsage =
+    "usage: fss-demo [--screenshot FILE.png] [--view iso|+x|-x|+y|-y|+z|-z] [--colormap none|angle|valence]\n"
+    "                [--size WxH] [MESH]\n";
+
+struct Options {
+    std::string mesh = FSS_DEFAULT_MESH;
+    std::optional<std::string> screenshot;
+    fss::StandardView view = fss::StandardView::Iso;
+    fss::widgets::ColorMap colorMap = fss::widgets::ColorMap::None;
+    int width = 1024, height = 768;
+};
+
+// Writes errors to stderr instead of opening a box (the --screenshot mode must never block).
+class StderrPresenter final : public fss::demo::MessagePresenter {
+public:
+    void showError(QWidget*, const QString&, const QString& message) override {
+        std::cerr << message.toStdString() << "\n";
+    }
+};
+
+// Parses the command line; prints one sentence and returns nullopt when it is wrong.
+std::optional<Options> parse(int argc, char** argv, bool& help) {
+    Options o;
+    bool haveMesh = false;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto value = [&](const char* name) -> std::optional<std::string> {
+            if (i + 1 >= argc) {
+                std::cerr << "Option " << name << " needs a value.\n" << kUsage;
+                return std::nullopt;
+            }
+            return std::string(argv[++i]);
+        };
+        if (a == "-h" || a == "--help") {
+            help = true;
+            return o;
+        } else if (a == "--screenshot") {
+            const auto v = value("--screenshot");
+            if (!v) return std::nullopt;
+            o.screenshot = *v;
+        } else if (a == "--view") {
+            const auto v = value("--view");
+            if (!v) return std::nullopt;
+            const auto view = fss::parseStandardView(*v);
+            if (!view) {
+                std::cerr << "Unknown view '" << *v << "': use iso, +x, -x, +y, -y, +z or -z.\n";
+                return std::nullopt;
+            }
+            o.view = *view;
+        } else if (a == "--colormap") {
+            const auto v = value("--colormap");
+            if (!v) return std::nullopt;
+            const auto map = fss::widgets::parseColorMap(*v);
+            if (!map) {
+                std::cerr << "Unknown colour map '" << *v << "': use none, angle or valence.\n";
+                return std::nullopt;
+            }
+            o.colorMap = *map;
+        } else if (a == "--size") {
+            const auto v = value("--size");
+            if (!v) return std::nullopt;
+            int w = 0, h = 0;
+            char rest = 0;
+            if (std::sscanf(v->c_str(), "%dx%d%c", &w, &h, &rest) != 2 || w < 64 || h < 64 || w > 8192 || h > 8192) {
+                std::cerr << "Bad size '" << *v << "': use WIDTHxHEIGHT, each between 64 and 8192.\n";
+                return std::nullopt;
+            }
+            o.width = w;
+            o.height = h;
+        } else if (!a.empty() && a[0] == '-') {
+            std::cerr << "Unknown option '" << a << "'.\n" << kUsage;
+            return std::nullopt;
+        } else if (haveMesh) {
+            std::cerr << "Only one mesh file can be given.\n" << kUsage;
+            return std::nullopt;
+        } else {
+            o.mesh = a;
+            haveMesh = true;
+        }
+    }
+    return o;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    bool help = false;
+    const std::optional<Options> options = parse(argc, argv, help);
+    if (help) {
+        std::cout << kUsage;
+        return 0;
+    }
+    if (!options) return 2;
+
+    // In --screenshot mode the mesh is read before any window exists, so that a bad file ends the program
+    // with its one sentence and nothing else.
+    std::optional<fss::Mesh> mesh;
+    if (options->screenshot) {
+        try {
+            mesh = fss::readMesh(options->mesh);
+        } catch (const std::exception& e) {
+            std::cerr << e.what() << "\n";
+            return 1;
+        }
+    }
+
+    fss::widgets::VtkView::setDefaultSurfaceFormat(); // before the QApplication exists
+    QApplication app(argc, argv);
+    QApplication::setApplicationName(QStringLiteral("fss-demo"));
+    QApplication::setApplicationVersion(QStringLiteral(FSS_VERSION));
+
+    std::unique_ptr<fss::demo::MessagePresenter> presenter;
+    if (options->screenshot) presenter = std::make_unique<StderrPresenter>();
+    fss::demo::MainWindow window(std::move(presenter));
+    window.resize(options->width, options->height);
+    window.view()->setInitialView(options->view);
+    window.setColorMap(options->colorMap);
+
+    if (options->screenshot) {
+        window.setMesh(std::move(*mesh), QString::fromStdString(std::filesystem::path(options->mesh).filename().string()));
+        const QString error = window.saveScreenshot(QString::fromStdString(*options->screenshot));
+        if (!error.isEmpty()) {
+            std::cerr << error.toStdString() << "\n";
+            return 1;
+        }
+        return 0;
+    }
+    window.show();
+    window.openMesh(QString::fromStdString(options->mesh));
+    return app.exec();
+}

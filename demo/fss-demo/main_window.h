@@ -1,0 +1,91 @@
+#pragma once
+/// \file main_window.h
+/// The main window of fss-demo: a VtkView with File / View / Colour menus and mesh statistics in the
+/// status bar. Errors go through a MessagePresenter so that tests can open bad files without a modal box.
+
+#include <fss/camera.h>
+#include <fss/mesh.h>
+#include <fss/widgets/vtk_view.h>
+
+#include <QMainWindow>
+#include <QString>
+
+#include <memory>
+#include <utility>
+#include <vector>
+
+class QAction;
+class QLabel;
+
+namespace fss::demo {
+
+/// Shows an error to the user. The default (MessageBoxPresenter) opens a modal QMessageBox; tests and
+/// the --screenshot mode install one that only records or prints.
+class MessagePresenter {
+public:
+    virtual ~MessagePresenter() = default;
+    /// Shows \p message (one sentence) with \p title over \p parent.
+    virtual void showError(QWidget* parent, const QString& title, const QString& message) = 0;
+};
+
+/// A modal QMessageBox::critical.
+class MessageBoxPresenter final : public MessagePresenter {
+public:
+    void showError(QWidget* parent, const QString& title, const QString& message) override;
+};
+
+/// The demo's main window. Owns the current mesh; the view shows it.
+class MainWindow : public QMainWindow {
+    Q_OBJECT
+public:
+    /// \param presenter how errors are shown (a MessageBoxPresenter when null)
+    explicit MainWindow(std::unique_ptr<MessagePresenter> presenter = nullptr, QWidget* parent = nullptr);
+    ~MainWindow() override;
+
+    /// Reads \p path with fss::readMesh and shows it. On failure the previous mesh stays, the error (one
+    /// sentence) is shown through the presenter and errorOccurred() is emitted. \return success
+    bool openMesh(const QString& path);
+    /// Writes the current mesh to \p path (format by extension). On failure reports like openMesh.
+    bool saveMesh(const QString& path);
+    /// Shows \p mesh under the display name \p name (used in the title and status bar).
+    void setMesh(Mesh mesh, const QString& name);
+
+    /// The current mesh (empty before the first successful open).
+    const Mesh& mesh() const { return mesh_; }
+    /// The file the current mesh came from (empty when none).
+    QString meshPath() const { return meshPath_; }
+    /// Colours the view by \p map and checks the matching Colour menu entry.
+    void setColorMap(widgets::ColorMap map);
+
+    /// The 3D view.
+    widgets::VtkView* view() const { return view_; }
+    /// The statistics shown in the status bar.
+    QString statisticsText() const;
+
+    /// Shows the window, waits until it is exposed and rendered, and saves it as an image (PNG by the
+    /// extension). \return an empty string on success, else one sentence saying why it failed.
+    QString saveScreenshot(const QString& path);
+
+signals:
+    /// An operation failed; \p message is the sentence shown to the user.
+    void errorOccurred(const QString& message);
+    /// A new mesh is shown.
+    void meshChanged();
+
+private:
+    void createMenus();
+    void reportError(const QString& title, const QString& message);
+    void updateStatistics();
+    void openDialog();
+    void saveDialog();
+
+    std::unique_ptr<MessagePresenter> presenter_;
+    widgets::VtkView* view_ = nullptr;
+    QLabel* statistics_ = nullptr;
+    std::vector<std::pair<widgets::ColorMap, QAction*>> colorActions_;
+    Mesh mesh_;
+    QString meshPath_;
+    QString meshName_;
+};
+
+} // namespace fss::demo

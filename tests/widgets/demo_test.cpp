@@ -1,0 +1,163 @@
+// fss-demo: the --screenshot command line (run as a program) and the main window's open / save paths
+// (driven directly, with a recording MessagePresenter instead of a modal box).
+#include "main_window.h"
+#include "pixel_stats.h"
+#include "test_data.h"
+
+#include <fss/mesh_io.h>
+#include <fss/widgets/vtk_view.h>
+
+#include <QApplication>
+#include <QFile>
+#include <QImage>
+#include <QProcess>
+#include <QSignalSpy>
+#include <QTest>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+namespace {
+
+struct RunResult {
+    int exitCode = -1;
+    QString err;
+};
+
+RunResult runDemo(const QStringList& args) {
+    QProcess process;
+    process.start(QStringLiteral(FSS_DEMO_EXE), args);
+    RunResult r;
+    if (!process.waitForFinished(120000) || process.exitStatus() != QProcess::NormalExit) return r;
+    r.exitCode = process.exitCode();
+    r.err = QString::fromUtf8(process.readAllStandardError());
+    return r;
+}
+
+QString tmp(const char* name) { return QString::fromStdString(fss::test::tmpPath(name).string()); }
+
+QString badMeshFile() {
+    const QString path = tmp("demo_bad.off");
+    std::ofstream(path.toStdString()) << "OFF\n3 1 0\n0 0 0\n1 0 0\n";  // truncated: a vertex and the face missing
+    return path;
+}
+
+// Records errors instead of showing a modal box.
+class RecordingPresenter final : public fss::demo::MessagePresenter {
+public:
+    explicit RecordingPresenter(QStringList* messages) : messages_(messages) {}
+    void showError(QWidget*, const QString&, const QString& message) override { messages_->append(message); }
+
+private:
+    QStringList* messages_;
+};
+
+} // namespace
+
+class DemoTest : public QObject {
+    Q_OBJECT
+private slots:
+    void screenshotOfAMesh() {
+        const QString out = tmp("demo_fandisk.png");
+        QFile::remove(out);
+        const RunResult r = runDemo({"--screenshot", out, "--size", "800x600", "--view", "+z",
+                                     QString::fromStdString(fss::test::meshPath("fandisk.off").string())});
+        QVERIFY2(r.exitCode == 0, qPrintable(r.err));
+        QImage image;
+        QVERIFY(image.load(out));
+        QVERIFY(image.width() >= 800 && image.height() >= 600); // the whole window (× device pixel ratio)
+        const double cover = fss::test::pixelFraction(image, fss::test::notBackground);
+        QVERIFY2(cover > 0.1 && cover < 0.9, qPrintable(QString::number(cover)));
+        QVERIFY(fss::test::pixelFraction(image, fss::test::surfaceColored) > 0.03);
+        // The view occupies most of the window: its background is there too.
+        QVERIFY(1 - cover > 0.1);
+    }
+
+    void screenshotWithColorMapAndDefaultMesh() {
+        const QString out = tmp("demo_default_angle.png");
+        QFile::remove(out);
+        const RunResult r = runDemo({"--screenshot", out, "--colormap", "angle"});
+        QVERIFY2(r.exitCode == 0, qPrintable(r.err));
+        QImage image;
+        QVERIFY(image.load(out));
+        QVERIFY(fss::test::pixelFraction(image, fss::test::qualityGreen) > 0.02);
+    }
+
+    void screenshotOfABadFileFails() {
+        const QString out = tmp("demo_bad.png");
+        QFile::remove(out);
+        const RunResult r = runDemo({"--screenshot", out, badMeshFile()});
+        QVERIFY(r.exitCode != 0 && r.exitCode != -1);
+        const QString sentence = r.err.trimmed();
+        QVERIFY2(!sentence.isEmpty() && !sentence.contains('\n') && sentence.endsWith('.'), qPrintable(r.err));
+        QVERIFY(sentence.contains("demo_bad.off"));
+        QVERIFY(!QFile::exists(out));
+    }
+
+    void wrongCommandLineIsRefused() {
+        const RunResult r = runDemo({"--screenshot", tmp("x.png"), "--view", "sideways"});
+        QCOMPARE(r.exitCode, 2);
+        QVERIFY(r.err.contains("sideways"));
+    }
+
+    void openingABadFileKeepsTheMesh() {
+        QStringList messages;
+        fss::demo::MainWindow window(std::make_unique<RecordingPresenter>(&messages));
+        const QString good = QString::fromStdString(fss::test::meshPath("fandisk.off").string());
+        QVERIFY(window.openMesh(good));
+        const std::size_t faces = window.mesh().number_of_faces();
+        QCOMPARE(faces, std::size_t(12946));
+        QVERIFY(window.statisticsText().contains("12946 faces"));
+        QVERIFY(window.view()->hasMesh());
+
+        QSignalSpy errors(&window, &fss::demo::MainWindow::errorOccurred);
+        QSignalSpy changed(&window, &fss::demo::MainWindow::meshChanged);
+        QVERIFY(!window.openMesh(badMeshFile()));
+        QCOMPARE(errors.count(), 1);
+        QCOMPARE(messages.size(), 1);
+        QCOMPARE(errors.at(0).at(0).toString(), messages.at(0));
+        QVERIFY(messages.at(0).contains("demo_bad.off") && messages.at(0).trimmed().endsWith('.'));
+        QCOMPARE(changed.count(), 0);
+        QCOMPARE(window.mesh().number_of_faces(), faces); // the previous mesh stays
+        QCOMPARE(window.meshPath(), good);
+        QVERIFY(window.statisticsText().contains("12946 faces"));
+
+        QVERIFY(!window.openMesh(tmp("does_not_exist.off")));
+        QCOMPARE(messages.size(), 2);
+        QCOMPARE(window.mesh().number_of_faces(), faces);
+    }
+
+    void saveWritesTheMeshAndReportsFailures() {
+        QStringList messages;
+        fss::demo::MainWindow window(std::make_unique<RecordingPresenter>(&messages));
+        QVERIFY(window.openMesh(QString::fromStdString(fss::test::meshPath("fandisk.off").string())));
+        const QString out = tmp("demo_saved.ply");
+        QVERIFY(window.saveMesh(out));
+        QCOMPARE(fss::readMesh(out.toStdString()).number_of_faces(), window.mesh().number_of_faces());
+        QVERIFY(messages.isEmpty());
+        QVERIFY(!window.saveMesh(tmp("demo_saved.unknown")));
+        QCOMPARE(messages.size(), 1);
+    }
+
+    void windowScreenshotShowsTheMesh() {
+        QStringList messages;
+        fss::demo::MainWindow window(std::make_unique<RecordingPresenter>(&messages));
+        QVERIFY(window.openMesh(QString::fromStdString(fss::test::meshPath("fandisk.off").string())));
+        window.setColorMap(fss::widgets::ColorMap::Valence);
+        const QString out = tmp("demo_window.png");
+        QCOMPARE(window.saveScreenshot(out), QString());
+        QImage image;
+        QVERIFY(image.load(out));
+        QVERIFY(fss::test::pixelFraction(image, fss::test::qualityGreen) > 0.02);
+    }
+};
+
+int main(int argc, char** argv) {
+    fss::widgets::VtkView::setDefaultSurfaceFormat();
+    QApplication app(argc, argv);
+    DemoTest test;
+    return QTest::qExec(&test, argc, argv);
+}
+
+#include "demo_test.moc"

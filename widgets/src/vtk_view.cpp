@@ -1,0 +1,539 @@
+#include "fss/widgets/vtk_view.h"
+
+#include "fss/error.h"
+
+// GL constants come from Qt's qopengl.h (through QOpenGLWidget); vtk_glew.h cannot be combined with it
+// and is not needed: every GL call goes through VTK (vtkOpenGLState, the render window).
+#include <vtkActor.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkCommand.h>
+#include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkGenericRenderWindowInteractor.h>
+#include <vtkInteractorStyleTrackballCamera.h>
+#include <vtkNew.h>
+#include <vtkObjectFactory.h>
+#include <vtkOpenGLState.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderer.h>
+#include <vtkSmartPointer.h>
+#include <vtkUnsignedCharArray.h>
+
+#include <QKeyEvent>
+#include <QMouseEvent>
+#include <QOpenGLContext>
+#include <QSurfaceFormat>
+#include <QWheelEvent>
+#include <QtDebug>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace fss::widgets {
+namespace {
+
+// A vtkCommand calling a std::function: observers that capture the view.
+class FunctionCommand : public vtkCommand {
+public:
+    static FunctionCommand* New() { return new FunctionCommand; }
+    std::function<void(unsigned long event, void* callData)> callback;
+    void Execute(vtkObject*, unsigned long event, void* callData) override {
+        if (callback) callback(event, callData);
+    }
+};
+
+// VTK's trackball camera without its keyboard shortcuts: 'e'/'q' would call exit(), 'w'/'s' switch the
+// representation (and lose the edges), 'f'/'p' fly to and pick (timers and pickers the view does not
+// drive), '3' stereo. Only 'r' (reset the camera onto the mesh) is kept.
+class NavigationStyle : public vtkInteractorStyleTrackballCamera {
+public:
+    static NavigationStyle* New();
+    vtkTypeMacro(NavigationStyle, vtkInteractorStyleTrackballCamera);
+    void OnChar() override {
+        const char key = this->Interactor ? this->Interactor->GetKeyCode() : 0;
+        if (key == 'r' || key == 'R') vtkInteractorStyleTrackballCamera::OnChar();
+    }
+};
+vtkStandardNewMacro(NavigationStyle);
+
+using Rgb = std::array<double, 3>;
+
+Rgb mix(const Rgb& a, const Rgb& b, double t) {
+    return {a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t};
+}
+
+constexpr Rgb kRed{0.85, 0.12, 0.10};
+constexpr Rgb kOrange{0.95, 0.50, 0.10};
+constexpr Rgb kYellow{0.95, 0.85, 0.15};
+constexpr Rgb kGreen{0.15, 0.70, 0.25};
+constexpr Rgb kGrey{0.60, 0.60, 0.60};
+
+// 0° red → 30° yellow → 60° green.
+Rgb minAngleColor(double deg) {
+    const double t = std::clamp(deg / 60.0, 0.0, 1.0);
+    return t < 0.5 ? mix(kRed, kYellow, t * 2) : mix(kYellow, kGreen, (t - 0.5) * 2);
+}
+
+Rgb valenceColor(int deviation) {
+    switch (deviation) {
+    case -1: return kGrey;
+    case 0: return kGreen;
+    case 1: return kYellow;
+    case 2: return kOrange;
+    default: return kRed;
+    }
+}
+
+double cornerAngleDeg(const Point3& at, const Point3& a, const Point3& b) {
+    const Vector3 u = a - at, v = b - at;
+    const double lu = std::sqrt(u.squared_length()), lv = std::sqrt(v.squared_length());
+    if (lu == 0 || lv == 0) return 0;
+    return std::acos(std::clamp((u * v) / (lu * lv), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+Eigen::Vector3d toEigen(const double* p) { return {p[0], p[1], p[2]}; }
+
+} // namespace
+
+std::optional<ColorMap> parseColorMap(std::string_view name) {
+    if (name == "none") return ColorMap::None;
+    if (name == "angle" || name == "min-angle") return ColorMap::MinAngle;
+    if (name == "valence") return ColorMap::Valence;
+    return std::nullopt;
+}
+
+QString colorMapName(ColorMap map) {
+    switch (map) {
+    case ColorMap::None: return QStringLiteral("none");
+    case ColorMap::MinAngle: return QStringLiteral("angle");
+    case ColorMap::Valence: return QStringLiteral("valence");
+    }
+    return {};
+}
+
+struct VtkView::Impl {
+    vtkNew<vtkGenericOpenGLRenderWindow> window;
+    vtkNew<vtkRenderer> renderer;
+    vtkNew<vtkGenericRenderWindowInteractor> interactor;
+    vtkNew<NavigationStyle> style;
+    vtkNew<vtkPolyData> polyData;
+    vtkNew<vtkPolyDataMapper> mapper;
+    vtkNew<vtkActor> actor;
+    std::vector<unsigned long> windowObservers;
+    unsigned long renderObserver = 0;
+
+    QOpenGLContext* context = nullptr; // the widget's context while VTK is initialised in it
+    QSurface* surface = nullptr;       // the surface the widget makes that context current with
+    QMetaObject::Connection contextDestroyed;
+    bool initialized = false;
+    bool inPaint = false;
+
+    // Per-face measures of the shown mesh (kept so that switching the colour map needs no mesh).
+    std::vector<double> faceMinAngle;
+    std::vector<int> faceValenceDeviation;
+    Eigen::AlignedBox3d bounds;
+    ColorMap colorMap = ColorMap::None;
+    StandardView initialView = StandardView::Iso;
+    vtkMTimeType cameraTime = 0;
+
+    void applyColorMap() {
+        if (colorMap == ColorMap::None || polyData->GetNumberOfCells() == 0) {
+            polyData->GetCellData()->SetScalars(nullptr);
+            mapper->ScalarVisibilityOff();
+            return;
+        }
+        vtkNew<vtkUnsignedCharArray> colors;
+        colors->SetName("face colour");
+        colors->SetNumberOfComponents(3);
+        const auto n = static_cast<vtkIdType>(faceMinAngle.size());
+        colors->SetNumberOfTuples(n);
+        for (vtkIdType f = 0; f < n; ++f) {
+            const Rgb c = colorMap == ColorMap::MinAngle ? minAngleColor(faceMinAngle[std::size_t(f)])
+                                                         : valenceColor(faceValenceDeviation[std::size_t(f)]);
+            for (int k = 0; k < 3; ++k)
+                colors->SetTypedComponent(f, k, static_cast<unsigned char>(std::lround(c[std::size_t(k)] * 255)));
+        }
+        polyData->GetCellData()->SetScalars(colors);
+        mapper->ScalarVisibilityOn();
+        mapper->SetScalarModeToUseCellData();
+        mapper->SetColorModeToDirectScalars();
+    }
+
+    void releaseGraphics(VtkView* view) {
+        if (!initialized) return;
+        view->makeCurrent();
+        window->Finalize();
+        window->SetReadyForRendering(false);
+        view->doneCurrent();
+        initialized = false;
+        context = nullptr;
+        surface = nullptr;
+    }
+};
+
+QSurfaceFormat VtkView::surfaceFormat() {
+    QSurfaceFormat format;
+    format.setRenderableType(QSurfaceFormat::OpenGL);
+    format.setVersion(3, 2);
+    format.setProfile(QSurfaceFormat::CoreProfile);
+    format.setSwapBehavior(QSurfaceFormat::DoubleBuffer);
+    format.setRedBufferSize(8);
+    format.setGreenBufferSize(8);
+    format.setBlueBufferSize(8);
+    format.setAlphaBufferSize(8);
+    format.setDepthBufferSize(24);
+    format.setStencilBufferSize(8);
+    format.setSamples(0);
+    return format;
+}
+
+void VtkView::setDefaultSurfaceFormat() { QSurfaceFormat::setDefaultFormat(surfaceFormat()); }
+
+VtkView::VtkView(QWidget* parent) : QOpenGLWidget(parent), impl_(std::make_unique<Impl>()) {
+    auto& d = *impl_;
+    setFocusPolicy(Qt::StrongFocus);
+    setMouseTracking(true);
+    setMinimumSize(64, 64);
+
+    // VTK renders in the widget's context (not one of its own), into its own framebuffer; paintGL blits.
+    d.window->SetOwnContext(0);
+    d.window->SetMultiSamples(0); // VTK's default of 8 breaks rendering into a QOpenGLWidget
+    d.window->SetFrameBlitModeToNoBlit();
+    d.window->SetReadyForRendering(false);
+    d.window->AddRenderer(d.renderer);
+
+    auto observe = [&](unsigned long event, std::function<void(void*)> f) {
+        vtkNew<FunctionCommand> command;
+        command->callback = [f = std::move(f)](unsigned long, void* callData) { f(callData); };
+        d.windowObservers.push_back(d.window->AddObserver(event, command));
+    };
+    // Trap (PLATFORM-NOTES): QOpenGLContext::makeCurrent, not QOpenGLWidget::makeCurrent — the latter
+    // rebinds Qt's framebuffer while VTK sets up its own and the image comes out garbage.
+    observe(vtkCommand::WindowMakeCurrentEvent, [this](void*) {
+        auto& dd = *impl_;
+        if (dd.context && dd.surface && QOpenGLContext::currentContext() != dd.context)
+            dd.context->makeCurrent(dd.surface);
+    });
+    observe(vtkCommand::WindowIsCurrentEvent, [this](void* callData) {
+        *static_cast<bool*>(callData) = impl_->context && QOpenGLContext::currentContext() == impl_->context;
+    });
+    // A render started outside paintGL (by code holding the render window) must reach the screen.
+    observe(vtkCommand::WindowFrameEvent, [this](void*) {
+        if (!impl_->inPaint) update();
+    });
+
+    d.interactor->SetRenderWindow(d.window);
+    d.interactor->SetInteractorStyle(d.style);
+    d.interactor->EnableRenderOff(); // the interactor asks for renders through RenderEvent → update()
+    {
+        vtkNew<FunctionCommand> command;
+        command->callback = [this](unsigned long, void*) { update(); };
+        d.renderObserver = d.interactor->AddObserver(vtkCommand::RenderEvent, command);
+    }
+    d.interactor->Initialize();
+
+    d.renderer->SetBackground(kBackground[0], kBackground[1], kBackground[2]);
+    d.renderer->SetBackgroundAlpha(1.0); // opaque: Qt composes the widget image with its alpha
+    d.mapper->SetInputData(d.polyData);
+    d.mapper->ScalarVisibilityOff();
+    d.actor->SetMapper(d.mapper);
+    vtkProperty* property = d.actor->GetProperty();
+    property->SetColor(kSurface[0], kSurface[1], kSurface[2]);
+    property->SetAmbient(0.15);
+    property->SetDiffuse(0.85);
+    property->SetSpecular(0.1);
+    property->SetInterpolationToFlat();
+    property->EdgeVisibilityOn();
+    property->SetEdgeColor(0.12, 0.12, 0.14);
+    property->SetLineWidth(1.0f);
+    d.actor->VisibilityOff();
+    d.renderer->AddActor(d.actor);
+    setStandardView(d.initialView);
+}
+
+VtkView::~VtkView() {
+    impl_->releaseGraphics(this);
+    for (unsigned long tag : impl_->windowObservers) impl_->window->RemoveObserver(tag);
+    impl_->interactor->RemoveObserver(impl_->renderObserver);
+}
+
+void VtkView::initializeGL() {
+    auto& d = *impl_;
+    d.context = context();
+    d.surface = context()->surface();
+    // QOpenGLWidget recreates its context when it is re-parented into another window: release VTK's
+    // resources in the old one (initializeGL then runs again in the new one).
+    QObject::disconnect(d.contextDestroyed);
+    d.contextDestroyed = connect(context(), &QOpenGLContext::aboutToBeDestroyed, this,
+                                 [this] { impl_->releaseGraphics(this); });
+    if (!d.window->InitializeFromCurrentContext()) {
+        qWarning("VtkView: VTK could not initialise OpenGL in the widget's context.");
+        d.context = nullptr;
+        d.surface = nullptr;
+        return;
+    }
+    d.window->SetReadyForRendering(true);
+    d.initialized = true;
+    resizeGL(width(), height());
+}
+
+void VtkView::resizeGL(int width, int height) {
+    auto& d = *impl_;
+    const qreal dpr = devicePixelRatioF();
+    const int w = std::max(1, int(std::lround(width * dpr)));
+    const int h = std::max(1, int(std::lround(height * dpr)));
+    d.window->SetSize(w, h);
+    d.interactor->UpdateSize(w, h);
+}
+
+void VtkView::paintGL() {
+    auto& d = *impl_;
+    if (!d.initialized) return;
+    vtkOpenGLState* state = d.window->GetState();
+    // Qt changes GL state behind VTK's back: resynchronise VTK's cache, and restore Qt's afterwards.
+    state->Reset();
+    state->Push();
+    state->vtkglDepthFunc(GL_LEQUAL); // Qt leaves GL_LESS, VTK expects GL_LEQUAL
+    d.inPaint = true;
+    d.window->Render();
+    d.inPaint = false;
+    // Rendering may have made another context current (observers of other widgets): back to ours.
+    makeCurrent();
+    const int* size = d.window->GetSize();
+    state->PushDrawFramebufferBinding();
+    state->vtkglBindFramebuffer(GL_DRAW_FRAMEBUFFER, defaultFramebufferObject());
+    state->vtkglDisable(GL_SCISSOR_TEST);
+    state->vtkglViewport(0, 0, size[0], size[1]);
+    d.window->BlitDisplayFramebuffer(0, 0, 0, size[0], size[1], 0, 0, size[0], size[1], GL_COLOR_BUFFER_BIT,
+                                     GL_NEAREST);
+    state->PopDrawFramebufferBinding();
+    state->Pop();
+    const vtkMTimeType t = d.renderer->GetActiveCamera()->GetMTime();
+    if (t != d.cameraTime) {
+        d.cameraTime = t;
+        emit cameraChanged();
+    }
+}
+
+void VtkView::setMesh(const Mesh& mesh) {
+    auto& d = *impl_;
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->Allocate(vtkIdType(mesh.number_of_vertices()));
+    std::vector<vtkIdType> pointId(mesh.num_vertices(), -1); // num_vertices counts removed ones too
+    d.bounds.setEmpty();
+    for (VertexIndex v : mesh.vertices()) {
+        const Point3& p = mesh.point(v);
+        pointId[std::size_t(v)] = points->InsertNextPoint(p.x(), p.y(), p.z());
+        d.bounds.extend(Eigen::Vector3d(p.x(), p.y(), p.z()));
+    }
+    vtkNew<vtkCellArray> polys;
+    polys->AllocateEstimate(vtkIdType(mesh.number_of_faces()), 3);
+    d.faceMinAngle.clear();
+    d.faceValenceDeviation.clear();
+    d.faceMinAngle.reserve(mesh.number_of_faces());
+    d.faceValenceDeviation.reserve(mesh.number_of_faces());
+    std::vector<int> deviation(mesh.num_vertices(), -1); // |valence − 6| of interior vertices, else −1
+    for (VertexIndex v : mesh.vertices())
+        if (!mesh.is_border(v) && !mesh.is_isolated(v)) deviation[std::size_t(v)] = std::abs(int(mesh.degree(v)) - 6);
+    std::vector<vtkIdType> ids;
+    std::vector<Point3> corners;
+    for (FaceIndex f : mesh.faces()) {
+        ids.clear();
+        corners.clear();
+        int worst = -1;
+        for (VertexIndex v : mesh.vertices_around_face(mesh.halfedge(f))) {
+            ids.push_back(pointId[std::size_t(v)]);
+            corners.push_back(mesh.point(v));
+            worst = std::max(worst, deviation[std::size_t(v)]);
+        }
+        polys->InsertNextCell(vtkIdType(ids.size()), ids.data());
+        double minAngle = 180;
+        const std::size_t n = corners.size();
+        for (std::size_t i = 0; i < n; ++i)
+            minAngle = std::min(minAngle, cornerAngleDeg(corners[i], corners[(i + n - 1) % n], corners[(i + 1) % n]));
+        d.faceMinAngle.push_back(minAngle);
+        d.faceValenceDeviation.push_back(worst);
+    }
+    vtkNew<vtkPolyData> fresh;
+    fresh->SetPoints(points);
+    fresh->SetPolys(polys);
+    d.polyData->ShallowCopy(fresh);
+    d.applyColorMap();
+    d.polyData->Modified();
+    d.actor->SetVisibility(d.polyData->GetNumberOfCells() > 0);
+    setStandardView(d.initialView);
+}
+
+void VtkView::clearMesh() { setMesh(Mesh{}); }
+
+bool VtkView::hasMesh() const { return impl_->polyData->GetNumberOfCells() > 0; }
+
+void VtkView::setColorMap(ColorMap map) {
+    impl_->colorMap = map;
+    impl_->applyColorMap();
+    impl_->polyData->Modified();
+    update();
+}
+
+ColorMap VtkView::colorMap() const { return impl_->colorMap; }
+
+Camera VtkView::camera() const {
+    vtkCamera* c = impl_->renderer->GetActiveCamera();
+    Camera camera;
+    camera.eye = toEigen(c->GetPosition());
+    camera.focal = toEigen(c->GetFocalPoint());
+    camera.up = toEigen(c->GetViewUp());
+    camera.parallel = c->GetParallelProjection() != 0;
+    camera.viewAngleDeg = c->GetViewAngle();
+    camera.parallelScale = c->GetParallelScale();
+    const double* range = c->GetClippingRange();
+    camera.nearPlane = range[0];
+    camera.farPlane = range[1];
+    const qreal dpr = devicePixelRatioF();
+    camera.width = std::clamp(int(std::lround(width() * dpr)), 1, Camera::kMaxResolution);
+    camera.height = std::clamp(int(std::lround(height() * dpr)), 1, Camera::kMaxResolution);
+    return camera;
+}
+
+void VtkView::setCamera(const Camera& camera) {
+    Camera checked = camera;
+    checked.width = checked.height = 1; // the view's own size decides; validate the rest
+    checked.validate();
+    vtkCamera* c = impl_->renderer->GetActiveCamera();
+    c->SetPosition(camera.eye.data());
+    c->SetFocalPoint(camera.focal.data());
+    c->SetViewUp(camera.up.data());
+    c->OrthogonalizeViewUp();
+    c->SetParallelProjection(camera.parallel);
+    c->SetViewAngle(camera.viewAngleDeg);
+    c->SetParallelScale(camera.parallelScale);
+    c->SetClippingRange(camera.nearPlane, camera.farPlane);
+    c->Modified();
+    impl_->cameraTime = c->GetMTime();
+    update();
+    emit cameraChanged();
+}
+
+void VtkView::setStandardView(StandardView view) {
+    Eigen::AlignedBox3d box = impl_->bounds;
+    if (box.isEmpty()) box = Eigen::AlignedBox3d(Eigen::Vector3d(-0.5, -0.5, -0.5), Eigen::Vector3d(0.5, 0.5, 0.5));
+    const Camera current = camera();
+    vtkCamera* c = impl_->renderer->GetActiveCamera();
+    setCamera(Camera::standardView(view, box, current.width, current.height, c->GetParallelProjection() != 0,
+                                   c->GetViewAngle()));
+}
+
+void VtkView::setInitialView(StandardView view) { impl_->initialView = view; }
+
+QImage VtkView::grabImage() { return grabFramebuffer(); }
+
+// ---- events: forwarded to VTK's interactor in device pixels, y flipped (VTK's origin is bottom-left) ----
+
+namespace {
+struct EventInfo {
+    int x, y, ctrl, shift, alt;
+};
+EventInfo eventInfo(const QPointF& pos, Qt::KeyboardModifiers modifiers, qreal dpr) {
+    return {int(std::lround(pos.x() * dpr)), int(std::lround(pos.y() * dpr)),
+            modifiers.testFlag(Qt::ControlModifier) ? 1 : 0, modifiers.testFlag(Qt::ShiftModifier) ? 1 : 0,
+            modifiers.testFlag(Qt::AltModifier) ? 1 : 0};
+}
+unsigned long buttonEvent(Qt::MouseButton button, bool press) {
+    switch (button) {
+    case Qt::LeftButton: return press ? vtkCommand::LeftButtonPressEvent : vtkCommand::LeftButtonReleaseEvent;
+    case Qt::MiddleButton: return press ? vtkCommand::MiddleButtonPressEvent : vtkCommand::MiddleButtonReleaseEvent;
+    case Qt::RightButton: return press ? vtkCommand::RightButtonPressEvent : vtkCommand::RightButtonReleaseEvent;
+    default: return vtkCommand::NoEvent;
+    }
+}
+} // namespace
+
+void VtkView::mousePressEvent(QMouseEvent* event) {
+    const EventInfo e = eventInfo(event->position(), event->modifiers(), devicePixelRatioF());
+    auto& iren = *impl_->interactor;
+    iren.SetEventInformationFlipY(e.x, e.y, e.ctrl, e.shift, 0, event->type() == QEvent::MouseButtonDblClick);
+    iren.SetAltKey(e.alt);
+    const unsigned long id = buttonEvent(event->button(), true);
+    if (id != vtkCommand::NoEvent) iren.InvokeEvent(id, event);
+    event->accept();
+}
+
+void VtkView::mouseDoubleClickEvent(QMouseEvent* event) { mousePressEvent(event); }
+
+void VtkView::mouseReleaseEvent(QMouseEvent* event) {
+    const EventInfo e = eventInfo(event->position(), event->modifiers(), devicePixelRatioF());
+    auto& iren = *impl_->interactor;
+    iren.SetEventInformationFlipY(e.x, e.y, e.ctrl, e.shift, 0, 0);
+    iren.SetAltKey(e.alt);
+    const unsigned long id = buttonEvent(event->button(), false);
+    if (id != vtkCommand::NoEvent) iren.InvokeEvent(id, event);
+    event->accept();
+}
+
+void VtkView::mouseMoveEvent(QMouseEvent* event) {
+    const EventInfo e = eventInfo(event->position(), event->modifiers(), devicePixelRatioF());
+    auto& iren = *impl_->interactor;
+    iren.SetEventInformationFlipY(e.x, e.y, e.ctrl, e.shift, 0, 0);
+    iren.SetAltKey(e.alt);
+    iren.InvokeEvent(vtkCommand::MouseMoveEvent, event);
+    event->accept();
+}
+
+void VtkView::wheelEvent(QWheelEvent* event) {
+    const EventInfo e = eventInfo(event->position(), event->modifiers(), devicePixelRatioF());
+    auto& iren = *impl_->interactor;
+    iren.SetEventInformationFlipY(e.x, e.y, e.ctrl, e.shift, 0, 0);
+    iren.SetAltKey(e.alt);
+    const QPoint delta = event->angleDelta();
+    const int steps = delta.y() != 0 ? delta.y() : delta.x();
+    if (steps > 0) iren.InvokeEvent(vtkCommand::MouseWheelForwardEvent, event);
+    else if (steps < 0) iren.InvokeEvent(vtkCommand::MouseWheelBackwardEvent, event);
+    event->accept();
+}
+
+namespace {
+void forwardKey(vtkRenderWindowInteractor& iren, QKeyEvent* event, bool press) {
+    const QString text = event->text();
+    const char ascii = text.size() == 1 && text.at(0).unicode() < 128 ? char(text.at(0).unicode()) : 0;
+    std::string keysym = ascii ? std::string(1, ascii) : std::string();
+    if (event->key() == Qt::Key_Escape) keysym = "Escape";
+    const Qt::KeyboardModifiers m = event->modifiers();
+    iren.SetKeyEventInformation(m.testFlag(Qt::ControlModifier), m.testFlag(Qt::ShiftModifier), ascii,
+                                event->count(), keysym.empty() ? nullptr : keysym.c_str());
+    iren.SetAltKey(m.testFlag(Qt::AltModifier));
+    iren.InvokeEvent(press ? vtkCommand::KeyPressEvent : vtkCommand::KeyReleaseEvent, event);
+    if (press && ascii) iren.InvokeEvent(vtkCommand::CharEvent, event);
+}
+} // namespace
+
+void VtkView::keyPressEvent(QKeyEvent* event) {
+    forwardKey(*impl_->interactor, event, true);
+    event->accept();
+}
+
+void VtkView::keyReleaseEvent(QKeyEvent* event) {
+    forwardKey(*impl_->interactor, event, false);
+    event->accept();
+}
+
+void VtkView::enterEvent(QEnterEvent* event) {
+    impl_->interactor->InvokeEvent(vtkCommand::EnterEvent, event);
+    QOpenGLWidget::enterEvent(event);
+}
+
+void VtkView::leaveEvent(QEvent* event) {
+    impl_->interactor->InvokeEvent(vtkCommand::LeaveEvent, event);
+    QOpenGLWidget::leaveEvent(event);
+}
+
+} // namespace fss::widgets
