@@ -64,7 +64,7 @@ private slots:
         for (int i = 1; i <= 10; ++i)
             sendMouse(view.get(), QEvent::MouseMove, {300.0 + 8 * i, 225.0 + 3 * i}, Qt::NoButton, Qt::LeftButton);
         sendMouse(view.get(), QEvent::MouseButtonRelease, {380, 255}, Qt::LeftButton, Qt::NoButton);
-        QTRY_VERIFY(moved.count() > 0); // the repaint reports the moved camera
+        QVERIFY(moved.count() > 0); // reported while dragging
         const fss::Camera after = view->camera();
         const double distance = (before.eye - before.focal).norm();
         QVERIFY2((after.eye - before.eye).norm() > 0.1 * distance, "the eye did not move");

@@ -236,7 +236,15 @@ VtkView::VtkView(QWidget* parent) : QOpenGLWidget(parent), impl_(std::make_uniqu
     d.interactor->EnableRenderOff(); // the interactor asks for renders through RenderEvent → update()
     {
         vtkNew<FunctionCommand> command;
-        command->callback = [this](unsigned long, void*) { update(); };
+        command->callback = [this](unsigned long, void*) {
+            update();
+            // Navigation changed the camera (the style asks for a render after every step).
+            const vtkMTimeType t = impl_->renderer->GetActiveCamera()->GetMTime();
+            if (t != impl_->cameraTime) {
+                impl_->cameraTime = t;
+                emit cameraChanged();
+            }
+        };
         d.renderObserver = d.interactor->AddObserver(vtkCommand::RenderEvent, command);
     }
     d.interactor->Initialize();
@@ -317,11 +325,6 @@ void VtkView::paintGL() {
                                      GL_NEAREST);
     state->PopDrawFramebufferBinding();
     state->Pop();
-    const vtkMTimeType t = d.renderer->GetActiveCamera()->GetMTime();
-    if (t != d.cameraTime) {
-        d.cameraTime = t;
-        emit cameraChanged();
-    }
 }
 
 void VtkView::setMesh(const Mesh& mesh) {
