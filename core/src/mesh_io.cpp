@@ -1,5 +1,6 @@
 // Mesh I/O: strict parsers for OFF, OBJ, PLY and STL into a polygon soup, soup statistics, repair with
 // CGAL's polygon-soup functions, and writers that replace the target atomically. See fss/mesh_io.h.
+#include "detail/disjoint_sets.h"
 #include "fss/mesh_io.h"
 
 #include "fss/error.h"
@@ -269,24 +270,7 @@ private:
     std::size_t count_ = 0;
 };
 
-/// Union-find over 0..n-1.
-class DisjointSets {
-public:
-    explicit DisjointSets(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
-    std::size_t find(std::size_t i) {
-        while (parent_[i] != i)
-            i = parent_[i] = parent_[parent_[i]];
-        return i;
-    }
-    void unite(std::size_t a, std::size_t b) {
-        a = find(a);
-        b = find(b);
-        if (a != b) parent_[std::max(a, b)] = std::min(a, b);
-    }
-
-private:
-    std::vector<std::size_t> parent_;
-};
+using detail::DisjointSets;
 
 // =====================================================================================================
 // The soup and the file it comes from

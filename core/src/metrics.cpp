@@ -1,3 +1,4 @@
+#include "detail/disjoint_sets.h"
 #include "fss/metrics.h"
 
 #include "fss/error.h"
@@ -89,24 +90,7 @@ void requireTriangles(const Mesh& m, const char* which) {
                                     std::to_string(m.degree(f)) + " corners.");
 }
 
-/// Union-find with path halving over dense indices.
-class DisjointSets {
-public:
-    explicit DisjointSets(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
-    std::size_t find(std::size_t x) {
-        while (parent_[x] != x)
-            x = parent_[x] = parent_[parent_[x]];
-        return x;
-    }
-    void unite(std::size_t a, std::size_t b) {
-        a = find(a);
-        b = find(b);
-        if (a != b) parent_[std::max(a, b)] = std::min(a, b);
-    }
-
-private:
-    std::vector<std::size_t> parent_;
-};
+using detail::DisjointSets;
 
 // ---- topology --------------------------------------------------------------------------------------
 

@@ -29,13 +29,8 @@ void CpuMeshRenderer::setMesh(const Mesh& mesh) {
 FrameBuffers CpuMeshRenderer::render(const Camera& camera) {
     if (!impl_->caster) throw InvalidInputError("No mesh was given to the CPU renderer before rendering.");
     const Mesh& mesh = impl_->caster->mesh();
-    Eigen::AlignedBox3d box;
-    for (VertexIndex v : mesh.vertices()) {
-        const Point3& p = mesh.point(v);
-        box.extend(Eigen::Vector3d(p.x(), p.y(), p.z()));
-    }
     Camera fitted = camera;
-    fitted.fitClippingRange(box);
+    fitted.fitClippingRange(boundingBox(mesh));
     fitted.validate();
     return rasterizeOnCpu(*impl_->caster, fitted);
 }

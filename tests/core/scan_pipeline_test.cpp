@@ -19,11 +19,7 @@ fss::Mesh load(const std::string& name) {
     return m;
 }
 
-Eigen::AlignedBox3d bbox(const fss::Mesh& m) {
-    Eigen::AlignedBox3d b;
-    for (auto v : m.vertices()) b.extend(Eigen::Vector3d(m.point(v).x(), m.point(v).y(), m.point(v).z()));
-    return b;
-}
+Eigen::AlignedBox3d bbox(const fss::Mesh& m) { return fss::boundingBox(m); }
 
 std::string messageOf(const std::function<void()>& f) {
     try {

@@ -5,6 +5,8 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 
+#include <Eigen/Geometry>
+
 #include <cstdint>
 
 namespace fss {
@@ -28,6 +30,16 @@ inline constexpr const char* faceQuality = "f:quality";
 /// `std::int32_t` id of the scan that made the face; -1 (or absent) for faces of the input mesh.
 inline constexpr const char* faceScanId = "f:scan_id";
 } // namespace props
+
+/// Axis-aligned bounding box of the mesh's (live) vertices; empty for an empty mesh.
+inline Eigen::AlignedBox3d boundingBox(const Mesh& mesh) {
+    Eigen::AlignedBox3d box;
+    for (VertexIndex v : mesh.vertices()) {
+        const Point3& p = mesh.point(v);
+        box.extend(Eigen::Vector3d(p.x(), p.y(), p.z()));
+    }
+    return box;
+}
 
 /// Quality value of a face that no scan has made (input faces rank lowest: any scan sample beats them).
 inline constexpr float kInputFaceQuality = 1e30f;
