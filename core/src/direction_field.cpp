@@ -134,8 +134,12 @@ std::optional<DirectionSample> DirectionField::sample(const Eigen::Vector2d& pos
     return DirectionSample{dir / len, aniso / weight};
 }
 
-DirectionField computeDirectionField(const Mesh& mesh, const CurvatureField& curvature,
-                                     const FrameBuffers& buffers, const DirectionFieldOptions& options) {
+namespace {
+
+// Fills the requested fields (either pointer may be null) in one pass over the pixels: the face lookup,
+// the ray/plane point and the barycentric coordinates are shared by both principal directions.
+void fillDirectionFields(const Mesh& mesh, const CurvatureField& curvature, const FrameBuffers& buffers,
+                         DirectionField* minField, DirectionField* maxField) {
     const Camera& camera = buffers.camera;
     camera.validate();
     const std::size_t pixels = std::size_t(camera.width) * std::size_t(camera.height);
@@ -149,9 +153,8 @@ DirectionField computeDirectionField(const Mesh& mesh, const CurvatureField& cur
                                 std::to_string(curvature.size()) + " vertices, the mesh " +
                                 std::to_string(slots) + ").");
     const std::size_t faceSlots = mesh.number_of_faces() + mesh.number_of_removed_faces();
-    const bool useMax = options.direction == PrincipalDirection::Max;
-
-    DirectionField field(camera.width, camera.height);
+    if (minField) *minField = DirectionField(camera.width, camera.height);
+    if (maxField) *maxField = DirectionField(camera.width, camera.height);
     const Projector projector(camera);
     for (int y = 0; y < camera.height; ++y)
         for (int x = 0; x < camera.width; ++x) {
@@ -194,38 +197,62 @@ DirectionField computeDirectionField(const Mesh& mesh, const CurvatureField& cur
                 wi /= sum;
             p = w[0] * a + w[1] * b + w[2] * c;
 
-            // Line field: align every vertex direction with the first defined one, then blend.
-            Eigen::Vector3d D = Eigen::Vector3d::Zero();
-            const Eigen::Vector3d* first = nullptr;
-            double aniso = 0;
-            for (int k = 0; k < 3; ++k) {
-                if (!curvature.isDefined(v[std::size_t(k)])) continue;
-                const Eigen::Vector3d& d = curvature.direction(v[std::size_t(k)], useMax);
-                if (!first) first = &d;
-                D += (d.dot(*first) < 0 ? -w[std::size_t(k)] : w[std::size_t(k)]) * d;
-                aniso += w[std::size_t(k)] * curvature.anisotropy[v[std::size_t(k)].idx()];
-            }
             // Into the tangent plane of the interpolated vertex normal (the smooth surface's plane at p).
             // The face plane would tilt D by up to half the dihedral angle of the faceting, which the
             // foreshortening near silhouettes turns into screen errors of degrees.
             Eigen::Vector3d N = Eigen::Vector3d::Zero();
-            for (int k = 0; k < 3; ++k)
+            double aniso = 0;
+            for (int k = 0; k < 3; ++k) {
                 N += w[std::size_t(k)] * curvature.normal[v[std::size_t(k)].idx()];
+                if (curvature.isDefined(v[std::size_t(k)]))
+                    aniso += w[std::size_t(k)] * curvature.anisotropy[v[std::size_t(k)].idx()];
+            }
             if (!(N.norm() > 1e-9)) N = n;
             N.normalize();
-            D -= D.dot(N) * N;
-            const double coherence = D.norm();
-            if (!(coherence > 1e-9)) continue;
-            const Eigen::Vector3d unit = D / coherence;
-
             const double eps = 1e-3 * projector.pixelFootprint(p);
-            const Eigen::Vector2d screen =
-                projector.project(p + eps * unit) - projector.project(p - eps * unit);
-            // A direction along the viewing ray projects to (almost) nothing: no screen direction.
-            if (!(screen.norm() > 1e-6 * 2e-3)) continue;
-            field.setPixel(x, y, screen, aniso * std::min(1.0, coherence));
+
+            for (DirectionField* field : {minField, maxField}) {
+                if (!field) continue;
+                const bool useMax = field == maxField;
+                // Line field: align every vertex direction with the first defined one, then blend.
+                Eigen::Vector3d D = Eigen::Vector3d::Zero();
+                const Eigen::Vector3d* first = nullptr;
+                for (int k = 0; k < 3; ++k) {
+                    if (!curvature.isDefined(v[std::size_t(k)])) continue;
+                    const Eigen::Vector3d& d = curvature.direction(v[std::size_t(k)], useMax);
+                    if (!first) first = &d;
+                    D += (d.dot(*first) < 0 ? -w[std::size_t(k)] : w[std::size_t(k)]) * d;
+                }
+                D -= D.dot(N) * N;
+                const double coherence = D.norm();
+                if (!(coherence > 1e-9)) continue;
+                const Eigen::Vector3d unit = D / coherence;
+                const Eigen::Vector2d screen =
+                    projector.project(p + eps * unit) - projector.project(p - eps * unit);
+                // A direction along the viewing ray projects to (almost) nothing: no screen direction.
+                if (!(screen.norm() > 1e-6 * 2e-3)) continue;
+                field->setPixel(x, y, screen, aniso * std::min(1.0, coherence));
+            }
         }
+}
+
+} // namespace
+
+DirectionField computeDirectionField(const Mesh& mesh, const CurvatureField& curvature,
+                                     const FrameBuffers& buffers, const DirectionFieldOptions& options) {
+    DirectionField field;
+    if (options.direction == PrincipalDirection::Max)
+        fillDirectionFields(mesh, curvature, buffers, nullptr, &field);
+    else
+        fillDirectionFields(mesh, curvature, buffers, &field, nullptr);
     return field;
+}
+
+DirectionFieldPair computeDirectionFields(const Mesh& mesh, const CurvatureField& curvature,
+                                          const FrameBuffers& buffers) {
+    DirectionFieldPair pair;
+    fillDirectionFields(mesh, curvature, buffers, &pair.min, &pair.max);
+    return pair;
 }
 
 } // namespace fss

@@ -211,3 +211,25 @@ TEST(DirectionField, BadInputsThrow) {
     EXPECT_THROW(fss::computeDirectionField(mesh, curv, bad), fss::InvalidInputError);
     EXPECT_THROW(DirectionField(-1, 3), fss::InvalidInputError);
 }
+
+TEST(DirectionField, BothFieldsInOnePassEqualTwoSingleFields) {
+    const fss::Mesh mesh = fss::shapes::torus(60, 30, 1.0, 0.35);
+    const fss::CurvatureField curv = fss::estimateCurvature(mesh);
+    fss::Camera cam;
+    cam.eye = {2.5, 1.0, 3.0};
+    cam.width = cam.height = 96;
+    cam.fitClippingRange(Eigen::AlignedBox3d(Eigen::Vector3d(-1.4, -1.4, -0.4), Eigen::Vector3d(1.4, 1.4, 0.4)));
+    const fss::FrameBuffers fb = fss::test::bruteForceRaster(mesh, cam);
+    const fss::DirectionFieldPair both = fss::computeDirectionFields(mesh, curv, fb);
+    const DirectionField mn = fss::computeDirectionField(mesh, curv, fb, {fss::PrincipalDirection::Min});
+    const DirectionField mx = fss::computeDirectionField(mesh, curv, fb, {fss::PrincipalDirection::Max});
+    ASSERT_GT(mn.validCount(), 2000u);
+    EXPECT_EQ(both.min.valid, mn.valid);
+    EXPECT_EQ(both.max.valid, mx.valid);
+    EXPECT_EQ(both.min.anisotropy, mn.anisotropy);
+    EXPECT_EQ(both.max.anisotropy, mx.anisotropy);
+    for (std::size_t i = 0; i < mn.direction.size(); ++i) {
+        ASSERT_EQ(both.min.direction[i], mn.direction[i]) << i;
+        ASSERT_EQ(both.max.direction[i], mx.direction[i]) << i;
+    }
+}

@@ -112,4 +112,16 @@ struct DirectionFieldOptions {
 DirectionField computeDirectionField(const Mesh& mesh, const CurvatureField& curvature,
                                      const FrameBuffers& buffers, const DirectionFieldOptions& options = {});
 
+/// Both principal direction fields of one scan.
+struct DirectionFieldPair {
+    DirectionField min; ///< PrincipalDirection::Min
+    DirectionField max; ///< PrincipalDirection::Max
+};
+
+/// The min and the max direction field in one pass: identical to computeDirectionField with each
+/// direction, at about 60 % of the cost of two calls (face lookup, surface point and barycentric
+/// coordinates are shared). Preconditions and errors as computeDirectionField.
+DirectionFieldPair computeDirectionFields(const Mesh& mesh, const CurvatureField& curvature,
+                                          const FrameBuffers& buffers);
+
 } // namespace fss

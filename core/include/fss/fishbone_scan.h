@@ -91,7 +91,8 @@ struct FishboneParams {
     /// Local search of the hinted ray casts.
     LocalSearchOptions raycast{};
 
-    /// Tracing with LowAnisotropyPolicy::ContinueStraight for the backbone and the ribs.
+    /// Tracing with LowAnisotropyPolicy::ContinueStraight and half-pixel RK4 steps for the backbone and the
+    /// ribs.
     static FishboneOptions defaultTracing();
 };
 
