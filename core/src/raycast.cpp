@@ -1,5 +1,6 @@
 #include "fss/raycast.h"
 
+#include "fss/camera_projector.h"
 #include "fss/error.h"
 
 #include <CGAL/AABB_face_graph_triangle_primitive.h>
@@ -241,16 +242,17 @@ FrameBuffers rasterizeOnCpu(const RayCaster& caster, const Camera& camera, const
     const std::size_t n = std::size_t(camera.width) * std::size_t(camera.height);
     buffers.depth.assign(n, 1.0f);
     buffers.faceId.assign(n, FrameBuffers::kNoFace);
+    const CameraProjector projector(camera);
     for (int y = 0; y < camera.height; ++y) {
         progress.report(double(y) / camera.height, "Ray casting");
         for (int x = 0; x < camera.width; ++x) {
             const double sx = x + 0.5, sy = y + 0.5;
             // Start on the near plane: what GL's near clipping leaves visible.
-            Ray ray = camera.ray(sx, sy);
-            ray.origin = camera.unproject(sx, sy, 0.0);
+            Ray ray = projector.ray(sx, sy);
+            ray.origin = projector.unproject(sx, sy, 0.0);
             const SurfacePoint hit = caster.intersect(ray);
             if (!hit) continue;
-            const double depth = camera.project(hit.point).z();
+            const double depth = projector.project(hit.point).z();
             if (!(depth <= 1.0)) continue;
             buffers.depth[buffers.index(x, y)] = float(std::clamp(depth, 0.0, 1.0));
             buffers.faceId[buffers.index(x, y)] = std::uint32_t(hit.face.idx());
