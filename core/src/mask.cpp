@@ -16,6 +16,9 @@ namespace {
 
 using Point2 = Kernel::Point_2;
 
+// A sample this close to the face under its pixel (in pixel footprints) is taken to lie on it.
+constexpr double kOnFaceFootprints = 1e-3;
+
 // The lasso's edges bucketed into horizontal bands, so a point query only visits the edges whose
 // y-range can contain the point's y. Floating-point band indices are monotone in y, so an edge whose
 // y-range contains y is always found in y's band.
@@ -194,8 +197,20 @@ std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameB
         if (std::size_t(id) >= current.num_faces() || current.is_removed(hint))
             throw InvalidInputError("The current mesh's face-id buffer names face " + std::to_string(id) +
                                     ", which the current mesh does not have.");
-        const SurfacePoint closest = closestPointNear(current, s.point, hint, search);
-        float faceQ = hasQuality ? qualityMap[closest.face] : kInputFaceQuality;
+        float faceQ = kInputFaceQuality;
+        if (hasQuality) { // without qualities every face has kInputFaceQuality: no need to know which
+            FaceIndex closest = hint;
+            // Fast path: the sample lies on the face under its pixel (up to rounding), as almost always
+            // where the current mesh is the reference; any closer face is closer by less than that.
+            const HalfedgeIndex h = current.halfedge(hint);
+            const Point3 &a = current.point(current.source(h)), &b = current.point(current.target(h)),
+                         &c = current.point(current.target(current.next(h)));
+            const Eigen::Vector3d q = closestPointOnTriangle(s.point, {a.x(), a.y(), a.z()},
+                                                             {b.x(), b.y(), b.z()}, {c.x(), c.y(), c.z()});
+            if (!((q - s.point).norm() <= kOnFaceFootprints * double(s.footprint)))
+                closest = closestPointNear(current, s.point, hint, search).face;
+            faceQ = qualityMap[closest];
+        }
         if (std::isnan(faceQ)) faceQ = kInputFaceQuality;
         if (double(s.quality) < (1.0 - options.margin) * double(faceQ)) continue;
         s.admissible = s.valid = false;
