@@ -95,6 +95,24 @@ void requireRadius(int radius) {
 std::vector<std::uint16_t> windowCounts(const std::vector<std::uint8_t>& in, int rows, int cols, int radius,
                                         bool alongColumns) {
     std::vector<std::uint16_t> out(in.size(), 0);
+    if (alongColumns) { // row by row with one running count per column: sequential memory access
+        std::vector<int> count(std::size_t(std::max(cols, 0)), 0);
+        auto addRow = [&](int r, int sign) {
+            const std::uint8_t* row = in.data() + std::size_t(r) * cols;
+            for (int c = 0; c < cols; ++c)
+                count[std::size_t(c)] += sign * row[c];
+        };
+        for (int i = 0; i < std::min(radius, rows); ++i)
+            addRow(i, 1);
+        for (int i = 0; i < rows; ++i) {
+            if (i + radius < rows) addRow(i + radius, 1);
+            if (i - radius - 1 >= 0) addRow(i - radius - 1, -1);
+            std::uint16_t* o = out.data() + std::size_t(i) * cols;
+            for (int c = 0; c < cols; ++c)
+                o[c] = std::uint16_t(count[std::size_t(c)]);
+        }
+        return out;
+    }
     const int lines = alongColumns ? cols : rows, length = alongColumns ? rows : cols;
     auto at = [&](int line, int i) {
         return alongColumns ? std::size_t(i) * cols + line : std::size_t(line) * cols + i;
