@@ -105,19 +105,19 @@ SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& r
             const std::uint32_t id = referenceBuffers.faceAt(c, r);
             if (id == FrameBuffers::kNoFace) continue;
             const FaceIndex f(id);
-            if (std::size_t(id) >= reference.num_faces() || reference.is_removed(f) ||
-                reference.degree(f) != 3)
-                throw InvalidInputError("The face-id buffer names face " + std::to_string(id) +
-                                        ", which is not a triangle of the reference mesh: the buffers were "
-                                        "not rendered from this mesh.");
+            if (f != cachedFace) { // checked once per run of pixels showing the same face
+                if (std::size_t(id) >= reference.num_faces() || reference.is_removed(f) ||
+                    reference.degree(f) != 3)
+                    throw InvalidInputError("The face-id buffer names face " + std::to_string(id) +
+                                            ", which is not a triangle of the reference mesh: the buffers "
+                                            "were not rendered from this mesh.");
+                g = faceGeometry(reference, f);
+                cachedFace = f;
+            }
             const Eigen::Vector3d unprojected =
                 projector.unprojectPixelCentre(c, r, referenceBuffers.depthAt(c, r));
             // Snap along the viewing ray onto the face's plane (removes depth quantisation).
             Eigen::Vector3d point = unprojected;
-            if (f != cachedFace) {
-                g = faceGeometry(reference, f);
-                cachedFace = f;
-            }
             const Ray ray = projector.ray(s.screen.x(), s.screen.y());
             const double denom = g.normal.dot(ray.direction);
             if (g.normal.squaredNorm() > 0 && std::abs(denom) > 1e-12) {
