@@ -6,6 +6,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -205,6 +206,8 @@ std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameB
     const auto [qualityMap, hasQuality] = current.property_map<FaceIndex, float>(props::faceQuality);
     const LocalSearchOptions search{.rings = options.searchRings, .verifyUnoccluded = false};
     std::size_t dropped = 0;
+    FaceIndex cachedHint = Mesh::null_face();
+    std::array<Eigen::Vector3d, 3> hintCorner;
     for (Sample& s : grid.samples) {
         if (!s.admissible) continue;
         const double fx = std::floor(s.screen.x()), fy = std::floor(s.screen.y());
@@ -212,19 +215,24 @@ std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameB
         const std::uint32_t id = currentBuffers.faceAt(int(fx), int(fy));
         if (id == FrameBuffers::kNoFace) continue;
         const FaceIndex hint(id);
-        if (std::size_t(id) >= current.num_faces() || current.is_removed(hint))
-            throw InvalidInputError("The current mesh's face-id buffer names face " + std::to_string(id) +
-                                    ", which the current mesh does not have.");
+        if (hint != cachedHint) { // neighbouring samples mostly share the face under their pixels
+            if (std::size_t(id) >= current.num_faces() || current.is_removed(hint))
+                throw InvalidInputError("The current mesh's face-id buffer names face " +
+                                        std::to_string(id) + ", which the current mesh does not have.");
+            const HalfedgeIndex h = current.halfedge(hint);
+            for (const auto& [corner, v] : {std::pair{0, current.source(h)}, std::pair{1, current.target(h)},
+                                            std::pair{2, current.target(current.next(h))}}) {
+                const Point3& p = current.point(v);
+                hintCorner[std::size_t(corner)] = {p.x(), p.y(), p.z()};
+            }
+            cachedHint = hint;
+        }
         float faceQ = kInputFaceQuality;
         if (hasQuality) { // without qualities every face has kInputFaceQuality: no need to know which
             FaceIndex closest = hint;
             // Fast path: the sample lies on the face under its pixel (up to rounding), as almost always
             // where the current mesh is the reference; any closer face is closer by less than that.
-            const HalfedgeIndex h = current.halfedge(hint);
-            const Point3 &a = current.point(current.source(h)), &b = current.point(current.target(h)),
-                         &c = current.point(current.target(current.next(h)));
-            const Eigen::Vector3d q = closestPointOnTriangle(s.point, {a.x(), a.y(), a.z()},
-                                                             {b.x(), b.y(), b.z()}, {c.x(), c.y(), c.z()});
+            const Eigen::Vector3d q = closestPointOnTriangle(s.point, hintCorner[0], hintCorner[1], hintCorner[2]);
             if (!((q - s.point).norm() <= kOnFaceFootprints * double(s.footprint)))
                 closest = closestPointNear(current, s.point, hint, search).face;
             faceQ = qualityMap[closest];
