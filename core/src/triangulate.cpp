@@ -65,7 +65,8 @@ Verdict judge(const SampleGrid& grid, const Triangle& t, CGAL::Orientation gridO
             return Verdict::BackFacing;
     for (auto [u, v] : {std::pair{&a, &b}, std::pair{&b, &c}, std::pair{&c, &a}}) {
         const double limit = limits.maxEdgeFootprints * std::min(double(u->footprint), double(v->footprint));
-        if (!((u->point - v->point).norm() <= limit)) return Verdict::LongEdge;
+        // Squared lengths: no square root in the innermost test.
+        if (!(limit >= 0 && (u->point - v->point).squaredNorm() <= limit * limit)) return Verdict::LongEdge;
     }
     for (const Sample* s : {&a, &b, &c})
         if (double(s->samplingAngle) > limits.maxAngle) return Verdict::Grazing;
