@@ -1,4 +1,5 @@
 #include "fss/camera.h"
+#include "fss/camera_projector.h"
 
 #include "fss/error.h"
 
@@ -137,6 +138,21 @@ Ray Camera::ray(double sx, double sy) const {
     const Eigen::Vector3d b = unproject(sx, sy, 1.0);
     Ray r;
     r.origin = parallel ? a : eye;
+    r.direction = (b - a).normalized();
+    return r;
+}
+
+CameraProjector::CameraProjector(const Camera& camera)
+    : viewProjection_(camera.viewProjectionMatrix()), inverseViewProjection_(viewProjection_.inverse()),
+      eye_(camera.eye), direction_(camera.viewDirection()), width_(camera.width), height_(camera.height),
+      tanHalfAngle_(std::tan(0.5 * camera.viewAngleDeg * kDegToRad)),
+      parallelFootprint_(2.0 * camera.parallelScale / camera.height), parallel_(camera.parallel) {}
+
+Ray CameraProjector::ray(double sx, double sy) const {
+    const Eigen::Vector3d a = unproject(sx, sy, 0.0);
+    const Eigen::Vector3d b = unproject(sx, sy, 1.0);
+    Ray r;
+    r.origin = parallel_ ? a : eye_;
     r.direction = (b - a).normalized();
     return r;
 }

@@ -6,6 +6,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -15,6 +16,9 @@ namespace fss {
 namespace {
 
 using Point2 = Kernel::Point_2;
+
+// A sample this close to the face under its pixel (in pixel footprints) is taken to lie on it.
+constexpr double kOnFaceFootprints = 1e-3;
 
 // The lasso's edges bucketed into horizontal bands, so a point query only visits the edges whose
 // y-range can contain the point's y. Floating-point band indices are monotone in y, so an edge whose
@@ -92,6 +96,24 @@ void requireRadius(int radius) {
 std::vector<std::uint16_t> windowCounts(const std::vector<std::uint8_t>& in, int rows, int cols, int radius,
                                         bool alongColumns) {
     std::vector<std::uint16_t> out(in.size(), 0);
+    if (alongColumns) { // row by row with one running count per column: sequential memory access
+        std::vector<int> count(std::size_t(std::max(cols, 0)), 0);
+        auto addRow = [&](int r, int sign) {
+            const std::uint8_t* row = in.data() + std::size_t(r) * cols;
+            for (int c = 0; c < cols; ++c)
+                count[std::size_t(c)] += sign * row[c];
+        };
+        for (int i = 0; i < std::min(radius, rows); ++i)
+            addRow(i, 1);
+        for (int i = 0; i < rows; ++i) {
+            if (i + radius < rows) addRow(i + radius, 1);
+            if (i - radius - 1 >= 0) addRow(i - radius - 1, -1);
+            std::uint16_t* o = out.data() + std::size_t(i) * cols;
+            for (int c = 0; c < cols; ++c)
+                o[c] = std::uint16_t(count[std::size_t(c)]);
+        }
+        return out;
+    }
     const int lines = alongColumns ? cols : rows, length = alongColumns ? rows : cols;
     auto at = [&](int line, int i) {
         return alongColumns ? std::size_t(i) * cols + line : std::size_t(line) * cols + i;
@@ -184,6 +206,8 @@ std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameB
     const auto [qualityMap, hasQuality] = current.property_map<FaceIndex, float>(props::faceQuality);
     const LocalSearchOptions search{.rings = options.searchRings, .verifyUnoccluded = false};
     std::size_t dropped = 0;
+    FaceIndex cachedHint = Mesh::null_face();
+    std::array<Eigen::Vector3d, 3> hintCorner;
     for (Sample& s : grid.samples) {
         if (!s.admissible) continue;
         const double fx = std::floor(s.screen.x()), fy = std::floor(s.screen.y());
@@ -191,11 +215,28 @@ std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameB
         const std::uint32_t id = currentBuffers.faceAt(int(fx), int(fy));
         if (id == FrameBuffers::kNoFace) continue;
         const FaceIndex hint(id);
-        if (std::size_t(id) >= current.num_faces() || current.is_removed(hint))
-            throw InvalidInputError("The current mesh's face-id buffer names face " + std::to_string(id) +
-                                    ", which the current mesh does not have.");
-        const SurfacePoint closest = closestPointNear(current, s.point, hint, search);
-        float faceQ = hasQuality ? qualityMap[closest.face] : kInputFaceQuality;
+        if (hint != cachedHint) { // neighbouring samples mostly share the face under their pixels
+            if (std::size_t(id) >= current.num_faces() || current.is_removed(hint))
+                throw InvalidInputError("The current mesh's face-id buffer names face " +
+                                        std::to_string(id) + ", which the current mesh does not have.");
+            const HalfedgeIndex h = current.halfedge(hint);
+            for (const auto& [corner, v] : {std::pair{0, current.source(h)}, std::pair{1, current.target(h)},
+                                            std::pair{2, current.target(current.next(h))}}) {
+                const Point3& p = current.point(v);
+                hintCorner[std::size_t(corner)] = {p.x(), p.y(), p.z()};
+            }
+            cachedHint = hint;
+        }
+        float faceQ = kInputFaceQuality;
+        if (hasQuality) { // without qualities every face has kInputFaceQuality: no need to know which
+            FaceIndex closest = hint;
+            // Fast path: the sample lies on the face under its pixel (up to rounding), as almost always
+            // where the current mesh is the reference; any closer face is closer by less than that.
+            const Eigen::Vector3d q = closestPointOnTriangle(s.point, hintCorner[0], hintCorner[1], hintCorner[2]);
+            if (!((q - s.point).norm() <= kOnFaceFootprints * double(s.footprint)))
+                closest = closestPointNear(current, s.point, hint, search).face;
+            faceQ = qualityMap[closest];
+        }
         if (std::isnan(faceQ)) faceQ = kInputFaceQuality;
         if (double(s.quality) < (1.0 - options.margin) * double(faceQ)) continue;
         s.admissible = s.valid = false;
@@ -204,83 +245,98 @@ std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameB
     return dropped;
 }
 
-std::size_t erode(SampleGrid& grid, int radius) {
-    requireRadius(radius);
-    requireGridShape(grid);
-    if (radius == 0 || grid.samples.empty()) return 0;
-    const long long side = 2LL * radius + 1;
-    if (side > std::min(grid.rows, grid.cols)) { // no square fits in the grid
-        std::size_t removed = 0;
-        for (Sample& s : grid.samples)
-            removed += std::exchange(s.valid, false) ? 1 : 0;
-        return removed;
+namespace {
+
+// The morphology works on one byte per sample (a Sample is ~90 bytes: every pass over the grid's
+// samples streams all of them through memory).
+struct Flags {
+    std::vector<std::uint8_t> valid, admissible;
+};
+
+Flags flagsOf(const SampleGrid& grid) {
+    Flags f;
+    f.valid.resize(grid.samples.size());
+    f.admissible.resize(grid.samples.size());
+    for (std::size_t i = 0; i < grid.samples.size(); ++i) {
+        f.valid[i] = grid.samples[i].valid ? 1 : 0;
+        f.admissible[i] = grid.samples[i].admissible ? 1 : 0;
     }
+    return f;
+}
+
+void storeValid(SampleGrid& grid, const std::vector<std::uint8_t>& valid) {
+    for (std::size_t i = 0; i < grid.samples.size(); ++i)
+        grid.samples[i].valid = valid[i] != 0;
+}
+
+std::size_t clearAll(std::vector<std::uint8_t>& valid) {
+    std::size_t removed = 0;
+    for (std::uint8_t& v : valid)
+        removed += std::exchange(v, std::uint8_t(0));
+    return removed;
+}
+
+std::size_t erodeFlags(std::vector<std::uint8_t>& valid, int rows, int cols, int radius) {
+    if (radius == 0 || valid.empty()) return 0;
+    const long long side = 2LL * radius + 1;
+    if (side > std::min(rows, cols)) return clearAll(valid); // no square fits in the grid
     // Separable: a full square = full rows of full columns.
-    std::vector<std::uint8_t> rowsFull(grid.samples.size());
+    std::vector<std::uint8_t> rowsFull(valid.size());
     {
-        const auto counts = windowCounts(validFlags(grid), grid.rows, grid.cols, radius, false);
+        const auto counts = windowCounts(valid, rows, cols, radius, false);
         for (std::size_t i = 0; i < counts.size(); ++i)
             rowsFull[i] = (long long)counts[i] == side ? 1 : 0;
     }
-    const auto counts = windowCounts(rowsFull, grid.rows, grid.cols, radius, true);
+    const auto counts = windowCounts(rowsFull, rows, cols, radius, true);
     std::size_t removed = 0;
     for (std::size_t i = 0; i < counts.size(); ++i) {
-        Sample& s = grid.samples[i];
-        if (s.valid && (long long)counts[i] != side) {
-            s.valid = false;
+        if (valid[i] && (long long)counts[i] != side) {
+            valid[i] = 0;
             ++removed;
         }
     }
     return removed;
 }
 
-std::size_t dilate(SampleGrid& grid, int radius) {
-    requireRadius(radius);
-    requireGridShape(grid);
-    if (radius == 0 || grid.samples.empty()) return 0;
-    radius = std::min(radius, std::max(grid.rows, grid.cols)); // larger squares cover the grid all the same
-    std::vector<std::uint8_t> rowsAny(grid.samples.size());
+std::size_t dilateFlags(std::vector<std::uint8_t>& valid, const std::vector<std::uint8_t>& admissible, int rows,
+                        int cols, int radius) {
+    if (radius == 0 || valid.empty()) return 0;
+    radius = std::min(radius, std::max(rows, cols)); // larger squares cover the grid all the same
+    std::vector<std::uint8_t> rowsAny(valid.size());
     {
-        const auto counts = windowCounts(validFlags(grid), grid.rows, grid.cols, radius, false);
+        const auto counts = windowCounts(valid, rows, cols, radius, false);
         for (std::size_t i = 0; i < counts.size(); ++i)
             rowsAny[i] = counts[i] > 0 ? 1 : 0;
     }
-    const auto counts = windowCounts(rowsAny, grid.rows, grid.cols, radius, true);
+    const auto counts = windowCounts(rowsAny, rows, cols, radius, true);
     std::size_t added = 0;
     for (std::size_t i = 0; i < counts.size(); ++i) {
-        Sample& s = grid.samples[i];
-        if (!s.valid && s.admissible && counts[i] > 0) {
-            s.valid = true;
+        if (!valid[i] && admissible[i] && counts[i] > 0) {
+            valid[i] = 1;
             ++added;
         }
     }
     return added;
 }
 
-std::size_t removeUntriangulatableSamples(SampleGrid& grid) {
-    requireGridShape(grid);
-    if (grid.rows < 2 || grid.cols < 2) {
-        std::size_t removed = 0;
-        for (Sample& s : grid.samples)
-            removed += std::exchange(s.valid, false) ? 1 : 0;
-        return removed;
-    }
+std::size_t removeUntriangulatableFlags(std::vector<std::uint8_t>& valid, int rows, int cols) {
+    if (rows < 2 || cols < 2) return clearAll(valid);
+    auto at = [&](int r, int c) { return valid[std::size_t(r) * std::size_t(cols) + std::size_t(c)]; };
     // quadFull(r, c): the quad with top-left corner (r, c) has four valid corners.
-    const int qr = grid.rows - 1, qc = grid.cols - 1;
+    const int qr = rows - 1, qc = cols - 1;
     std::vector<std::uint8_t> quadFull(std::size_t(qr) * std::size_t(qc));
     for (int r = 0; r < qr; ++r)
         for (int c = 0; c < qc; ++c)
-            quadFull[std::size_t(r) * qc + c] = grid.at(r, c).valid && grid.at(r, c + 1).valid &&
-                                                grid.at(r + 1, c).valid && grid.at(r + 1, c + 1).valid;
+            quadFull[std::size_t(r) * qc + c] = at(r, c) && at(r, c + 1) && at(r + 1, c) && at(r + 1, c + 1);
     auto full = [&](int r, int c) {
         return r >= 0 && c >= 0 && r < qr && c < qc && quadFull[std::size_t(r) * qc + c];
     };
     std::size_t removed = 0;
-    for (int r = 0; r < grid.rows; ++r) {
-        for (int c = 0; c < grid.cols; ++c) {
-            Sample& s = grid.at(r, c);
-            if (s.valid && !full(r - 1, c - 1) && !full(r - 1, c) && !full(r, c - 1) && !full(r, c)) {
-                s.valid = false;
+    for (int r = 0; r < rows; ++r) {
+        for (int c = 0; c < cols; ++c) {
+            std::uint8_t& v = valid[std::size_t(r) * std::size_t(cols) + std::size_t(c)];
+            if (v && !full(r - 1, c - 1) && !full(r - 1, c) && !full(r, c - 1) && !full(r, c)) {
+                v = 0;
                 ++removed;
             }
         }
@@ -288,12 +344,44 @@ std::size_t removeUntriangulatableSamples(SampleGrid& grid) {
     return removed;
 }
 
+} // namespace
+
+std::size_t erode(SampleGrid& grid, int radius) {
+    requireRadius(radius);
+    requireGridShape(grid);
+    std::vector<std::uint8_t> valid = validFlags(grid);
+    const std::size_t removed = erodeFlags(valid, grid.rows, grid.cols, radius);
+    if (removed) storeValid(grid, valid);
+    return removed;
+}
+
+std::size_t dilate(SampleGrid& grid, int radius) {
+    requireRadius(radius);
+    requireGridShape(grid);
+    Flags f = flagsOf(grid);
+    const std::size_t added = dilateFlags(f.valid, f.admissible, grid.rows, grid.cols, radius);
+    if (added) storeValid(grid, f.valid);
+    return added;
+}
+
+std::size_t removeUntriangulatableSamples(SampleGrid& grid) {
+    requireGridShape(grid);
+    std::vector<std::uint8_t> valid = validFlags(grid);
+    const std::size_t removed = removeUntriangulatableFlags(valid, grid.rows, grid.cols);
+    if (removed) storeValid(grid, valid);
+    return removed;
+}
+
 MorphologyReport applyMorphology(SampleGrid& grid, const MorphologyOptions& options) {
     requireRadius(options.radius);
+    requireGridShape(grid);
+    // One read and one write of the samples for all three steps.
+    Flags f = flagsOf(grid);
     MorphologyReport report;
-    report.eroded = erode(grid, options.radius);
-    report.restored = dilate(grid, options.radius);
-    report.untriangulatable = removeUntriangulatableSamples(grid);
+    report.eroded = erodeFlags(f.valid, grid.rows, grid.cols, options.radius);
+    report.restored = dilateFlags(f.valid, f.admissible, grid.rows, grid.cols, options.radius);
+    report.untriangulatable = removeUntriangulatableFlags(f.valid, grid.rows, grid.cols);
+    if (report.eroded || report.restored || report.untriangulatable) storeValid(grid, f.valid);
     return report;
 }
 

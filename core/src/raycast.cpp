@@ -1,5 +1,6 @@
 #include "fss/raycast.h"
 
+#include "fss/camera_projector.h"
 #include "fss/error.h"
 
 #include <CGAL/AABB_face_graph_triangle_primitive.h>
@@ -203,22 +204,97 @@ Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Ve
     return a + ab * v + ac * w;
 }
 
+namespace {
+
+// Faces of a local search, deduplicated with a small open-addressing set that is cleared by bumping a
+// generation stamp: no allocation per query once the scratch has grown (one per thread).
+class LocalFaceSet {
+public:
+    void clear() {
+        faces.clear();
+        if (++generation_ == 0) { // wrapped: forget every stamp
+            std::fill(stamp_.begin(), stamp_.end(), 0u);
+            generation_ = 1;
+        }
+    }
+    // Adds f unless present; true when it was added.
+    bool insert(FaceIndex f) {
+        if (2 * (faces.size() + 1) > slot_.size()) grow();
+        const std::uint32_t id = std::uint32_t(f.idx());
+        const std::size_t mask = slot_.size() - 1;
+        for (std::size_t i = hash(id) & mask;; i = (i + 1) & mask) {
+            if (stamp_[i] != generation_) {
+                stamp_[i] = generation_;
+                slot_[i] = id;
+                faces.push_back(f);
+                return true;
+            }
+            if (slot_[i] == id) return false;
+        }
+    }
+    std::vector<FaceIndex> faces;
+
+private:
+    static std::size_t hash(std::uint32_t id) { return std::size_t(id * 2654435761u); }
+    void grow() {
+        const std::vector<FaceIndex> kept = faces;
+        const std::size_t size = std::max<std::size_t>(64, 2 * slot_.size());
+        slot_.assign(size, 0);
+        stamp_.assign(size, 0);
+        generation_ = 1;
+        faces.clear();
+        for (FaceIndex f : kept)
+            insert(f);
+    }
+    std::vector<std::uint32_t> slot_, stamp_;
+    std::uint32_t generation_ = 1;
+};
+
+// collectRings with the scratch set (same faces in the same order).
+void collectRingsInto(const Mesh& mesh, FaceIndex centre, int rings, LocalFaceSet& set) {
+    set.clear();
+    set.insert(centre);
+    std::size_t begin = 0;
+    for (int ring = 0; ring < rings; ++ring) {
+        const std::size_t end = set.faces.size();
+        for (std::size_t i = begin; i < end; ++i) {
+            for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(set.faces[i]), mesh)) {
+                for (FaceIndex g : CGAL::faces_around_target(h, mesh)) {
+                    if (g != Mesh::null_face()) set.insert(g);
+                }
+            }
+        }
+        begin = end;
+    }
+}
+
+Eigen::Vector3d closestOnFace(const Mesh& mesh, FaceIndex f, const Eigen::Vector3d& p) {
+    const HalfedgeIndex h = mesh.halfedge(f);
+    return closestPointOnTriangle(p, toEigen(mesh.point(mesh.source(h))), toEigen(mesh.point(mesh.target(h))),
+                                  toEigen(mesh.point(mesh.target(mesh.next(h)))));
+}
+
+} // namespace
+
 SurfacePoint closestPointNear(const Mesh& mesh, const Eigen::Vector3d& p, FaceIndex hint,
                               const LocalSearchOptions& options) {
     requireFace(mesh, hint, "hint face");
-    std::vector<FaceIndex> candidates;
-    std::unordered_set<std::uint32_t> seen;
     SurfacePoint best;
+    // Fast path: p on the hint face itself (the sample's own face in the quality mask). The walk visits
+    // the hint first and only replaces it by a strictly closer face, so at distance 0 it returns the hint.
+    {
+        const Eigen::Vector3d q = closestOnFace(mesh, hint, p);
+        const double d = (q - p).norm();
+        if (d == 0) return {hint, q, d};
+    }
+    thread_local LocalFaceSet candidates;
     best.distance = std::numeric_limits<double>::infinity();
     FaceIndex centre = hint;
     constexpr int kMaxRecentring = 16;
     for (int iteration = 0; iteration <= kMaxRecentring; ++iteration) {
-        collectRings(mesh, centre, std::max(0, options.rings), candidates, seen);
-        for (FaceIndex f : candidates) {
-            const HalfedgeIndex h = mesh.halfedge(f);
-            const Eigen::Vector3d q = closestPointOnTriangle(p, toEigen(mesh.point(mesh.source(h))),
-                                                             toEigen(mesh.point(mesh.target(h))),
-                                                             toEigen(mesh.point(mesh.target(mesh.next(h)))));
+        collectRingsInto(mesh, centre, std::max(0, options.rings), candidates);
+        for (FaceIndex f : candidates.faces) {
+            const Eigen::Vector3d q = closestOnFace(mesh, f, p);
             const double d = (q - p).norm();
             if (d < best.distance) best = {f, q, d};
         }
@@ -241,16 +317,17 @@ FrameBuffers rasterizeOnCpu(const RayCaster& caster, const Camera& camera, const
     const std::size_t n = std::size_t(camera.width) * std::size_t(camera.height);
     buffers.depth.assign(n, 1.0f);
     buffers.faceId.assign(n, FrameBuffers::kNoFace);
+    const CameraProjector projector(camera);
     for (int y = 0; y < camera.height; ++y) {
         progress.report(double(y) / camera.height, "Ray casting");
         for (int x = 0; x < camera.width; ++x) {
             const double sx = x + 0.5, sy = y + 0.5;
             // Start on the near plane: what GL's near clipping leaves visible.
-            Ray ray = camera.ray(sx, sy);
-            ray.origin = camera.unproject(sx, sy, 0.0);
+            Ray ray = projector.ray(sx, sy);
+            ray.origin = projector.unproject(sx, sy, 0.0);
             const SurfacePoint hit = caster.intersect(ray);
             if (!hit) continue;
-            const double depth = camera.project(hit.point).z();
+            const double depth = projector.project(hit.point).z();
             if (!(depth <= 1.0)) continue;
             buffers.depth[buffers.index(x, y)] = float(std::clamp(depth, 0.0, 1.0));
             buffers.faceId[buffers.index(x, y)] = std::uint32_t(hit.face.idx());

@@ -1,5 +1,6 @@
 #include "fss/scan.h"
 
+#include "fss/camera_projector.h"
 #include "fss/error.h"
 
 #include <algorithm>
@@ -31,11 +32,33 @@ FaceGeometry faceGeometry(const Mesh& mesh, FaceIndex f) {
 }
 
 // Unit vector from the sample towards the viewer along its viewing ray.
-Eigen::Vector3d towardsViewer(const Camera& camera, const Eigen::Vector3d& point) {
-    if (camera.parallel) return -camera.viewDirection();
-    const Eigen::Vector3d d = camera.eye - point;
+Eigen::Vector3d towardsViewer(const CameraProjector& camera, const Eigen::Vector3d& point) {
+    if (camera.parallel()) return -camera.viewDirection();
+    const Eigen::Vector3d d = camera.eye() - point;
     const double len = d.norm();
     return len > 0 ? Eigen::Vector3d(d / len) : Eigen::Vector3d(-camera.viewDirection());
+}
+
+double cosOfLimit(double qualityAngleLimitDeg) {
+    return std::cos(std::clamp(qualityAngleLimitDeg, 0.0, 89.9) * kDegToRad);
+}
+
+// setSampleOnSurface with the face's geometry and the camera's matrices already at hand.
+void setSample(Sample& sample, const CameraProjector& camera, FaceIndex face, const FaceGeometry& g,
+               const Eigen::Vector3d& point, double cosLimit) {
+    const bool degenerate = !(g.normal.squaredNorm() > 0);
+    const double cosAngle = degenerate ? 0.0 : std::clamp(g.normal.dot(towardsViewer(camera, point)), -1.0, 1.0);
+    const bool frontFacing = !degenerate && cosAngle > 0;
+    sample.point = point;
+    sample.face = std::uint32_t(face.idx());
+    sample.normal = g.normal;
+    sample.samplingAngle = float(degenerate ? std::numbers::pi / 2 : std::acos(cosAngle));
+    sample.footprint = float(camera.pixelFootprint(point));
+    // sampleQuality of the stored (float) angle, with cos of the limit computed once per grid.
+    sample.quality = float(double(sample.footprint) / std::max(std::cos(double(sample.samplingAngle)), cosLimit));
+    sample.hit = true;
+    sample.admissible = frontFacing;
+    sample.valid = frontFacing;
 }
 
 } // namespace
@@ -51,18 +74,8 @@ float triangleQuality(const Sample& a, const Sample& b, const Sample& c) {
 
 void setSampleOnSurface(Sample& sample, const Mesh& reference, const Camera& camera, FaceIndex face,
                         const Eigen::Vector3d& point, const ScanOptions& options) {
-    const FaceGeometry g = faceGeometry(reference, face);
-    const double cosAngle = std::clamp(g.normal.dot(towardsViewer(camera, point)), -1.0, 1.0);
-    const bool frontFacing = g.normal.squaredNorm() > 0 && cosAngle > 0;
-    sample.point = point;
-    sample.face = std::uint32_t(face.idx());
-    sample.normal = g.normal;
-    sample.samplingAngle = float(g.normal.squaredNorm() > 0 ? std::acos(cosAngle) : std::numbers::pi / 2);
-    sample.footprint = float(camera.pixelFootprint(point));
-    sample.quality = sampleQuality(sample.footprint, sample.samplingAngle, options.qualityAngleLimitDeg);
-    sample.hit = true;
-    sample.admissible = frontFacing;
-    sample.valid = frontFacing;
+    setSample(sample, CameraProjector(camera), face, faceGeometry(reference, face), point,
+              cosOfLimit(options.qualityAngleLimitDeg));
 }
 
 SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& reference,
@@ -78,6 +91,11 @@ SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& r
                                 std::to_string(w) + "x" + std::to_string(h) + " camera.");
     SampleGrid grid(h, w);
     grid.camera = camera;
+    const CameraProjector projector(camera);
+    const double cosLimit = cosOfLimit(options.qualityAngleLimitDeg);
+    // Neighbouring pixels mostly show the same face: keep the last face's geometry.
+    FaceIndex cachedFace = Mesh::null_face();
+    FaceGeometry g;
     grid.scanId = options.scanId;
     for (int r = 0; r < h; ++r) {
         progress.report(double(r) / h, "Sampling");
@@ -87,25 +105,28 @@ SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& r
             const std::uint32_t id = referenceBuffers.faceAt(c, r);
             if (id == FrameBuffers::kNoFace) continue;
             const FaceIndex f(id);
-            if (std::size_t(id) >= reference.num_faces() || reference.is_removed(f) ||
-                reference.degree(f) != 3)
-                throw InvalidInputError("The face-id buffer names face " + std::to_string(id) +
-                                        ", which is not a triangle of the reference mesh: the buffers were "
-                                        "not rendered from this mesh.");
+            if (f != cachedFace) { // checked once per run of pixels showing the same face
+                if (std::size_t(id) >= reference.num_faces() || reference.is_removed(f) ||
+                    reference.degree(f) != 3)
+                    throw InvalidInputError("The face-id buffer names face " + std::to_string(id) +
+                                            ", which is not a triangle of the reference mesh: the buffers "
+                                            "were not rendered from this mesh.");
+                g = faceGeometry(reference, f);
+                cachedFace = f;
+            }
             const Eigen::Vector3d unprojected =
-                camera.unprojectPixelCentre(c, r, referenceBuffers.depthAt(c, r));
+                projector.unprojectPixelCentre(c, r, referenceBuffers.depthAt(c, r));
             // Snap along the viewing ray onto the face's plane (removes depth quantisation).
             Eigen::Vector3d point = unprojected;
-            const FaceGeometry g = faceGeometry(reference, f);
-            const Ray ray = camera.ray(s.screen.x(), s.screen.y());
+            const Ray ray = projector.ray(s.screen.x(), s.screen.y());
             const double denom = g.normal.dot(ray.direction);
             if (g.normal.squaredNorm() > 0 && std::abs(denom) > 1e-12) {
                 const Eigen::Vector3d snapped =
                     ray.origin + (g.normal.dot(g.a - ray.origin) / denom) * ray.direction;
-                const double limit = options.maxSnapFootprints * camera.pixelFootprint(unprojected);
+                const double limit = options.maxSnapFootprints * projector.pixelFootprint(unprojected);
                 if (snapped.allFinite() && (snapped - unprojected).norm() <= limit) point = snapped;
             }
-            setSampleOnSurface(s, reference, camera, f, point, options);
+            setSample(s, projector, f, g, point, cosLimit);
         }
     }
     progress.report(1.0, "Sampling");

@@ -19,13 +19,19 @@ bool usable(const Sample& s) {
     return s.valid && s.hit && s.point.allFinite();
 }
 
-// Unit vector from \p p towards the viewer along its viewing ray.
-Eigen::Vector3d towardsViewer(const Camera& camera, const Eigen::Vector3d& p) {
-    if (camera.parallel) return -camera.viewDirection();
-    const Eigen::Vector3d d = camera.eye - p;
-    const double len = d.norm();
-    return len > 0 ? Eigen::Vector3d(d / len) : Eigen::Vector3d(-camera.viewDirection());
-}
+// Direction from \p p towards the viewer along its viewing ray, not normalised (its sign tests need no
+// length); the view direction's opposite where p is the eye itself.
+struct Viewer {
+    explicit Viewer(const Camera& camera)
+        : eye(camera.eye), back(-camera.viewDirection()), parallel(camera.parallel) {}
+    Eigen::Vector3d towards(const Eigen::Vector3d& p) const {
+        if (parallel) return back;
+        const Eigen::Vector3d d = eye - p;
+        return d.squaredNorm() > 0 ? d : back;
+    }
+    Eigen::Vector3d eye, back;
+    bool parallel;
+};
 
 // Screen orientation with y pointing down: a triangle that the camera sees counter-clockwise (OpenGL's
 // front face, y up) is a right turn in these coordinates.
@@ -38,27 +44,33 @@ CGAL::Orientation screenOrientation(const SampleGrid& grid, const Triangle& t) {
 
 enum class Verdict { Keep, Flipped, BackFacing, LongEdge, Grazing };
 
-Verdict judge(const SampleGrid& grid, const Triangle& t, CGAL::Orientation gridOrientation,
-              const TriangulateOptions& options) {
+struct JudgeLimits {
+    double maxEdgeFootprints;
+    double maxAngle;    // radians
+    double cosMaxAngle; // cos(maxAngle)
+};
+
+Verdict judge(const SampleGrid& grid, const Triangle& t, CGAL::Orientation gridOrientation, const Viewer& viewer,
+              const JudgeLimits& limits) {
     if (screenOrientation(grid, t) != gridOrientation) return Verdict::Flipped;
     const Sample& a = grid.samples[t[0]];
     const Sample& b = grid.samples[t[1]];
     const Sample& c = grid.samples[t[2]];
     const Eigen::Vector3d centroid = (a.point + b.point + c.point) / 3.0;
-    const Eigen::Vector3d toViewer = towardsViewer(grid.camera, centroid);
+    const Eigen::Vector3d toViewer = viewer.towards(centroid);
     const Eigen::Vector3d normal = (b.point - a.point).cross(c.point - a.point);
     if (!(normal.dot(toViewer) > 0)) return Verdict::BackFacing;
     for (const Sample* s : {&a, &b, &c})
-        if (s->normal.squaredNorm() > 0 && !(s->normal.dot(towardsViewer(grid.camera, s->point)) > 0))
+        if (s->normal.squaredNorm() > 0 && !(s->normal.dot(viewer.towards(s->point)) > 0))
             return Verdict::BackFacing;
     for (auto [u, v] : {std::pair{&a, &b}, std::pair{&b, &c}, std::pair{&c, &a}}) {
-        const double limit = options.maxEdgeFootprints * std::min(double(u->footprint), double(v->footprint));
-        if (!((u->point - v->point).norm() <= limit)) return Verdict::LongEdge;
+        const double limit = limits.maxEdgeFootprints * std::min(double(u->footprint), double(v->footprint));
+        // Squared lengths: no square root in the innermost test.
+        if (!(limit >= 0 && (u->point - v->point).squaredNorm() <= limit * limit)) return Verdict::LongEdge;
     }
-    const double maxAngle = options.maxSamplingAngleDeg * std::numbers::pi / 180.0;
     for (const Sample* s : {&a, &b, &c})
-        if (double(s->samplingAngle) > maxAngle) return Verdict::Grazing;
-    if (normal.normalized().dot(toViewer) < std::cos(maxAngle)) return Verdict::Grazing;
+        if (double(s->samplingAngle) > limits.maxAngle) return Verdict::Grazing;
+    if (normal.normalized().dot(toViewer.normalized()) < limits.cosMaxAngle) return Verdict::Grazing;
     return Verdict::Keep;
 }
 
@@ -94,7 +106,9 @@ std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, std::vector<b
         fan.clear();
         for (std::uint32_t k = offset[v]; k < offset[v + 1]; ++k)
             if (alive[incident[k]]) fan.push_back(incident[k]);
-        if (fan.size() < 2) continue;
+        // A grid vertex lies in at most the six grid triangles around it, which form one closed fan:
+        // all six alive means manifold (the common interior case, skipped without the search below).
+        if (fan.size() < 2 || fan.size() == 6) continue;
         // Connected components of the triangles around v: two are adjacent when they share an edge at v,
         // i.e. a vertex other than v.
         component.assign(fan.size(), std::uint32_t(-1));
@@ -194,8 +208,11 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
 
     std::vector<Triangle> triangles;
     triangles.reserve(candidates.size());
+    const Viewer viewer(grid.camera);
+    const double maxAngle = options.maxSamplingAngleDeg * std::numbers::pi / 180.0;
+    const JudgeLimits limits{options.maxEdgeFootprints, maxAngle, std::cos(maxAngle)};
     for (const Triangle& t : candidates) {
-        switch (judge(grid, t, CGAL::RIGHT_TURN, options)) {
+        switch (judge(grid, t, CGAL::RIGHT_TURN, viewer, limits)) {
         case Verdict::Keep:
             triangles.push_back(t);
             break;
@@ -219,28 +236,93 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
         makeVerticesManifold(triangles, alive, grid.samples.size(), report.nonManifoldTriangles);
 
     Mesh& mesh = patch.mesh;
+    {
+        std::size_t faces = 0;
+        for (bool a : alive)
+            faces += a ? 1 : 0;
+        // Euler: about two faces per vertex and three edges per face pair in a grid patch.
+        mesh.reserve(Mesh::size_type(faces / 2 + 2 * std::size_t(grid.cols + grid.rows) + 4),
+                     Mesh::size_type(faces * 3 / 2 + std::size_t(grid.cols + grid.rows) + 4),
+                     Mesh::size_type(faces));
+    }
     auto gridIndex = mesh.add_property_map<VertexIndex, GridIndex>(props::vertexGridIndex, GridIndex{}).first;
     auto quality = mesh.add_property_map<FaceIndex, float>(props::faceQuality, kInputFaceQuality).first;
     auto scanId = mesh.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1).first;
-    auto vertexOf = [&](std::uint32_t i) {
-        VertexIndex& v = patch.vertexOfSample[i];
-        if (v == Mesh::null_vertex()) {
+    // Vertices in order of first use, as Euler-style add_face would create them.
+    std::vector<std::uint32_t> sampleOf; // sample of each patch vertex
+    for (std::size_t k = 0; k < triangles.size(); ++k) {
+        if (!alive[k]) continue;
+        for (std::uint32_t i : triangles[k]) {
+            VertexIndex& v = patch.vertexOfSample[i];
+            if (v != Mesh::null_vertex()) continue;
             const Eigen::Vector3d& p = grid.samples[i].point;
             v = mesh.add_vertex(Point3(p.x(), p.y(), p.z()));
-            gridIndex[v] = {std::int32_t(i / std::size_t(grid.cols)),
-                            std::int32_t(i % std::size_t(grid.cols))};
+            gridIndex[v] = {std::int32_t(i / std::size_t(grid.cols)), std::int32_t(i % std::size_t(grid.cols))};
+            sampleOf.push_back(i);
         }
-        return v;
+    }
+    // The halfedge structure directly (Surface_mesh::add_face searches each new edge around its vertex):
+    // every triangle edge joins two grid neighbours, so an edge is found in O(1) at slot 3·(patch vertex
+    // of its smaller sample) + (horizontal, vertical or diagonal).
+    auto fail = [](std::uint32_t sample) {
+        return Error("Internal error: the grid triangulation produced a non-manifold patch at sample " +
+                     std::to_string(sample) + ".");
+    };
+    const auto cols = std::uint32_t(grid.cols);
+    std::vector<HalfedgeIndex> edgeSlot(3 * sampleOf.size());
+    auto slotOf = [&](std::uint32_t i, std::uint32_t j) -> HalfedgeIndex& {
+        const std::uint32_t lo = std::min(i, j), d = std::max(i, j) - lo;
+        const std::size_t type = d == 1 ? 0 : d == cols ? 1 : d == cols + 1 ? 2 : 3;
+        if (type == 3) throw fail(lo); // not grid neighbours: cannot happen for grid triangles
+        return edgeSlot[3 * std::size_t(patch.vertexOfSample[lo].idx()) + type];
     };
     for (std::size_t k = 0; k < triangles.size(); ++k) {
         if (!alive[k]) continue;
         const Triangle& t = triangles[k];
-        const FaceIndex f = mesh.add_face(vertexOf(t[0]), vertexOf(t[1]), vertexOf(t[2]));
-        if (f == Mesh::null_face())
-            throw Error("Internal error: the grid triangulation produced a non-manifold patch at sample " +
-                        std::to_string(t[0]) + ".");
+        const FaceIndex f = mesh.add_face();
+        std::array<HalfedgeIndex, 3> h;
+        for (std::size_t j = 0; j < 3; ++j) {
+            const std::uint32_t from = t[j], to = t[(j + 1) % 3];
+            HalfedgeIndex& slot = slotOf(from, to);
+            if (slot == HalfedgeIndex()) {
+                slot = mesh.add_edge();
+                mesh.set_target(slot, patch.vertexOfSample[to]);
+                mesh.set_target(mesh.opposite(slot), patch.vertexOfSample[from]);
+                h[j] = slot;
+            } else {
+                h[j] = mesh.opposite(slot); // the other face's halfedge runs to → from
+                if (mesh.target(h[j]) != patch.vertexOfSample[to] || mesh.face(h[j]) != Mesh::null_face())
+                    throw fail(from);
+            }
+        }
+        mesh.set_halfedge(f, h[0]);
+        for (std::size_t j = 0; j < 3; ++j) {
+            mesh.set_face(h[j], f);
+            mesh.set_next(h[j], h[(j + 1) % 3]);
+            mesh.set_halfedge(mesh.target(h[j]), h[j]);
+        }
         quality[f] = triangleQuality(grid.samples[t[0]], grid.samples[t[1]], grid.samples[t[2]]);
         scanId[f] = grid.scanId;
+    }
+    // Border halfedges follow each other around the patch's boundary; a border vertex points to its
+    // incoming one. Vertex-manifold: at most one border halfedge leaves each vertex.
+    std::vector<HalfedgeIndex> borderFrom(sampleOf.size());
+    std::vector<HalfedgeIndex> borders;
+    for (const HalfedgeIndex slot : edgeSlot) {
+        if (slot == HalfedgeIndex()) continue;
+        for (const HalfedgeIndex b : {slot, mesh.opposite(slot)}) {
+            if (mesh.face(b) != Mesh::null_face()) continue;
+            HalfedgeIndex& out = borderFrom[mesh.source(b).idx()];
+            if (out != HalfedgeIndex()) throw fail(sampleOf[mesh.source(b).idx()]);
+            out = b;
+            borders.push_back(b);
+        }
+    }
+    for (const HalfedgeIndex b : borders) {
+        const VertexIndex end = mesh.target(b);
+        if (borderFrom[end.idx()] == HalfedgeIndex()) throw fail(sampleOf[end.idx()]);
+        mesh.set_next(b, borderFrom[end.idx()]);
+        mesh.set_halfedge(end, b);
     }
     report.faces = mesh.number_of_faces();
     report.vertices = mesh.number_of_vertices();

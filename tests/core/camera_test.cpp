@@ -1,6 +1,7 @@
 // Camera maths: matrices against closed forms, project/unproject round trips, rays, footprints,
 // standard views and validation of bad parameters.
 #include "fss/camera.h"
+#include "fss/camera_projector.h"
 #include "fss/error.h"
 
 #include <gtest/gtest.h>
@@ -191,4 +192,30 @@ TEST(Camera, FitClippingRangeIsTightAndRejectsBoxBehind) {
     EXPECT_GT(c.farPlane, 10.5);
     c.focal = {0, 0, 20};  // looking away
     EXPECT_THROW(c.fitClippingRange(box), fss::InvalidInputError);
+}
+
+TEST(CameraProjector, MatchesTheCameraMethods) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-3, 3), s(0, 1);
+    for (bool parallel : {false, true}) {
+        const Camera c = makeCamera(parallel);
+        const fss::CameraProjector p(c);
+        EXPECT_LT((p.viewDirection() - c.viewDirection()).norm(), 1e-15);
+        for (int i = 0; i < 200; ++i) {
+            const Eigen::Vector3d w(u(rng), u(rng), u(rng));
+            const Eigen::Vector3d a = c.project(w), b = p.project(w);
+            EXPECT_LT((a - b).norm(), 1e-12 * std::max(1.0, a.norm()));
+            const double sx = s(rng) * c.width, sy = s(rng) * c.height, z = s(rng);
+            EXPECT_LT((c.unproject(sx, sy, z) - p.unproject(sx, sy, z)).norm(), 1e-12);
+            EXPECT_LT((c.unprojectPixelCentre(i % c.width, i % c.height, z) -
+                       p.unprojectPixelCentre(i % c.width, i % c.height, z))
+                          .norm(),
+                      1e-12);
+            const fss::Ray r = c.ray(sx, sy), q = p.ray(sx, sy);
+            EXPECT_LT((r.origin - q.origin).norm(), 1e-12);
+            EXPECT_LT((r.direction - q.direction).norm(), 1e-12);
+            EXPECT_NEAR(c.pixelFootprint(w), p.pixelFootprint(w), 1e-12);
+            EXPECT_NEAR(c.viewDepth(w), p.viewDepth(w), 1e-12);
+        }
+    }
 }

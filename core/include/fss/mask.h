@@ -65,7 +65,8 @@ struct QualityMaskOptions {
 /// Sampling-quality mask against the *current* mesh. For every admissible sample, the face of
 /// \p currentBuffers under the sample's screen position (pixel floor(x), floor(y)) is the first guess;
 /// a local walk on \p current (closestPointNear, `options.searchRings` rings) finds the face closest to
-/// the sample's point. The sample stays admissible only when its quality is better than that face's
+/// the sample's point (a sample within 10⁻³ pixel footprints of the first guess is on it: the guess is
+/// taken without a walk). The sample stays admissible only when its quality is better than that face's
 /// quality, q_sample < (1 − margin) · q_face, where q_face is the face's props::faceQuality, or
 /// kInputFaceQuality for faces without one (input faces: every sample beats them; a NaN counts as none).
 /// Samples whose pixel shows no face of \p current (or lies outside the image) stay admissible: the
