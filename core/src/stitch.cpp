@@ -39,6 +39,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <set>
 #include <sstream>
@@ -1398,6 +1399,32 @@ private:
                 if (f->info().inside == 0)
                     newFaces_.push_back({{f->vertex(0)->info().id, f->vertex(1)->info().id, f->vertex(2)->info().id}, q, sid, false, n});
         }
+        // The seam optimisation may also change the faces around the re-triangulated ones (seamRings):
+        // they join the faces replaced (by themselves, to begin with).
+        {
+            std::unordered_set<std::uint32_t> taken;
+            for (FaceIndex f : replaced_) taken.insert(std::uint32_t(f));
+            std::vector<FaceIndex> ring;
+            for (FaceIndex f : replaced_)
+                if (regionIndex_.count(std::uint32_t(f))) ring.push_back(f);
+            for (int k = 1; k < O_.seamRings; ++k) {
+                std::vector<FaceIndex> next;
+                for (FaceIndex f : ring)
+                    for (VertexIndex v : faceVertices(f))
+                        for (FaceIndex g : CGAL::faces_around_target(M_.halfedge(v), M_)) {
+                            if (g == Mesh::null_face() || taken.count(std::uint32_t(g)) || !acceptable(g)) continue;
+                            taken.insert(std::uint32_t(g));
+                            next.push_back(g);
+                            replaced_.push_back(g);
+                            const auto vs = faceVertices(g);
+                            const Vec3 n = normalOf(toVec(M_.point(vs[0])), toVec(M_.point(vs[1])), toVec(M_.point(vs[2]))).normalized();
+                            newFaces_.push_back({{regionVertex(vs[0]), regionVertex(vs[1]), regionVertex(vs[2])},
+                                                 curHasQuality_ ? curQuality_[g] : kInputFaceQuality,
+                                                 curHasScanId_ ? curScanId_[g] : -1, false, n});
+                        }
+                ring.swap(next);
+            }
+        }
         // Patch faces, the boundary ones re-triangulated over the seam vertices of their edges.
         double patchArea = 0;
         std::vector<int> bad;
@@ -1631,7 +1658,8 @@ private:
         auto isNewFace = [&](FaceIndex f) { return f != Mesh::null_face() && !loc.star.kept[f]; };
         auto removable = [&](VertexIndex v) {
             const int id = loc.lid[v];
-            return !loc.locked[v] && id >= 0 && L_[std::size_t(id)].kind != LVert::Region;
+            // Mesh vertices stay (they carry the old surface's shape); crossings, patch and Steiner vertices may go.
+            return !loc.locked[v] && (id < 0 || L_[std::size_t(id)].kind != LVert::Region);
         };
         // -- collapses: remove a into b
         auto tryCollapse = [&](VertexIndex a, VertexIndex b, double& score) -> bool {
@@ -1666,7 +1694,8 @@ private:
             score = newMin;
             return true;
         };
-        for (int pass = 0; pass < 4; ++pass) {
+        auto collapsePass = [&] {
+          for (int pass = 0; pass < 4; ++pass) {
             const auto near = seamNeighbourhood(loc);
             std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
             for (EdgeIndex e : S.edges()) {
@@ -1690,8 +1719,94 @@ private:
             }
             plan.collapses += done;
             if (done == 0) break;
+          }
+        };
+        collapsePass();
+        // -- refinement outside the patch: split long edges of the pieces around the seam (the new vertices
+        // lie on the old surface: in a face's plane or on a mesh edge), graded from the patch's edge length at
+        // the seam outwards, then flip within the faces' planes.
+        for (int round = 0; round < 4 && O_.seamGrading > 0; ++round) {
+            if (refineOutside(loc) == 0) break;
+            flipPass(loc, plan);
         }
-        // -- flips: raise the smallest angle, valence towards 6
+        collapsePass();
+        flipPass(loc, plan);
+    }
+
+    std::size_t refineOutside(Local& loc) {
+        Mesh& S = loc.star.S;
+        const auto near = seamNeighbourhood(loc);
+        std::vector<Vec3> seamPoints;
+        for (const auto& [a, b] : loc.seam) seamPoints.push_back(pt(S, VertexIndex(a)));
+        auto target = [&](const Vec3& p) {
+            double d2 = std::numeric_limits<double>::infinity();
+            for (const Vec3& q : seamPoints) d2 = std::min(d2, (p - q).squaredNorm());
+            return h3_ + O_.seamGrading * std::sqrt(d2);
+        };
+        std::vector<std::pair<double, EdgeIndex>> cands;
+        for (EdgeIndex e : S.edges()) {
+            const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
+            const FaceIndex f = S.face(h), g = S.face(o);
+            if (f == Mesh::null_face() || g == Mesh::null_face() || loc.star.kept[f] || loc.star.kept[g]) continue;
+            if (loc.patchSide[f] || loc.patchSide[g]) continue;
+            if (!near.count(std::uint32_t(S.source(h))) && !near.count(std::uint32_t(S.target(h)))) continue;
+            const Vec3 a = pt(S, S.source(h)), b = pt(S, S.target(h));
+            const double len = (a - b).norm();
+            if (len > 4.0 / 3.0 * target(0.5 * (a + b))) cands.push_back({len, e});
+        }
+        std::sort(cands.begin(), cands.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+        std::size_t splits = 0;
+        for (const auto& [len, e] : cands) {
+            if (S.is_removed(e)) continue;
+            const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
+            const FaceIndex f = S.face(h), g = S.face(o);
+            const VertexIndex x = S.source(h), y = S.target(h);
+            const Vec3 mid = 0.5 * (pt(S, x) + pt(S, y));
+            Point2 uv;
+            double w;
+            if (!V_.project(mid, uv, w)) continue;
+            // The split must leave all four triangles counter-clockwise in the view.
+            const VertexIndex z = S.target(S.next(h)), u = S.target(S.next(o));
+            if (!leftTurn(loc.uv[x], uv, loc.uv[z]) || !leftTurn(uv, loc.uv[y], loc.uv[z]) ||
+                !leftTurn(loc.uv[y], uv, loc.uv[u]) || !leftTurn(uv, loc.uv[x], loc.uv[u]))
+                continue;
+            // ... and not make the smallest angle there worse.
+            const Vec3 X = pt(S, x), Y = pt(S, y), Z = pt(S, z), U = pt(S, u);
+            if (std::min({minAngle(X, mid, Z), minAngle(mid, Y, Z), minAngle(Y, mid, U), minAngle(mid, X, U)}) <
+                std::min(minAngle(X, Y, Z), minAngle(Y, X, U)))
+                continue;
+            const HalfedgeIndex hn = CGAL::Euler::split_edge(h, S);
+            const VertexIndex v = S.target(hn);
+            S.point(v) = toPoint(mid);
+            loc.uv[v] = uv;
+            loc.lid[v] = -1;
+            loc.locked[v] = false;
+            loc.star.cur[v] = kNone;
+            const HalfedgeIndex h3 = CGAL::Euler::split_face(hn, S.next(S.next(hn)), S);
+            copyFace(loc, f, S.face(h3));
+            copyFace(loc, f, S.face(S.opposite(h3)));
+            const HalfedgeIndex og = S.opposite(h);
+            const HalfedgeIndex h4 = CGAL::Euler::split_face(og, S.next(S.next(og)), S);
+            copyFace(loc, g, S.face(h4));
+            copyFace(loc, g, S.face(S.opposite(h4)));
+            ++splits;
+        }
+        return splits;
+    }
+    static void copyFace(Local& loc, FaceIndex from, FaceIndex to) {
+        if (from == to) return;
+        loc.star.kept[to] = loc.star.kept[from];
+        loc.quality[to] = loc.quality[from];
+        loc.scanId[to] = loc.scanId[from];
+        loc.patchSide[to] = loc.patchSide[from];
+        loc.planeNormal[to] = loc.planeNormal[from];
+    }
+
+    // -- flips: raise the smallest angle, valence towards 6
+    void flipPass(Local& loc, Plan& plan) {
+        Mesh& S = loc.star.S;
+        const double maxTurn = O_.maxNormalChangeDeg * kDeg;
+        auto isNewFace = [&](FaceIndex f) { return f != Mesh::null_face() && !loc.star.kept[f]; };
         const auto near = seamNeighbourhood(loc);
         auto valenceCost = [&](VertexIndex v, int delta) {
             const int target = S.is_border(v) ? 4 : 6;
@@ -1861,7 +1976,17 @@ private:
     bool extractPlan(Local& loc, Attempt& a) {
         Mesh& S = loc.star.S;
         Plan& plan = a.plan;
-        plan.removed = replaced_;
+        // Faces that come out exactly as they were stay in the mesh untouched (same index).
+        std::map<std::array<std::uint32_t, 3>, FaceIndex> byCorners;
+        auto corners = [](std::array<std::uint32_t, 3> c) {
+            std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
+            return c;
+        };
+        for (FaceIndex f : replaced_) {
+            const auto vs = faceVertices(f);
+            byCorners[corners({std::uint32_t(vs[0]), std::uint32_t(vs[1]), std::uint32_t(vs[2])})] = f;
+        }
+        std::unordered_set<std::uint32_t> unchanged;
         // Vertices: current ones stay themselves, new ones are numbered in order of use.
         std::unordered_map<std::uint32_t, std::uint32_t> freshIndex;
         std::vector<std::array<VertexIndex, 3>> faces;
@@ -1869,9 +1994,20 @@ private:
         for (FaceIndex f : S.faces())
             if (!loc.star.kept[f]) {
                 const HalfedgeIndex h = S.halfedge(f);
-                faces.push_back({S.source(h), S.target(h), S.target(S.next(h))});
+                const std::array<VertexIndex, 3> fv{S.source(h), S.target(h), S.target(S.next(h))};
+                const std::array<std::uint32_t, 3> c{loc.star.cur[fv[0]], loc.star.cur[fv[1]], loc.star.cur[fv[2]]};
+                if (c[0] != kNone && c[1] != kNone && c[2] != kNone) {
+                    auto it = byCorners.find(corners(c));
+                    if (it != byCorners.end()) {
+                        unchanged.insert(std::uint32_t(it->second));
+                        continue;
+                    }
+                }
+                faces.push_back(fv);
                 sfaces.push_back(f);
             }
+        for (FaceIndex f : replaced_)
+            if (!unchanged.count(std::uint32_t(f))) plan.removed.push_back(f);
         std::unordered_set<std::uint32_t> reused;
         // Order faces for growth in the rehearsal mesh: build it first (same star, same removals).
         Star rehearsal;
@@ -1906,7 +2042,7 @@ private:
         for (const Vec3& p : plan.freshPositions) fresh.push_back(rehearsal.S.add_vertex(toPoint(p)));
         std::unordered_set<std::uint32_t> keep;
         for (VertexIndex v : plan.reused) keep.insert(std::uint32_t(rehearsal.fromCurrent.at(std::uint32_t(v))));
-        for (FaceIndex f : replaced_)
+        for (FaceIndex f : plan.removed)
             removeFaceKeeping(rehearsal.S, rehearsal.faceFromCurrent.at(std::uint32_t(f)),
                               [&](VertexIndex v) { return keep.count(std::uint32_t(v)) > 0; });
         std::vector<std::array<VertexIndex, 3>> rf;
@@ -1952,6 +2088,14 @@ private:
             if (!seamVerts.count(std::uint32_t(fv[0])) && !seamVerts.count(std::uint32_t(fv[1])) && !seamVerts.count(std::uint32_t(fv[2])))
                 continue;
             plan.seamFaceMinAngles.push_back(minAngle(pt(S, fv[0]), pt(S, fv[1]), pt(S, fv[2])) / kDeg);
+            if (std::getenv("FSS_STITCH_DEBUG_Q")) {
+                const double ang = plan.seamFaceMinAngles.back();
+                int kinds[4] = {0, 0, 0, 0};
+                for (VertexIndex v : fv) { const int id = loc.lid[v]; if (id >= 0) ++kinds[int(L_[std::size_t(id)].kind)]; }
+                std::fprintf(stderr, "Q %d %.2f R%d B%d C%d I%d", int(loc.patchSide[sfaces[i]]), ang, kinds[0], kinds[1], kinds[2], kinds[3]);
+                for (VertexIndex v : fv) std::fprintf(stderr, " (%.4f %.4f c%d l%d)", loc.uv[v].x(), loc.uv[v].y(), int(loc.lid[v] >= 0 && L_[std::size_t(loc.lid[v])].chain), int(loc.locked[v]));
+                std::fprintf(stderr, "\n");
+            }
         }
         return true;
     }
@@ -2096,9 +2240,9 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
                                 std::to_string(std::size_t(scanCamera.width) * std::size_t(scanCamera.height)) + ".");
     if (!(options.collapseEdgeRatio >= 0 && options.collapseEdgeRatio < 0.5) || options.seamRings < 0 ||
         !(options.maxViewAngleDeg > 0 && options.maxViewAngleDeg < 90) || !(options.maxNormalChangeDeg >= 0) ||
-        !(options.maxGapRatio > 0) || options.maxTrimRounds < 0)
+        !(options.maxGapRatio > 0) || options.maxTrimRounds < 0 || !(options.seamGrading >= 0))
         throw InvalidInputError("The stitch options are out of range (collapseEdgeRatio in [0, 0.5), seamRings >= 0, "
-                                "maxViewAngleDeg in (0, 90), maxNormalChangeDeg >= 0, maxGapRatio > 0, maxTrimRounds >= 0).");
+                                "maxViewAngleDeg in (0, 90), maxNormalChangeDeg >= 0, maxGapRatio > 0, maxTrimRounds >= 0, seamGrading >= 0).");
 
     const View view(scanCamera);
     StitchReport report;
