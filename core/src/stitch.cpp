@@ -308,6 +308,9 @@ struct Star {
     Mesh::Property_map<VertexIndex, std::uint32_t> cur;          // S vertex → current vertex (kNone: new)
     Mesh::Property_map<FaceIndex, bool> kept;                    // face of the current mesh that stays
     std::vector<VertexIndex> full; // S vertices whose whole star is in S (vertices of the replaced faces)
+    std::unordered_set<std::uint32_t> fullCurrent; // the same, as current-mesh vertices
+    // Is the whole star of S vertex v in S (a vertex of the replaced faces, or a new one)?
+    bool isFull(VertexIndex v) const { return cur[v] == kNone || fullCurrent.count(cur[v]) > 0; }
 };
 
 bool buildStar(const Mesh& M, const std::vector<FaceIndex>& replaced, Star& st) {
@@ -347,6 +350,7 @@ bool buildStar(const Mesh& M, const std::vector<FaceIndex>& replaced, Star& st) 
         // The whole umbrella must have been copied (else the mesh is not vertex-manifold here).
         if (st.S.degree(s) != M.degree(v) || st.S.is_border(s) != M.is_border(v)) return false;
         st.full.push_back(s);
+        st.fullCurrent.insert(std::uint32_t(v));
     }
     return true;
 }
@@ -387,6 +391,7 @@ struct LFace {
     std::int32_t scanId;
     bool patchSide; // a patch face (or a piece of one); else a piece of a mesh face outside the patch
     Vec3 planeNormal{0, 0, 0}; // pieces outside: unit normal of the mesh face they lie in
+    double minAllowed = 0;     // smallest angle accepted (radians): the floor, or less if the parent had less
 };
 
 // ---------------------------------------------------------------------------------------------------
@@ -409,7 +414,6 @@ public:
         if (!splitRegion(a)) return a;
         buildLocalVertices();
         snap();
-        pruneEdgeSnaps();
         if (!computeCrossings(a)) return a;
         Cdt cdt;
         std::vector<CdtVertex> vh;
@@ -503,12 +507,20 @@ private:
         });
         return out;
     }
+    // Records a problem at q: the patch vertices nearest to it are to be trimmed. The marker -1 makes sure
+    // the problem counts even when no patch vertex is near (fail() drops the markers).
     void addNear(std::vector<int>& bad, const Point2& q) {
-        auto near = patchVerticesNear(q, 1.5 * h2_);
-        bad.insert(bad.end(), near.begin(), near.end());
+        bad.push_back(-1);
+        for (double r = 1.5 * h2_; r < 100.0 * h2_; r *= 2.0) {
+            auto near = patchVerticesNear(q, r);
+            if (near.empty()) continue;
+            bad.insert(bad.end(), near.begin(), near.end());
+            return;
+        }
     }
     // Patch vertices to trim for a problem at local vertex i.
     void addBad(std::vector<int>& bad, int i) {
+        bad.push_back(-1);
         const LVert& l = L_[std::size_t(i)];
         if (l.patchA >= 0 || l.patchB >= 0) {
             bad.push_back(l.patchA);
@@ -997,65 +1009,62 @@ private:
                 redges_[std::size_t(best)].splits.push_back({lineParam(q, L_[std::size_t(redges_[std::size_t(best)].u)].uv, L_[std::size_t(redges_[std::size_t(best)].w)].uv), lid});
             }
         }
-        // Rule 3: a mesh vertex close to a patch boundary edge splits that edge.
+        // Rule 3: a mesh vertex close to a patch boundary edge splits that edge. The closest go first; a
+        // vertex is taken when the patch triangle on the edge stays a fan of counter-clockwise triangles.
         {
             BucketGrid grid(cell, pedges_.size());
             for (std::size_t i = 0; i < pedges_.size(); ++i) grid.insert(int(i), bboxOf(L_uvOfPatch(pedges_[i].a), L_uvOfPatch(pedges_[i].b)));
+            struct Cand {
+                double d, s;
+                int lid;
+            };
+            std::vector<std::vector<Cand>> cands(pedges_.size());
             for (std::size_t i = 0; i < L_.size(); ++i) {
-                LVert& l = L_[i];
+                const LVert& l = L_[i];
                 if (l.kind != LVert::Region || l.chain) continue;
                 int best = -1;
-                double bestRel = 1, bestS = 0;
-                grid.query(grown(l.uv.bbox(), O_.collapseEdgeRatio * 4.0 * h2_), [&](int e) {
+                double bestRel = 1, bestS = 0, bestD = 0;
+                grid.query(grown(l.uv.bbox(), margin_), [&](int e) {
                     const auto& pe = pedges_[std::size_t(e)];
                     const int la = lidOfPatch_.at(pe.a), lb = lidOfPatch_.at(pe.b);
                     if (la == int(i) || lb == int(i)) return;
                     const Point2 &A = L_[std::size_t(la)].uv, &B = L_[std::size_t(lb)].uv;
-                    const double len = std::sqrt(dist2(A, B));
                     double s;
                     const double d = segmentDistance(l.uv, A, B, s);
-                    const double rel = d / (ratio * std::min(len, regionEdgeMin[i]));
+                    const double rel = d / (ratio * std::sqrt(dist2(A, B)));
                     if (rel < bestRel && s > 1e-3 && s < 1 - 1e-3) {
                         bestRel = rel;
                         best = e;
                         bestS = s;
+                        bestD = d;
                     }
                 });
-                if (best < 0) continue;
-                {
-                    // The patch triangle on that edge must stay a fan of counter-clockwise triangles.
-                    const auto& pe = pedges_[std::size_t(best)];
-                    const Point2 A = L_uvOfPatch(pe.a), B = L_uvOfPatch(pe.b), C = L_uvOfPatch(pe.opposite);
-                    if (!leftTurn(A, l.uv, C) || !leftTurn(l.uv, B, C)) continue;
-                }
-                pedges_[std::size_t(best)].splits.push_back({bestS, int(i)});
-                l.chain = true;
-                l.patchA = pedges_[std::size_t(best)].a;
-                l.patchB = pedges_[std::size_t(best)].b;
+                if (best >= 0) cands[std::size_t(best)].push_back({bestD, bestS, int(i)});
             }
-        }
-    }
-    // Mesh vertices snapped onto a patch boundary edge must leave the patch triangle on it a fan of
-    // counter-clockwise triangles: keep them greedily in order along the edge.
-    void pruneEdgeSnaps() {
-        for (auto& pe : pedges_) {
-            if (pe.splits.empty()) continue;
-            std::sort(pe.splits.begin(), pe.splits.end());
-            const Point2 B = L_uvOfPatch(pe.b), C = L_uvOfPatch(pe.opposite);
-            Point2 prev = L_uvOfPatch(pe.a);
-            std::vector<std::pair<double, int>> kept;
-            for (const auto& sp : pe.splits) {
-                LVert& l = L_[std::size_t(sp.second)];
-                if (leftTurn(prev, l.uv, C) && leftTurn(l.uv, B, C) &&
-                    (kept.empty() || lineParam(l.uv, prev, B) > 0)) {
-                    kept.push_back(sp);
-                    prev = l.uv;
-                } else {
-                    l.chain = false;
-                    l.patchA = l.patchB = -1;
+            for (std::size_t e = 0; e < pedges_.size(); ++e) {
+                auto& cs = cands[e];
+                if (cs.empty()) continue;
+                std::sort(cs.begin(), cs.end(), [](const Cand& x, const Cand& y) { return x.d != y.d ? x.d < y.d : x.lid < y.lid; });
+                auto& pe = pedges_[e];
+                const Point2 A = L_uvOfPatch(pe.a), B = L_uvOfPatch(pe.b), C = L_uvOfPatch(pe.opposite);
+                std::vector<std::pair<double, int>> taken; // sorted by s
+                for (const Cand& c : cs) {
+                    const auto pos = std::lower_bound(taken.begin(), taken.end(), std::pair{c.s, -1});
+                    const Point2 prev = pos == taken.begin() ? A : L_[std::size_t(std::prev(pos)->second)].uv;
+                    const Point2 next = pos == taken.end() ? B : L_[std::size_t(pos->second)].uv;
+                    const Point2& v = L_[std::size_t(c.lid)].uv;
+                    if (!leftTurn(prev, v, C) || !leftTurn(v, next, C)) continue;
+                    if (!(lineParam(v, prev, next) > 0 && lineParam(v, prev, next) < 1)) continue;
+                    taken.insert(pos, {c.s, c.lid});
+                }
+                for (const auto& [sp, lid] : taken) {
+                    pe.splits.push_back({sp, lid});
+                    LVert& l = L_[std::size_t(lid)];
+                    l.chain = true;
+                    l.patchA = pe.a;
+                    l.patchB = pe.b;
                 }
             }
-            pe.splits.swap(kept);
         }
     }
     // Polyline (local ids) of a region edge or a patch boundary edge with its splits, sorted.
@@ -1304,13 +1313,13 @@ private:
     // `edges` holds for every corner the triangle edges it lies on (bit k: edge k): a diagonal between
     // two corners on the same edge would leave a triangle of collinear points, so it is never used.
     bool triangulatePolygon(const std::vector<int>& poly, const std::vector<unsigned>& edges, float q,
-                            std::int32_t sid) {
+                            std::int32_t sid, double floor) {
         const std::size_t n = poly.size();
         auto P = [&](std::size_t i) -> const Point2& { return L_[std::size_t(poly[i])].uv; };
         auto X = [&](std::size_t i) -> const Vec3& { return L_[std::size_t(poly[i])].pos; };
         if (n == 3) {
             if (!leftTurn(P(0), P(1), P(2))) return false;
-            newFaces_.push_back({{poly[0], poly[1], poly[2]}, q, sid, true});
+            newFaces_.push_back({{poly[0], poly[1], poly[2]}, q, sid, true, Vec3(0, 0, 0), floor});
             return true;
         }
         // diagonal[i][j]: the segment i–j lies inside the polygon and does not run along a triangle edge.
@@ -1364,7 +1373,7 @@ private:
             stack.pop_back();
             if (j == i + 1) continue;
             const std::size_t k = split[i * n + j];
-            newFaces_.push_back({{poly[i], poly[k], poly[j]}, q, sid, true});
+            newFaces_.push_back({{poly[i], poly[k], poly[j]}, q, sid, true, Vec3(0, 0, 0), floor});
             stack.push_back({i, k});
             stack.push_back({k, j});
         }
@@ -1394,10 +1403,12 @@ private:
             replaced_.push_back(region_[r]);
             const float q = curHasQuality_ ? curQuality_[region_[r]] : kInputFaceQuality;
             const std::int32_t sid = curHasScanId_ ? curScanId_[region_[r]] : -1;
-            const Vec3 n = normalOf(toVec(M_.point(vs[0])), toVec(M_.point(vs[1])), toVec(M_.point(vs[2]))).normalized();
+            const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
+            const Vec3 n = normalOf(A, B, C).normalized();
+            const double floor = std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C));
             for (CdtFace f : pieces[r])
                 if (f->info().inside == 0)
-                    newFaces_.push_back({{f->vertex(0)->info().id, f->vertex(1)->info().id, f->vertex(2)->info().id}, q, sid, false, n});
+                    newFaces_.push_back({{f->vertex(0)->info().id, f->vertex(1)->info().id, f->vertex(2)->info().id}, q, sid, false, n, floor});
         }
         // The seam optimisation may also change the faces around the re-triangulated ones (seamRings):
         // they join the faces replaced (by themselves, to begin with).
@@ -1417,10 +1428,11 @@ private:
                             next.push_back(g);
                             replaced_.push_back(g);
                             const auto vs = faceVertices(g);
-                            const Vec3 n = normalOf(toVec(M_.point(vs[0])), toVec(M_.point(vs[1])), toVec(M_.point(vs[2]))).normalized();
+                            const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
                             newFaces_.push_back({{regionVertex(vs[0]), regionVertex(vs[1]), regionVertex(vs[2])},
                                                  curHasQuality_ ? curQuality_[g] : kInputFaceQuality,
-                                                 curHasScanId_ ? curScanId_[g] : -1, false, n});
+                                                 curHasScanId_ ? curScanId_[g] : -1, false, normalOf(A, B, C).normalized(),
+                                                 std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C))});
                         }
                 ring.swap(next);
             }
@@ -1446,7 +1458,9 @@ private:
             const float q = P_.hasQuality ? P_.quality[std::size_t(f)] : kInputFaceQuality;
             const std::int32_t sid = P_.hasScanId ? P_.scanId[std::size_t(f)] : -1;
             const std::size_t before = newFaces_.size();
-            if (!triangulatePolygon(poly, edges, q, sid)) {
+            const double floor = std::min(O_.minAngleFloorDeg * kDeg,
+                                          0.999 * minAngle(P_.pos[std::size_t(t[0])], P_.pos[std::size_t(t[1])], P_.pos[std::size_t(t[2])]));
+            if (!triangulatePolygon(poly, edges, q, sid, floor)) {
                 if (std::getenv("FSS_STITCH_DEBUG")) {
                     std::fprintf(stderr, "  polygon failed:");
                     for (std::size_t k = 0; k < poly.size(); ++k)
@@ -1489,6 +1503,7 @@ private:
         Mesh::Property_map<FaceIndex, std::int32_t> scanId;
         Mesh::Property_map<FaceIndex, bool> patchSide;
         Mesh::Property_map<FaceIndex, Vec3> planeNormal; // outside pieces: normal of their mesh face
+        Mesh::Property_map<FaceIndex, double> minAllowed; // smallest angle accepted (radians)
         std::set<std::pair<std::uint32_t, std::uint32_t>> seam;
     };
     static std::pair<std::uint32_t, std::uint32_t> seamKey(VertexIndex a, VertexIndex b) {
@@ -1549,6 +1564,7 @@ private:
         loc.scanId = S.add_property_map<FaceIndex, std::int32_t>("f:s", -1).first;
         loc.patchSide = S.add_property_map<FaceIndex, bool>("f:patch", false).first;
         loc.planeNormal = S.add_property_map<FaceIndex, Vec3>("f:plane", Vec3(0, 0, 0)).first;
+        loc.minAllowed = S.add_property_map<FaceIndex, double>("f:floor", 0.0).first;
         // Border edges around the replaced faces before (must be the same after: no new holes).
         const auto bordersBefore = bordersAround(loc);
         // Map local ids to S vertices.
@@ -1602,6 +1618,7 @@ private:
             loc.scanId[g] = newFaces_[i].scanId;
             loc.patchSide[g] = newFaces_[i].patchSide;
             loc.planeNormal[g] = newFaces_[i].planeNormal;
+            loc.minAllowed[g] = newFaces_[i].minAllowed;
         }
         if (!bad.empty()) return fail(a, "its seam would not be manifold", std::move(bad));
         for (VertexIndex v : S.vertices()) {
@@ -1623,8 +1640,8 @@ private:
     std::set<std::pair<std::uint32_t, std::uint32_t>> bordersAround(Local& loc) const {
         std::set<std::pair<std::uint32_t, std::uint32_t>> out;
         const Mesh& S = loc.star.S;
-        for (VertexIndex v : loc.star.full) {
-            if (S.is_removed(v) || S.halfedge(v) == Mesh::null_halfedge()) continue;
+        for (VertexIndex v : S.vertices()) {
+            if (!loc.star.isFull(v) || S.halfedge(v) == Mesh::null_halfedge()) continue;
             for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(v), S))
                 for (HalfedgeIndex g : {h, S.opposite(h)})
                     if (S.is_border(g)) out.insert(std::minmax(loc.star.cur[S.source(g)], loc.star.cur[S.target(g)]));
@@ -1800,6 +1817,7 @@ private:
         loc.scanId[to] = loc.scanId[from];
         loc.patchSide[to] = loc.patchSide[from];
         loc.planeNormal[to] = loc.planeNormal[from];
+        loc.minAllowed[to] = loc.minAllowed[from];
     }
 
     // -- flips: raise the smallest angle, valence towards 6
@@ -1917,11 +1935,19 @@ private:
             if (CGAL::collinear(S.point(p), S.point(q), S.point(r)) || !leftTurn(loc.uv[p], loc.uv[q], loc.uv[r])) badFace(f);
         }
         if (!bad.empty()) return fail(a, "it would create degenerate or back-facing faces", std::move(bad));
+        for (FaceIndex f : S.faces()) {
+            if (loc.star.kept[f]) continue;
+            const HalfedgeIndex h = S.halfedge(f);
+            if (minAngle(pt(S, S.source(h)), pt(S, S.target(h)), pt(S, S.target(S.next(h)))) < loc.minAllowed[f]) badFace(f);
+            if (std::getenv("FSS_STITCH_DEBUG_Q") && minAngle(pt(S, S.source(h)), pt(S, S.target(h)), pt(S, S.target(S.next(h)))) < 0.5 * kDeg)
+                std::fprintf(stderr, "LOW %.3f allowed %.3f patchSide %d\n", minAngle(pt(S, S.source(h)), pt(S, S.target(h)), pt(S, S.target(S.next(h)))) / kDeg, loc.minAllowed[f] / kDeg, int(loc.patchSide[f]));
+        }
+        if (!bad.empty()) return fail(a, "it would create needle-like faces at its seam", std::move(bad));
         // Vertices: manifold (one umbrella) and no new border.
         std::unordered_map<std::uint32_t, int> incoming;
         for (HalfedgeIndex h : S.halfedges()) ++incoming[std::uint32_t(S.target(h))];
         for (VertexIndex v : S.vertices()) {
-            if (S.halfedge(v) == Mesh::null_halfedge()) continue;
+            if (S.halfedge(v) == Mesh::null_halfedge() || !loc.star.isFull(v)) continue;
             int n = 0, borders = 0;
             for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(v), S)) {
                 ++n;
@@ -2240,9 +2266,9 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
                                 std::to_string(std::size_t(scanCamera.width) * std::size_t(scanCamera.height)) + ".");
     if (!(options.collapseEdgeRatio >= 0 && options.collapseEdgeRatio < 0.5) || options.seamRings < 0 ||
         !(options.maxViewAngleDeg > 0 && options.maxViewAngleDeg < 90) || !(options.maxNormalChangeDeg >= 0) ||
-        !(options.maxGapRatio > 0) || options.maxTrimRounds < 0 || !(options.seamGrading >= 0))
+        !(options.maxGapRatio > 0) || options.maxTrimRounds < 0 || !(options.seamGrading >= 0) || !(options.minAngleFloorDeg >= 0 && options.minAngleFloorDeg < 30))
         throw InvalidInputError("The stitch options are out of range (collapseEdgeRatio in [0, 0.5), seamRings >= 0, "
-                                "maxViewAngleDeg in (0, 90), maxNormalChangeDeg >= 0, maxGapRatio > 0, maxTrimRounds >= 0, seamGrading >= 0).");
+                                "maxViewAngleDeg in (0, 90), maxNormalChangeDeg >= 0, maxGapRatio > 0, maxTrimRounds >= 0, seamGrading >= 0, minAngleFloorDeg in [0, 30)).");
 
     const View view(scanCamera);
     StitchReport report;

@@ -37,6 +37,9 @@ struct StitchOptions {
     /// the old surface) where longer than 4/3 × (the patch's median edge length + seamGrading × their
     /// distance from the seam): a graded transition from the patch to the mesh. 0 disables the refinement.
     double seamGrading = 1.0;
+    /// A face made by the stitch whose smallest angle is below this (degrees) is not accepted (unless the
+    /// triangle it comes from already had a smaller one): the patch is trimmed there and retried.
+    double minAngleFloorDeg = 1.0;
     /// Current-mesh faces seen at a larger angle between normal and view ray (degrees) are not stitched to;
     /// the patch is trimmed away from them.
     double maxViewAngleDeg = 85.0;
