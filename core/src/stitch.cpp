@@ -39,6 +39,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <set>
 #include <sstream>
@@ -307,6 +308,9 @@ struct Star {
     Mesh::Property_map<VertexIndex, std::uint32_t> cur;          // S vertex → current vertex (kNone: new)
     Mesh::Property_map<FaceIndex, bool> kept;                    // face of the current mesh that stays
     std::vector<VertexIndex> full; // S vertices whose whole star is in S (vertices of the replaced faces)
+    std::unordered_set<std::uint32_t> fullCurrent; // the same, as current-mesh vertices
+    // Is the whole star of S vertex v in S (a vertex of the replaced faces, or a new one)?
+    bool isFull(VertexIndex v) const { return cur[v] == kNone || fullCurrent.count(cur[v]) > 0; }
 };
 
 bool buildStar(const Mesh& M, const std::vector<FaceIndex>& replaced, Star& st) {
@@ -346,6 +350,7 @@ bool buildStar(const Mesh& M, const std::vector<FaceIndex>& replaced, Star& st) 
         // The whole umbrella must have been copied (else the mesh is not vertex-manifold here).
         if (st.S.degree(s) != M.degree(v) || st.S.is_border(s) != M.is_border(v)) return false;
         st.full.push_back(s);
+        st.fullCurrent.insert(std::uint32_t(v));
     }
     return true;
 }
@@ -386,6 +391,7 @@ struct LFace {
     std::int32_t scanId;
     bool patchSide; // a patch face (or a piece of one); else a piece of a mesh face outside the patch
     Vec3 planeNormal{0, 0, 0}; // pieces outside: unit normal of the mesh face they lie in
+    double minAllowed = 0;     // smallest angle accepted (radians): the floor, or less if the parent had less
 };
 
 // ---------------------------------------------------------------------------------------------------
@@ -408,7 +414,6 @@ public:
         if (!splitRegion(a)) return a;
         buildLocalVertices();
         snap();
-        pruneEdgeSnaps();
         if (!computeCrossings(a)) return a;
         Cdt cdt;
         std::vector<CdtVertex> vh;
@@ -502,12 +507,20 @@ private:
         });
         return out;
     }
+    // Records a problem at q: the patch vertices nearest to it are to be trimmed. The marker -1 makes sure
+    // the problem counts even when no patch vertex is near (fail() drops the markers).
     void addNear(std::vector<int>& bad, const Point2& q) {
-        auto near = patchVerticesNear(q, 1.5 * h2_);
-        bad.insert(bad.end(), near.begin(), near.end());
+        bad.push_back(-1);
+        for (double r = 1.5 * h2_; r < 100.0 * h2_; r *= 2.0) {
+            auto near = patchVerticesNear(q, r);
+            if (near.empty()) continue;
+            bad.insert(bad.end(), near.begin(), near.end());
+            return;
+        }
     }
     // Patch vertices to trim for a problem at local vertex i.
     void addBad(std::vector<int>& bad, int i) {
+        bad.push_back(-1);
         const LVert& l = L_[std::size_t(i)];
         if (l.patchA >= 0 || l.patchB >= 0) {
             bad.push_back(l.patchA);
@@ -996,65 +1009,62 @@ private:
                 redges_[std::size_t(best)].splits.push_back({lineParam(q, L_[std::size_t(redges_[std::size_t(best)].u)].uv, L_[std::size_t(redges_[std::size_t(best)].w)].uv), lid});
             }
         }
-        // Rule 3: a mesh vertex close to a patch boundary edge splits that edge.
+        // Rule 3: a mesh vertex close to a patch boundary edge splits that edge. The closest go first; a
+        // vertex is taken when the patch triangle on the edge stays a fan of counter-clockwise triangles.
         {
             BucketGrid grid(cell, pedges_.size());
             for (std::size_t i = 0; i < pedges_.size(); ++i) grid.insert(int(i), bboxOf(L_uvOfPatch(pedges_[i].a), L_uvOfPatch(pedges_[i].b)));
+            struct Cand {
+                double d, s;
+                int lid;
+            };
+            std::vector<std::vector<Cand>> cands(pedges_.size());
             for (std::size_t i = 0; i < L_.size(); ++i) {
-                LVert& l = L_[i];
+                const LVert& l = L_[i];
                 if (l.kind != LVert::Region || l.chain) continue;
                 int best = -1;
-                double bestRel = 1, bestS = 0;
-                grid.query(grown(l.uv.bbox(), O_.collapseEdgeRatio * 4.0 * h2_), [&](int e) {
+                double bestRel = 1, bestS = 0, bestD = 0;
+                grid.query(grown(l.uv.bbox(), margin_), [&](int e) {
                     const auto& pe = pedges_[std::size_t(e)];
                     const int la = lidOfPatch_.at(pe.a), lb = lidOfPatch_.at(pe.b);
                     if (la == int(i) || lb == int(i)) return;
                     const Point2 &A = L_[std::size_t(la)].uv, &B = L_[std::size_t(lb)].uv;
-                    const double len = std::sqrt(dist2(A, B));
                     double s;
                     const double d = segmentDistance(l.uv, A, B, s);
-                    const double rel = d / (ratio * std::min(len, regionEdgeMin[i]));
+                    const double rel = d / (ratio * std::sqrt(dist2(A, B)));
                     if (rel < bestRel && s > 1e-3 && s < 1 - 1e-3) {
                         bestRel = rel;
                         best = e;
                         bestS = s;
+                        bestD = d;
                     }
                 });
-                if (best < 0) continue;
-                {
-                    // The patch triangle on that edge must stay a fan of counter-clockwise triangles.
-                    const auto& pe = pedges_[std::size_t(best)];
-                    const Point2 A = L_uvOfPatch(pe.a), B = L_uvOfPatch(pe.b), C = L_uvOfPatch(pe.opposite);
-                    if (!leftTurn(A, l.uv, C) || !leftTurn(l.uv, B, C)) continue;
-                }
-                pedges_[std::size_t(best)].splits.push_back({bestS, int(i)});
-                l.chain = true;
-                l.patchA = pedges_[std::size_t(best)].a;
-                l.patchB = pedges_[std::size_t(best)].b;
+                if (best >= 0) cands[std::size_t(best)].push_back({bestD, bestS, int(i)});
             }
-        }
-    }
-    // Mesh vertices snapped onto a patch boundary edge must leave the patch triangle on it a fan of
-    // counter-clockwise triangles: keep them greedily in order along the edge.
-    void pruneEdgeSnaps() {
-        for (auto& pe : pedges_) {
-            if (pe.splits.empty()) continue;
-            std::sort(pe.splits.begin(), pe.splits.end());
-            const Point2 B = L_uvOfPatch(pe.b), C = L_uvOfPatch(pe.opposite);
-            Point2 prev = L_uvOfPatch(pe.a);
-            std::vector<std::pair<double, int>> kept;
-            for (const auto& sp : pe.splits) {
-                LVert& l = L_[std::size_t(sp.second)];
-                if (leftTurn(prev, l.uv, C) && leftTurn(l.uv, B, C) &&
-                    (kept.empty() || lineParam(l.uv, prev, B) > 0)) {
-                    kept.push_back(sp);
-                    prev = l.uv;
-                } else {
-                    l.chain = false;
-                    l.patchA = l.patchB = -1;
+            for (std::size_t e = 0; e < pedges_.size(); ++e) {
+                auto& cs = cands[e];
+                if (cs.empty()) continue;
+                std::sort(cs.begin(), cs.end(), [](const Cand& x, const Cand& y) { return x.d != y.d ? x.d < y.d : x.lid < y.lid; });
+                auto& pe = pedges_[e];
+                const Point2 A = L_uvOfPatch(pe.a), B = L_uvOfPatch(pe.b), C = L_uvOfPatch(pe.opposite);
+                std::vector<std::pair<double, int>> taken; // sorted by s
+                for (const Cand& c : cs) {
+                    const auto pos = std::lower_bound(taken.begin(), taken.end(), std::pair{c.s, -1});
+                    const Point2 prev = pos == taken.begin() ? A : L_[std::size_t(std::prev(pos)->second)].uv;
+                    const Point2 next = pos == taken.end() ? B : L_[std::size_t(pos->second)].uv;
+                    const Point2& v = L_[std::size_t(c.lid)].uv;
+                    if (!leftTurn(prev, v, C) || !leftTurn(v, next, C)) continue;
+                    if (!(lineParam(v, prev, next) > 0 && lineParam(v, prev, next) < 1)) continue;
+                    taken.insert(pos, {c.s, c.lid});
+                }
+                for (const auto& [sp, lid] : taken) {
+                    pe.splits.push_back({sp, lid});
+                    LVert& l = L_[std::size_t(lid)];
+                    l.chain = true;
+                    l.patchA = pe.a;
+                    l.patchB = pe.b;
                 }
             }
-            pe.splits.swap(kept);
         }
     }
     // Polyline (local ids) of a region edge or a patch boundary edge with its splits, sorted.
@@ -1303,13 +1313,13 @@ private:
     // `edges` holds for every corner the triangle edges it lies on (bit k: edge k): a diagonal between
     // two corners on the same edge would leave a triangle of collinear points, so it is never used.
     bool triangulatePolygon(const std::vector<int>& poly, const std::vector<unsigned>& edges, float q,
-                            std::int32_t sid) {
+                            std::int32_t sid, double floor) {
         const std::size_t n = poly.size();
         auto P = [&](std::size_t i) -> const Point2& { return L_[std::size_t(poly[i])].uv; };
         auto X = [&](std::size_t i) -> const Vec3& { return L_[std::size_t(poly[i])].pos; };
         if (n == 3) {
             if (!leftTurn(P(0), P(1), P(2))) return false;
-            newFaces_.push_back({{poly[0], poly[1], poly[2]}, q, sid, true});
+            newFaces_.push_back({{poly[0], poly[1], poly[2]}, q, sid, true, Vec3(0, 0, 0), floor});
             return true;
         }
         // diagonal[i][j]: the segment i–j lies inside the polygon and does not run along a triangle edge.
@@ -1363,7 +1373,7 @@ private:
             stack.pop_back();
             if (j == i + 1) continue;
             const std::size_t k = split[i * n + j];
-            newFaces_.push_back({{poly[i], poly[k], poly[j]}, q, sid, true});
+            newFaces_.push_back({{poly[i], poly[k], poly[j]}, q, sid, true, Vec3(0, 0, 0), floor});
             stack.push_back({i, k});
             stack.push_back({k, j});
         }
@@ -1393,10 +1403,39 @@ private:
             replaced_.push_back(region_[r]);
             const float q = curHasQuality_ ? curQuality_[region_[r]] : kInputFaceQuality;
             const std::int32_t sid = curHasScanId_ ? curScanId_[region_[r]] : -1;
-            const Vec3 n = normalOf(toVec(M_.point(vs[0])), toVec(M_.point(vs[1])), toVec(M_.point(vs[2]))).normalized();
+            const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
+            const Vec3 n = normalOf(A, B, C).normalized();
+            const double floor = std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C));
             for (CdtFace f : pieces[r])
                 if (f->info().inside == 0)
-                    newFaces_.push_back({{f->vertex(0)->info().id, f->vertex(1)->info().id, f->vertex(2)->info().id}, q, sid, false, n});
+                    newFaces_.push_back({{f->vertex(0)->info().id, f->vertex(1)->info().id, f->vertex(2)->info().id}, q, sid, false, n, floor});
+        }
+        // The seam optimisation may also change the faces around the re-triangulated ones (seamRings):
+        // they join the faces replaced (by themselves, to begin with).
+        {
+            std::unordered_set<std::uint32_t> taken;
+            for (FaceIndex f : replaced_) taken.insert(std::uint32_t(f));
+            std::vector<FaceIndex> ring;
+            for (FaceIndex f : replaced_)
+                if (regionIndex_.count(std::uint32_t(f))) ring.push_back(f);
+            for (int k = 1; k < O_.seamRings; ++k) {
+                std::vector<FaceIndex> next;
+                for (FaceIndex f : ring)
+                    for (VertexIndex v : faceVertices(f))
+                        for (FaceIndex g : CGAL::faces_around_target(M_.halfedge(v), M_)) {
+                            if (g == Mesh::null_face() || taken.count(std::uint32_t(g)) || !acceptable(g)) continue;
+                            taken.insert(std::uint32_t(g));
+                            next.push_back(g);
+                            replaced_.push_back(g);
+                            const auto vs = faceVertices(g);
+                            const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
+                            newFaces_.push_back({{regionVertex(vs[0]), regionVertex(vs[1]), regionVertex(vs[2])},
+                                                 curHasQuality_ ? curQuality_[g] : kInputFaceQuality,
+                                                 curHasScanId_ ? curScanId_[g] : -1, false, normalOf(A, B, C).normalized(),
+                                                 std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C))});
+                        }
+                ring.swap(next);
+            }
         }
         // Patch faces, the boundary ones re-triangulated over the seam vertices of their edges.
         double patchArea = 0;
@@ -1419,7 +1458,9 @@ private:
             const float q = P_.hasQuality ? P_.quality[std::size_t(f)] : kInputFaceQuality;
             const std::int32_t sid = P_.hasScanId ? P_.scanId[std::size_t(f)] : -1;
             const std::size_t before = newFaces_.size();
-            if (!triangulatePolygon(poly, edges, q, sid)) {
+            const double floor = std::min(O_.minAngleFloorDeg * kDeg,
+                                          0.999 * minAngle(P_.pos[std::size_t(t[0])], P_.pos[std::size_t(t[1])], P_.pos[std::size_t(t[2])]));
+            if (!triangulatePolygon(poly, edges, q, sid, floor)) {
                 if (std::getenv("FSS_STITCH_DEBUG")) {
                     std::fprintf(stderr, "  polygon failed:");
                     for (std::size_t k = 0; k < poly.size(); ++k)
@@ -1462,6 +1503,7 @@ private:
         Mesh::Property_map<FaceIndex, std::int32_t> scanId;
         Mesh::Property_map<FaceIndex, bool> patchSide;
         Mesh::Property_map<FaceIndex, Vec3> planeNormal; // outside pieces: normal of their mesh face
+        Mesh::Property_map<FaceIndex, double> minAllowed; // smallest angle accepted (radians)
         std::set<std::pair<std::uint32_t, std::uint32_t>> seam;
     };
     static std::pair<std::uint32_t, std::uint32_t> seamKey(VertexIndex a, VertexIndex b) {
@@ -1522,6 +1564,7 @@ private:
         loc.scanId = S.add_property_map<FaceIndex, std::int32_t>("f:s", -1).first;
         loc.patchSide = S.add_property_map<FaceIndex, bool>("f:patch", false).first;
         loc.planeNormal = S.add_property_map<FaceIndex, Vec3>("f:plane", Vec3(0, 0, 0)).first;
+        loc.minAllowed = S.add_property_map<FaceIndex, double>("f:floor", 0.0).first;
         // Border edges around the replaced faces before (must be the same after: no new holes).
         const auto bordersBefore = bordersAround(loc);
         // Map local ids to S vertices.
@@ -1575,6 +1618,7 @@ private:
             loc.scanId[g] = newFaces_[i].scanId;
             loc.patchSide[g] = newFaces_[i].patchSide;
             loc.planeNormal[g] = newFaces_[i].planeNormal;
+            loc.minAllowed[g] = newFaces_[i].minAllowed;
         }
         if (!bad.empty()) return fail(a, "its seam would not be manifold", std::move(bad));
         for (VertexIndex v : S.vertices()) {
@@ -1596,8 +1640,8 @@ private:
     std::set<std::pair<std::uint32_t, std::uint32_t>> bordersAround(Local& loc) const {
         std::set<std::pair<std::uint32_t, std::uint32_t>> out;
         const Mesh& S = loc.star.S;
-        for (VertexIndex v : loc.star.full) {
-            if (S.is_removed(v) || S.halfedge(v) == Mesh::null_halfedge()) continue;
+        for (VertexIndex v : S.vertices()) {
+            if (!loc.star.isFull(v) || S.halfedge(v) == Mesh::null_halfedge()) continue;
             for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(v), S))
                 for (HalfedgeIndex g : {h, S.opposite(h)})
                     if (S.is_border(g)) out.insert(std::minmax(loc.star.cur[S.source(g)], loc.star.cur[S.target(g)]));
@@ -1631,7 +1675,8 @@ private:
         auto isNewFace = [&](FaceIndex f) { return f != Mesh::null_face() && !loc.star.kept[f]; };
         auto removable = [&](VertexIndex v) {
             const int id = loc.lid[v];
-            return !loc.locked[v] && id >= 0 && L_[std::size_t(id)].kind != LVert::Region;
+            // Mesh vertices stay (they carry the old surface's shape); crossings, patch and Steiner vertices may go.
+            return !loc.locked[v] && (id < 0 || L_[std::size_t(id)].kind != LVert::Region);
         };
         // -- collapses: remove a into b
         auto tryCollapse = [&](VertexIndex a, VertexIndex b, double& score) -> bool {
@@ -1666,7 +1711,8 @@ private:
             score = newMin;
             return true;
         };
-        for (int pass = 0; pass < 4; ++pass) {
+        auto collapsePass = [&] {
+          for (int pass = 0; pass < 4; ++pass) {
             const auto near = seamNeighbourhood(loc);
             std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
             for (EdgeIndex e : S.edges()) {
@@ -1690,8 +1736,95 @@ private:
             }
             plan.collapses += done;
             if (done == 0) break;
+          }
+        };
+        collapsePass();
+        // -- refinement outside the patch: split long edges of the pieces around the seam (the new vertices
+        // lie on the old surface: in a face's plane or on a mesh edge), graded from the patch's edge length at
+        // the seam outwards, then flip within the faces' planes.
+        for (int round = 0; round < 4 && O_.seamGrading > 0; ++round) {
+            if (refineOutside(loc) == 0) break;
+            flipPass(loc, plan);
         }
-        // -- flips: raise the smallest angle, valence towards 6
+        collapsePass();
+        flipPass(loc, plan);
+    }
+
+    std::size_t refineOutside(Local& loc) {
+        Mesh& S = loc.star.S;
+        const auto near = seamNeighbourhood(loc);
+        std::vector<Vec3> seamPoints;
+        for (const auto& [a, b] : loc.seam) seamPoints.push_back(pt(S, VertexIndex(a)));
+        auto target = [&](const Vec3& p) {
+            double d2 = std::numeric_limits<double>::infinity();
+            for (const Vec3& q : seamPoints) d2 = std::min(d2, (p - q).squaredNorm());
+            return h3_ + O_.seamGrading * std::sqrt(d2);
+        };
+        std::vector<std::pair<double, EdgeIndex>> cands;
+        for (EdgeIndex e : S.edges()) {
+            const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
+            const FaceIndex f = S.face(h), g = S.face(o);
+            if (f == Mesh::null_face() || g == Mesh::null_face() || loc.star.kept[f] || loc.star.kept[g]) continue;
+            if (loc.patchSide[f] || loc.patchSide[g]) continue;
+            if (!near.count(std::uint32_t(S.source(h))) && !near.count(std::uint32_t(S.target(h)))) continue;
+            const Vec3 a = pt(S, S.source(h)), b = pt(S, S.target(h));
+            const double len = (a - b).norm();
+            if (len > 4.0 / 3.0 * target(0.5 * (a + b))) cands.push_back({len, e});
+        }
+        std::sort(cands.begin(), cands.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+        std::size_t splits = 0;
+        for (const auto& [len, e] : cands) {
+            if (S.is_removed(e)) continue;
+            const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
+            const FaceIndex f = S.face(h), g = S.face(o);
+            const VertexIndex x = S.source(h), y = S.target(h);
+            const Vec3 mid = 0.5 * (pt(S, x) + pt(S, y));
+            Point2 uv;
+            double w;
+            if (!V_.project(mid, uv, w)) continue;
+            // The split must leave all four triangles counter-clockwise in the view.
+            const VertexIndex z = S.target(S.next(h)), u = S.target(S.next(o));
+            if (!leftTurn(loc.uv[x], uv, loc.uv[z]) || !leftTurn(uv, loc.uv[y], loc.uv[z]) ||
+                !leftTurn(loc.uv[y], uv, loc.uv[u]) || !leftTurn(uv, loc.uv[x], loc.uv[u]))
+                continue;
+            // ... and not make the smallest angle there worse.
+            const Vec3 X = pt(S, x), Y = pt(S, y), Z = pt(S, z), U = pt(S, u);
+            if (std::min({minAngle(X, mid, Z), minAngle(mid, Y, Z), minAngle(Y, mid, U), minAngle(mid, X, U)}) <
+                std::min(minAngle(X, Y, Z), minAngle(Y, X, U)))
+                continue;
+            const HalfedgeIndex hn = CGAL::Euler::split_edge(h, S);
+            const VertexIndex v = S.target(hn);
+            S.point(v) = toPoint(mid);
+            loc.uv[v] = uv;
+            loc.lid[v] = -1;
+            loc.locked[v] = false;
+            loc.star.cur[v] = kNone;
+            const HalfedgeIndex h3 = CGAL::Euler::split_face(hn, S.next(S.next(hn)), S);
+            copyFace(loc, f, S.face(h3));
+            copyFace(loc, f, S.face(S.opposite(h3)));
+            const HalfedgeIndex og = S.opposite(h);
+            const HalfedgeIndex h4 = CGAL::Euler::split_face(og, S.next(S.next(og)), S);
+            copyFace(loc, g, S.face(h4));
+            copyFace(loc, g, S.face(S.opposite(h4)));
+            ++splits;
+        }
+        return splits;
+    }
+    static void copyFace(Local& loc, FaceIndex from, FaceIndex to) {
+        if (from == to) return;
+        loc.star.kept[to] = loc.star.kept[from];
+        loc.quality[to] = loc.quality[from];
+        loc.scanId[to] = loc.scanId[from];
+        loc.patchSide[to] = loc.patchSide[from];
+        loc.planeNormal[to] = loc.planeNormal[from];
+        loc.minAllowed[to] = loc.minAllowed[from];
+    }
+
+    // -- flips: raise the smallest angle, valence towards 6
+    void flipPass(Local& loc, Plan& plan) {
+        Mesh& S = loc.star.S;
+        const double maxTurn = O_.maxNormalChangeDeg * kDeg;
+        auto isNewFace = [&](FaceIndex f) { return f != Mesh::null_face() && !loc.star.kept[f]; };
         const auto near = seamNeighbourhood(loc);
         auto valenceCost = [&](VertexIndex v, int delta) {
             const int target = S.is_border(v) ? 4 : 6;
@@ -1802,11 +1935,19 @@ private:
             if (CGAL::collinear(S.point(p), S.point(q), S.point(r)) || !leftTurn(loc.uv[p], loc.uv[q], loc.uv[r])) badFace(f);
         }
         if (!bad.empty()) return fail(a, "it would create degenerate or back-facing faces", std::move(bad));
+        for (FaceIndex f : S.faces()) {
+            if (loc.star.kept[f]) continue;
+            const HalfedgeIndex h = S.halfedge(f);
+            if (minAngle(pt(S, S.source(h)), pt(S, S.target(h)), pt(S, S.target(S.next(h)))) < loc.minAllowed[f]) badFace(f);
+            if (std::getenv("FSS_STITCH_DEBUG_Q") && minAngle(pt(S, S.source(h)), pt(S, S.target(h)), pt(S, S.target(S.next(h)))) < 0.5 * kDeg)
+                std::fprintf(stderr, "LOW %.3f allowed %.3f patchSide %d\n", minAngle(pt(S, S.source(h)), pt(S, S.target(h)), pt(S, S.target(S.next(h)))) / kDeg, loc.minAllowed[f] / kDeg, int(loc.patchSide[f]));
+        }
+        if (!bad.empty()) return fail(a, "it would create needle-like faces at its seam", std::move(bad));
         // Vertices: manifold (one umbrella) and no new border.
         std::unordered_map<std::uint32_t, int> incoming;
         for (HalfedgeIndex h : S.halfedges()) ++incoming[std::uint32_t(S.target(h))];
         for (VertexIndex v : S.vertices()) {
-            if (S.halfedge(v) == Mesh::null_halfedge()) continue;
+            if (S.halfedge(v) == Mesh::null_halfedge() || !loc.star.isFull(v)) continue;
             int n = 0, borders = 0;
             for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(v), S)) {
                 ++n;
@@ -1861,7 +2002,17 @@ private:
     bool extractPlan(Local& loc, Attempt& a) {
         Mesh& S = loc.star.S;
         Plan& plan = a.plan;
-        plan.removed = replaced_;
+        // Faces that come out exactly as they were stay in the mesh untouched (same index).
+        std::map<std::array<std::uint32_t, 3>, FaceIndex> byCorners;
+        auto corners = [](std::array<std::uint32_t, 3> c) {
+            std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
+            return c;
+        };
+        for (FaceIndex f : replaced_) {
+            const auto vs = faceVertices(f);
+            byCorners[corners({std::uint32_t(vs[0]), std::uint32_t(vs[1]), std::uint32_t(vs[2])})] = f;
+        }
+        std::unordered_set<std::uint32_t> unchanged;
         // Vertices: current ones stay themselves, new ones are numbered in order of use.
         std::unordered_map<std::uint32_t, std::uint32_t> freshIndex;
         std::vector<std::array<VertexIndex, 3>> faces;
@@ -1869,9 +2020,20 @@ private:
         for (FaceIndex f : S.faces())
             if (!loc.star.kept[f]) {
                 const HalfedgeIndex h = S.halfedge(f);
-                faces.push_back({S.source(h), S.target(h), S.target(S.next(h))});
+                const std::array<VertexIndex, 3> fv{S.source(h), S.target(h), S.target(S.next(h))};
+                const std::array<std::uint32_t, 3> c{loc.star.cur[fv[0]], loc.star.cur[fv[1]], loc.star.cur[fv[2]]};
+                if (c[0] != kNone && c[1] != kNone && c[2] != kNone) {
+                    auto it = byCorners.find(corners(c));
+                    if (it != byCorners.end()) {
+                        unchanged.insert(std::uint32_t(it->second));
+                        continue;
+                    }
+                }
+                faces.push_back(fv);
                 sfaces.push_back(f);
             }
+        for (FaceIndex f : replaced_)
+            if (!unchanged.count(std::uint32_t(f))) plan.removed.push_back(f);
         std::unordered_set<std::uint32_t> reused;
         // Order faces for growth in the rehearsal mesh: build it first (same star, same removals).
         Star rehearsal;
@@ -1906,7 +2068,7 @@ private:
         for (const Vec3& p : plan.freshPositions) fresh.push_back(rehearsal.S.add_vertex(toPoint(p)));
         std::unordered_set<std::uint32_t> keep;
         for (VertexIndex v : plan.reused) keep.insert(std::uint32_t(rehearsal.fromCurrent.at(std::uint32_t(v))));
-        for (FaceIndex f : replaced_)
+        for (FaceIndex f : plan.removed)
             removeFaceKeeping(rehearsal.S, rehearsal.faceFromCurrent.at(std::uint32_t(f)),
                               [&](VertexIndex v) { return keep.count(std::uint32_t(v)) > 0; });
         std::vector<std::array<VertexIndex, 3>> rf;
@@ -1952,6 +2114,14 @@ private:
             if (!seamVerts.count(std::uint32_t(fv[0])) && !seamVerts.count(std::uint32_t(fv[1])) && !seamVerts.count(std::uint32_t(fv[2])))
                 continue;
             plan.seamFaceMinAngles.push_back(minAngle(pt(S, fv[0]), pt(S, fv[1]), pt(S, fv[2])) / kDeg);
+            if (std::getenv("FSS_STITCH_DEBUG_Q")) {
+                const double ang = plan.seamFaceMinAngles.back();
+                int kinds[4] = {0, 0, 0, 0};
+                for (VertexIndex v : fv) { const int id = loc.lid[v]; if (id >= 0) ++kinds[int(L_[std::size_t(id)].kind)]; }
+                std::fprintf(stderr, "Q %d %.2f R%d B%d C%d I%d", int(loc.patchSide[sfaces[i]]), ang, kinds[0], kinds[1], kinds[2], kinds[3]);
+                for (VertexIndex v : fv) std::fprintf(stderr, " (%.4f %.4f c%d l%d)", loc.uv[v].x(), loc.uv[v].y(), int(loc.lid[v] >= 0 && L_[std::size_t(loc.lid[v])].chain), int(loc.locked[v]));
+                std::fprintf(stderr, "\n");
+            }
         }
         return true;
     }
@@ -2096,9 +2266,9 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
                                 std::to_string(std::size_t(scanCamera.width) * std::size_t(scanCamera.height)) + ".");
     if (!(options.collapseEdgeRatio >= 0 && options.collapseEdgeRatio < 0.5) || options.seamRings < 0 ||
         !(options.maxViewAngleDeg > 0 && options.maxViewAngleDeg < 90) || !(options.maxNormalChangeDeg >= 0) ||
-        !(options.maxGapRatio > 0) || options.maxTrimRounds < 0)
+        !(options.maxGapRatio > 0) || options.maxTrimRounds < 0 || !(options.seamGrading >= 0) || !(options.minAngleFloorDeg >= 0 && options.minAngleFloorDeg < 30))
         throw InvalidInputError("The stitch options are out of range (collapseEdgeRatio in [0, 0.5), seamRings >= 0, "
-                                "maxViewAngleDeg in (0, 90), maxNormalChangeDeg >= 0, maxGapRatio > 0, maxTrimRounds >= 0).");
+                                "maxViewAngleDeg in (0, 90), maxNormalChangeDeg >= 0, maxGapRatio > 0, maxTrimRounds >= 0, seamGrading >= 0, minAngleFloorDeg in [0, 30)).");
 
     const View view(scanCamera);
     StitchReport report;

@@ -32,7 +32,14 @@ struct StitchOptions {
     /// Seam edges shorter than this × the patch's median edge length are collapsed. The same fraction of
     /// the local patch edge length (in pixels) is the distance within which a patch boundary vertex is
     /// snapped onto a mesh vertex or edge, and a mesh vertex onto a patch boundary edge.
-    double collapseEdgeRatio = 0.3;
+    double collapseEdgeRatio = 0.4;
+    /// Outside the patch, edges of the re-triangulated mesh faces near the seam are split (new vertices on
+    /// the old surface) where longer than 4/3 × (the patch's median edge length + seamGrading × their
+    /// distance from the seam): a graded transition from the patch to the mesh. 0 disables the refinement.
+    double seamGrading = 1.0;
+    /// A face made by the stitch whose smallest angle is below this (degrees) is not accepted (unless the
+    /// triangle it comes from already had a smaller one): the patch is trimmed there and retried.
+    double minAngleFloorDeg = 1.0;
     /// Current-mesh faces seen at a larger angle between normal and view ray (degrees) are not stitched to;
     /// the patch is trimmed away from them.
     double maxViewAngleDeg = 85.0;
