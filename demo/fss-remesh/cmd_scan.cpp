@@ -20,6 +20,18 @@
 namespace fss::cli {
 namespace {
 
+// The patch part of a scan's JSON counts (regular and fishbone alike).
+void addPatchCounts(nlohmann::json& counts, const Patch& patch) {
+    const TriangulateReport& tr = patch.report;
+    counts["patch_vertices"] = patch.mesh.number_of_vertices();
+    counts["patch_faces"] = patch.mesh.number_of_faces();
+    counts["dropped_flipped"] = tr.flipped;
+    counts["dropped_back_facing"] = tr.backFacing;
+    counts["dropped_long_edges"] = tr.longEdges;
+    counts["dropped_grazing"] = tr.grazing;
+    counts["dropped_non_manifold"] = tr.nonManifoldTriangles;
+}
+
 Eigen::AlignedBox3d boundingBox(const Mesh& mesh) {
     Eigen::AlignedBox3d box;
     for (VertexIndex v : mesh.vertices()) {
@@ -164,7 +176,6 @@ int runFishboneScan(const Mesh& reference, MeshRenderer& renderer, std::string r
     const FishboneCounts& c = result.counts;
     const FishboneTimings& t = result.timings;
     if (json) {
-        const TriangulateReport& tr = result.patch.report;
         nlohmann::json j;
         j["input"] = meshPath;
         j["output"] = outPath;
@@ -183,14 +194,8 @@ int runFishboneScan(const Mesh& reference, MeshRenderer& renderer, std::string r
                        {"on_hint_face", c.onHintFace},
                        {"after_lasso", c.afterLasso},
                        {"after_quality", c.afterQuality},
-                       {"after_morphology", c.afterMorphology},
-                       {"patch_vertices", result.patch.mesh.number_of_vertices()},
-                       {"patch_faces", result.patch.mesh.number_of_faces()},
-                       {"dropped_flipped", tr.flipped},
-                       {"dropped_back_facing", tr.backFacing},
-                       {"dropped_long_edges", tr.longEdges},
-                       {"dropped_grazing", tr.grazing},
-                       {"dropped_non_manifold", tr.nonManifoldTriangles}};
+                       {"after_morphology", c.afterMorphology}};
+        addPatchCounts(j["counts"], result.patch);
         j["timings_s"] = {{"curvature", t.curvature},          {"ray_caster_build", t.rayCasterBuild},
                           {"render_reference", t.renderReference}, {"direction_field", t.directionField},
                           {"tracing", t.tracing},              {"ray_casting", t.rayCasting},
@@ -305,7 +310,6 @@ int runScan(const std::vector<std::string>& args) {
     if (json) {
         const ScanCounts& c = result.counts;
         const ScanTimings& t = result.timings;
-        const TriangulateReport& tr = result.patch.report;
         nlohmann::json j;
         j["input"] = meshPath;
         j["output"] = outPath;
@@ -322,14 +326,8 @@ int runScan(const std::vector<std::string>& args) {
                        {"front_facing", c.frontFacing},
                        {"after_lasso", c.afterLasso},
                        {"after_quality", c.afterQuality},
-                       {"after_morphology", c.afterMorphology},
-                       {"patch_vertices", result.patch.mesh.number_of_vertices()},
-                       {"patch_faces", result.patch.mesh.number_of_faces()},
-                       {"dropped_flipped", tr.flipped},
-                       {"dropped_back_facing", tr.backFacing},
-                       {"dropped_long_edges", tr.longEdges},
-                       {"dropped_grazing", tr.grazing},
-                       {"dropped_non_manifold", tr.nonManifoldTriangles}};
+                       {"after_morphology", c.afterMorphology}};
+        addPatchCounts(j["counts"], result.patch);
         j["timings_s"] = {{"render_reference", t.renderReference}, {"render_current", t.renderCurrent},
                           {"sample", t.sample},                    {"lasso", t.lasso},
                           {"quality_mask", t.qualityMask},         {"morphology", t.morphology},

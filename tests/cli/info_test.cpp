@@ -8,6 +8,7 @@
 
 #include <fstream>
 
+using fss::test::expectCleanFailure;
 using fss::test::meshPath;
 using fss::test::remeshExe;
 using fss::test::runProcess;
@@ -22,14 +23,6 @@ fss::test::ProcessResult remesh(const std::vector<std::string>& args) {
 void writeFile(const std::filesystem::path& p, const std::string& bytes) {
     std::filesystem::create_directories(p.parent_path());
     std::ofstream(p, std::ios::binary) << bytes;
-}
-
-// The error contract: non-zero exit, no signal, exactly one line on stderr, naming what is wrong.
-void expectCleanFailure(const fss::test::ProcessResult& r, const std::string& mustMention) {
-    EXPECT_EQ(r.signal, 0) << "crashed with signal " << r.signal << "; stderr: " << r.err;
-    EXPECT_NE(r.exitCode, 0);
-    EXPECT_EQ(fss::test::countLines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find(mustMention), std::string::npos) << "stderr does not mention '" << mustMention << "': " << r.err;
 }
 
 } // namespace

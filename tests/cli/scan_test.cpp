@@ -12,6 +12,7 @@
 
 #include <cstdlib>
 
+using fss::test::expectCleanFailure;
 using fss::test::meshPath;
 using fss::test::tmpPath;
 
@@ -19,13 +20,6 @@ namespace {
 
 fss::test::ProcessResult remesh(const std::vector<std::string>& args) {
     return fss::test::runProcess(fss::test::remeshExe(), args, tmpPath("cli_scan"));
-}
-
-void expectCleanFailure(const fss::test::ProcessResult& r, const std::string& mustMention) {
-    EXPECT_EQ(r.signal, 0) << "crashed with signal " << r.signal << "; stderr: " << r.err;
-    EXPECT_NE(r.exitCode, 0);
-    EXPECT_EQ(fss::test::countLines(r.err), 1) << r.err;
-    EXPECT_NE(r.err.find(mustMention), std::string::npos) << "expected '" << mustMention << "' in: " << r.err;
 }
 
 const std::string kFandisk = meshPath("fandisk.off").string();

@@ -5,6 +5,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -70,6 +72,15 @@ inline int countLines(const std::string& s) {
     int n = 0;
     for (char c : s) n += (c == '\n');
     return n;
+}
+
+/// The command-line error contract: the program exited (no signal) with a non-zero code and printed exactly
+/// one line on stderr that mentions \p mustMention.
+inline void expectCleanFailure(const ProcessResult& r, const std::string& mustMention) {
+    EXPECT_EQ(r.signal, 0) << "crashed with signal " << r.signal << "; stderr: " << r.err;
+    EXPECT_NE(r.exitCode, 0);
+    EXPECT_EQ(countLines(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(mustMention), std::string::npos) << "expected '" << mustMention << "' in: " << r.err;
 }
 
 } // namespace fss::test
