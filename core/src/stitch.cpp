@@ -41,6 +41,7 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <queue>
 #include <set>
 #include <sstream>
 #include <unordered_map>
@@ -408,20 +409,34 @@ public:
 
     Attempt run() {
         Attempt a;
+        auto t0 = std::chrono::steady_clock::now();
+        auto lap = [&](const char* what) {
+            if (!std::getenv("FSS_STITCH_TIME")) return;
+            const auto t = std::chrono::steady_clock::now();
+            std::fprintf(stderr, "  %-10s %7.2f ms\n", what, std::chrono::duration<double, std::milli>(t - t0).count());
+            t0 = t;
+        };
         if (!setupComponent(a)) return a;
+        lap("setup");
         if (!findRegion(a)) return a;
+        lap("region");
         if (!preTrim(a)) return a;
         if (!splitRegion(a)) return a;
+        lap("split");
         buildLocalVertices();
         snap();
         if (!computeCrossings(a)) return a;
+        lap("snap+cross");
         Cdt cdt;
         std::vector<CdtVertex> vh;
         if (!triangulate(cdt, vh, a)) return a;
         if (!classify(cdt, vh, a)) return a;
         if (!checkCoverage(cdt, vh, a)) return a;
+        lap("cdt");
         if (!assemble(cdt, a)) return a;
+        lap("assemble");
         if (!buildAndOptimise(a)) return a;
+        lap("local");
         a.ok = true;
         return a;
     }
@@ -440,18 +455,24 @@ private:
 
     // ---- step 0: the component's boundary, sizes and a grid over its triangles
     bool setupComponent(Attempt& a) {
-        std::unordered_set<std::uint64_t> directed;
+        std::vector<std::uint64_t> directed;
+        directed.reserve(3 * faces_.size());
         for (int f : faces_) {
             const auto& t = P_.tri[std::size_t(f)];
-            for (int k = 0; k < 3; ++k) directed.insert(dirKey(std::uint32_t(t[std::size_t(k)]), std::uint32_t(t[std::size_t((k + 1) % 3)])));
+            for (int k = 0; k < 3; ++k) {
+                directed.push_back(dirKey(std::uint32_t(t[std::size_t(k)]), std::uint32_t(t[std::size_t((k + 1) % 3)])));
+                compVerts_.push_back(t[std::size_t(k)]);
+            }
         }
+        std::sort(directed.begin(), directed.end());
+        std::sort(compVerts_.begin(), compVerts_.end());
+        compVerts_.erase(std::unique(compVerts_.begin(), compVerts_.end()), compVerts_.end());
         std::vector<double> len2, len3;
         for (int f : faces_) {
             const auto& t = P_.tri[std::size_t(f)];
             for (int k = 0; k < 3; ++k) {
                 const int p = t[std::size_t(k)], q = t[std::size_t((k + 1) % 3)];
-                vertexFaces_[p].push_back(f);
-                const bool border = !directed.count(dirKey(std::uint32_t(q), std::uint32_t(p)));
+                const bool border = !std::binary_search(directed.begin(), directed.end(), dirKey(std::uint32_t(q), std::uint32_t(p)));
                 if (border) {
                     pedgeIndex_[dirKey(std::uint32_t(p), std::uint32_t(q))] = int(pedges_.size());
                     pedges_.push_back({p, q, t[std::size_t((k + 2) % 3)], {}, {}});
@@ -464,6 +485,9 @@ private:
             }
         }
         if (pedges_.empty()) return fail(a, "it has no boundary in the scan's view (it would cover the whole view)");
+        for (int f : faces_)
+            for (int v : P_.tri[std::size_t(f)])
+                if (boundary_.count(v)) vertexFaces_[v].push_back(f);
         auto median = [](std::vector<double> v) {
             std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
             return v[v.size() / 2];
@@ -484,7 +508,7 @@ private:
         }
         margin_ *= 1.01;
         compBox_ = CGAL::Bbox_2();
-        for (const auto& [v, fs] : vertexFaces_) compBox_ += P_.uv[std::size_t(v)].bbox();
+        for (int v : compVerts_) compBox_ += P_.uv[std::size_t(v)].bbox();
         compGrid_ = BucketGrid(2.0 * h2_, faces_.size());
         for (std::size_t i = 0; i < faces_.size(); ++i) compGrid_.insert(int(i), triBox(faces_[i]));
         return true;
@@ -653,7 +677,7 @@ private:
         std::sort(samples.begin(), samples.end());
         {
             std::vector<int> interior;
-            for (const auto& [v, fs] : vertexFaces_)
+            for (int v : compVerts_)
                 if (!boundary_.count(v)) interior.push_back(v);
             std::sort(interior.begin(), interior.end());
             const std::size_t stride = std::max<std::size_t>(1, interior.size() / 2048);
@@ -714,7 +738,7 @@ private:
         regionGrid_ = BucketGrid(std::max(2.0 * h2_, edge), region_.size());
         for (std::size_t i = 0; i < region_.size(); ++i) regionGrid_.insert(int(i), faceTriangle(region_[i]).bbox());
         std::vector<int> bad;
-        for (const auto& [v, fs] : vertexFaces_) {
+        for (int v : compVerts_) {
             const Point2& uv = P_.uv[std::size_t(v)];
             bool inside = false;
             regionGrid_.query(uv.bbox(), [&](int i) {
@@ -1598,6 +1622,13 @@ private:
             }
             faceVs.push_back(vs);
         }
+        for (VertexIndex v : S.vertices()) {
+            // Vertices of the star only: their place in the view (vertices behind the eye keep the origin;
+            // their faces are kept and always tested for intersections).
+            double w;
+            Point2 uv(0, 0);
+            if (loc.star.cur[v] != kNone && V_.project(pt(S, v), uv, w)) loc.uv[v] = uv;
+        }
         for (std::size_t i = 0; i < L_.size(); ++i)
             if (sv[i] != VertexIndex()) {
                 loc.lid[sv[i]] = int(i);
@@ -1631,9 +1662,20 @@ private:
             for (std::size_t j = 0; j + 1 < pe.line.size(); ++j)
                 loc.seam.insert(seamKey(sv[std::size_t(pe.line[j])], sv[std::size_t(pe.line[j + 1])]));
 
+        auto t0 = std::chrono::steady_clock::now();
+        auto lap = [&](const char* what) {
+            if (!std::getenv("FSS_STITCH_TIME")) return;
+            const auto t = std::chrono::steady_clock::now();
+            std::fprintf(stderr, "    %-10s %7.2f ms\n", what, std::chrono::duration<double, std::milli>(t - t0).count());
+            t0 = t;
+        };
         if (O_.optimiseSeam) optimise(loc, a.plan);
+        lap("optimise");
         if (!validate(loc, bordersBefore, a)) return false;
-        return extractPlan(loc, a);
+        lap("validate");
+        const bool ok = extractPlan(loc, a);
+        lap("extract");
+        return ok;
     }
 
     // Border edges (pairs of current-mesh vertices) incident to the vertices of the replaced faces.
@@ -1667,6 +1709,45 @@ private:
         return inside;
     }
     Vec3 pt(const Mesh& S, VertexIndex v) const { return toVec(S.point(v)); }
+    // Edges incident to the given vertices (each once, in a deterministic order).
+    static std::vector<EdgeIndex> edgesAround(const Mesh& S, const std::unordered_set<std::uint32_t>& vertices) {
+        std::vector<std::uint32_t> vs(vertices.begin(), vertices.end());
+        std::sort(vs.begin(), vs.end());
+        std::vector<EdgeIndex> out;
+        for (std::uint32_t v : vs) {
+            const VertexIndex x(v);
+            if (S.is_removed(x) || S.halfedge(x) == Mesh::null_halfedge()) continue;
+            for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(x), S)) out.push_back(S.edge(h));
+        }
+        std::sort(out.begin(), out.end());
+        out.erase(std::unique(out.begin(), out.end()), out.end());
+        return out;
+    }
+    // Distance from the seam along edges (Dijkstra), for the vertices of the given set.
+    std::unordered_map<std::uint32_t, double> seamDistance(const Local& loc, const std::unordered_set<std::uint32_t>& within) const {
+        const Mesh& S = loc.star.S;
+        std::unordered_map<std::uint32_t, double> dist;
+        using Item = std::pair<double, std::uint32_t>;
+        std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+        for (const auto& [a, b] : loc.seam)
+            for (std::uint32_t v : {a, b})
+                if (dist.emplace(v, 0.0).second) queue.push({0.0, v});
+        while (!queue.empty()) {
+            const auto [d, v] = queue.top();
+            queue.pop();
+            if (d > dist[v]) continue;
+            for (VertexIndex w : CGAL::vertices_around_target(S.halfedge(VertexIndex(v)), S)) {
+                if (!within.count(std::uint32_t(w))) continue;
+                const double dw = d + (pt(S, VertexIndex(v)) - pt(S, w)).norm();
+                auto [it, fresh] = dist.try_emplace(std::uint32_t(w), dw);
+                if (fresh || dw < it->second) {
+                    it->second = dw;
+                    queue.push({dw, std::uint32_t(w)});
+                }
+            }
+        }
+        return dist;
+    }
 
     void optimise(Local& loc, Plan& plan) {
         Mesh& S = loc.star.S;
@@ -1715,10 +1796,9 @@ private:
           for (int pass = 0; pass < 4; ++pass) {
             const auto near = seamNeighbourhood(loc);
             std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
-            for (EdgeIndex e : S.edges()) {
+            for (EdgeIndex e : edgesAround(S, near)) {
                 const HalfedgeIndex h = S.halfedge(e);
                 const VertexIndex a = S.source(h), b = S.target(h);
-                if (!near.count(std::uint32_t(a)) && !near.count(std::uint32_t(b))) continue;
                 const double len = (pt(S, a) - pt(S, b)).norm();
                 if (len < shortEdge) cands.push_back({len, {a, b}});
             }
@@ -1753,23 +1833,24 @@ private:
     std::size_t refineOutside(Local& loc) {
         Mesh& S = loc.star.S;
         const auto near = seamNeighbourhood(loc);
-        std::vector<Vec3> seamPoints;
-        for (const auto& [a, b] : loc.seam) seamPoints.push_back(pt(S, VertexIndex(a)));
-        auto target = [&](const Vec3& p) {
-            double d2 = std::numeric_limits<double>::infinity();
-            for (const Vec3& q : seamPoints) d2 = std::min(d2, (p - q).squaredNorm());
-            return h3_ + O_.seamGrading * std::sqrt(d2);
+        auto within = near;
+        for (EdgeIndex e : edgesAround(S, near))
+            for (VertexIndex v : {S.source(S.halfedge(e)), S.target(S.halfedge(e))}) within.insert(std::uint32_t(v));
+        const auto dist = seamDistance(loc, within);
+        auto distance = [&](VertexIndex v) {
+            auto it = dist.find(std::uint32_t(v));
+            return it == dist.end() ? std::numeric_limits<double>::infinity() : it->second;
         };
         std::vector<std::pair<double, EdgeIndex>> cands;
-        for (EdgeIndex e : S.edges()) {
+        for (EdgeIndex e : edgesAround(S, near)) {
             const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
             const FaceIndex f = S.face(h), g = S.face(o);
             if (f == Mesh::null_face() || g == Mesh::null_face() || loc.star.kept[f] || loc.star.kept[g]) continue;
             if (loc.patchSide[f] || loc.patchSide[g]) continue;
-            if (!near.count(std::uint32_t(S.source(h))) && !near.count(std::uint32_t(S.target(h)))) continue;
             const Vec3 a = pt(S, S.source(h)), b = pt(S, S.target(h));
             const double len = (a - b).norm();
-            if (len > 4.0 / 3.0 * target(0.5 * (a + b))) cands.push_back({len, e});
+            const double target = h3_ + O_.seamGrading * 0.5 * (distance(S.source(h)) + distance(S.target(h)));
+            if (len > 4.0 / 3.0 * target) cands.push_back({len, e});
         }
         std::sort(cands.begin(), cands.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
         std::size_t splits = 0;
@@ -1832,7 +1913,7 @@ private:
         };
         std::deque<EdgeIndex> queue;
         std::unordered_set<std::uint32_t> queued;
-        for (EdgeIndex e : S.edges()) {
+        for (EdgeIndex e : edgesAround(S, near)) {
             const HalfedgeIndex h = S.halfedge(e);
             if (near.count(std::uint32_t(S.source(h))) && near.count(std::uint32_t(S.target(h)))) {
                 queue.push_back(e);
@@ -1913,7 +1994,59 @@ private:
         loc.seam.swap(seam);
     }
 
+    // The faces that could intersect each other: new faces are a height field in the view (checked face
+    // by face), so only the seam neighbourhood, the kept faces around, and new faces overlapping those in
+    // the view need the 3D test.
+    std::vector<FaceIndex> intersectionCandidates(Local& loc) {
+        Mesh& S = loc.star.S;
+        std::unordered_set<std::uint32_t> near;
+        {
+            const int rings = O_.seamRings + 2;
+            std::vector<VertexIndex> ring;
+            for (const auto& [a, b] : loc.seam)
+                for (std::uint32_t v : {a, b})
+                    if (near.insert(v).second) ring.push_back(VertexIndex(v));
+            for (int r = 0; r < rings; ++r) {
+                std::vector<VertexIndex> next;
+                for (VertexIndex v : ring)
+                    for (VertexIndex w : CGAL::vertices_around_target(S.halfedge(v), S))
+                        if (near.insert(std::uint32_t(w)).second) next.push_back(w);
+                ring.swap(next);
+            }
+        }
+        auto faceBox = [&](FaceIndex f) {
+            CGAL::Bbox_2 b;
+            for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(f), S)) b += loc.uv[v].bbox();
+            return b;
+        };
+        std::vector<FaceIndex> out, kept;
+        for (FaceIndex f : S.faces()) if (loc.star.kept[f]) kept.push_back(f);
+        BucketGrid keptGrid(4.0 * h2_, S.num_faces());
+        for (FaceIndex f : kept) keptGrid.insert(int(std::uint32_t(f)), faceBox(f));
+        for (FaceIndex f : S.faces()) {
+            bool take = loc.star.kept[f];
+            if (!take)
+                for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(f), S))
+                    if (near.count(std::uint32_t(v))) take = true;
+            if (!take) {
+                const CGAL::Bbox_2 b = faceBox(f);
+                keptGrid.query(b, [&](int g) {
+                    if (!take && CGAL::do_overlap(b, faceBox(FaceIndex(std::uint32_t(g))))) take = true;
+                });
+            }
+            if (take) out.push_back(f);
+        }
+        return out;
+    }
+
     bool validate(Local& loc, const std::set<std::pair<std::uint32_t, std::uint32_t>>& bordersBefore, Attempt& a) {
+        auto t0 = std::chrono::steady_clock::now();
+        auto lap = [&](const char* what) {
+            if (!std::getenv("FSS_STITCH_TIME")) return;
+            const auto t = std::chrono::steady_clock::now();
+            std::fprintf(stderr, "      %-10s %7.2f ms\n", what, std::chrono::duration<double, std::milli>(t - t0).count());
+            t0 = t;
+        };
         Mesh& S = loc.star.S;
         std::vector<int> bad;
         auto badFace = [&](FaceIndex f) {
@@ -1926,25 +2059,24 @@ private:
             c = Point2(x, y);
             addNear(bad, c);
         };
-        if (!S.is_valid(false)) return fail(a, "internal error: the local mesh is not valid");
-        // Faces: not degenerate, facing the camera.
+        // Faces: not degenerate, facing the camera, no needles.
+        bool needles = false;
         for (FaceIndex f : S.faces()) {
             if (loc.star.kept[f]) continue;
             const HalfedgeIndex h = S.halfedge(f);
             const VertexIndex p = S.source(h), q = S.target(h), r = S.target(S.next(h));
-            if (CGAL::collinear(S.point(p), S.point(q), S.point(r)) || !leftTurn(loc.uv[p], loc.uv[q], loc.uv[r])) badFace(f);
+            if (CGAL::collinear(S.point(p), S.point(q), S.point(r)) || !leftTurn(loc.uv[p], loc.uv[q], loc.uv[r])) {
+                badFace(f);
+            } else if (minAngle(pt(S, p), pt(S, q), pt(S, r)) < loc.minAllowed[f]) {
+                badFace(f);
+                needles = true;
+            }
         }
-        if (!bad.empty()) return fail(a, "it would create degenerate or back-facing faces", std::move(bad));
-        for (FaceIndex f : S.faces()) {
-            if (loc.star.kept[f]) continue;
-            const HalfedgeIndex h = S.halfedge(f);
-            if (minAngle(pt(S, S.source(h)), pt(S, S.target(h)), pt(S, S.target(S.next(h)))) < loc.minAllowed[f]) badFace(f);
-            if (std::getenv("FSS_STITCH_DEBUG_Q") && minAngle(pt(S, S.source(h)), pt(S, S.target(h)), pt(S, S.target(S.next(h)))) < 0.5 * kDeg)
-                std::fprintf(stderr, "LOW %.3f allowed %.3f patchSide %d\n", minAngle(pt(S, S.source(h)), pt(S, S.target(h)), pt(S, S.target(S.next(h)))) / kDeg, loc.minAllowed[f] / kDeg, int(loc.patchSide[f]));
-        }
+        if (!bad.empty() && !needles) return fail(a, "it would create degenerate or back-facing faces", std::move(bad));
         if (!bad.empty()) return fail(a, "it would create needle-like faces at its seam", std::move(bad));
+        lap("faces");
         // Vertices: manifold (one umbrella) and no new border.
-        std::unordered_map<std::uint32_t, int> incoming;
+        std::vector<int> incoming(S.num_vertices(), 0);
         for (HalfedgeIndex h : S.halfedges()) ++incoming[std::uint32_t(S.target(h))];
         for (VertexIndex v : S.vertices()) {
             if (S.halfedge(v) == Mesh::null_halfedge() || !loc.star.isFull(v)) continue;
@@ -1976,9 +2108,14 @@ private:
         }
         if (!bad.empty() || bordersAfter != bordersBefore)
             return fail(a, "it would open or close a hole in the mesh", std::move(bad));
+        lap("vertices");
         // No new self-intersections among the local faces.
         std::vector<std::pair<FaceIndex, FaceIndex>> pairs;
-        PMP::self_intersections(S.faces(), S, std::back_inserter(pairs));
+        const auto candidates = intersectionCandidates(loc);
+        if (std::getenv("FSS_STITCH_TIME")) std::fprintf(stderr, "      %zu candidates of %zu faces\n", candidates.size(), std::size_t(S.number_of_faces()));
+        lap("candidates");
+        PMP::self_intersections(candidates, S, std::back_inserter(pairs));
+        lap("selfinter");
         if (std::getenv("FSS_STITCH_DEBUG"))
             for (const auto& [f, g] : pairs) {
                 std::fprintf(stderr, "  intersect kept %d %d\n", int(loc.star.kept[f]), int(loc.star.kept[g]));
@@ -1997,6 +2134,51 @@ private:
         if (!bad.empty()) return fail(a, "it would make the mesh intersect itself", std::move(bad));
         if (O_.failValidationForTesting) return fail(a, "its final check was forced to fail for testing");
         return true;
+    }
+
+    // An order of the new faces of S in which each is added next to what is already there: breadth first
+    // from the faces next to kept faces (the hole's border) across S's edges.
+    static std::vector<std::size_t> growthOrderIn(const Mesh& S, const std::vector<FaceIndex>& sfaces, const Local& loc) {
+        std::unordered_map<std::uint32_t, std::size_t> index;
+        index.reserve(sfaces.size());
+        for (std::size_t i = 0; i < sfaces.size(); ++i) index[std::uint32_t(sfaces[i])] = i;
+        std::vector<char> done(sfaces.size(), 0);
+        std::vector<std::size_t> order;
+        order.reserve(sfaces.size());
+        std::deque<std::size_t> queue;
+        for (std::size_t i = 0; i < sfaces.size(); ++i)
+            for (HalfedgeIndex h : CGAL::halfedges_around_face(S.halfedge(sfaces[i]), S)) {
+                const FaceIndex g = S.face(S.opposite(h));
+                // Next to a face that exists before the additions (kept, or left unchanged).
+                if (!done[i] && (g == Mesh::null_face() || loc.star.kept[g] || !index.count(std::uint32_t(g)))) {
+                    done[i] = 1;
+                    queue.push_back(i);
+                }
+            }
+        auto drain = [&] {
+            while (!queue.empty()) {
+                const std::size_t i = queue.front();
+                queue.pop_front();
+                order.push_back(i);
+                for (HalfedgeIndex h : CGAL::halfedges_around_face(S.halfedge(sfaces[i]), S)) {
+                    const FaceIndex g = S.face(S.opposite(h));
+                    if (g == Mesh::null_face() || loc.star.kept[g]) continue;
+                    auto it = index.find(std::uint32_t(g));
+                    if (it != index.end() && !done[it->second]) {
+                        done[it->second] = 1;
+                        queue.push_back(it->second);
+                    }
+                }
+            }
+        };
+        drain();
+        for (std::size_t i = 0; i < sfaces.size(); ++i)
+            if (!done[i]) {
+                done[i] = 1;
+                queue.push_back(i);
+                drain();
+            }
+        return order;
     }
 
     bool extractPlan(Local& loc, Attempt& a) {
@@ -2079,7 +2261,7 @@ private:
                                                              : rehearsal.fromCurrent.at(p[std::size_t(k)].index);
             rf.push_back(r);
         }
-        const auto order = growthOrder(rf, rehearsal.S);
+        const auto order = growthOrderIn(S, sfaces, loc);
         for (std::size_t i : order)
             if (rehearsal.S.add_face(rf[i][0], rf[i][1], rf[i][2]) == Mesh::null_face())
                 return fail(a, "internal error: the stitch could not be rehearsed");
@@ -2150,7 +2332,8 @@ private:
         std::vector<std::pair<double, int>> splits;
         std::vector<int> line;
     };
-    std::unordered_map<int, std::vector<int>> vertexFaces_;
+    std::vector<int> compVerts_;                             // vertices of the component, sorted
+    std::unordered_map<int, std::vector<int>> vertexFaces_; // faces around each boundary vertex
     std::unordered_set<int> boundary_;
     std::vector<PEdge> pedges_;
     std::unordered_map<std::uint64_t, int> pedgeIndex_;
