@@ -34,8 +34,6 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -409,34 +407,20 @@ public:
 
     Attempt run() {
         Attempt a;
-        auto t0 = std::chrono::steady_clock::now();
-        auto lap = [&](const char* what) {
-            if (!std::getenv("FSS_STITCH_TIME")) return;
-            const auto t = std::chrono::steady_clock::now();
-            std::fprintf(stderr, "  %-10s %7.2f ms\n", what, std::chrono::duration<double, std::milli>(t - t0).count());
-            t0 = t;
-        };
         if (!setupComponent(a)) return a;
-        lap("setup");
         if (!findRegion(a)) return a;
-        lap("region");
         if (!preTrim(a)) return a;
         if (!splitRegion(a)) return a;
-        lap("split");
         buildLocalVertices();
         snap();
         if (!computeCrossings(a)) return a;
-        lap("snap+cross");
         Cdt cdt;
         std::vector<CdtVertex> vh;
         if (!triangulate(cdt, vh, a)) return a;
         if (!classify(cdt, vh, a)) return a;
         if (!checkCoverage(cdt, vh, a)) return a;
-        lap("cdt");
         if (!assemble(cdt, a)) return a;
-        lap("assemble");
         if (!buildAndOptimise(a)) return a;
-        lap("local");
         a.ok = true;
         return a;
     }
@@ -1193,26 +1177,6 @@ private:
             for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v)
                 if (v->info().id < 0) {
                     addNear(bad, v->point());
-                    if (std::getenv("FSS_STITCH_DEBUG")) {
-                        std::fprintf(stderr, "  extra vertex at %.17g %.17g\n", v->point().x(), v->point().y());
-                        for (FaceIndex f : region_) {
-                            const Triangle2 t = faceTriangle(f);
-                            if (!inTriangle(v->point(), t[0], t[1], t[2])) continue;
-                            const auto vs = faceVertices(f);
-                            const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
-                            const double c = normalOf(A, B, C).normalized().dot(V_.towardsViewer((A + B + C) / 3.0));
-                            std::fprintf(stderr, "    in face %u cos %.3f depth %.5f sid %d\n", std::uint32_t(f), c, V_.camera().viewDepth((A+B+C)/3.0), curHasScanId_ ? curScanId_[f] : -9);
-                        }
-                        const CdtVertex vv = v;
-                        auto ec = cdt.incident_edges(vv), end = ec;
-                        do {
-                            if (cdt.is_constrained(*ec)) {
-                                const CdtVertex w = ec->first->vertex(ec->first->ccw(ec->second)) == vv ? ec->first->vertex(ec->first->cw(ec->second)) : ec->first->vertex(ec->first->ccw(ec->second));
-                                const int id = w->info().id;
-                                std::fprintf(stderr, "    to lid %d kind %d uv %.17g %.17g\n", id, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, w->point().x(), w->point().y());
-                            }
-                        } while (++ec != end);
-                    }
                 }
             return fail(a, "it or the mesh under it overlaps itself in the scan's view", std::move(bad));
         }
@@ -1485,12 +1449,6 @@ private:
             const double floor = std::min(O_.minAngleFloorDeg * kDeg,
                                           0.999 * minAngle(P_.pos[std::size_t(t[0])], P_.pos[std::size_t(t[1])], P_.pos[std::size_t(t[2])]));
             if (!triangulatePolygon(poly, edges, q, sid, floor)) {
-                if (std::getenv("FSS_STITCH_DEBUG")) {
-                    std::fprintf(stderr, "  polygon failed:");
-                    for (std::size_t k = 0; k < poly.size(); ++k)
-                        std::fprintf(stderr, " [lid %d kind %d e%u %.6f %.6f]", poly[k], int(L_[std::size_t(poly[k])].kind), edges[k], L_[std::size_t(poly[k])].uv.x(), L_[std::size_t(poly[k])].uv.y());
-                    std::fprintf(stderr, "\n");
-                }
                 for (int v : t) bad.push_back(v);
                 continue;
             }
@@ -1662,19 +1620,9 @@ private:
             for (std::size_t j = 0; j + 1 < pe.line.size(); ++j)
                 loc.seam.insert(seamKey(sv[std::size_t(pe.line[j])], sv[std::size_t(pe.line[j + 1])]));
 
-        auto t0 = std::chrono::steady_clock::now();
-        auto lap = [&](const char* what) {
-            if (!std::getenv("FSS_STITCH_TIME")) return;
-            const auto t = std::chrono::steady_clock::now();
-            std::fprintf(stderr, "    %-10s %7.2f ms\n", what, std::chrono::duration<double, std::milli>(t - t0).count());
-            t0 = t;
-        };
         if (O_.optimiseSeam) optimise(loc, a.plan);
-        lap("optimise");
         if (!validate(loc, bordersBefore, a)) return false;
-        lap("validate");
         const bool ok = extractPlan(loc, a);
-        lap("extract");
         return ok;
     }
 
@@ -2040,13 +1988,6 @@ private:
     }
 
     bool validate(Local& loc, const std::set<std::pair<std::uint32_t, std::uint32_t>>& bordersBefore, Attempt& a) {
-        auto t0 = std::chrono::steady_clock::now();
-        auto lap = [&](const char* what) {
-            if (!std::getenv("FSS_STITCH_TIME")) return;
-            const auto t = std::chrono::steady_clock::now();
-            std::fprintf(stderr, "      %-10s %7.2f ms\n", what, std::chrono::duration<double, std::milli>(t - t0).count());
-            t0 = t;
-        };
         Mesh& S = loc.star.S;
         std::vector<int> bad;
         auto badFace = [&](FaceIndex f) {
@@ -2074,7 +2015,6 @@ private:
         }
         if (!bad.empty() && !needles) return fail(a, "it would create degenerate or back-facing faces", std::move(bad));
         if (!bad.empty()) return fail(a, "it would create needle-like faces at its seam", std::move(bad));
-        lap("faces");
         // Vertices: manifold (one umbrella) and no new border.
         std::vector<int> incoming(S.num_vertices(), 0);
         for (HalfedgeIndex h : S.halfedges()) ++incoming[std::uint32_t(S.target(h))];
@@ -2108,25 +2048,10 @@ private:
         }
         if (!bad.empty() || bordersAfter != bordersBefore)
             return fail(a, "it would open or close a hole in the mesh", std::move(bad));
-        lap("vertices");
         // No new self-intersections among the local faces.
         std::vector<std::pair<FaceIndex, FaceIndex>> pairs;
         const auto candidates = intersectionCandidates(loc);
-        if (std::getenv("FSS_STITCH_TIME")) std::fprintf(stderr, "      %zu candidates of %zu faces\n", candidates.size(), std::size_t(S.number_of_faces()));
-        lap("candidates");
         PMP::self_intersections(candidates, S, std::back_inserter(pairs));
-        lap("selfinter");
-        if (std::getenv("FSS_STITCH_DEBUG"))
-            for (const auto& [f, g] : pairs) {
-                std::fprintf(stderr, "  intersect kept %d %d\n", int(loc.star.kept[f]), int(loc.star.kept[g]));
-                for (FaceIndex x : {f, g}) {
-                    for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(x), S)) {
-                        const int id = loc.lid[v];
-                        std::fprintf(stderr, "    v%u lid %d pa %d pb %d kind %d p %.17g %.17g %.17g uv %.17g %.17g\n", std::uint32_t(v), id, id >= 0 ? L_[std::size_t(id)].patchA : -9, id >= 0 ? L_[std::size_t(id)].patchB : -9, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, S.point(v).x(), S.point(v).y(), S.point(v).z(), loc.uv[v].x(), loc.uv[v].y());
-                    }
-                }
-                break;
-            }
         for (const auto& [f, g] : pairs) {
             if (!loc.star.kept[f]) badFace(f);
             if (!loc.star.kept[g]) badFace(g);
@@ -2228,10 +2153,6 @@ private:
                 } else if (!freshIndex.count(std::uint32_t(v))) {
                     freshIndex[std::uint32_t(v)] = std::uint32_t(plan.freshPositions.size());
                     plan.freshPositions.push_back(pt(S, v));
-                    if (std::getenv("FSS_STITCH_DEBUG") && std::abs(pt(S, v).norm() - 1.0) > 0.0177) {
-                        const int id = loc.lid[v];
-                        std::fprintf(stderr, "  off-sphere fresh vertex lid %d kind %d |p| %g\n", id, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, pt(S, v).norm());
-                    }
                 }
             }
         // Face order: growth order over the faces expressed in the rehearsal mesh after the removals.
@@ -2270,19 +2191,6 @@ private:
             plan.quality.push_back(loc.quality[sfaces[i]]);
             plan.scanId.push_back(loc.scanId[sfaces[i]]);
         }
-        if (std::getenv("FSS_STITCH_DEBUG_DEEP"))
-            for (std::size_t i = 0; i < faces.size(); ++i) {
-                const auto& fv = faces[i];
-                const Kernel::Triangle_3 t(S.point(fv[0]), S.point(fv[1]), S.point(fv[2]));
-                const double d = 1.0 - std::sqrt(CGAL::squared_distance(Point3(0, 0, 0), t));
-                if (d > 0.0178) {
-                    std::fprintf(stderr, "  deep face %.5f patchSide %d\n", d, int(loc.patchSide[sfaces[i]]));
-                    for (VertexIndex v : fv) {
-                        const int id = loc.lid[v];
-                        std::fprintf(stderr, "    lid %d kind %d |p| %.5f\n", id, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, pt(S, v).norm());
-                    }
-                }
-            }
         // Seam figures.
         plan.seamEdges = loc.seam.size();
         std::unordered_set<std::uint32_t> seamVerts;
@@ -2296,14 +2204,6 @@ private:
             if (!seamVerts.count(std::uint32_t(fv[0])) && !seamVerts.count(std::uint32_t(fv[1])) && !seamVerts.count(std::uint32_t(fv[2])))
                 continue;
             plan.seamFaceMinAngles.push_back(minAngle(pt(S, fv[0]), pt(S, fv[1]), pt(S, fv[2])) / kDeg);
-            if (std::getenv("FSS_STITCH_DEBUG_Q")) {
-                const double ang = plan.seamFaceMinAngles.back();
-                int kinds[4] = {0, 0, 0, 0};
-                for (VertexIndex v : fv) { const int id = loc.lid[v]; if (id >= 0) ++kinds[int(L_[std::size_t(id)].kind)]; }
-                std::fprintf(stderr, "Q %d %.2f R%d B%d C%d I%d", int(loc.patchSide[sfaces[i]]), ang, kinds[0], kinds[1], kinds[2], kinds[3]);
-                for (VertexIndex v : fv) std::fprintf(stderr, " (%.4f %.4f c%d l%d)", loc.uv[v].x(), loc.uv[v].y(), int(loc.lid[v] >= 0 && L_[std::size_t(loc.lid[v])].chain), int(loc.locked[v]));
-                std::fprintf(stderr, "\n");
-            }
         }
         return true;
     }
@@ -2497,9 +2397,6 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
         const bool curS = current.property_map<FaceIndex, std::int32_t>(props::faceScanId).second;
         ComponentStitcher stitcher(current, P, view, options, faceIds, w.faces, curQ, curS);
         Attempt a = stitcher.run();
-        if (std::getenv("FSS_STITCH_DEBUG"))
-            std::fprintf(stderr, "stitch: component %d round %d (%zu faces): %s (%zu bad)\n", w.name, w.rounds,
-                         w.faces.size(), a.ok ? "ok" : a.reason.c_str(), a.bad.size());
         if (!a.ok) {
             if (a.bad.empty() || w.rounds >= options.maxTrimRounds) {
                 skip(w, a.reason);

@@ -12,7 +12,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <functional>
 #include <map>
 #include <numbers>
@@ -644,7 +643,6 @@ TEST(Stitch, RandomChainedScansKeepAllInvariants) {
                 sphereStats.fracSum += r.seamFracMinAngleAbove25;
                 sphereStats.seconds += r.seconds;
             } catch (const fss::InvalidInputError& e) {
-                if (std::getenv("FSS_STITCH_DEBUG")) std::printf("refused: %s\n", e.what());
                 ++sphereStats.refused;
                 expectBitIdentical(m, before);
             }
@@ -674,7 +672,6 @@ TEST(Stitch, RandomChainedScansKeepAllInvariants) {
                 gridStats.fracSum += r.seamFracMinAngleAbove25;
                 gridStats.seconds += r.seconds;
             } catch (const fss::InvalidInputError& e) {
-                if (std::getenv("FSS_STITCH_DEBUG")) std::printf("refused: %s\n", e.what());
                 ++gridStats.refused;
                 expectBitIdentical(g, before);
             }
