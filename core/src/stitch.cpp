@@ -1,24 +1,29 @@
 // Stitching a scanned patch into the current mesh (DESIGN.md §1 "Stitch", §6).
 //
-// Per patch component:
-//  1. region     current faces under the component's view footprint: front-facing, not grazing, on the
-//                sheet the patch lies on (seeds = faces under the patch vertices with the smallest depth
-//                gap, grown over faces whose projection meets the component's projection);
-//  2. insert     snap patch boundary vertices onto nearby mesh vertices / edges and mesh vertices onto
-//                nearby patch boundary edges (no slivers), compute the crossings of patch boundary edges
-//                with mesh edges (3D position on the mesh edge, perspective-correct), and build a
-//                constrained Delaunay triangulation of all these edges in the view;
-//  3. cut, glue  flood-fill the triangulation: which mesh face each triangle lies in, inside or outside
-//                the patch. Mesh faces cut by the seam are replaced by their outside triangles (lifted
-//                into the plane of the mesh face, so the surface outside does not move); the patch's
-//                boundary triangles are re-triangulated over the seam vertices of their edges;
-//  4. optimise   on a local copy (the star of the replaced faces): collapse short edges, flip edges for
-//                minimum angle and valence; never flip a face in the view, fold, or move a vertex;
-//  5. check      on the local copy (manifold, oriented, no degenerate faces, every new face facing the
-//                camera, border edges unchanged, no self-intersections), then replay the exact sequence of
-//                edits on a fresh local copy (it must succeed), and only then edit the mesh itself.
-// A problem that can be located (the patch reaching past a silhouette, a border, a grazing face, another
-// sheet; a degenerate contact; a failed check) trims the patch faces there and the component is retried.
+// Per patch component (connected through vertices), without touching the mesh:
+//  1. region     the faces of the current mesh under the component in the scan's view: front-facing, not
+//                grazing, on the sheet the patch lies on (seeds: under the patch vertices, the face whose
+//                plane is nearest along the view ray; grown over faces meeting the component's projection).
+//                Faces near the patch boundary ("seam faces") are re-triangulated; the faces under the
+//                patch, away from its boundary, are removed whole (folds and all).
+//  2. insert     snap patch boundary vertices onto nearby mesh vertices / edges and mesh vertices onto nearby
+//                patch boundary edges (no slivers), compute where patch boundary edges cross mesh edges (the
+//                new vertex lies on the 3D mesh edge, perspective-correct), and build a constrained Delaunay
+//                triangulation of the seam faces' edges and the patch boundary in the view (exact predicates).
+//  3. cut, glue  flood-fill the triangulation: which seam face each triangle lies in, inside or outside the
+//                patch. Seam faces are replaced by their outside triangles (in the face's plane: the surface
+//                outside does not move); patch triangles on the boundary are re-triangulated over the seam
+//                vertices of their edges (max-min angle, never three collinear points).
+//  4. optimise   on a local copy (the star of the replaced faces): collapse short seam edges, refine the
+//                pieces outside the patch with a graded size (new vertices on the old surface), flip for
+//                angles and valence; never flip a face in the view, fold, move a vertex or bend the surface
+//                outside the patch.
+//  5. check      on the local copy: manifold, oriented, no degenerate or needle faces, every new face facing
+//                the camera, border edges (so holes and boundary loops) unchanged, no self-intersections;
+//                then rehearse the exact sequence of edits on a fresh local copy; only then edit the mesh.
+// A problem that can be located (the patch reaching past a silhouette, a border, a grazing face, a fold,
+// another sheet; a degenerate contact; a failed check) trims the patch faces there and the component is
+// retried; what cannot be made stitchable is skipped and reported.
 
 #include "fss/stitch.h"
 
@@ -203,7 +208,6 @@ private:
 struct PatchData {
     std::vector<Vec3> pos;
     std::vector<Point2> uv;
-    std::vector<double> w;
     std::vector<std::array<int, 3>> tri; // counter-clockwise in the view
     std::vector<float> quality;
     std::vector<std::int32_t> scanId;
@@ -1013,7 +1017,6 @@ private:
                 LVert& l = L_[std::size_t(lid)];
                 l.pos = pos;
                 l.uv = q;
-                onEdge_[lid] = best;
                 redges_[std::size_t(best)].splits.push_back({lineParam(q, L_[std::size_t(redges_[std::size_t(best)].u)].uv, L_[std::size_t(redges_[std::size_t(best)].w)].uv), lid});
             }
         }
@@ -2258,7 +2261,6 @@ private:
     std::vector<LVert> L_;
     std::unordered_map<std::uint32_t, int> lidOfCurrent_;
     std::unordered_map<int, int> lidOfPatch_;
-    std::unordered_map<int, int> onEdge_;
     std::vector<REdge> redges_;
     std::unordered_map<std::uint32_t, int> redgeIndex_;
     std::vector<std::pair<int, int>> subEdges_;
@@ -2280,7 +2282,6 @@ PatchData readPatch(const Mesh& patch, const View& view, std::size_t& dropped) {
         double w = 0;
         if (!view.project(p, uv, w)) uv = Point2(std::numeric_limits<double>::quiet_NaN(), 0);
         P.uv.push_back(uv);
-        P.w.push_back(w);
     }
     auto q = patch.property_map<FaceIndex, float>(props::faceQuality);
     auto s = patch.property_map<FaceIndex, std::int32_t>(props::faceScanId);
