@@ -1,24 +1,29 @@
 // Stitching a scanned patch into the current mesh (DESIGN.md §1 "Stitch", §6).
 //
-// Per patch component:
-//  1. region     current faces under the component's view footprint: front-facing, not grazing, on the
-//                sheet the patch lies on (seeds = faces under the patch vertices with the smallest depth
-//                gap, grown over faces whose projection meets the component's projection);
-//  2. insert     snap patch boundary vertices onto nearby mesh vertices / edges and mesh vertices onto
-//                nearby patch boundary edges (no slivers), compute the crossings of patch boundary edges
-//                with mesh edges (3D position on the mesh edge, perspective-correct), and build a
-//                constrained Delaunay triangulation of all these edges in the view;
-//  3. cut, glue  flood-fill the triangulation: which mesh face each triangle lies in, inside or outside
-//                the patch. Mesh faces cut by the seam are replaced by their outside triangles (lifted
-//                into the plane of the mesh face, so the surface outside does not move); the patch's
-//                boundary triangles are re-triangulated over the seam vertices of their edges;
-//  4. optimise   on a local copy (the star of the replaced faces): collapse short edges, flip edges for
-//                minimum angle and valence; never flip a face in the view, fold, or move a vertex;
-//  5. check      on the local copy (manifold, oriented, no degenerate faces, every new face facing the
-//                camera, border edges unchanged, no self-intersections), then replay the exact sequence of
-//                edits on a fresh local copy (it must succeed), and only then edit the mesh itself.
-// A problem that can be located (the patch reaching past a silhouette, a border, a grazing face, another
-// sheet; a degenerate contact; a failed check) trims the patch faces there and the component is retried.
+// Per patch component (connected through vertices), without touching the mesh:
+//  1. region     the faces of the current mesh under the component in the scan's view: front-facing, not
+//                grazing, on the sheet the patch lies on (seeds: under the patch vertices, the face whose
+//                plane is nearest along the view ray; grown over faces meeting the component's projection).
+//                Faces near the patch boundary ("seam faces") are re-triangulated; the faces under the
+//                patch, away from its boundary, are removed whole (folds and all).
+//  2. insert     snap patch boundary vertices onto nearby mesh vertices / edges and mesh vertices onto nearby
+//                patch boundary edges (no slivers), compute where patch boundary edges cross mesh edges (the
+//                new vertex lies on the 3D mesh edge, perspective-correct), and build a constrained Delaunay
+//                triangulation of the seam faces' edges and the patch boundary in the view (exact predicates).
+//  3. cut, glue  flood-fill the triangulation: which seam face each triangle lies in, inside or outside the
+//                patch. Seam faces are replaced by their outside triangles (in the face's plane: the surface
+//                outside does not move); patch triangles on the boundary are re-triangulated over the seam
+//                vertices of their edges (max-min angle, never three collinear points).
+//  4. optimise   on a local copy (the star of the replaced faces): collapse short seam edges, refine the
+//                pieces outside the patch with a graded size (new vertices on the old surface), flip for
+//                angles and valence; never flip a face in the view, fold, move a vertex or bend the surface
+//                outside the patch.
+//  5. check      on the local copy: manifold, oriented, no degenerate or needle faces, every new face facing
+//                the camera, border edges (so holes and boundary loops) unchanged, no self-intersections;
+//                then rehearse the exact sequence of edits on a fresh local copy; only then edit the mesh.
+// A problem that can be located (the patch reaching past a silhouette, a border, a grazing face, a fold,
+// another sheet; a degenerate contact; a failed check) trims the patch faces there and the component is
+// retried; what cannot be made stitchable is skipped and reported.
 
 #include "fss/stitch.h"
 
@@ -34,13 +39,12 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <deque>
 #include <limits>
 #include <map>
 #include <numbers>
+#include <queue>
 #include <set>
 #include <sstream>
 #include <unordered_map>
@@ -204,7 +208,6 @@ private:
 struct PatchData {
     std::vector<Vec3> pos;
     std::vector<Point2> uv;
-    std::vector<double> w;
     std::vector<std::array<int, 3>> tri; // counter-clockwise in the view
     std::vector<float> quality;
     std::vector<std::int32_t> scanId;
@@ -440,18 +443,24 @@ private:
 
     // ---- step 0: the component's boundary, sizes and a grid over its triangles
     bool setupComponent(Attempt& a) {
-        std::unordered_set<std::uint64_t> directed;
+        std::vector<std::uint64_t> directed;
+        directed.reserve(3 * faces_.size());
         for (int f : faces_) {
             const auto& t = P_.tri[std::size_t(f)];
-            for (int k = 0; k < 3; ++k) directed.insert(dirKey(std::uint32_t(t[std::size_t(k)]), std::uint32_t(t[std::size_t((k + 1) % 3)])));
+            for (int k = 0; k < 3; ++k) {
+                directed.push_back(dirKey(std::uint32_t(t[std::size_t(k)]), std::uint32_t(t[std::size_t((k + 1) % 3)])));
+                compVerts_.push_back(t[std::size_t(k)]);
+            }
         }
+        std::sort(directed.begin(), directed.end());
+        std::sort(compVerts_.begin(), compVerts_.end());
+        compVerts_.erase(std::unique(compVerts_.begin(), compVerts_.end()), compVerts_.end());
         std::vector<double> len2, len3;
         for (int f : faces_) {
             const auto& t = P_.tri[std::size_t(f)];
             for (int k = 0; k < 3; ++k) {
                 const int p = t[std::size_t(k)], q = t[std::size_t((k + 1) % 3)];
-                vertexFaces_[p].push_back(f);
-                const bool border = !directed.count(dirKey(std::uint32_t(q), std::uint32_t(p)));
+                const bool border = !std::binary_search(directed.begin(), directed.end(), dirKey(std::uint32_t(q), std::uint32_t(p)));
                 if (border) {
                     pedgeIndex_[dirKey(std::uint32_t(p), std::uint32_t(q))] = int(pedges_.size());
                     pedges_.push_back({p, q, t[std::size_t((k + 2) % 3)], {}, {}});
@@ -464,6 +473,9 @@ private:
             }
         }
         if (pedges_.empty()) return fail(a, "it has no boundary in the scan's view (it would cover the whole view)");
+        for (int f : faces_)
+            for (int v : P_.tri[std::size_t(f)])
+                if (boundary_.count(v)) vertexFaces_[v].push_back(f);
         auto median = [](std::vector<double> v) {
             std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
             return v[v.size() / 2];
@@ -484,7 +496,7 @@ private:
         }
         margin_ *= 1.01;
         compBox_ = CGAL::Bbox_2();
-        for (const auto& [v, fs] : vertexFaces_) compBox_ += P_.uv[std::size_t(v)].bbox();
+        for (int v : compVerts_) compBox_ += P_.uv[std::size_t(v)].bbox();
         compGrid_ = BucketGrid(2.0 * h2_, faces_.size());
         for (std::size_t i = 0; i < faces_.size(); ++i) compGrid_.insert(int(i), triBox(faces_[i]));
         return true;
@@ -653,7 +665,7 @@ private:
         std::sort(samples.begin(), samples.end());
         {
             std::vector<int> interior;
-            for (const auto& [v, fs] : vertexFaces_)
+            for (int v : compVerts_)
                 if (!boundary_.count(v)) interior.push_back(v);
             std::sort(interior.begin(), interior.end());
             const std::size_t stride = std::max<std::size_t>(1, interior.size() / 2048);
@@ -714,7 +726,7 @@ private:
         regionGrid_ = BucketGrid(std::max(2.0 * h2_, edge), region_.size());
         for (std::size_t i = 0; i < region_.size(); ++i) regionGrid_.insert(int(i), faceTriangle(region_[i]).bbox());
         std::vector<int> bad;
-        for (const auto& [v, fs] : vertexFaces_) {
+        for (int v : compVerts_) {
             const Point2& uv = P_.uv[std::size_t(v)];
             bool inside = false;
             regionGrid_.query(uv.bbox(), [&](int i) {
@@ -1005,7 +1017,6 @@ private:
                 LVert& l = L_[std::size_t(lid)];
                 l.pos = pos;
                 l.uv = q;
-                onEdge_[lid] = best;
                 redges_[std::size_t(best)].splits.push_back({lineParam(q, L_[std::size_t(redges_[std::size_t(best)].u)].uv, L_[std::size_t(redges_[std::size_t(best)].w)].uv), lid});
             }
         }
@@ -1169,26 +1180,6 @@ private:
             for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v)
                 if (v->info().id < 0) {
                     addNear(bad, v->point());
-                    if (std::getenv("FSS_STITCH_DEBUG")) {
-                        std::fprintf(stderr, "  extra vertex at %.17g %.17g\n", v->point().x(), v->point().y());
-                        for (FaceIndex f : region_) {
-                            const Triangle2 t = faceTriangle(f);
-                            if (!inTriangle(v->point(), t[0], t[1], t[2])) continue;
-                            const auto vs = faceVertices(f);
-                            const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
-                            const double c = normalOf(A, B, C).normalized().dot(V_.towardsViewer((A + B + C) / 3.0));
-                            std::fprintf(stderr, "    in face %u cos %.3f depth %.5f sid %d\n", std::uint32_t(f), c, V_.camera().viewDepth((A+B+C)/3.0), curHasScanId_ ? curScanId_[f] : -9);
-                        }
-                        const CdtVertex vv = v;
-                        auto ec = cdt.incident_edges(vv), end = ec;
-                        do {
-                            if (cdt.is_constrained(*ec)) {
-                                const CdtVertex w = ec->first->vertex(ec->first->ccw(ec->second)) == vv ? ec->first->vertex(ec->first->cw(ec->second)) : ec->first->vertex(ec->first->ccw(ec->second));
-                                const int id = w->info().id;
-                                std::fprintf(stderr, "    to lid %d kind %d uv %.17g %.17g\n", id, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, w->point().x(), w->point().y());
-                            }
-                        } while (++ec != end);
-                    }
                 }
             return fail(a, "it or the mesh under it overlaps itself in the scan's view", std::move(bad));
         }
@@ -1461,12 +1452,6 @@ private:
             const double floor = std::min(O_.minAngleFloorDeg * kDeg,
                                           0.999 * minAngle(P_.pos[std::size_t(t[0])], P_.pos[std::size_t(t[1])], P_.pos[std::size_t(t[2])]));
             if (!triangulatePolygon(poly, edges, q, sid, floor)) {
-                if (std::getenv("FSS_STITCH_DEBUG")) {
-                    std::fprintf(stderr, "  polygon failed:");
-                    for (std::size_t k = 0; k < poly.size(); ++k)
-                        std::fprintf(stderr, " [lid %d kind %d e%u %.6f %.6f]", poly[k], int(L_[std::size_t(poly[k])].kind), edges[k], L_[std::size_t(poly[k])].uv.x(), L_[std::size_t(poly[k])].uv.y());
-                    std::fprintf(stderr, "\n");
-                }
                 for (int v : t) bad.push_back(v);
                 continue;
             }
@@ -1598,6 +1583,13 @@ private:
             }
             faceVs.push_back(vs);
         }
+        for (VertexIndex v : S.vertices()) {
+            // Vertices of the star only: their place in the view (vertices behind the eye keep the origin;
+            // their faces are kept and always tested for intersections).
+            double w;
+            Point2 uv(0, 0);
+            if (loc.star.cur[v] != kNone && V_.project(pt(S, v), uv, w)) loc.uv[v] = uv;
+        }
         for (std::size_t i = 0; i < L_.size(); ++i)
             if (sv[i] != VertexIndex()) {
                 loc.lid[sv[i]] = int(i);
@@ -1633,7 +1625,8 @@ private:
 
         if (O_.optimiseSeam) optimise(loc, a.plan);
         if (!validate(loc, bordersBefore, a)) return false;
-        return extractPlan(loc, a);
+        const bool ok = extractPlan(loc, a);
+        return ok;
     }
 
     // Border edges (pairs of current-mesh vertices) incident to the vertices of the replaced faces.
@@ -1667,6 +1660,45 @@ private:
         return inside;
     }
     Vec3 pt(const Mesh& S, VertexIndex v) const { return toVec(S.point(v)); }
+    // Edges incident to the given vertices (each once, in a deterministic order).
+    static std::vector<EdgeIndex> edgesAround(const Mesh& S, const std::unordered_set<std::uint32_t>& vertices) {
+        std::vector<std::uint32_t> vs(vertices.begin(), vertices.end());
+        std::sort(vs.begin(), vs.end());
+        std::vector<EdgeIndex> out;
+        for (std::uint32_t v : vs) {
+            const VertexIndex x(v);
+            if (S.is_removed(x) || S.halfedge(x) == Mesh::null_halfedge()) continue;
+            for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(x), S)) out.push_back(S.edge(h));
+        }
+        std::sort(out.begin(), out.end());
+        out.erase(std::unique(out.begin(), out.end()), out.end());
+        return out;
+    }
+    // Distance from the seam along edges (Dijkstra), for the vertices of the given set.
+    std::unordered_map<std::uint32_t, double> seamDistance(const Local& loc, const std::unordered_set<std::uint32_t>& within) const {
+        const Mesh& S = loc.star.S;
+        std::unordered_map<std::uint32_t, double> dist;
+        using Item = std::pair<double, std::uint32_t>;
+        std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+        for (const auto& [a, b] : loc.seam)
+            for (std::uint32_t v : {a, b})
+                if (dist.emplace(v, 0.0).second) queue.push({0.0, v});
+        while (!queue.empty()) {
+            const auto [d, v] = queue.top();
+            queue.pop();
+            if (d > dist[v]) continue;
+            for (VertexIndex w : CGAL::vertices_around_target(S.halfedge(VertexIndex(v)), S)) {
+                if (!within.count(std::uint32_t(w))) continue;
+                const double dw = d + (pt(S, VertexIndex(v)) - pt(S, w)).norm();
+                auto [it, fresh] = dist.try_emplace(std::uint32_t(w), dw);
+                if (fresh || dw < it->second) {
+                    it->second = dw;
+                    queue.push({dw, std::uint32_t(w)});
+                }
+            }
+        }
+        return dist;
+    }
 
     void optimise(Local& loc, Plan& plan) {
         Mesh& S = loc.star.S;
@@ -1715,10 +1747,9 @@ private:
           for (int pass = 0; pass < 4; ++pass) {
             const auto near = seamNeighbourhood(loc);
             std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
-            for (EdgeIndex e : S.edges()) {
+            for (EdgeIndex e : edgesAround(S, near)) {
                 const HalfedgeIndex h = S.halfedge(e);
                 const VertexIndex a = S.source(h), b = S.target(h);
-                if (!near.count(std::uint32_t(a)) && !near.count(std::uint32_t(b))) continue;
                 const double len = (pt(S, a) - pt(S, b)).norm();
                 if (len < shortEdge) cands.push_back({len, {a, b}});
             }
@@ -1753,23 +1784,24 @@ private:
     std::size_t refineOutside(Local& loc) {
         Mesh& S = loc.star.S;
         const auto near = seamNeighbourhood(loc);
-        std::vector<Vec3> seamPoints;
-        for (const auto& [a, b] : loc.seam) seamPoints.push_back(pt(S, VertexIndex(a)));
-        auto target = [&](const Vec3& p) {
-            double d2 = std::numeric_limits<double>::infinity();
-            for (const Vec3& q : seamPoints) d2 = std::min(d2, (p - q).squaredNorm());
-            return h3_ + O_.seamGrading * std::sqrt(d2);
+        auto within = near;
+        for (EdgeIndex e : edgesAround(S, near))
+            for (VertexIndex v : {S.source(S.halfedge(e)), S.target(S.halfedge(e))}) within.insert(std::uint32_t(v));
+        const auto dist = seamDistance(loc, within);
+        auto distance = [&](VertexIndex v) {
+            auto it = dist.find(std::uint32_t(v));
+            return it == dist.end() ? std::numeric_limits<double>::infinity() : it->second;
         };
         std::vector<std::pair<double, EdgeIndex>> cands;
-        for (EdgeIndex e : S.edges()) {
+        for (EdgeIndex e : edgesAround(S, near)) {
             const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
             const FaceIndex f = S.face(h), g = S.face(o);
             if (f == Mesh::null_face() || g == Mesh::null_face() || loc.star.kept[f] || loc.star.kept[g]) continue;
             if (loc.patchSide[f] || loc.patchSide[g]) continue;
-            if (!near.count(std::uint32_t(S.source(h))) && !near.count(std::uint32_t(S.target(h)))) continue;
             const Vec3 a = pt(S, S.source(h)), b = pt(S, S.target(h));
             const double len = (a - b).norm();
-            if (len > 4.0 / 3.0 * target(0.5 * (a + b))) cands.push_back({len, e});
+            const double target = h3_ + O_.seamGrading * 0.5 * (distance(S.source(h)) + distance(S.target(h)));
+            if (len > 4.0 / 3.0 * target) cands.push_back({len, e});
         }
         std::sort(cands.begin(), cands.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
         std::size_t splits = 0;
@@ -1832,7 +1864,7 @@ private:
         };
         std::deque<EdgeIndex> queue;
         std::unordered_set<std::uint32_t> queued;
-        for (EdgeIndex e : S.edges()) {
+        for (EdgeIndex e : edgesAround(S, near)) {
             const HalfedgeIndex h = S.halfedge(e);
             if (near.count(std::uint32_t(S.source(h))) && near.count(std::uint32_t(S.target(h)))) {
                 queue.push_back(e);
@@ -1913,6 +1945,51 @@ private:
         loc.seam.swap(seam);
     }
 
+    // The faces that could intersect each other: new faces are a height field in the view (checked face
+    // by face), so only the seam neighbourhood, the kept faces around, and new faces overlapping those in
+    // the view need the 3D test.
+    std::vector<FaceIndex> intersectionCandidates(Local& loc) {
+        Mesh& S = loc.star.S;
+        std::unordered_set<std::uint32_t> near;
+        {
+            const int rings = O_.seamRings + 2;
+            std::vector<VertexIndex> ring;
+            for (const auto& [a, b] : loc.seam)
+                for (std::uint32_t v : {a, b})
+                    if (near.insert(v).second) ring.push_back(VertexIndex(v));
+            for (int r = 0; r < rings; ++r) {
+                std::vector<VertexIndex> next;
+                for (VertexIndex v : ring)
+                    for (VertexIndex w : CGAL::vertices_around_target(S.halfedge(v), S))
+                        if (near.insert(std::uint32_t(w)).second) next.push_back(w);
+                ring.swap(next);
+            }
+        }
+        auto faceBox = [&](FaceIndex f) {
+            CGAL::Bbox_2 b;
+            for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(f), S)) b += loc.uv[v].bbox();
+            return b;
+        };
+        std::vector<FaceIndex> out, kept;
+        for (FaceIndex f : S.faces()) if (loc.star.kept[f]) kept.push_back(f);
+        BucketGrid keptGrid(4.0 * h2_, S.num_faces());
+        for (FaceIndex f : kept) keptGrid.insert(int(std::uint32_t(f)), faceBox(f));
+        for (FaceIndex f : S.faces()) {
+            bool take = loc.star.kept[f];
+            if (!take)
+                for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(f), S))
+                    if (near.count(std::uint32_t(v))) take = true;
+            if (!take) {
+                const CGAL::Bbox_2 b = faceBox(f);
+                keptGrid.query(b, [&](int g) {
+                    if (!take && CGAL::do_overlap(b, faceBox(FaceIndex(std::uint32_t(g))))) take = true;
+                });
+            }
+            if (take) out.push_back(f);
+        }
+        return out;
+    }
+
     bool validate(Local& loc, const std::set<std::pair<std::uint32_t, std::uint32_t>>& bordersBefore, Attempt& a) {
         Mesh& S = loc.star.S;
         std::vector<int> bad;
@@ -1926,25 +2003,23 @@ private:
             c = Point2(x, y);
             addNear(bad, c);
         };
-        if (!S.is_valid(false)) return fail(a, "internal error: the local mesh is not valid");
-        // Faces: not degenerate, facing the camera.
+        // Faces: not degenerate, facing the camera, no needles.
+        bool needles = false;
         for (FaceIndex f : S.faces()) {
             if (loc.star.kept[f]) continue;
             const HalfedgeIndex h = S.halfedge(f);
             const VertexIndex p = S.source(h), q = S.target(h), r = S.target(S.next(h));
-            if (CGAL::collinear(S.point(p), S.point(q), S.point(r)) || !leftTurn(loc.uv[p], loc.uv[q], loc.uv[r])) badFace(f);
+            if (CGAL::collinear(S.point(p), S.point(q), S.point(r)) || !leftTurn(loc.uv[p], loc.uv[q], loc.uv[r])) {
+                badFace(f);
+            } else if (minAngle(pt(S, p), pt(S, q), pt(S, r)) < loc.minAllowed[f]) {
+                badFace(f);
+                needles = true;
+            }
         }
-        if (!bad.empty()) return fail(a, "it would create degenerate or back-facing faces", std::move(bad));
-        for (FaceIndex f : S.faces()) {
-            if (loc.star.kept[f]) continue;
-            const HalfedgeIndex h = S.halfedge(f);
-            if (minAngle(pt(S, S.source(h)), pt(S, S.target(h)), pt(S, S.target(S.next(h)))) < loc.minAllowed[f]) badFace(f);
-            if (std::getenv("FSS_STITCH_DEBUG_Q") && minAngle(pt(S, S.source(h)), pt(S, S.target(h)), pt(S, S.target(S.next(h)))) < 0.5 * kDeg)
-                std::fprintf(stderr, "LOW %.3f allowed %.3f patchSide %d\n", minAngle(pt(S, S.source(h)), pt(S, S.target(h)), pt(S, S.target(S.next(h)))) / kDeg, loc.minAllowed[f] / kDeg, int(loc.patchSide[f]));
-        }
+        if (!bad.empty() && !needles) return fail(a, "it would create degenerate or back-facing faces", std::move(bad));
         if (!bad.empty()) return fail(a, "it would create needle-like faces at its seam", std::move(bad));
         // Vertices: manifold (one umbrella) and no new border.
-        std::unordered_map<std::uint32_t, int> incoming;
+        std::vector<int> incoming(S.num_vertices(), 0);
         for (HalfedgeIndex h : S.halfedges()) ++incoming[std::uint32_t(S.target(h))];
         for (VertexIndex v : S.vertices()) {
             if (S.halfedge(v) == Mesh::null_halfedge() || !loc.star.isFull(v)) continue;
@@ -1978,18 +2053,8 @@ private:
             return fail(a, "it would open or close a hole in the mesh", std::move(bad));
         // No new self-intersections among the local faces.
         std::vector<std::pair<FaceIndex, FaceIndex>> pairs;
-        PMP::self_intersections(S.faces(), S, std::back_inserter(pairs));
-        if (std::getenv("FSS_STITCH_DEBUG"))
-            for (const auto& [f, g] : pairs) {
-                std::fprintf(stderr, "  intersect kept %d %d\n", int(loc.star.kept[f]), int(loc.star.kept[g]));
-                for (FaceIndex x : {f, g}) {
-                    for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(x), S)) {
-                        const int id = loc.lid[v];
-                        std::fprintf(stderr, "    v%u lid %d pa %d pb %d kind %d p %.17g %.17g %.17g uv %.17g %.17g\n", std::uint32_t(v), id, id >= 0 ? L_[std::size_t(id)].patchA : -9, id >= 0 ? L_[std::size_t(id)].patchB : -9, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, S.point(v).x(), S.point(v).y(), S.point(v).z(), loc.uv[v].x(), loc.uv[v].y());
-                    }
-                }
-                break;
-            }
+        const auto candidates = intersectionCandidates(loc);
+        PMP::self_intersections(candidates, S, std::back_inserter(pairs));
         for (const auto& [f, g] : pairs) {
             if (!loc.star.kept[f]) badFace(f);
             if (!loc.star.kept[g]) badFace(g);
@@ -1997,6 +2062,51 @@ private:
         if (!bad.empty()) return fail(a, "it would make the mesh intersect itself", std::move(bad));
         if (O_.failValidationForTesting) return fail(a, "its final check was forced to fail for testing");
         return true;
+    }
+
+    // An order of the new faces of S in which each is added next to what is already there: breadth first
+    // from the faces next to kept faces (the hole's border) across S's edges.
+    static std::vector<std::size_t> growthOrderIn(const Mesh& S, const std::vector<FaceIndex>& sfaces, const Local& loc) {
+        std::unordered_map<std::uint32_t, std::size_t> index;
+        index.reserve(sfaces.size());
+        for (std::size_t i = 0; i < sfaces.size(); ++i) index[std::uint32_t(sfaces[i])] = i;
+        std::vector<char> done(sfaces.size(), 0);
+        std::vector<std::size_t> order;
+        order.reserve(sfaces.size());
+        std::deque<std::size_t> queue;
+        for (std::size_t i = 0; i < sfaces.size(); ++i)
+            for (HalfedgeIndex h : CGAL::halfedges_around_face(S.halfedge(sfaces[i]), S)) {
+                const FaceIndex g = S.face(S.opposite(h));
+                // Next to a face that exists before the additions (kept, or left unchanged).
+                if (!done[i] && (g == Mesh::null_face() || loc.star.kept[g] || !index.count(std::uint32_t(g)))) {
+                    done[i] = 1;
+                    queue.push_back(i);
+                }
+            }
+        auto drain = [&] {
+            while (!queue.empty()) {
+                const std::size_t i = queue.front();
+                queue.pop_front();
+                order.push_back(i);
+                for (HalfedgeIndex h : CGAL::halfedges_around_face(S.halfedge(sfaces[i]), S)) {
+                    const FaceIndex g = S.face(S.opposite(h));
+                    if (g == Mesh::null_face() || loc.star.kept[g]) continue;
+                    auto it = index.find(std::uint32_t(g));
+                    if (it != index.end() && !done[it->second]) {
+                        done[it->second] = 1;
+                        queue.push_back(it->second);
+                    }
+                }
+            }
+        };
+        drain();
+        for (std::size_t i = 0; i < sfaces.size(); ++i)
+            if (!done[i]) {
+                done[i] = 1;
+                queue.push_back(i);
+                drain();
+            }
+        return order;
     }
 
     bool extractPlan(Local& loc, Attempt& a) {
@@ -2046,10 +2156,6 @@ private:
                 } else if (!freshIndex.count(std::uint32_t(v))) {
                     freshIndex[std::uint32_t(v)] = std::uint32_t(plan.freshPositions.size());
                     plan.freshPositions.push_back(pt(S, v));
-                    if (std::getenv("FSS_STITCH_DEBUG") && std::abs(pt(S, v).norm() - 1.0) > 0.0177) {
-                        const int id = loc.lid[v];
-                        std::fprintf(stderr, "  off-sphere fresh vertex lid %d kind %d |p| %g\n", id, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, pt(S, v).norm());
-                    }
                 }
             }
         // Face order: growth order over the faces expressed in the rehearsal mesh after the removals.
@@ -2079,7 +2185,7 @@ private:
                                                              : rehearsal.fromCurrent.at(p[std::size_t(k)].index);
             rf.push_back(r);
         }
-        const auto order = growthOrder(rf, rehearsal.S);
+        const auto order = growthOrderIn(S, sfaces, loc);
         for (std::size_t i : order)
             if (rehearsal.S.add_face(rf[i][0], rf[i][1], rf[i][2]) == Mesh::null_face())
                 return fail(a, "internal error: the stitch could not be rehearsed");
@@ -2088,19 +2194,6 @@ private:
             plan.quality.push_back(loc.quality[sfaces[i]]);
             plan.scanId.push_back(loc.scanId[sfaces[i]]);
         }
-        if (std::getenv("FSS_STITCH_DEBUG_DEEP"))
-            for (std::size_t i = 0; i < faces.size(); ++i) {
-                const auto& fv = faces[i];
-                const Kernel::Triangle_3 t(S.point(fv[0]), S.point(fv[1]), S.point(fv[2]));
-                const double d = 1.0 - std::sqrt(CGAL::squared_distance(Point3(0, 0, 0), t));
-                if (d > 0.0178) {
-                    std::fprintf(stderr, "  deep face %.5f patchSide %d\n", d, int(loc.patchSide[sfaces[i]]));
-                    for (VertexIndex v : fv) {
-                        const int id = loc.lid[v];
-                        std::fprintf(stderr, "    lid %d kind %d |p| %.5f\n", id, id >= 0 ? int(L_[std::size_t(id)].kind) : -1, pt(S, v).norm());
-                    }
-                }
-            }
         // Seam figures.
         plan.seamEdges = loc.seam.size();
         std::unordered_set<std::uint32_t> seamVerts;
@@ -2114,14 +2207,6 @@ private:
             if (!seamVerts.count(std::uint32_t(fv[0])) && !seamVerts.count(std::uint32_t(fv[1])) && !seamVerts.count(std::uint32_t(fv[2])))
                 continue;
             plan.seamFaceMinAngles.push_back(minAngle(pt(S, fv[0]), pt(S, fv[1]), pt(S, fv[2])) / kDeg);
-            if (std::getenv("FSS_STITCH_DEBUG_Q")) {
-                const double ang = plan.seamFaceMinAngles.back();
-                int kinds[4] = {0, 0, 0, 0};
-                for (VertexIndex v : fv) { const int id = loc.lid[v]; if (id >= 0) ++kinds[int(L_[std::size_t(id)].kind)]; }
-                std::fprintf(stderr, "Q %d %.2f R%d B%d C%d I%d", int(loc.patchSide[sfaces[i]]), ang, kinds[0], kinds[1], kinds[2], kinds[3]);
-                for (VertexIndex v : fv) std::fprintf(stderr, " (%.4f %.4f c%d l%d)", loc.uv[v].x(), loc.uv[v].y(), int(loc.lid[v] >= 0 && L_[std::size_t(loc.lid[v])].chain), int(loc.locked[v]));
-                std::fprintf(stderr, "\n");
-            }
         }
         return true;
     }
@@ -2150,7 +2235,8 @@ private:
         std::vector<std::pair<double, int>> splits;
         std::vector<int> line;
     };
-    std::unordered_map<int, std::vector<int>> vertexFaces_;
+    std::vector<int> compVerts_;                             // vertices of the component, sorted
+    std::unordered_map<int, std::vector<int>> vertexFaces_; // faces around each boundary vertex
     std::unordered_set<int> boundary_;
     std::vector<PEdge> pedges_;
     std::unordered_map<std::uint64_t, int> pedgeIndex_;
@@ -2175,7 +2261,6 @@ private:
     std::vector<LVert> L_;
     std::unordered_map<std::uint32_t, int> lidOfCurrent_;
     std::unordered_map<int, int> lidOfPatch_;
-    std::unordered_map<int, int> onEdge_;
     std::vector<REdge> redges_;
     std::unordered_map<std::uint32_t, int> redgeIndex_;
     std::vector<std::pair<int, int>> subEdges_;
@@ -2197,7 +2282,6 @@ PatchData readPatch(const Mesh& patch, const View& view, std::size_t& dropped) {
         double w = 0;
         if (!view.project(p, uv, w)) uv = Point2(std::numeric_limits<double>::quiet_NaN(), 0);
         P.uv.push_back(uv);
-        P.w.push_back(w);
     }
     auto q = patch.property_map<FaceIndex, float>(props::faceQuality);
     auto s = patch.property_map<FaceIndex, std::int32_t>(props::faceScanId);
@@ -2314,9 +2398,6 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
         const bool curS = current.property_map<FaceIndex, std::int32_t>(props::faceScanId).second;
         ComponentStitcher stitcher(current, P, view, options, faceIds, w.faces, curQ, curS);
         Attempt a = stitcher.run();
-        if (std::getenv("FSS_STITCH_DEBUG"))
-            std::fprintf(stderr, "stitch: component %d round %d (%zu faces): %s (%zu bad)\n", w.name, w.rounds,
-                         w.faces.size(), a.ok ? "ok" : a.reason.c_str(), a.bad.size());
         if (!a.ok) {
             if (a.bad.empty() || w.rounds >= options.maxTrimRounds) {
                 skip(w, a.reason);

@@ -5,14 +5,17 @@
 #include "fss/shapes.h"
 #include "fss/stitch.h"
 
+#include "test_data.h"
+
 #include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Surface_mesh/IO/OFF.h>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <numbers>
@@ -644,7 +647,6 @@ TEST(Stitch, RandomChainedScansKeepAllInvariants) {
                 sphereStats.fracSum += r.seamFracMinAngleAbove25;
                 sphereStats.seconds += r.seconds;
             } catch (const fss::InvalidInputError& e) {
-                if (std::getenv("FSS_STITCH_DEBUG")) std::printf("refused: %s\n", e.what());
                 ++sphereStats.refused;
                 expectBitIdentical(m, before);
             }
@@ -674,7 +676,6 @@ TEST(Stitch, RandomChainedScansKeepAllInvariants) {
                 gridStats.fracSum += r.seamFracMinAngleAbove25;
                 gridStats.seconds += r.seconds;
             } catch (const fss::InvalidInputError& e) {
-                if (std::getenv("FSS_STITCH_DEBUG")) std::printf("refused: %s\n", e.what());
                 ++gridStats.refused;
                 expectBitIdentical(g, before);
             }
@@ -691,4 +692,85 @@ TEST(Stitch, RandomChainedScansKeepAllInvariants) {
                     1e3 * s.seconds / std::max(1, s.stitched));
         EXPECT_GE(s.stitched, 50);
     }
+}
+
+namespace {
+
+// A mesh as the reference surface: the nearest hit of a view ray (Moeller-Trumbore, all faces).
+Surface meshSurface(const Mesh& ref) {
+    std::vector<std::array<Vec3, 3>> tris;
+    for (auto f : ref.faces()) {
+        std::array<Vec3, 3> t;
+        int k = 0;
+        for (auto v : CGAL::vertices_around_face(ref.halfedge(f), ref)) t[std::size_t(k++)] = vec(ref.point(v));
+        tris.push_back(t);
+    }
+    return [tris](const fss::Ray& r) -> std::optional<Vec3> {
+        double best = std::numeric_limits<double>::infinity();
+        for (const auto& t : tris) {
+            const Vec3 e1 = t[1] - t[0], e2 = t[2] - t[0], p = r.direction.cross(e2);
+            const double det = e1.dot(p);
+            if (std::abs(det) < 1e-14) continue;
+            const Vec3 s = r.origin - t[0];
+            const double u = s.dot(p) / det;
+            if (u < 0 || u > 1) continue;
+            const Vec3 q = s.cross(e1);
+            const double v = r.direction.dot(q) / det;
+            if (v < 0 || u + v > 1) continue;
+            const double d = e2.dot(q) / det;
+            if (d > 0 && d < best) best = d;
+        }
+        if (!std::isfinite(best)) return std::nullopt;
+        return r.origin + best * r.direction;
+    };
+}
+
+} // namespace
+
+TEST(Stitch, RealMeshChainedScans) {
+    Mesh ref;
+    std::ifstream in(fss::test::meshPath("elephant.off"));
+    ASSERT_TRUE(CGAL::IO::read_OFF(in, ref));
+    ASSERT_TRUE(CGAL::is_triangle_mesh(ref));
+    const bool closed = CGAL::is_closed(ref);
+    const std::size_t loops = boundaryLoops(ref);
+    const double volume = closed ? PMP::volume(ref) : 0.0;
+    Eigen::AlignedBox3d box;
+    for (auto v : ref.vertices()) box.extend(vec(ref.point(v)));
+    const Surface surface = meshSurface(ref);
+    Mesh m = ref;
+    const Vec3 dirs[] = {{0, 0, 1}, {1, 0.3, 0.2}, {-0.4, 1, 0.3}, {0.3, -0.5, -1}, {-1, -0.2, 0.5}};
+    int n = 0;
+    double minAngle = 180;
+    for (const Vec3& d : dirs) {
+        Camera cam = Camera::standardView(fss::StandardView::PosZ, box, 96, 96);
+        const double dist = (cam.eye - cam.focal).norm();
+        cam.eye = cam.focal + d.normalized() * dist;
+        cam.up = std::abs(d.normalized().z()) < 0.9 ? Vec3(0, 0, 1) : Vec3(0, 1, 0);
+        cam.fitClippingRange(box);
+        const Mesh patch = makePatch(cam, disk(48, 48, 26), surface, ++n, 75.0);
+        if (patch.number_of_faces() == 0) continue;
+        const fss::StitchReport r = fss::stitchPatch(m, patch, cam);
+        SCOPED_TRACE(reportText(r));
+        EXPECT_GE(r.componentsStitched, 1);
+        expectValid(m, {closed, loops});
+        minAngle = std::min(minAngle, r.seamMinAngleDeg);
+    }
+    if (closed) {
+        EXPECT_NEAR(PMP::volume(m), volume, 0.01 * volume);
+    }
+    std::printf("elephant: %d scans, %zu faces, seam min angle %.2f deg\n", n, std::size_t(m.number_of_faces()), minAngle);
+}
+
+TEST(Stitch, CollectGarbageOnRequest) {
+    Mesh grid = fss::shapes::grid(10, 10, 1.0);
+    const Camera cam = downCamera(5.0, 5.0, 20, 5.0, 64);
+    fss::StitchOptions o;
+    o.collectGarbage = true;
+    const fss::StitchReport r =
+        fss::stitchPatch(grid, makePatch(cam, disk(32, 32, 12), planeZ0()), cam, o);
+    EXPECT_EQ(r.componentsStitched, 1);
+    EXPECT_FALSE(grid.has_garbage());
+    expectValid(grid, {false, 1});
+    EXPECT_NEAR(sumArea(grid), 100.0, 100.0 * 1e-9);
 }
