@@ -46,7 +46,7 @@
 #include <numbers>
 #include <queue>
 #include <set>
-#include <sstream>
+#include <stdexcept>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -596,17 +596,42 @@ private:
             l = std::max(l, std::sqrt(CGAL::squared_distance(M_.point(v[std::size_t(k)]), M_.point(v[std::size_t((k + 1) % 3)]))));
         return l;
     }
-    // Does face f meet the component in the view, or come closer to it than snapping can move things?
+    // The largest distance along view rays between the patch and a mesh face it belongs to.
+    double gapTolerance(FaceIndex f) const { return O_.maxGapRatio * (longestEdge(f) + h3_); }
+    // Does face f meet the component in the view (or come closer to it than snapping can move things), on
+    // the same sheet: the patch triangles there lie on f's plane, not in front of it (an occluder) or
+    // behind it (f occludes them)?
     bool meetsComponent(FaceIndex f) {
         const Triangle2 t = faceTriangle(f);
         const double r2 = margin_ * margin_;
+        const double tolerance = gapTolerance(f);
         bool hit = false;
         compGrid_.query(grown(t.bbox(), margin_), [&](int i) {
             if (hit) return;
-            const Triangle2 p = patchTriangle(faces_[std::size_t(i)]);
-            hit = CGAL::do_intersect(t, p) || CGAL::squared_distance(t, p) <= r2;
+            const int pf = faces_[std::size_t(i)];
+            const Triangle2 p = patchTriangle(pf);
+            if (!CGAL::do_intersect(t, p) && CGAL::squared_distance(t, p) > r2) return;
+            for (int v : P_.tri[std::size_t(pf)])
+                if (gapTo(P_.pos[std::size_t(v)], f) <= tolerance) hit = true;
         });
         return hit;
+    }
+    // Distance along p's view ray from p to the patch surface at uv (infinite when uv is off the patch).
+    double gapToPatch(const Vec3& p, const Point2& uv) {
+        double gap = std::numeric_limits<double>::infinity();
+        compGrid_.query(uv.bbox(), [&](int i) {
+            const auto& tri = P_.tri[std::size_t(faces_[std::size_t(i)])];
+            const Triangle2 t = patchTriangle(faces_[std::size_t(i)]);
+            if (!inTriangle(uv, t[0], t[1], t[2])) return;
+            const Vec3 &A = P_.pos[std::size_t(tri[0])], &B = P_.pos[std::size_t(tri[1])], &C = P_.pos[std::size_t(tri[2])];
+            const Vec3 n = normalOf(A, B, C);
+            Vec3 o, d;
+            V_.rayThrough(p, o, d);
+            const double den = n.dot(d);
+            if (!(std::abs(den) > 0)) return;
+            gap = std::min(gap, (p - (o + d * (n.dot(A - o) / den))).norm());
+        });
+        return gap;
     }
 
     // ---- step 1: the region under the component
@@ -765,6 +790,40 @@ private:
             }
         return true;
     }
+    // A point inside the overlap of two counter-clockwise triangles (centre of s clipped by t).
+    static Point2 overlapCentre(const Triangle2& s, const Triangle2& t) {
+        std::vector<Point2> poly{s[0], s[1], s[2]};
+        for (int k = 0; k < 3 && !poly.empty(); ++k) {
+            const Point2 &a = t[k], &b = t[(k + 1) % 3];
+            std::vector<Point2> out;
+            for (std::size_t i = 0; i < poly.size(); ++i) {
+                const Point2 &p = poly[i], &q = poly[(i + 1) % poly.size()];
+                const double dp = area2(a, b, p), dq = area2(a, b, q);
+                if (dp >= 0) out.push_back(p);
+                if ((dp >= 0) != (dq >= 0)) {
+                    const double u = dp / (dp - dq);
+                    out.emplace_back(p.x() + u * (q.x() - p.x()), p.y() + u * (q.y() - p.y()));
+                }
+            }
+            poly.swap(out);
+        }
+        if (poly.empty()) return CGAL::centroid(s);
+        double x = 0, y = 0;
+        for (const Point2& p : poly) {
+            x += p.x();
+            y += p.y();
+        }
+        return {x / double(poly.size()), y / double(poly.size())};
+    }
+    // Distance from the eye (along the view direction) of face f's plane at view position q.
+    double depthAt(FaceIndex f, const Point2& q) const {
+        const Ray ray = V_.camera().ray(q.x(), -q.y());
+        const auto v = faceVertices(f);
+        const Vec3 A = toVec(M_.point(v[0])), n = normalOf(A, toVec(M_.point(v[1])), toVec(M_.point(v[2])));
+        const double den = n.dot(ray.direction);
+        if (!(std::abs(den) > 0)) return std::numeric_limits<double>::infinity();
+        return V_.camera().viewDepth(ray.origin + ray.direction * (n.dot(A - ray.origin) / den));
+    }
     bool splitRegion(Attempt& a) {
         BucketGrid segments(2.0 * h2_, pedges_.size());
         for (std::size_t i = 0; i < pedges_.size(); ++i)
@@ -800,7 +859,7 @@ private:
                 while (parent[std::size_t(x)] != x) x = parent[std::size_t(x)] = parent[std::size_t(parent[std::size_t(x)])];
                 return x;
             };
-            std::vector<char> folded(region_.size(), 0);
+            std::vector<char> folded(region_.size(), 0), hidden(region_.size(), 0);
             for (std::size_t i = 0; i < region_.size(); ++i) {
                 const Triangle2 t = faceTriangle(region_[i]);
                 regionGrid_.query(t.bbox(), [&](int j) {
@@ -808,21 +867,32 @@ private:
                     if (!interiorsOverlap(region_[i], region_[std::size_t(j)])) return;
                     folded[i] = folded[std::size_t(j)] = 1;
                     parent[std::size_t(find(j))] = find(int(i));
+                    // The one farther from the eye where they overlap is hidden there.
+                    const Point2 q = overlapCentre(t, faceTriangle(region_[std::size_t(j)]));
+                    hidden[depthAt(region_[i], q) > depthAt(region_[std::size_t(j)], q) ? i : std::size_t(j)] = 1;
                 });
             }
             std::unordered_map<int, bool> clusterAtSeam;
             for (std::size_t i = 0; i < region_.size(); ++i)
                 if (folded[i] && isSeam.count(std::uint32_t(region_[i]))) clusterAtSeam[find(int(i))] = true;
-            for (std::size_t i = 0; i < region_.size(); ++i) {
-                if (!folded[i] || !clusterAtSeam.count(find(int(i)))) continue;
-                const Triangle2 t = faceTriangle(region_[i]);
-                const double r = margin_ + h2_;
-                compGrid_.query(grown(t.bbox(), r), [&](int k) {
-                    const Triangle2 p = patchTriangle(faces_[std::size_t(k)]);
-                    if (CGAL::do_intersect(t, p) || CGAL::squared_distance(t, p) <= r * r)
-                        for (int v : P_.tri[std::size_t(faces_[std::size_t(k)])]) bad.push_back(v);
-                });
-            }
+            // Cut the patch back around the hidden faces, where it lies on their sheet; if that frees
+            // nothing, around the whole fold.
+            const double r = margin_ + h2_;
+            for (int pass = 0; pass < 2 && bad.empty(); ++pass)
+                for (std::size_t i = 0; i < region_.size(); ++i) {
+                    if (!folded[i] || !clusterAtSeam.count(find(int(i))) || (pass == 0 && !hidden[i])) continue;
+                    const FaceIndex g = region_[i];
+                    const Triangle2 t = faceTriangle(g);
+                    const double tolerance = gapTolerance(g);
+                    compGrid_.query(grown(t.bbox(), r), [&](int k) {
+                        const auto& tri = P_.tri[std::size_t(faces_[std::size_t(k)])];
+                        const Triangle2 p = patchTriangle(faces_[std::size_t(k)]);
+                        if (!CGAL::do_intersect(t, p) && CGAL::squared_distance(t, p) > r * r) return;
+                        bool onSheet = pass == 1;
+                        for (int v : tri) onSheet = onSheet || gapTo(P_.pos[std::size_t(v)], g) <= tolerance;
+                        if (onSheet) bad.insert(bad.end(), tri.begin(), tri.end());
+                    });
+                }
             if (!bad.empty()) return fail(a, "the mesh under its boundary folds over itself in the scan's view", std::move(bad));
         }
         // Faces connected to the interior ones, away from the seam, lying under the patch in the view.
@@ -837,10 +907,12 @@ private:
                     continue;
                 }
                 if (isSeam.count(std::uint32_t(g)) || isInterior.count(std::uint32_t(g))) continue;
+                // Under the patch in the view, on its sheet (not a part of the mesh far behind or in front).
                 bool under = true;
+                const double tolerance = gapTolerance(g);
                 for (VertexIndex v : CGAL::vertices_around_face(M_.halfedge(g), M_)) {
                     const VProj& p = vproj(v);
-                    if (!p.ok || !insidePatch(p.uv)) under = false;
+                    if (!p.ok || !(gapToPatch(toVec(M_.point(v)), p.uv) <= tolerance)) under = false;
                 }
                 if (!under) {
                     addNear(bad, vproj(M_.target(h)).uv); // a face reaching out without a seam: a fold, a hole
@@ -1291,7 +1363,7 @@ private:
             if (l.kind == LVert::PatchBoundary && !uncovered) {
                 // The patch must lie on the surface under it (not on an occluder or another sheet).
                 const FaceIndex f = region_[std::size_t(v->face()->info().region)];
-                if (gapTo(l.pos, f) > O_.maxGapRatio * (longestEdge(f) + h3_)) addBad(bad, int(i));
+                if (gapTo(l.pos, f) > gapTolerance(f)) addBad(bad, int(i));
             }
         }
         if (!bad.empty()) return fail(a, "it reaches past the visible, stitchable part of the mesh", std::move(bad));
@@ -2397,7 +2469,14 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
         const bool curQ = current.property_map<FaceIndex, float>(props::faceQuality).second;
         const bool curS = current.property_map<FaceIndex, std::int32_t>(props::faceScanId).second;
         ComponentStitcher stitcher(current, P, view, options, faceIds, w.faces, curQ, curS);
-        Attempt a = stitcher.run();
+        Attempt a;
+        try {
+            a = stitcher.run(); // never touches `current`
+        } catch (const CGAL::Failure_exception& e) {
+            a.reason = "an internal geometric check failed (" + std::string(e.what()) + ")";
+        } catch (const std::logic_error& e) {
+            a.reason = "an internal consistency check failed (" + std::string(e.what()) + ")";
+        }
         if (!a.ok) {
             if (a.bad.empty() || w.rounds >= options.maxTrimRounds) {
                 skip(w, a.reason);

@@ -48,7 +48,7 @@ struct StitchOptions {
     /// A patch boundary vertex whose distance to the current surface along its view ray exceeds this × (the
     /// longest edge of the face under it + the patch's median edge length) is trimmed: the patch does not
     /// belong to that surface there (an occluder, another sheet).
-    double maxGapRatio = 1.0;
+    double maxGapRatio = 0.25;
     /// Rounds of trimming a component (removing the patch faces at places that cannot be stitched safely)
     /// before it is skipped.
     int maxTrimRounds = 16;
