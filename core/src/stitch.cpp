@@ -2442,19 +2442,17 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
         int rounds;  // trim rounds used
     };
     std::deque<Work> work;
-    {
-        int n = 0;
-        for (auto& c : components(P, all)) work.push_back({std::move(c), ++n, 0});
+    std::vector<std::size_t> componentFaces; // faces of each original component
+    for (auto& c : components(P, all)) {
+        componentFaces.push_back(c.size());
+        work.push_back({std::move(c), int(componentFaces.size()), 0});
     }
-    const int componentCount = int(work.size());
-    std::string firstReason;
-    auto skip = [&](const Work& w, const std::string& why) {
-        ++report.componentsSkipped;
+    const int componentCount = int(componentFaces.size());
+    std::map<int, std::string> firstReason; // per original component: the first reason a piece was dropped
+    std::set<int> stitched;                 // original components with at least one piece glued in
+    auto drop = [&](const Work& w, const std::string& why) {
         report.patchFacesTrimmed += w.faces.size();
-        const std::string s = "Patch component " + std::to_string(w.name) + " (" + std::to_string(w.faces.size()) +
-                              " faces) was not stitched: " + why + ".";
-        report.skipped.push_back(s);
-        if (firstReason.empty()) firstReason = why;
+        firstReason.try_emplace(w.name, why);
     };
 
     bool propsReady = false;
@@ -2463,7 +2461,8 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
         Work w = std::move(work.front());
         work.pop_front();
         if (w.faces.size() < options.minComponentFaces) {
-            skip(w, "it has fewer than " + std::to_string(options.minComponentFaces) + " faces");
+            drop(w, w.rounds == 0 ? "it has fewer than " + std::to_string(options.minComponentFaces) + " faces"
+                                  : "what trimming left of it was too small");
             continue;
         }
         const bool curQ = current.property_map<FaceIndex, float>(props::faceQuality).second;
@@ -2478,10 +2477,6 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
             a.reason = "an internal consistency check failed (" + std::string(e.what()) + ")";
         }
         if (!a.ok) {
-            if (a.bad.empty() || w.rounds >= options.maxTrimRounds) {
-                skip(w, a.reason);
-                continue;
-            }
             // Trim the faces around the problem and retry what is left (it may fall apart).
             std::unordered_set<int> bad(a.bad.begin(), a.bad.end());
             std::vector<int> rest;
@@ -2489,18 +2484,12 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
                 const auto& t = P.tri[std::size_t(f)];
                 if (!bad.count(t[0]) && !bad.count(t[1]) && !bad.count(t[2])) rest.push_back(f);
             }
-            if (rest.size() == w.faces.size()) {
-                skip(w, a.reason);
+            if (rest.size() == w.faces.size() || w.rounds >= options.maxTrimRounds) {
+                drop(w, a.reason);
                 continue;
             }
             report.patchFacesTrimmed += w.faces.size() - rest.size();
-            if (rest.empty()) {
-                ++report.componentsSkipped;
-                const std::string why = a.reason;
-                report.skipped.push_back("Patch component " + std::to_string(w.name) + " was trimmed away: " + why + ".");
-                if (firstReason.empty()) firstReason = why;
-                continue;
-            }
+            firstReason.try_emplace(w.name, a.reason);
             for (auto& c : components(P, rest)) work.push_front({std::move(c), w.name, w.rounds + 1});
             continue;
         }
@@ -2520,7 +2509,8 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
                 if (s.second) s.first[f] = plan.scanId[i];
             });
         if (!applied) throw Error("Internal error: a rehearsed stitch could not be applied to the mesh.");
-        ++report.componentsStitched;
+        stitched.insert(w.name);
+        ++report.piecesStitched;
         report.facesRemoved += plan.removed.size();
         report.facesAdded += plan.faces.size();
         report.seamEdges += plan.seamEdges;
@@ -2533,11 +2523,19 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
         }
         report.seamFaces += plan.seamFaceMinAngles.size();
     }
+    report.componentsStitched = int(stitched.size());
+    for (int c = 1; c <= componentCount; ++c) {
+        if (stitched.count(c)) continue;
+        ++report.componentsSkipped;
+        report.skipped.push_back("Patch component " + std::to_string(c) + " (" +
+                                 std::to_string(componentFaces[std::size_t(c - 1)]) + " faces) was not stitched: " +
+                                 firstReason[c] + ".");
+    }
     report.seamFracMinAngleAbove25 = report.seamFaces ? double(seamFacesAbove25) / double(report.seamFaces) : 1.0;
     if (report.componentsStitched == 0)
         throw InvalidInputError("No part of the patch could be stitched" +
                                 (componentCount > 1 ? " (" + std::to_string(componentCount) + " components)" : std::string()) +
-                                ": " + (firstReason.empty() ? std::string("it is empty") : firstReason) + ".");
+                                ": " + (firstReason.empty() ? std::string("it is empty") : firstReason.begin()->second) + ".");
     if (options.collectGarbage) current.collect_garbage();
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return report;

@@ -52,8 +52,9 @@ struct StitchOptions {
     /// Rounds of trimming a component (removing the patch faces at places that cannot be stitched safely)
     /// before it is skipped.
     int maxTrimRounds = 16;
-    /// Components (or pieces left by trimming) with fewer faces are dropped and reported.
-    std::size_t minComponentFaces = 1;
+    /// Components (and pieces left by trimming) with fewer faces are not stitched: a few isolated triangles
+    /// only add seam.
+    std::size_t minComponentFaces = 8;
     /// Call collect_garbage() on the mesh at the end (renumbers all indices, O(mesh)). When false the
     /// removed elements stay as garbage that later additions reuse.
     bool collectGarbage = false;
@@ -70,12 +71,13 @@ struct StitchReport {
     double seamMinAngleDeg = 180;      ///< smallest angle of the faces touching the seam (180 when none)
     double seamFracMinAngleAbove25 = 1; ///< fraction of those faces whose smallest angle is ≥ 25°
     std::size_t seamFaces = 0;         ///< number of faces touching the seam
-    int componentsStitched = 0;        ///< patch components (or pieces of them after trimming) glued in
-    int componentsSkipped = 0;         ///< components left out, each with a sentence in `skipped`
-    std::size_t patchFacesTrimmed = 0; ///< patch faces dropped so that the rest could be stitched
+    int componentsStitched = 0;        ///< patch components glued in (wholly or the part left by trimming)
+    int componentsSkipped = 0;         ///< patch components left out entirely, each with a sentence in `skipped`
+    int piecesStitched = 0;            ///< pieces glued in (a component trimmed apart counts each piece)
+    std::size_t patchFacesTrimmed = 0; ///< patch faces left out (trimmed, dropped or in skipped components)
     std::size_t collapses = 0;         ///< seam edge collapses performed
     std::size_t flips = 0;             ///< seam edge flips performed
-    std::vector<std::string> skipped;  ///< one sentence per skipped component
+    std::vector<std::string> skipped;  ///< one sentence per skipped component (and for dropped back-facing faces)
     double seconds = 0;                ///< wall time
 };
 
