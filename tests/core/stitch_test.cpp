@@ -8,6 +8,7 @@
 #include "test_data.h"
 
 #include <CGAL/Polygon_mesh_processing/measure.h>
+#include <CGAL/boost/graph/Euler_operations.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh/IO/OFF.h>
 
@@ -781,4 +782,34 @@ TEST(Stitch, CollectGarbageOnRequest) {
     EXPECT_FALSE(grid.has_garbage());
     expectValid(grid, {false, 1});
     EXPECT_NEAR(sumArea(grid), 100.0, 100.0 * 1e-9);
+}
+
+TEST(Stitch, PatchOverAHoleOfTheMeshKeepsTheHole) {
+    Mesh grid = fss::shapes::grid(20, 20, 1.0);
+    // Punch a 2 x 2 hole in the middle.
+    std::vector<FaceIndex> hole;
+    for (auto f : grid.faces()) {
+        const auto c = CGAL::centroid(grid.point(grid.source(grid.halfedge(f))), grid.point(grid.target(grid.halfedge(f))),
+                                      grid.point(grid.target(grid.next(grid.halfedge(f)))));
+        if (c.x() > 9 && c.x() < 11 && c.y() > 9 && c.y() < 11) hole.push_back(f);
+    }
+    for (auto f : hole) CGAL::Euler::remove_face(grid.halfedge(f), grid);
+    ASSERT_EQ(boundaryLoops(grid), 2u);
+    const double area = PMP::area(grid);
+    const Camera cam = downCamera(10.2, 9.9, 30, 6.0, 96);
+    const Mesh patch = makePatch(cam, [](int x, int y) { return x >= 24 && x < 72 && y >= 24 && y < 72; }, planeZ0());
+    const fss::StitchReport r = fss::stitchPatch(grid, patch, cam);
+    SCOPED_TRACE(reportText(r));
+    EXPECT_EQ(r.componentsStitched, 1);
+    EXPECT_GT(r.patchFacesTrimmed, 0u);
+    expectValid(grid, {false, 2});
+    EXPECT_NEAR(PMP::area(grid), area, area * 1e-9);
+    // The hole is still there: no face covers its centre.
+    for (auto f : grid.faces()) {
+        auto h = grid.halfedge(f);
+        const fss::Kernel::Triangle_2 t({grid.point(grid.source(h)).x(), grid.point(grid.source(h)).y()},
+                                        {grid.point(grid.target(h)).x(), grid.point(grid.target(h)).y()},
+                                        {grid.point(grid.target(grid.next(h))).x(), grid.point(grid.target(grid.next(h))).y()});
+        EXPECT_FALSE(t.has_on_bounded_side({10.0, 10.0}));
+    }
 }
