@@ -1894,7 +1894,7 @@ private:
             // ... and not make the smallest angle there worse.
             const Vec3 X = pt(S, x), Y = pt(S, y), Z = pt(S, z), U = pt(S, u);
             if (std::min({minAngle(X, mid, Z), minAngle(mid, Y, Z), minAngle(Y, mid, U), minAngle(mid, X, U)}) <
-                std::min(minAngle(X, Y, Z), minAngle(Y, X, U)))
+                0.99 * std::min(minAngle(X, Y, Z), minAngle(Y, X, U)))
                 continue;
             const HalfedgeIndex hn = CGAL::Euler::split_edge(h, S);
             const VertexIndex v = S.target(hn);
@@ -1962,12 +1962,20 @@ private:
             if (CGAL::collinear(S.point(x), S.point(z2), S.point(z1)) || CGAL::collinear(S.point(z2), S.point(y), S.point(z1))) continue;
             const Vec3 X = pt(S, x), Y = pt(S, y), Z1 = pt(S, z1), Z2 = pt(S, z2);
             const Vec3 o1 = normalOf(X, Y, Z1), o2 = normalOf(Y, X, Z2), n1 = normalOf(X, Z2, Z1), n2 = normalOf(Z2, Y, Z1);
-            // Outside the patch a flip may not change the surface (the pieces must be coplanar); on the
-            // patch side it may not turn a normal more than maxNormalChangeDeg.
+            // On the patch side a flip may not turn a normal more than maxNormalChangeDeg. Outside the patch
+            // it may not change the surface: the pieces are coplanar, or they are pieces of one mesh face
+            // (tilted only where they reach a patch vertex) and the new ones are tilted no more.
             const bool patchSide = loc.patchSide[S.face(h)];
             if (patchSide != loc.patchSide[S.face(o)]) continue;
             const double turn = std::max({angleBetween(o1, n1), angleBetween(o1, n2), angleBetween(o2, n1), angleBetween(o2, n2)});
-            if (turn > (patchSide ? maxTurn : kCoplanar)) continue;
+            if (patchSide) {
+                if (turn > maxTurn) continue;
+            } else if (turn > kCoplanar) {
+                const Vec3 &p1 = loc.planeNormal[S.face(h)], &p2 = loc.planeNormal[S.face(o)];
+                if (angleBetween(p1, p2) > kCoplanar) continue;
+                const double tilt = std::max(angleBetween(o1, p1), angleBetween(o2, p1));
+                if (std::max(angleBetween(n1, p1), angleBetween(n2, p1)) > tilt + kCoplanar || turn > maxTurn) continue;
+            }
             const double oldMin = std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2));
             const double newMin = std::min(minAngle(X, Z2, Z1), minAngle(Z2, Y, Z1));
             const int devOld = valenceCost(x, 0) + valenceCost(y, 0) + valenceCost(z1, 0) + valenceCost(z2, 0);
