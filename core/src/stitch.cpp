@@ -1851,6 +1851,65 @@ private:
         }
         collapsePass();
         flipPass(loc, plan);
+        // -- smoothing: the vertices added outside the patch move within their face's plane towards the
+        // centre of their neighbours where that raises the smallest angle around them.
+        for (int pass = 0; pass < 3; ++pass) {
+            if (smoothOutside(loc) == 0) break;
+            flipPass(loc, plan);
+        }
+    }
+
+    std::size_t smoothOutside(Local& loc) {
+        Mesh& S = loc.star.S;
+        const auto near = seamNeighbourhood(loc);
+        std::vector<std::uint32_t> order(near.begin(), near.end());
+        std::sort(order.begin(), order.end());
+        std::size_t moved = 0;
+        for (std::uint32_t vi : order) {
+            const VertexIndex v(vi);
+            if (S.is_removed(v) || loc.locked[v] || loc.lid[v] >= 0 || loc.star.cur[v] != kNone) continue;
+            if (S.halfedge(v) == Mesh::null_halfedge()) continue;
+            // All faces around: pieces of one mesh face (a Steiner point inside it, not on a mesh edge).
+            Vec3 n(0, 0, 0);
+            bool inPlane = true;
+            std::vector<std::pair<VertexIndex, VertexIndex>> ring; // (p, q): faces (v, p, q)
+            Vec3 centre(0, 0, 0);
+            int count = 0;
+            for (HalfedgeIndex g : CGAL::halfedges_around_target(S.halfedge(v), S)) {
+                const FaceIndex f = S.face(g);
+                if (f == Mesh::null_face() || loc.star.kept[f] || loc.patchSide[f]) {
+                    inPlane = false;
+                    break;
+                }
+                if (count == 0) n = loc.planeNormal[f];
+                else if (angleBetween(n, loc.planeNormal[f]) > kCoplanar) inPlane = false;
+                ring.push_back({S.target(S.next(g)), S.source(g)});
+                centre += pt(S, S.source(g));
+                ++count;
+            }
+            if (!inPlane || count < 3) continue;
+            centre /= double(count);
+            const Vec3 p0 = pt(S, v);
+            const Vec3 p1 = centre - n * n.dot(centre - p0);
+            Point2 uv;
+            double w;
+            if (!V_.project(p1, uv, w)) continue;
+            double oldMin = std::numbers::pi, newMin = std::numbers::pi;
+            bool valid = true;
+            for (const auto& [p, q] : ring) {
+                if (!leftTurn(uv, loc.uv[p], loc.uv[q]) || CGAL::collinear(toPoint(p1), S.point(p), S.point(q))) {
+                    valid = false;
+                    break;
+                }
+                oldMin = std::min(oldMin, minAngle(p0, pt(S, p), pt(S, q)));
+                newMin = std::min(newMin, minAngle(p1, pt(S, p), pt(S, q)));
+            }
+            if (!valid || !(newMin > oldMin)) continue;
+            S.point(v) = toPoint(p1);
+            loc.uv[v] = uv;
+            ++moved;
+        }
+        return moved;
     }
 
     std::size_t refineOutside(Local& loc) {
