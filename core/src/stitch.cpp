@@ -383,6 +383,7 @@ struct LVert {
     int patchA = -1, patchB = -1; // the patch vertex it stands for, or the patch boundary edge it lies on
     bool alive = true;         // false for patch boundary vertices merged into a region vertex
     bool chain = false;        // lies on the patch boundary (a seam vertex)
+    int edgeU = -1, edgeW = -1; // crossings and vertices snapped onto a mesh edge: that edge's ends
     Vec3 pos{0, 0, 0};
     Point2 uv{0, 0};
 };
@@ -1089,6 +1090,8 @@ private:
                 LVert& l = L_[std::size_t(lid)];
                 l.pos = pos;
                 l.uv = q;
+                l.edgeU = redges_[std::size_t(best)].u;
+                l.edgeW = redges_[std::size_t(best)].w;
                 redges_[std::size_t(best)].splits.push_back({lineParam(q, L_[std::size_t(redges_[std::size_t(best)].u)].uv, L_[std::size_t(redges_[std::size_t(best)].w)].uv), lid});
             }
         }
@@ -1198,6 +1201,8 @@ private:
                     l.patchA = pe.a;
                     l.patchB = pe.b;
                     liftOnEdge(rs.owner, s, l.pos, l.uv);
+                    l.edgeU = re.u;
+                    l.edgeW = re.w;
                     const int id = addLocal(l);
                     re.splits.push_back({lineParam(l.uv, L_[std::size_t(re.u)].uv, L_[std::size_t(re.w)].uv), id});
                     pe.splits.push_back({lineParam(l.uv, L_uvOfPatch(pe.a), L_uvOfPatch(pe.b)), id});
@@ -1859,6 +1864,53 @@ private:
         }
     }
 
+    // A seam vertex on a mesh edge (a crossing, a snapped patch vertex) slides along that edge towards the
+    // centre of its neighbours where that raises the smallest angle around it: the pieces outside stay in
+    // their faces' planes; the patch side turns no normal more than maxNormalChangeDeg.
+    int slideAlongEdge(Local& loc, VertexIndex v) {
+        Mesh& S = loc.star.S;
+        const LVert& l = L_[std::size_t(loc.lid[v])];
+        if (l.edgeU < 0) return 0;
+        const Vec3 U = L_[std::size_t(l.edgeU)].pos, W = L_[std::size_t(l.edgeW)].pos;
+        Vec3 centre(0, 0, 0);
+        int count = 0;
+        std::vector<std::pair<VertexIndex, VertexIndex>> ring;
+        std::vector<FaceIndex> faces;
+        for (HalfedgeIndex g : CGAL::halfedges_around_target(S.halfedge(v), S)) {
+            const FaceIndex f = S.face(g);
+            if (f == Mesh::null_face() || loc.star.kept[f]) return 0;
+            ring.push_back({S.target(S.next(g)), S.source(g)});
+            faces.push_back(f);
+            centre += pt(S, S.source(g));
+            ++count;
+        }
+        if (count < 3) return 0;
+        centre /= double(count);
+        const double len2 = (W - U).squaredNorm();
+        if (!(len2 > 0)) return 0;
+        const double t = std::clamp((centre - U).dot(W - U) / len2, 0.02, 0.98);
+        const Vec3 p0 = pt(S, v), p1 = U + t * (W - U);
+        Point2 uv;
+        double w;
+        if (!V_.project(p1, uv, w)) return 0;
+        double oldMin = std::numbers::pi, newMin = std::numbers::pi;
+        for (std::size_t i = 0; i < ring.size(); ++i) {
+            const auto [p, q] = ring[i];
+            if (!leftTurn(uv, loc.uv[p], loc.uv[q]) || CGAL::collinear(toPoint(p1), S.point(p), S.point(q))) return 0;
+            if (loc.patchSide[faces[i]] &&
+                angleBetween(normalOf(p0, pt(S, p), pt(S, q)), normalOf(p1, pt(S, p), pt(S, q))) > O_.maxNormalChangeDeg * kDeg)
+                return 0;
+            const double before = minAngle(p0, pt(S, p), pt(S, q)), after = minAngle(p1, pt(S, p), pt(S, q));
+            if (after < loc.minAllowed[faces[i]]) return 0;
+            oldMin = std::min(oldMin, before);
+            newMin = std::min(newMin, after);
+        }
+        if (!(newMin > oldMin)) return 0;
+        S.point(v) = toPoint(p1);
+        loc.uv[v] = uv;
+        return 1;
+    }
+
     std::size_t smoothOutside(Local& loc) {
         Mesh& S = loc.star.S;
         const auto near = seamNeighbourhood(loc);
@@ -1867,8 +1919,12 @@ private:
         std::size_t moved = 0;
         for (std::uint32_t vi : order) {
             const VertexIndex v(vi);
-            if (S.is_removed(v) || loc.locked[v] || loc.lid[v] >= 0 || loc.star.cur[v] != kNone) continue;
+            if (S.is_removed(v) || loc.locked[v] || loc.star.cur[v] != kNone) continue;
             if (S.halfedge(v) == Mesh::null_halfedge()) continue;
+            if (loc.lid[v] >= 0) {
+                moved += slideAlongEdge(loc, v);
+                continue;
+            }
             // All faces around: pieces of one mesh face (a Steiner point inside it, not on a mesh edge).
             Vec3 n(0, 0, 0);
             bool inPlane = true;
