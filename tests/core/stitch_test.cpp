@@ -376,6 +376,21 @@ double sumArea(const Mesh& m) { return PMP::area(m); }
 
 } // namespace
 
+TEST(Stitch, ParallelCamera) {
+    Mesh grid = fss::shapes::grid(12, 12, 1.0);
+    Camera cam = downCamera(6.1, 5.8, 20, -9.0, 80);
+    cam.parallel = true;
+    cam.parallelScale = 5.0;
+    const fss::StitchReport r = fss::stitchPatch(grid, makePatch(cam, disk(40, 38, 22), planeZ0()), cam);
+    SCOPED_TRACE(reportText(r));
+    EXPECT_EQ(r.componentsStitched, 1);
+    EXPECT_EQ(r.patchFacesTrimmed, 0u);
+    expectValid(grid, {false, 1});
+    EXPECT_NEAR(sumArea(grid), 144.0, 144.0 * 1e-9);
+    for (auto v : grid.vertices()) EXPECT_EQ(grid.point(v).z(), 0.0);
+    EXPECT_EQ(facesNotFacing(grid, cam, {}), 0u);
+}
+
 TEST(Stitch, SphereChainedPatchesStayClosed) {
     Mesh m = fss::shapes::icosphere(3, 1.0);
     const double sag = sphereSag(m, 1.0);
@@ -657,6 +672,16 @@ TEST(Stitch, RandomChainedScansKeepAllInvariants) {
             }
             expectValid(m, {true, 0});
             expectOnSphere(m, 1.0, sag * 1.0001);
+            // This scan's faces face its camera.
+            auto sid = m.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId);
+            if (sid.second) {
+                std::set<std::uint32_t> mine;
+                for (auto f : m.faces())
+                    if (sid.first[f] == i + 1) mine.insert(std::uint32_t(f));
+                if (!mine.empty()) {
+                    EXPECT_EQ(facesNotFacing(m, cam, mine), 0u);
+                }
+            }
             if (HasFailure()) return;
         }
     }
