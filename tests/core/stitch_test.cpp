@@ -838,3 +838,32 @@ TEST(Stitch, PatchOverAHoleOfTheMeshKeepsTheHole) {
         EXPECT_FALSE(t.has_on_bounded_side({10.0, 10.0}));
     }
 }
+
+TEST(Stitch, DegenerateAlignmentsWithTheMesh) {
+    // Parallel scans whose pixel centres fall exactly on the grid's vertices, on its edges' midpoints and
+    // on its diagonals: every kind of exact contact between patch and mesh elements.
+    for (const double offset : {0.0, 0.5, 0.25}) {
+        for (const bool flipDiagonal : {false, true}) {
+            SCOPED_TRACE("offset " + std::to_string(offset) + (flipDiagonal ? " flipped" : ""));
+            Mesh grid = fss::shapes::grid(16, 16, 1.0);
+            Camera cam;
+            cam.parallel = true;
+            cam.width = cam.height = 16;
+            cam.parallelScale = 8.0; // one pixel = one grid cell
+            cam.eye = {8.0 + offset, 8.0 + offset, 20.0};
+            cam.focal = {8.0 + offset, 8.0 + offset, 0.0};
+            cam.up = flipDiagonal ? Vec3(0, -1, 0) : Vec3(0, 1, 0);
+            cam.nearPlane = 1;
+            cam.farPlane = 40;
+            const Mesh patch = makePatch(cam, [](int x, int y) { return x >= 3 && x < 13 && y >= 4 && y < 12; }, planeZ0());
+            ASSERT_GT(patch.number_of_faces(), 100u);
+            const fss::StitchReport r = fss::stitchPatch(grid, patch, cam);
+            SCOPED_TRACE(reportText(r));
+            EXPECT_EQ(r.componentsStitched, 1);
+            expectValid(grid, {false, 1});
+            EXPECT_NEAR(sumArea(grid), 256.0, 256.0 * 1e-9);
+            EXPECT_GE(r.seamMinAngleDeg, 1.0);
+            EXPECT_EQ(r.patchFacesTrimmed, 0u);
+        }
+    }
+}
