@@ -867,3 +867,23 @@ TEST(Stitch, DegenerateAlignmentsWithTheMesh) {
         }
     }
 }
+
+TEST(Stitch, TorusSeenObliquelyWithSelfOcclusion) {
+    // A coarse torus scanned from views where the tube hides parts of itself: several sheets under one
+    // view, occlusion contours inside the patch.
+    const Mesh reference = fss::shapes::torus(72, 36, 1.0, 0.35);
+    const Surface surface = meshSurface(reference);
+    Mesh m = fss::shapes::torus(24, 12, 1.0, 0.35);
+    const Vec3 dirs[] = {{0.2, 0.1, 1}, {1, 0.3, 0.45}, {-0.3, -1, 0.25}, {0.5, -0.4, -0.8}};
+    int n = 0;
+    for (const Vec3& d : dirs) {
+        const Camera cam = orbitCamera(d, 4.5, 96);
+        const Mesh patch = makePatch(cam, disk(48, 48, 30), surface, ++n, 75.0);
+        const fss::StitchReport r = fss::stitchPatch(m, patch, cam);
+        SCOPED_TRACE(reportText(r));
+        EXPECT_GE(r.componentsStitched, 1);
+        expectValid(m, {true, 0});
+        EXPECT_GT(PMP::volume(m), 0.0);
+        std::printf("torus scan %d: %s\n", n, reportText(r).c_str());
+    }
+}
