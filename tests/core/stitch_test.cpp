@@ -53,7 +53,7 @@ Surface planeZ0() {
     };
 }
 
-[[maybe_unused]] Surface sphere(double radius) {
+Surface sphere(double radius) {
     return [radius](const fss::Ray& r) -> std::optional<Vec3> {
         const double b = r.origin.dot(r.direction), c = r.origin.squaredNorm() - radius * radius;
         const double disc = b * b - c;
