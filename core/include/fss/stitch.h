@@ -67,21 +67,27 @@ struct StitchOptions {
 
 /// What stitchPatch did.
 struct StitchReport {
-    std::size_t facesRemoved = 0;      ///< faces of the current mesh replaced
-    std::size_t facesAdded = 0;        ///< faces added (patch faces, re-triangulated pieces around the seam)
-    std::size_t seamEdges = 0;         ///< edges of the final seam (patch boundary ↔ old mesh)
-    double seamLength = 0;             ///< 3D length of the seam
-    double seamMinAngleDeg = 180;      ///< smallest angle of the faces touching the seam (180 when none)
-    double seamFracMinAngleAbove25 = 1; ///< fraction of those faces whose smallest angle is ≥ 25°
-    std::size_t seamFaces = 0;         ///< number of faces touching the seam
-    int componentsStitched = 0;        ///< patch components glued in (wholly or the part left by trimming)
-    int componentsSkipped = 0;         ///< patch components left out entirely, each with a sentence in `skipped`
-    int piecesStitched = 0;            ///< pieces glued in (a component trimmed apart counts each piece)
-    std::size_t patchFacesTrimmed = 0; ///< patch faces left out (trimmed, dropped or in skipped components)
-    std::size_t collapses = 0;         ///< seam edge collapses performed
-    std::size_t flips = 0;             ///< seam edge flips performed
-    std::vector<std::string> skipped;  ///< one sentence per skipped component (and for dropped back-facing faces)
-    double seconds = 0;                ///< wall time
+    std::size_t facesRemoved = 0; ///< faces of the current mesh replaced
+    std::size_t facesAdded = 0;   ///< faces added (patch faces, re-triangulated pieces around the seam)
+    std::size_t seamEdges = 0;    ///< edges of the final seam (patch boundary ↔ old mesh)
+    double seamLength = 0;        ///< 3D length of the seam
+    double seamMinAngleDeg = 180; ///< smallest angle of the faces touching the seam (180 when none)
+    /// Fraction of the faces touching the seam whose smallest angle is ≥ 25°.
+    double seamFracMinAngleAbove25 = 1;
+    std::size_t seamFaces = 0; ///< number of faces touching the seam
+    /// Patch components glued in (wholly or the part left by trimming).
+    int componentsStitched = 0;
+    /// Patch components left out entirely, each with a sentence in `skipped`.
+    int componentsSkipped = 0;
+    /// Pieces glued in (a component trimmed apart counts each piece).
+    int piecesStitched = 0;
+    /// Patch faces left out (trimmed, dropped, or in skipped components).
+    std::size_t patchFacesTrimmed = 0;
+    std::size_t collapses = 0; ///< seam edge collapses performed
+    std::size_t flips = 0;     ///< seam edge flips performed
+    /// One sentence per skipped component (and one for patch faces dropped as back-facing).
+    std::vector<std::string> skipped;
+    double seconds = 0; ///< wall time
 };
 
 /// Zippers \p patch into \p current (DESIGN.md §1 "Stitch", §6).
