@@ -9,7 +9,8 @@
 //  2. insert     snap patch boundary vertices onto nearby mesh vertices / edges and mesh vertices onto nearby
 //                patch boundary edges (no slivers), compute where patch boundary edges cross mesh edges (the
 //                new vertex lies on the 3D mesh edge, perspective-correct), and build a constrained Delaunay
-//                triangulation of the seam faces' edges and the patch boundary in the view (exact predicates).
+//                triangulation of the seam faces' edges and the patch boundary in the view (exact
+//                predicates).
 //  3. cut, glue  flood-fill the triangulation: which seam face each triangle lies in, inside or outside the
 //                patch. Seam faces are replaced by their outside triangles (in the face's plane: the surface
 //                outside does not move); patch triangles on the boundary are re-triangulated over the seam
@@ -65,13 +66,19 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 // Normals of pieces of one planar face agree to rounding; a flip between such pieces keeps the surface.
 constexpr double kCoplanar = 1e-4 * kDeg;
 
-Vec3 toVec(const Point3& p) { return {p.x(), p.y(), p.z()}; }
-Point3 toPoint(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+Vec3 toVec(const Point3& p) {
+    return {p.x(), p.y(), p.z()};
+}
+Point3 toPoint(const Vec3& v) {
+    return {v.x(), v.y(), v.z()};
+}
 std::uint64_t edgeKey(std::uint32_t a, std::uint32_t b) {
     if (a > b) std::swap(a, b);
     return (std::uint64_t(a) << 32) | b;
 }
-std::uint64_t dirKey(std::uint32_t a, std::uint32_t b) { return (std::uint64_t(a) << 32) | b; }
+std::uint64_t dirKey(std::uint32_t a, std::uint32_t b) {
+    return (std::uint64_t(a) << 32) | b;
+}
 
 bool leftTurn(const Point2& a, const Point2& b, const Point2& c) {
     return CGAL::orientation(a, b, c) == CGAL::LEFT_TURN;
@@ -84,7 +91,9 @@ bool inTriangle(const Point2& p, const Point2& a, const Point2& b, const Point2&
 double area2(const Point2& a, const Point2& b, const Point2& c) {
     return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
 }
-double dist2(const Point2& a, const Point2& b) { return CGAL::squared_distance(a, b); }
+double dist2(const Point2& a, const Point2& b) {
+    return CGAL::squared_distance(a, b);
+}
 // Parameter of the projection of p onto the line ab (0 at a, 1 at b).
 double lineParam(const Point2& p, const Point2& a, const Point2& b) {
     const double dx = b.x() - a.x(), dy = b.y() - a.y();
@@ -97,8 +106,12 @@ double segmentDistance(const Point2& p, const Point2& a, const Point2& b, double
     const Point2 q(a.x() + tc * (b.x() - a.x()), a.y() + tc * (b.y() - a.y()));
     return std::sqrt(dist2(p, q));
 }
-CGAL::Bbox_2 bboxOf(const Point2& a, const Point2& b) { return a.bbox() + b.bbox(); }
-CGAL::Bbox_2 bboxOf(const Point2& a, const Point2& b, const Point2& c) { return a.bbox() + b.bbox() + c.bbox(); }
+CGAL::Bbox_2 bboxOf(const Point2& a, const Point2& b) {
+    return a.bbox() + b.bbox();
+}
+CGAL::Bbox_2 bboxOf(const Point2& a, const Point2& b, const Point2& c) {
+    return a.bbox() + b.bbox() + c.bbox();
+}
 CGAL::Bbox_2 grown(const CGAL::Bbox_2& b, double r) {
     return {b.xmin() - r, b.ymin() - r, b.xmax() + r, b.ymax() + r};
 }
@@ -115,9 +128,12 @@ double minAngle(const Vec3& a, const Vec3& b, const Vec3& c) {
     }
     return best;
 }
-Vec3 normalOf(const Vec3& a, const Vec3& b, const Vec3& c) { return (b - a).cross(c - a); }
-double angleBetween(const Vec3& n1, const Vec3& n2) { return std::atan2(n1.cross(n2).norm(), n1.dot(n2)); }
-
+Vec3 normalOf(const Vec3& a, const Vec3& b, const Vec3& c) {
+    return (b - a).cross(c - a);
+}
+double angleBetween(const Vec3& n1, const Vec3& n2) {
+    return std::atan2(n1.cross(n2).norm(), n1.dot(n2));
+}
 
 // ---------------------------------------------------------------------------------------------------
 // The scan's view: projection to a 2D plane where front-facing triangles are counter-clockwise.
@@ -191,8 +207,10 @@ public:
 
 private:
     template <class F> void forCells(const CGAL::Bbox_2& b, F&& f) const {
-        const auto x0 = std::int64_t(std::floor(b.xmin() * inv_)), x1 = std::int64_t(std::floor(b.xmax() * inv_));
-        const auto y0 = std::int64_t(std::floor(b.ymin() * inv_)), y1 = std::int64_t(std::floor(b.ymax() * inv_));
+        const auto x0 = std::int64_t(std::floor(b.xmin() * inv_)),
+                   x1 = std::int64_t(std::floor(b.xmax() * inv_));
+        const auto y0 = std::int64_t(std::floor(b.ymin() * inv_)),
+                   y1 = std::int64_t(std::floor(b.ymax() * inv_));
         for (std::int64_t x = x0; x <= x1; ++x)
             for (std::int64_t y = y0; y <= y1; ++y)
                 f((std::uint64_t(std::uint32_t(x)) << 32) | std::uint32_t(y));
@@ -258,15 +276,15 @@ struct PlanVertex {
 
 // Everything needed to apply one component's stitch to the mesh, computed without touching it.
 struct Plan {
-    std::vector<FaceIndex> removed;                  // faces of the current mesh replaced (in this order)
-    std::vector<VertexIndex> reused;                 // vertices of removed faces that new faces use
-    std::vector<Vec3> freshPositions;                // new vertices, added in this order
-    std::vector<std::array<PlanVertex, 3>> faces;    // new faces, added in this order
+    std::vector<FaceIndex> removed;               // faces of the current mesh replaced (in this order)
+    std::vector<VertexIndex> reused;              // vertices of removed faces that new faces use
+    std::vector<Vec3> freshPositions;             // new vertices, added in this order
+    std::vector<std::array<PlanVertex, 3>> faces; // new faces, added in this order
     std::vector<float> quality;
     std::vector<std::int32_t> scanId;
     std::size_t seamEdges = 0;
     double seamLength = 0;
-    std::vector<double> seamFaceMinAngles;           // degrees, one per face touching the seam
+    std::vector<double> seamFaceMinAngles; // degrees, one per face touching the seam
     std::size_t collapses = 0, flips = 0;
 };
 
@@ -283,9 +301,11 @@ template <class VertexOf, class FaceOf, class OnFace>
 bool replay(Mesh& m, const Plan& plan, const VertexOf& vertexOf, const FaceOf& faceOf, const OnFace& onFace) {
     std::vector<VertexIndex> fresh;
     fresh.reserve(plan.freshPositions.size());
-    for (const Vec3& p : plan.freshPositions) fresh.push_back(m.add_vertex(toPoint(p)));
+    for (const Vec3& p : plan.freshPositions)
+        fresh.push_back(m.add_vertex(toPoint(p)));
     std::unordered_set<std::uint32_t> keep;
-    for (VertexIndex v : plan.reused) keep.insert(std::uint32_t(vertexOf(v)));
+    for (VertexIndex v : plan.reused)
+        keep.insert(std::uint32_t(vertexOf(v)));
     for (FaceIndex f : plan.removed)
         removeFaceKeeping(m, faceOf(f), [&](VertexIndex v) { return keep.count(std::uint32_t(v)) > 0; });
     for (std::size_t i = 0; i < plan.faces.size(); ++i) {
@@ -306,10 +326,10 @@ bool replay(Mesh& m, const Plan& plan, const VertexOf& vertexOf, const FaceOf& f
 // small local mesh on which the stitch is built, optimised, checked and rehearsed.
 struct Star {
     Mesh S;
-    std::unordered_map<std::uint32_t, VertexIndex> fromCurrent;  // current vertex → S vertex
+    std::unordered_map<std::uint32_t, VertexIndex> fromCurrent;   // current vertex → S vertex
     std::unordered_map<std::uint32_t, FaceIndex> faceFromCurrent; // current face → S face
-    Mesh::Property_map<VertexIndex, std::uint32_t> cur;          // S vertex → current vertex (kNone: new)
-    Mesh::Property_map<FaceIndex, bool> kept;                    // face of the current mesh that stays
+    Mesh::Property_map<VertexIndex, std::uint32_t> cur;           // S vertex → current vertex (kNone: new)
+    Mesh::Property_map<FaceIndex, bool> kept;                     // face of the current mesh that stays
     std::vector<VertexIndex> full; // S vertices whose whole star is in S (vertices of the replaced faces)
     std::unordered_set<std::uint32_t> fullCurrent; // the same, as current-mesh vertices
     // Is the whole star of S vertex v in S (a vertex of the replaced faces, or a new one)?
@@ -361,7 +381,7 @@ bool buildStar(const Mesh& M, const std::vector<FaceIndex>& replaced, Star& st) 
 // ---------------------------------------------------------------------------------------------------
 // Constrained Delaunay triangulation of the view.
 struct CdtFaceInfo {
-    int region = -1;       // index of the region face the triangle lies in
+    int region = -1;         // index of the region face the triangle lies in
     std::int8_t inside = -1; // 1 inside the patch, 0 outside, -1 unknown
 };
 struct CdtVertexInfo {
@@ -379,10 +399,11 @@ using CdtFace = Cdt::Face_handle;
 struct LVert {
     enum Kind : std::uint8_t { Region, PatchBoundary, Crossing, PatchInterior };
     Kind kind = Region;
-    std::uint32_t cur = kNone; // Region: the current-mesh vertex
+    std::uint32_t cur = kNone;    // Region: the current-mesh vertex
     int patchA = -1, patchB = -1; // the patch vertex it stands for, or the patch boundary edge it lies on
-    bool alive = true;         // false for patch boundary vertices merged into a region vertex
-    bool chain = false;        // lies on the patch boundary (a seam vertex)
+    bool alive = true;            // false for patch boundary vertices merged into a region vertex
+    bool chain = false;           // lies on the patch boundary (a seam vertex)
+    int edgeU = -1, edgeW = -1;   // crossings and vertices snapped onto a mesh edge: that edge's ends
     Vec3 pos{0, 0, 0};
     Point2 uv{0, 0};
 };
@@ -448,7 +469,8 @@ private:
         for (int f : faces_) {
             const auto& t = P_.tri[std::size_t(f)];
             for (int k = 0; k < 3; ++k) {
-                directed.push_back(dirKey(std::uint32_t(t[std::size_t(k)]), std::uint32_t(t[std::size_t((k + 1) % 3)])));
+                directed.push_back(
+                    dirKey(std::uint32_t(t[std::size_t(k)]), std::uint32_t(t[std::size_t((k + 1) % 3)])));
                 compVerts_.push_back(t[std::size_t(k)]);
             }
         }
@@ -460,7 +482,8 @@ private:
             const auto& t = P_.tri[std::size_t(f)];
             for (int k = 0; k < 3; ++k) {
                 const int p = t[std::size_t(k)], q = t[std::size_t((k + 1) % 3)];
-                const bool border = !std::binary_search(directed.begin(), directed.end(), dirKey(std::uint32_t(q), std::uint32_t(p)));
+                const bool border = !std::binary_search(directed.begin(), directed.end(),
+                                                        dirKey(std::uint32_t(q), std::uint32_t(p)));
                 if (border) {
                     pedgeIndex_[dirKey(std::uint32_t(p), std::uint32_t(q))] = int(pedges_.size());
                     pedges_.push_back({p, q, t[std::size_t((k + 2) % 3)], {}, {}});
@@ -472,7 +495,8 @@ private:
                 }
             }
         }
-        if (pedges_.empty()) return fail(a, "it has no boundary in the scan's view (it would cover the whole view)");
+        if (pedges_.empty())
+            return fail(a, "it has no boundary in the scan's view (it would cover the whole view)");
         for (int f : faces_)
             for (int v : P_.tri[std::size_t(f)])
                 if (boundary_.count(v)) vertexFaces_[v].push_back(f);
@@ -496,9 +520,11 @@ private:
         }
         margin_ *= 1.01;
         compBox_ = CGAL::Bbox_2();
-        for (int v : compVerts_) compBox_ += P_.uv[std::size_t(v)].bbox();
+        for (int v : compVerts_)
+            compBox_ += P_.uv[std::size_t(v)].bbox();
         compGrid_ = BucketGrid(2.0 * h2_, faces_.size());
-        for (std::size_t i = 0; i < faces_.size(); ++i) compGrid_.insert(int(i), triBox(faces_[i]));
+        for (std::size_t i = 0; i < faces_.size(); ++i)
+            compGrid_.insert(int(i), triBox(faces_[i]));
         return true;
     }
     CGAL::Bbox_2 triBox(int f) const {
@@ -515,7 +541,8 @@ private:
         const CGAL::Bbox_2 box = grown(q.bbox(), radius);
         compGrid_.query(box, [&](int i) {
             if (CGAL::do_overlap(box, triBox(faces_[std::size_t(i)])))
-                for (int v : P_.tri[std::size_t(faces_[std::size_t(i)])]) out.push_back(v);
+                for (int v : P_.tri[std::size_t(faces_[std::size_t(i)])])
+                    out.push_back(v);
         });
         return out;
     }
@@ -593,7 +620,8 @@ private:
         const auto v = faceVertices(f);
         double l = 0;
         for (int k = 0; k < 3; ++k)
-            l = std::max(l, std::sqrt(CGAL::squared_distance(M_.point(v[std::size_t(k)]), M_.point(v[std::size_t((k + 1) % 3)]))));
+            l = std::max(l, std::sqrt(CGAL::squared_distance(M_.point(v[std::size_t(k)]),
+                                                             M_.point(v[std::size_t((k + 1) % 3)]))));
         return l;
     }
     // The largest distance along view rays between the patch and a mesh face it belongs to.
@@ -623,7 +651,8 @@ private:
             const auto& tri = P_.tri[std::size_t(faces_[std::size_t(i)])];
             const Triangle2 t = patchTriangle(faces_[std::size_t(i)]);
             if (!inTriangle(uv, t[0], t[1], t[2])) return;
-            const Vec3 &A = P_.pos[std::size_t(tri[0])], &B = P_.pos[std::size_t(tri[1])], &C = P_.pos[std::size_t(tri[2])];
+            const Vec3 &A = P_.pos[std::size_t(tri[0])], &B = P_.pos[std::size_t(tri[1])],
+                       &C = P_.pos[std::size_t(tri[2])];
             const Vec3 n = normalOf(A, B, C);
             Vec3 o, d;
             V_.rayThrough(p, o, d);
@@ -679,9 +708,11 @@ private:
             fallback_.push_back(f);
             boxes.push_back(fb);
         }
-        const double cell = std::max(4.0 * h2_, std::max(box.xmax() - box.xmin(), box.ymax() - box.ymin()) / 64.0);
+        const double cell =
+            std::max(4.0 * h2_, std::max(box.xmax() - box.xmin(), box.ymax() - box.ymin()) / 64.0);
         fallbackGrid_ = BucketGrid(cell, fallback_.size());
-        for (std::size_t i = 0; i < fallback_.size(); ++i) fallbackGrid_.insert(int(i), boxes[i]);
+        for (std::size_t i = 0; i < fallback_.size(); ++i)
+            fallbackGrid_.insert(int(i), boxes[i]);
     }
     bool findRegion(Attempt& a) {
         // Seeds: under every boundary vertex and a sample of the interior, the acceptable face containing
@@ -694,7 +725,8 @@ private:
                 if (!boundary_.count(v)) interior.push_back(v);
             std::sort(interior.begin(), interior.end());
             const std::size_t stride = std::max<std::size_t>(1, interior.size() / 2048);
-            for (std::size_t i = 0; i < interior.size(); i += stride) samples.push_back(interior[i]);
+            for (std::size_t i = 0; i < interior.size(); i += stride)
+                samples.push_back(interior[i]);
         }
         std::vector<FaceIndex> seeds, cands;
         for (int pass = 0; pass < 2 && seeds.empty(); ++pass) {
@@ -749,7 +781,8 @@ private:
         }
         edge /= double(region_.size());
         regionGrid_ = BucketGrid(std::max(2.0 * h2_, edge), region_.size());
-        for (std::size_t i = 0; i < region_.size(); ++i) regionGrid_.insert(int(i), faceTriangle(region_[i]).bbox());
+        for (std::size_t i = 0; i < region_.size(); ++i)
+            regionGrid_.insert(int(i), faceTriangle(region_[i]).bbox());
         std::vector<int> bad;
         for (int v : compVerts_) {
             const Point2& uv = P_.uv[std::size_t(v)];
@@ -784,7 +817,8 @@ private:
         for (const auto& [x, y] : {std::pair{&s, &t}, std::pair{&t, &s}})
             for (int k = 0; k < 3; ++k) {
                 const Point2 &p = (*x)[k], &q = (*x)[(k + 1) % 3];
-                if (CGAL::orientation(p, q, (*y)[0]) != CGAL::LEFT_TURN && CGAL::orientation(p, q, (*y)[1]) != CGAL::LEFT_TURN &&
+                if (CGAL::orientation(p, q, (*y)[0]) != CGAL::LEFT_TURN &&
+                    CGAL::orientation(p, q, (*y)[1]) != CGAL::LEFT_TURN &&
                     CGAL::orientation(p, q, (*y)[2]) != CGAL::LEFT_TURN)
                     return false;
             }
@@ -827,7 +861,8 @@ private:
     bool splitRegion(Attempt& a) {
         BucketGrid segments(2.0 * h2_, pedges_.size());
         for (std::size_t i = 0; i < pedges_.size(); ++i)
-            segments.insert(int(i), bboxOf(P_.uv[std::size_t(pedges_[i].a)], P_.uv[std::size_t(pedges_[i].b)]));
+            segments.insert(int(i),
+                            bboxOf(P_.uv[std::size_t(pedges_[i].a)], P_.uv[std::size_t(pedges_[i].b)]));
         const double reach2 = margin_ * margin_; // the snapping distance
         std::vector<FaceIndex> seam;
         std::vector<FaceIndex> stack;
@@ -837,7 +872,8 @@ private:
             bool near = false;
             segments.query(grown(t.bbox(), margin_), [&](int i) {
                 if (near) return;
-                const Segment2 e(P_.uv[std::size_t(pedges_[std::size_t(i)].a)], P_.uv[std::size_t(pedges_[std::size_t(i)].b)]);
+                const Segment2 e(P_.uv[std::size_t(pedges_[std::size_t(i)].a)],
+                                 P_.uv[std::size_t(pedges_[std::size_t(i)].b)]);
                 near = CGAL::do_intersect(t, e) || CGAL::squared_distance(t, e) <= reach2;
             });
             if (near) {
@@ -854,9 +890,11 @@ private:
         // to cut, so the patch is cut back around every fold that reaches its boundary.
         {
             std::vector<int> parent(region_.size());
-            for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = int(i);
+            for (std::size_t i = 0; i < parent.size(); ++i)
+                parent[i] = int(i);
             auto find = [&](int x) {
-                while (parent[std::size_t(x)] != x) x = parent[std::size_t(x)] = parent[std::size_t(parent[std::size_t(x)])];
+                while (parent[std::size_t(x)] != x)
+                    x = parent[std::size_t(x)] = parent[std::size_t(parent[std::size_t(x)])];
                 return x;
             };
             std::vector<char> folded(region_.size(), 0), hidden(region_.size(), 0);
@@ -869,7 +907,8 @@ private:
                     parent[std::size_t(find(j))] = find(int(i));
                     // The one farther from the eye where they overlap is hidden there.
                     const Point2 q = overlapCentre(t, faceTriangle(region_[std::size_t(j)]));
-                    hidden[depthAt(region_[i], q) > depthAt(region_[std::size_t(j)], q) ? i : std::size_t(j)] = 1;
+                    hidden[depthAt(region_[i], q) > depthAt(region_[std::size_t(j)], q) ? i
+                                                                                        : std::size_t(j)] = 1;
                 });
             }
             std::unordered_map<int, bool> clusterAtSeam;
@@ -880,7 +919,8 @@ private:
             const double r = margin_ + h2_;
             for (int pass = 0; pass < 2 && bad.empty(); ++pass)
                 for (std::size_t i = 0; i < region_.size(); ++i) {
-                    if (!folded[i] || !clusterAtSeam.count(find(int(i))) || (pass == 0 && !hidden[i])) continue;
+                    if (!folded[i] || !clusterAtSeam.count(find(int(i))) || (pass == 0 && !hidden[i]))
+                        continue;
                     const FaceIndex g = region_[i];
                     const Triangle2 t = faceTriangle(g);
                     const double tolerance = gapTolerance(g);
@@ -889,11 +929,14 @@ private:
                         const Triangle2 p = patchTriangle(faces_[std::size_t(k)]);
                         if (!CGAL::do_intersect(t, p) && CGAL::squared_distance(t, p) > r * r) return;
                         bool onSheet = pass == 1;
-                        for (int v : tri) onSheet = onSheet || gapTo(P_.pos[std::size_t(v)], g) <= tolerance;
+                        for (int v : tri)
+                            onSheet = onSheet || gapTo(P_.pos[std::size_t(v)], g) <= tolerance;
                         if (onSheet) bad.insert(bad.end(), tri.begin(), tri.end());
                     });
                 }
-            if (!bad.empty()) return fail(a, "the mesh under its boundary folds over itself in the scan's view", std::move(bad));
+            if (!bad.empty())
+                return fail(a, "the mesh under its boundary folds over itself in the scan's view",
+                            std::move(bad));
         }
         // Faces connected to the interior ones, away from the seam, lying under the patch in the view.
         while (!stack.empty()) {
@@ -915,17 +958,20 @@ private:
                     if (!p.ok || !(gapToPatch(toVec(M_.point(v)), p.uv) <= tolerance)) under = false;
                 }
                 if (!under) {
-                    addNear(bad, vproj(M_.target(h)).uv); // a face reaching out without a seam: a fold, a hole
+                    addNear(bad,
+                            vproj(M_.target(h)).uv); // a face reaching out without a seam: a fold, a hole
                     continue;
                 }
                 isInterior.insert(std::uint32_t(g));
                 stack.push_back(g);
             }
         }
-        if (!bad.empty()) return fail(a, "the mesh under it folds or has a hole in the scan's view", std::move(bad));
+        if (!bad.empty())
+            return fail(a, "the mesh under it folds or has a hole in the scan's view", std::move(bad));
         region_ = std::move(seam);
         regionIndex_.clear();
-        for (std::size_t i = 0; i < region_.size(); ++i) regionIndex_[std::uint32_t(region_[i])] = int(i);
+        for (std::size_t i = 0; i < region_.size(); ++i)
+            regionIndex_[std::uint32_t(region_[i])] = int(i);
         if (region_.empty()) return fail(a, "no visible face of the mesh lies under its boundary");
         return true;
     }
@@ -986,7 +1032,8 @@ private:
         for (int f : vertexFaces_.at(v)) {
             const auto& t = P_.tri[std::size_t(f)];
             Point2 q[3];
-            for (int k = 0; k < 3; ++k) q[k] = t[std::size_t(k)] == v ? uv : L_uvOfPatch(t[std::size_t(k)]);
+            for (int k = 0; k < 3; ++k)
+                q[k] = t[std::size_t(k)] == v ? uv : L_uvOfPatch(t[std::size_t(k)]);
             if (!leftTurn(q[0], q[1], q[2])) return false;
         }
         return true;
@@ -999,11 +1046,13 @@ private:
     // Lift a point at 2D parameter s of region edge re onto the 3D mesh edge.
     void liftOnEdge(int re, double s, Vec3& pos, Point2& uv) {
         const int u = redges_[std::size_t(re)].u, w = redges_[std::size_t(re)].w;
-        const VProj &pu = vproj(VertexIndex(L_[std::size_t(u)].cur)), &pw = vproj(VertexIndex(L_[std::size_t(w)].cur));
+        const VProj &pu = vproj(VertexIndex(L_[std::size_t(u)].cur)),
+                    &pw = vproj(VertexIndex(L_[std::size_t(w)].cur));
         const double t = View::perspectiveParam(s, pu.w, pw.w);
         pos = L_[std::size_t(u)].pos + t * (L_[std::size_t(w)].pos - L_[std::size_t(u)].pos);
         double wq;
-        if (!V_.project(pos, uv, wq)) uv = Point2(pu.uv.x() + s * (pw.uv.x() - pu.uv.x()), pu.uv.y() + s * (pw.uv.y() - pu.uv.y()));
+        if (!V_.project(pos, uv, wq))
+            uv = Point2(pu.uv.x() + s * (pw.uv.x() - pu.uv.x()), pu.uv.y() + s * (pw.uv.y() - pu.uv.y()));
     }
     // A region edge may be split when both its faces are region faces (never a border edge).
     bool splittable(int re) const {
@@ -1019,7 +1068,8 @@ private:
         std::vector<double> regionEdgeMin(L_.size(), std::numeric_limits<double>::infinity());
         for (const auto& re : redges_) {
             const double l = std::sqrt(dist2(L_[std::size_t(re.u)].uv, L_[std::size_t(re.w)].uv));
-            for (int v : {re.u, re.w}) regionEdgeMin[std::size_t(v)] = std::min(regionEdgeMin[std::size_t(v)], l);
+            for (int v : {re.u, re.w})
+                regionEdgeMin[std::size_t(v)] = std::min(regionEdgeMin[std::size_t(v)], l);
         }
         const double ratio = O_.collapseEdgeRatio;
         // Rule 1: a patch boundary vertex close to a mesh vertex becomes that vertex.
@@ -1060,7 +1110,8 @@ private:
         {
             BucketGrid grid(cell, redges_.size());
             for (std::size_t i = 0; i < redges_.size(); ++i)
-                grid.insert(int(i), bboxOf(L_[std::size_t(redges_[i].u)].uv, L_[std::size_t(redges_[i].w)].uv));
+                grid.insert(int(i),
+                            bboxOf(L_[std::size_t(redges_[i].u)].uv, L_[std::size_t(redges_[i].w)].uv));
             std::vector<int> verts;
             for (const auto& [v, lid] : lidOfPatch_)
                 if (L_[std::size_t(lid)].kind == LVert::PatchBoundary) verts.push_back(v);
@@ -1073,7 +1124,8 @@ private:
                 double bestD = r, bestS = 0;
                 grid.query(grown(uv.bbox(), r), [&](int i) {
                     double s;
-                    const Point2 &U = L_[std::size_t(redges_[std::size_t(i)].u)].uv, &W = L_[std::size_t(redges_[std::size_t(i)].w)].uv;
+                    const Point2 &U = L_[std::size_t(redges_[std::size_t(i)].u)].uv,
+                                 &W = L_[std::size_t(redges_[std::size_t(i)].w)].uv;
                     const double d = segmentDistance(uv, U, W, s);
                     if (d < bestD && d < ratio * std::sqrt(dist2(U, W)) && s > 1e-3 && s < 1 - 1e-3) {
                         bestD = d;
@@ -1089,14 +1141,20 @@ private:
                 LVert& l = L_[std::size_t(lid)];
                 l.pos = pos;
                 l.uv = q;
-                redges_[std::size_t(best)].splits.push_back({lineParam(q, L_[std::size_t(redges_[std::size_t(best)].u)].uv, L_[std::size_t(redges_[std::size_t(best)].w)].uv), lid});
+                l.edgeU = redges_[std::size_t(best)].u;
+                l.edgeW = redges_[std::size_t(best)].w;
+                redges_[std::size_t(best)].splits.push_back(
+                    {lineParam(q, L_[std::size_t(redges_[std::size_t(best)].u)].uv,
+                               L_[std::size_t(redges_[std::size_t(best)].w)].uv),
+                     lid});
             }
         }
         // Rule 3: a mesh vertex close to a patch boundary edge splits that edge. The closest go first; a
         // vertex is taken when the patch triangle on the edge stays a fan of counter-clockwise triangles.
         {
             BucketGrid grid(cell, pedges_.size());
-            for (std::size_t i = 0; i < pedges_.size(); ++i) grid.insert(int(i), bboxOf(L_uvOfPatch(pedges_[i].a), L_uvOfPatch(pedges_[i].b)));
+            for (std::size_t i = 0; i < pedges_.size(); ++i)
+                grid.insert(int(i), bboxOf(L_uvOfPatch(pedges_[i].a), L_uvOfPatch(pedges_[i].b)));
             struct Cand {
                 double d, s;
                 int lid;
@@ -1127,7 +1185,9 @@ private:
             for (std::size_t e = 0; e < pedges_.size(); ++e) {
                 auto& cs = cands[e];
                 if (cs.empty()) continue;
-                std::sort(cs.begin(), cs.end(), [](const Cand& x, const Cand& y) { return x.d != y.d ? x.d < y.d : x.lid < y.lid; });
+                std::sort(cs.begin(), cs.end(), [](const Cand& x, const Cand& y) {
+                    return x.d != y.d ? x.d < y.d : x.lid < y.lid;
+                });
                 auto& pe = pedges_[e];
                 const Point2 A = L_uvOfPatch(pe.a), B = L_uvOfPatch(pe.b), C = L_uvOfPatch(pe.opposite);
                 std::vector<std::pair<double, int>> taken; // sorted by s
@@ -1166,14 +1226,18 @@ private:
         std::vector<Sub> rsubs, psubs;
         for (std::size_t i = 0; i < redges_.size(); ++i) {
             const auto pl = polyline(redges_[i].u, redges_[i].w, redges_[i].splits);
-            for (std::size_t k = 0; k + 1 < pl.size(); ++k) rsubs.push_back({pl[k], pl[k + 1], int(i)});
+            for (std::size_t k = 0; k + 1 < pl.size(); ++k)
+                rsubs.push_back({pl[k], pl[k + 1], int(i)});
         }
         for (std::size_t i = 0; i < pedges_.size(); ++i) {
-            const auto pl = polyline(lidOfPatch_.at(pedges_[i].a), lidOfPatch_.at(pedges_[i].b), pedges_[i].splits);
-            for (std::size_t k = 0; k + 1 < pl.size(); ++k) psubs.push_back({pl[k], pl[k + 1], int(i)});
+            const auto pl =
+                polyline(lidOfPatch_.at(pedges_[i].a), lidOfPatch_.at(pedges_[i].b), pedges_[i].splits);
+            for (std::size_t k = 0; k + 1 < pl.size(); ++k)
+                psubs.push_back({pl[k], pl[k + 1], int(i)});
         }
         BucketGrid grid(2.0 * h2_, rsubs.size());
-        for (std::size_t i = 0; i < rsubs.size(); ++i) grid.insert(int(i), bboxOf(L_[std::size_t(rsubs[i].p)].uv, L_[std::size_t(rsubs[i].q)].uv));
+        for (std::size_t i = 0; i < rsubs.size(); ++i)
+            grid.insert(int(i), bboxOf(L_[std::size_t(rsubs[i].p)].uv, L_[std::size_t(rsubs[i].q)].uv));
         std::vector<int> bad;
         for (const Sub& ps : psubs) {
             const Point2 P = L_[std::size_t(ps.p)].uv, Q = L_[std::size_t(ps.q)].uv;
@@ -1183,14 +1247,19 @@ private:
                 const Point2 R = L_[std::size_t(rs.p)].uv, S = L_[std::size_t(rs.q)].uv;
                 const auto o1 = CGAL::orientation(P, Q, R), o2 = CGAL::orientation(P, Q, S);
                 const auto o3 = CGAL::orientation(R, S, P), o4 = CGAL::orientation(R, S, Q);
-                if (o1 != CGAL::COLLINEAR && o2 != CGAL::COLLINEAR && o3 != CGAL::COLLINEAR && o4 != CGAL::COLLINEAR) {
+                if (o1 != CGAL::COLLINEAR && o2 != CGAL::COLLINEAR && o3 != CGAL::COLLINEAR &&
+                    o4 != CGAL::COLLINEAR) {
                     if (o1 == o2 || o3 == o4) return; // no crossing
                     // Proper crossing: intersection in the view, then lifted onto the 3D mesh edge.
-                    const double d = area2(Point2(0, 0), Point2(Q.x() - P.x(), Q.y() - P.y()), Point2(S.x() - R.x(), S.y() - R.y()));
-                    const double t = area2(Point2(0, 0), Point2(R.x() - P.x(), R.y() - P.y()), Point2(S.x() - R.x(), S.y() - R.y())) / d;
+                    const double d = area2(Point2(0, 0), Point2(Q.x() - P.x(), Q.y() - P.y()),
+                                           Point2(S.x() - R.x(), S.y() - R.y()));
+                    const double t = area2(Point2(0, 0), Point2(R.x() - P.x(), R.y() - P.y()),
+                                           Point2(S.x() - R.x(), S.y() - R.y())) /
+                                     d;
                     const Point2 X(P.x() + t * (Q.x() - P.x()), P.y() + t * (Q.y() - P.y()));
                     auto& re = redges_[std::size_t(rs.owner)];
-                    const double s = std::clamp(lineParam(X, L_[std::size_t(re.u)].uv, L_[std::size_t(re.w)].uv), 0.0, 1.0);
+                    const double s = std::clamp(
+                        lineParam(X, L_[std::size_t(re.u)].uv, L_[std::size_t(re.w)].uv), 0.0, 1.0);
                     LVert l;
                     l.kind = LVert::Crossing;
                     l.chain = true;
@@ -1198,8 +1267,11 @@ private:
                     l.patchA = pe.a;
                     l.patchB = pe.b;
                     liftOnEdge(rs.owner, s, l.pos, l.uv);
+                    l.edgeU = re.u;
+                    l.edgeW = re.w;
                     const int id = addLocal(l);
-                    re.splits.push_back({lineParam(l.uv, L_[std::size_t(re.u)].uv, L_[std::size_t(re.w)].uv), id});
+                    re.splits.push_back(
+                        {lineParam(l.uv, L_[std::size_t(re.u)].uv, L_[std::size_t(re.w)].uv), id});
                     pe.splits.push_back({lineParam(l.uv, L_uvOfPatch(pe.a), L_uvOfPatch(pe.b)), id});
                     return;
                 }
@@ -1210,9 +1282,12 @@ private:
                 }
             });
         }
-        if (!bad.empty()) return fail(a, "its boundary touches mesh edges in a degenerate way", std::move(bad));
-        for (auto& re : redges_) re.line = polyline(re.u, re.w, re.splits);
-        for (auto& pe : pedges_) pe.line = polyline(lidOfPatch_.at(pe.a), lidOfPatch_.at(pe.b), pe.splits);
+        if (!bad.empty())
+            return fail(a, "its boundary touches mesh edges in a degenerate way", std::move(bad));
+        for (auto& re : redges_)
+            re.line = polyline(re.u, re.w, re.splits);
+        for (auto& pe : pedges_)
+            pe.line = polyline(lidOfPatch_.at(pe.a), lidOfPatch_.at(pe.b), pe.splits);
         return true;
     }
 
@@ -1237,7 +1312,9 @@ private:
             vh[std::size_t(i)] = v;
             hint = v->face();
         }
-        if (!bad.empty()) return fail(a, "some of its boundary vertices coincide with mesh vertices in the view", std::move(bad));
+        if (!bad.empty())
+            return fail(a, "some of its boundary vertices coincide with mesh vertices in the view",
+                        std::move(bad));
         auto constrain = [&](const std::vector<int>& line) {
             for (std::size_t k = 0; k + 1 < line.size(); ++k) {
                 const std::size_t p = std::size_t(line[k]), q = std::size_t(line[k + 1]);
@@ -1245,9 +1322,11 @@ private:
                 cdt.insert_constraint(vh[p], vh[q]);
             }
         };
-        for (const auto& re : redges_) constrain(re.line);
+        for (const auto& re : redges_)
+            constrain(re.line);
         const std::size_t regionSubs = subEdges_.size();
-        for (const auto& pe : pedges_) constrain(pe.line);
+        for (const auto& pe : pedges_)
+            constrain(pe.line);
         if (cdt.number_of_vertices() != inserted) {
             for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v)
                 if (v->info().id < 0) {
@@ -1266,7 +1345,8 @@ private:
             }
             (k < regionSubs ? regionSub_ : patchSub_).insert(edgeKey(std::uint32_t(p), std::uint32_t(q)));
         }
-        if (!bad.empty()) return fail(a, "its boundary passes exactly through mesh vertices in the view", std::move(bad));
+        if (!bad.empty())
+            return fail(a, "its boundary passes exactly through mesh vertices in the view", std::move(bad));
         return true;
     }
     // The triangle to the left of the directed edge p → q of the triangulation.
@@ -1277,7 +1357,8 @@ private:
         return f->vertex(f->ccw(i)) == p ? f : f->neighbor(i);
     }
     std::uint64_t keyOf(CdtFace f, int i) const {
-        return edgeKey(std::uint32_t(f->vertex(f->ccw(i))->info().id), std::uint32_t(f->vertex(f->cw(i))->info().id));
+        return edgeKey(std::uint32_t(f->vertex(f->ccw(i))->info().id),
+                       std::uint32_t(f->vertex(f->cw(i))->info().id));
     }
     // ---- step 3a: which region face and which side of the patch boundary every triangle lies in
     bool classify(Cdt& cdt, const std::vector<CdtVertex>& vh, Attempt& a) {
@@ -1320,7 +1401,8 @@ private:
             const double full = area2(t[0], t[1], t[2]);
             if (std::abs(covered - full) > 1e-7 * full) addNear(bad, CGAL::centroid(t));
         }
-        if (!bad.empty()) return fail(a, "the mesh under it overlaps itself in the scan's view", std::move(bad));
+        if (!bad.empty())
+            return fail(a, "the mesh under it overlaps itself in the scan's view", std::move(bad));
         // Inside / outside of the patch: the interior lies to the left of every boundary edge.
         std::vector<std::pair<CdtFace, std::int8_t>> fill;
         for (const auto& pe : pedges_)
@@ -1334,8 +1416,10 @@ private:
             fill.pop_back();
             if (f->info().inside == side) continue;
             if (f->info().inside >= 0) {
-                if (!cdt.is_infinite(f)) addNear(bad, CGAL::centroid(cdt.triangle(f)));
-                else bad.push_back(-1);
+                if (!cdt.is_infinite(f))
+                    addNear(bad, CGAL::centroid(cdt.triangle(f)));
+                else
+                    bad.push_back(-1);
                 continue;
             }
             f->info().inside = side;
@@ -1366,7 +1450,8 @@ private:
                 if (gapTo(l.pos, f) > gapTolerance(f)) addBad(bad, int(i));
             }
         }
-        if (!bad.empty()) return fail(a, "it reaches past the visible, stitchable part of the mesh", std::move(bad));
+        if (!bad.empty())
+            return fail(a, "it reaches past the visible, stitchable part of the mesh", std::move(bad));
         return true;
     }
 
@@ -1414,7 +1499,8 @@ private:
         const double none = -1;
         std::vector<double> best(n * n, none);
         std::vector<std::size_t> split(n * n, 0);
-        for (std::size_t i = 0; i + 1 < n; ++i) best[i * n + i + 1] = 4; // an edge: nothing to do
+        for (std::size_t i = 0; i + 1 < n; ++i)
+            best[i * n + i + 1] = 4; // an edge: nothing to do
         for (std::size_t len = 2; len < n; ++len)
             for (std::size_t i = 0; i + len < n; ++i) {
                 const std::size_t j = i + len;
@@ -1450,7 +1536,8 @@ private:
         double insideArea = 0;
         for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
             if (f->info().region >= 0) pieces[std::size_t(f->info().region)].push_back(f);
-            if (f->info().inside == 1) insideArea += area2(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point());
+            if (f->info().inside == 1)
+                insideArea += area2(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point());
         }
         for (std::size_t r = 0; r < region_.size(); ++r) {
             const auto vs = faceVertices(region_[r]);
@@ -1471,13 +1558,20 @@ private:
             const double floor = std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C));
             for (CdtFace f : pieces[r])
                 if (f->info().inside == 0)
-                    newFaces_.push_back({{f->vertex(0)->info().id, f->vertex(1)->info().id, f->vertex(2)->info().id}, q, sid, false, n, floor});
+                    newFaces_.push_back(
+                        {{f->vertex(0)->info().id, f->vertex(1)->info().id, f->vertex(2)->info().id},
+                         q,
+                         sid,
+                         false,
+                         n,
+                         floor});
         }
         // The seam optimisation may also change the faces around the re-triangulated ones (seamRings):
         // they join the faces replaced (by themselves, to begin with).
         {
             std::unordered_set<std::uint32_t> taken;
-            for (FaceIndex f : replaced_) taken.insert(std::uint32_t(f));
+            for (FaceIndex f : replaced_)
+                taken.insert(std::uint32_t(f));
             std::vector<FaceIndex> ring;
             for (FaceIndex f : replaced_)
                 if (regionIndex_.count(std::uint32_t(f))) ring.push_back(f);
@@ -1486,16 +1580,21 @@ private:
                 for (FaceIndex f : ring)
                     for (VertexIndex v : faceVertices(f))
                         for (FaceIndex g : CGAL::faces_around_target(M_.halfedge(v), M_)) {
-                            if (g == Mesh::null_face() || taken.count(std::uint32_t(g)) || !acceptable(g)) continue;
+                            if (g == Mesh::null_face() || taken.count(std::uint32_t(g)) || !acceptable(g))
+                                continue;
                             taken.insert(std::uint32_t(g));
                             next.push_back(g);
                             replaced_.push_back(g);
                             const auto vs = faceVertices(g);
-                            const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
-                            newFaces_.push_back({{regionVertex(vs[0]), regionVertex(vs[1]), regionVertex(vs[2])},
-                                                 curHasQuality_ ? curQuality_[g] : kInputFaceQuality,
-                                                 curHasScanId_ ? curScanId_[g] : -1, false, normalOf(A, B, C).normalized(),
-                                                 std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C))});
+                            const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])),
+                                       C = toVec(M_.point(vs[2]));
+                            newFaces_.push_back(
+                                {{regionVertex(vs[0]), regionVertex(vs[1]), regionVertex(vs[2])},
+                                 curHasQuality_ ? curQuality_[g] : kInputFaceQuality,
+                                 curHasScanId_ ? curScanId_[g] : -1,
+                                 false,
+                                 normalOf(A, B, C).normalized(),
+                                 std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C))});
                         }
                 ring.swap(next);
             }
@@ -1521,18 +1620,23 @@ private:
             const float q = P_.hasQuality ? P_.quality[std::size_t(f)] : kInputFaceQuality;
             const std::int32_t sid = P_.hasScanId ? P_.scanId[std::size_t(f)] : -1;
             const std::size_t before = newFaces_.size();
-            const double floor = std::min(O_.minAngleFloorDeg * kDeg,
-                                          0.999 * minAngle(P_.pos[std::size_t(t[0])], P_.pos[std::size_t(t[1])], P_.pos[std::size_t(t[2])]));
+            const double floor =
+                std::min(O_.minAngleFloorDeg * kDeg,
+                         0.999 * minAngle(P_.pos[std::size_t(t[0])], P_.pos[std::size_t(t[1])],
+                                          P_.pos[std::size_t(t[2])]));
             if (!triangulatePolygon(poly, edges, q, sid, floor)) {
-                for (int v : t) bad.push_back(v);
+                for (int v : t)
+                    bad.push_back(v);
                 continue;
             }
             for (std::size_t i = before; i < newFaces_.size(); ++i) {
                 const auto& nf = newFaces_[i].v;
-                patchArea += area2(L_[std::size_t(nf[0])].uv, L_[std::size_t(nf[1])].uv, L_[std::size_t(nf[2])].uv);
+                patchArea +=
+                    area2(L_[std::size_t(nf[0])].uv, L_[std::size_t(nf[1])].uv, L_[std::size_t(nf[2])].uv);
             }
         }
-        if (!bad.empty()) return fail(a, "some of its boundary triangles cannot be joined to the seam", std::move(bad));
+        if (!bad.empty())
+            return fail(a, "some of its boundary triangles cannot be joined to the seam", std::move(bad));
         if (std::abs(patchArea - insideArea) > 1e-6 * insideArea)
             return fail(a, "it overlaps itself in the scan's view");
         return true;
@@ -1559,7 +1663,7 @@ private:
         Mesh::Property_map<FaceIndex, float> quality;
         Mesh::Property_map<FaceIndex, std::int32_t> scanId;
         Mesh::Property_map<FaceIndex, bool> patchSide;
-        Mesh::Property_map<FaceIndex, Vec3> planeNormal; // outside pieces: normal of their mesh face
+        Mesh::Property_map<FaceIndex, Vec3> planeNormal;  // outside pieces: normal of their mesh face
         Mesh::Property_map<FaceIndex, double> minAllowed; // smallest angle accepted (radians)
         std::set<std::pair<std::uint32_t, std::uint32_t>> seam;
     };
@@ -1567,18 +1671,21 @@ private:
         return std::minmax(std::uint32_t(a), std::uint32_t(b));
     }
     // Adds faces in an order that grows from the hole's border (each face next to what is there).
-    static std::vector<std::size_t> growthOrder(const std::vector<std::array<VertexIndex, 3>>& faces, const Mesh& m) {
+    static std::vector<std::size_t> growthOrder(const std::vector<std::array<VertexIndex, 3>>& faces,
+                                                const Mesh& m) {
         std::unordered_map<std::uint64_t, std::size_t> byEdge;
         for (std::size_t i = 0; i < faces.size(); ++i)
             for (int k = 0; k < 3; ++k)
-                byEdge[dirKey(std::uint32_t(faces[i][std::size_t(k)]), std::uint32_t(faces[i][std::size_t((k + 1) % 3)]))] = i;
+                byEdge[dirKey(std::uint32_t(faces[i][std::size_t(k)]),
+                              std::uint32_t(faces[i][std::size_t((k + 1) % 3)]))] = i;
         std::vector<std::size_t> order;
         std::vector<char> done(faces.size(), 0);
         std::deque<std::size_t> queue;
         for (std::size_t i = 0; i < faces.size(); ++i)
             for (int k = 0; k < 3 && !done[i]; ++k) {
                 const VertexIndex a = faces[i][std::size_t(k)], b = faces[i][std::size_t((k + 1) % 3)];
-                if (!m.has_valid_index(a) || !m.has_valid_index(b) || m.is_removed(a) || m.is_removed(b)) continue;
+                if (!m.has_valid_index(a) || !m.has_valid_index(b) || m.is_removed(a) || m.is_removed(b))
+                    continue;
                 const auto h = m.halfedge(a, b);
                 if (h != Mesh::null_halfedge() && m.is_border(h)) {
                     done[i] = 1;
@@ -1591,7 +1698,8 @@ private:
                 queue.pop_front();
                 order.push_back(i);
                 for (int k = 0; k < 3; ++k) {
-                    auto it = byEdge.find(dirKey(std::uint32_t(faces[i][std::size_t((k + 1) % 3)]), std::uint32_t(faces[i][std::size_t(k)])));
+                    auto it = byEdge.find(dirKey(std::uint32_t(faces[i][std::size_t((k + 1) % 3)]),
+                                                 std::uint32_t(faces[i][std::size_t(k)])));
                     if (it != byEdge.end() && !done[it->second]) {
                         done[it->second] = 1;
                         queue.push_back(it->second);
@@ -1612,8 +1720,7 @@ private:
     bool buildAndOptimise(Attempt& a) {
         Local loc;
         Mesh& S = loc.star.S;
-        if (!buildStar(M_, replaced_, loc.star))
-            return fail(a, "the mesh is not manifold near its seam");
+        if (!buildStar(M_, replaced_, loc.star)) return fail(a, "the mesh is not manifold near its seam");
         loc.lid = S.add_property_map<VertexIndex, int>("v:lid", -1).first;
         loc.uv = S.add_property_map<VertexIndex, Point2>("v:uv", Point2(0, 0)).first;
         loc.locked = S.add_property_map<VertexIndex, bool>("v:locked", false).first;
@@ -1674,7 +1781,8 @@ private:
         for (std::size_t i : growthOrder(faceVs, S)) {
             const FaceIndex g = S.add_face(faceVs[i][0], faceVs[i][1], faceVs[i][2]);
             if (g == Mesh::null_face()) {
-                for (int id : newFaces_[i].v) addBad(bad, id);
+                for (int id : newFaces_[i].v)
+                    addBad(bad, id);
                 continue;
             }
             loc.star.kept[g] = false;
@@ -1709,7 +1817,8 @@ private:
             if (!loc.star.isFull(v) || S.halfedge(v) == Mesh::null_halfedge()) continue;
             for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(v), S))
                 for (HalfedgeIndex g : {h, S.opposite(h)})
-                    if (S.is_border(g)) out.insert(std::minmax(loc.star.cur[S.source(g)], loc.star.cur[S.target(g)]));
+                    if (S.is_border(g))
+                        out.insert(std::minmax(loc.star.cur[S.source(g)], loc.star.cur[S.target(g)]));
         }
         return out;
     }
@@ -1733,21 +1842,24 @@ private:
     }
     Vec3 pt(const Mesh& S, VertexIndex v) const { return toVec(S.point(v)); }
     // Edges incident to the given vertices (each once, in a deterministic order).
-    static std::vector<EdgeIndex> edgesAround(const Mesh& S, const std::unordered_set<std::uint32_t>& vertices) {
+    static std::vector<EdgeIndex> edgesAround(const Mesh& S,
+                                              const std::unordered_set<std::uint32_t>& vertices) {
         std::vector<std::uint32_t> vs(vertices.begin(), vertices.end());
         std::sort(vs.begin(), vs.end());
         std::vector<EdgeIndex> out;
         for (std::uint32_t v : vs) {
             const VertexIndex x(v);
             if (S.is_removed(x) || S.halfedge(x) == Mesh::null_halfedge()) continue;
-            for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(x), S)) out.push_back(S.edge(h));
+            for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(x), S))
+                out.push_back(S.edge(h));
         }
         std::sort(out.begin(), out.end());
         out.erase(std::unique(out.begin(), out.end()), out.end());
         return out;
     }
     // Distance from the seam along edges (Dijkstra), for the vertices of the given set.
-    std::unordered_map<std::uint32_t, double> seamDistance(const Local& loc, const std::unordered_set<std::uint32_t>& within) const {
+    std::unordered_map<std::uint32_t, double>
+    seamDistance(const Local& loc, const std::unordered_set<std::uint32_t>& within) const {
         const Mesh& S = loc.star.S;
         std::unordered_map<std::uint32_t, double> dist;
         using Item = std::pair<double, std::uint32_t>;
@@ -1779,7 +1891,8 @@ private:
         auto isNewFace = [&](FaceIndex f) { return f != Mesh::null_face() && !loc.star.kept[f]; };
         auto removable = [&](VertexIndex v) {
             const int id = loc.lid[v];
-            // Mesh vertices stay (they carry the old surface's shape); crossings, patch and Steiner vertices may go.
+            // Mesh vertices stay (they carry the old surface's shape); crossings, patch and Steiner vertices
+            // may go.
             return !loc.locked[v] && (id < 0 || L_[std::size_t(id)].kind != LVert::Region);
         };
         // -- collapses: remove a into b
@@ -1788,7 +1901,8 @@ private:
             const bool seamA = seamVertex(loc, a), seamB = seamVertex(loc, b);
             if (seamA && seamB && !loc.seam.count(seamKey(a, b))) return false;
             const HalfedgeIndex h = S.halfedge(a, b);
-            if (h == Mesh::null_halfedge() || !isNewFace(S.face(h)) || !isNewFace(S.face(S.opposite(h)))) return false;
+            if (h == Mesh::null_halfedge() || !isNewFace(S.face(h)) || !isNewFace(S.face(S.opposite(h))))
+                return false;
             if (!CGAL::Euler::does_satisfy_link_condition(S.edge(h), S)) return false;
             double oldMin = std::numbers::pi, newMin = std::numbers::pi;
             for (HalfedgeIndex g : CGAL::halfedges_around_target(S.halfedge(a), S)) {
@@ -1800,7 +1914,8 @@ private:
                 if (p == b || q == b) continue;
                 if (!leftTurn(loc.uv[b], loc.uv[p], loc.uv[q])) return false;
                 if (CGAL::collinear(S.point(b), S.point(p), S.point(q))) return false;
-                const Vec3 n0 = normalOf(pt(S, a), pt(S, p), pt(S, q)), n1 = normalOf(pt(S, b), pt(S, p), pt(S, q));
+                const Vec3 n0 = normalOf(pt(S, a), pt(S, p), pt(S, q)),
+                           n1 = normalOf(pt(S, b), pt(S, p), pt(S, q));
                 if (loc.patchSide[f]) {
                     if (angleBetween(n0, n1) > maxTurn) return false;
                 } else {
@@ -1816,41 +1931,156 @@ private:
             return true;
         };
         auto collapsePass = [&] {
-          for (int pass = 0; pass < 4; ++pass) {
-            const auto near = seamNeighbourhood(loc);
-            std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
-            for (EdgeIndex e : edgesAround(S, near)) {
-                const HalfedgeIndex h = S.halfedge(e);
-                const VertexIndex a = S.source(h), b = S.target(h);
-                const double len = (pt(S, a) - pt(S, b)).norm();
-                if (len < shortEdge) cands.push_back({len, {a, b}});
+            for (int pass = 0; pass < 4; ++pass) {
+                const auto near = seamNeighbourhood(loc);
+                std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
+                for (EdgeIndex e : edgesAround(S, near)) {
+                    const HalfedgeIndex h = S.halfedge(e);
+                    const VertexIndex a = S.source(h), b = S.target(h);
+                    const double len = (pt(S, a) - pt(S, b)).norm();
+                    if (len < shortEdge) cands.push_back({len, {a, b}});
+                }
+                std::sort(cands.begin(), cands.end());
+                std::size_t done = 0;
+                for (const auto& c : cands) {
+                    const auto [a, b] = c.second;
+                    if (S.is_removed(a) || S.is_removed(b)) continue;
+                    double s1 = -1, s2 = -1;
+                    const bool ok1 = tryCollapse(a, b, s1), ok2 = tryCollapse(b, a, s2);
+                    if (!ok1 && !ok2) continue;
+                    const VertexIndex from = (ok1 && (!ok2 || s1 >= s2)) ? a : b, to = from == a ? b : a;
+                    collapse(loc, from, to);
+                    ++done;
+                }
+                plan.collapses += done;
+                if (done == 0) break;
             }
-            std::sort(cands.begin(), cands.end());
-            std::size_t done = 0;
-            for (const auto& c : cands) {
-                const auto [a, b] = c.second;
-                if (S.is_removed(a) || S.is_removed(b)) continue;
-                double s1 = -1, s2 = -1;
-                const bool ok1 = tryCollapse(a, b, s1), ok2 = tryCollapse(b, a, s2);
-                if (!ok1 && !ok2) continue;
-                const VertexIndex from = (ok1 && (!ok2 || s1 >= s2)) ? a : b, to = from == a ? b : a;
-                collapse(loc, from, to);
-                ++done;
-            }
-            plan.collapses += done;
-            if (done == 0) break;
-          }
         };
         collapsePass();
         // -- refinement outside the patch: split long edges of the pieces around the seam (the new vertices
-        // lie on the old surface: in a face's plane or on a mesh edge), graded from the patch's edge length at
-        // the seam outwards, then flip within the faces' planes.
+        // lie on the old surface: in a face's plane or on a mesh edge), graded from the patch's edge length
+        // at the seam outwards, then flip within the faces' planes.
         for (int round = 0; round < 4 && O_.seamGrading > 0; ++round) {
             if (refineOutside(loc) == 0) break;
             flipPass(loc, plan);
         }
         collapsePass();
         flipPass(loc, plan);
+        // -- smoothing: the vertices added outside the patch move within their face's plane towards the
+        // centre of their neighbours where that raises the smallest angle around them.
+        for (int pass = 0; pass < 3; ++pass) {
+            if (smoothOutside(loc) == 0) break;
+            flipPass(loc, plan);
+        }
+    }
+
+    // A seam vertex on a mesh edge (a crossing, a snapped patch vertex) slides along that edge towards the
+    // centre of its neighbours where that raises the smallest angle around it: the pieces outside stay in
+    // their faces' planes; the patch side turns no normal more than maxNormalChangeDeg.
+    int slideAlongEdge(Local& loc, VertexIndex v) {
+        Mesh& S = loc.star.S;
+        const LVert& l = L_[std::size_t(loc.lid[v])];
+        if (l.edgeU < 0) return 0;
+        const Vec3 U = L_[std::size_t(l.edgeU)].pos, W = L_[std::size_t(l.edgeW)].pos;
+        Vec3 centre(0, 0, 0);
+        int count = 0;
+        std::vector<std::pair<VertexIndex, VertexIndex>> ring;
+        std::vector<FaceIndex> faces;
+        for (HalfedgeIndex g : CGAL::halfedges_around_target(S.halfedge(v), S)) {
+            const FaceIndex f = S.face(g);
+            if (f == Mesh::null_face() || loc.star.kept[f]) return 0;
+            ring.push_back({S.target(S.next(g)), S.source(g)});
+            faces.push_back(f);
+            centre += pt(S, S.source(g));
+            ++count;
+        }
+        if (count < 3) return 0;
+        centre /= double(count);
+        const double len2 = (W - U).squaredNorm();
+        if (!(len2 > 0)) return 0;
+        const double t = std::clamp((centre - U).dot(W - U) / len2, 0.02, 0.98);
+        const Vec3 p0 = pt(S, v), p1 = U + t * (W - U);
+        Point2 uv;
+        double w;
+        if (!V_.project(p1, uv, w)) return 0;
+        double oldMin = std::numbers::pi, newMin = std::numbers::pi;
+        for (std::size_t i = 0; i < ring.size(); ++i) {
+            const auto [p, q] = ring[i];
+            if (!leftTurn(uv, loc.uv[p], loc.uv[q]) || CGAL::collinear(toPoint(p1), S.point(p), S.point(q)))
+                return 0;
+            if (loc.patchSide[faces[i]] &&
+                angleBetween(normalOf(p0, pt(S, p), pt(S, q)), normalOf(p1, pt(S, p), pt(S, q))) >
+                    O_.maxNormalChangeDeg * kDeg)
+                return 0;
+            const double before = minAngle(p0, pt(S, p), pt(S, q)), after = minAngle(p1, pt(S, p), pt(S, q));
+            if (after < loc.minAllowed[faces[i]]) return 0;
+            oldMin = std::min(oldMin, before);
+            newMin = std::min(newMin, after);
+        }
+        if (!(newMin > oldMin)) return 0;
+        S.point(v) = toPoint(p1);
+        loc.uv[v] = uv;
+        return 1;
+    }
+
+    std::size_t smoothOutside(Local& loc) {
+        Mesh& S = loc.star.S;
+        const auto near = seamNeighbourhood(loc);
+        std::vector<std::uint32_t> order(near.begin(), near.end());
+        std::sort(order.begin(), order.end());
+        std::size_t moved = 0;
+        for (std::uint32_t vi : order) {
+            const VertexIndex v(vi);
+            if (S.is_removed(v) || loc.locked[v] || loc.star.cur[v] != kNone) continue;
+            if (S.halfedge(v) == Mesh::null_halfedge()) continue;
+            if (loc.lid[v] >= 0) {
+                moved += slideAlongEdge(loc, v);
+                continue;
+            }
+            // All faces around: pieces of one mesh face (a Steiner point inside it, not on a mesh edge).
+            Vec3 n(0, 0, 0);
+            bool inPlane = true;
+            std::vector<std::pair<VertexIndex, VertexIndex>> ring; // (p, q): faces (v, p, q)
+            Vec3 centre(0, 0, 0);
+            int count = 0;
+            for (HalfedgeIndex g : CGAL::halfedges_around_target(S.halfedge(v), S)) {
+                const FaceIndex f = S.face(g);
+                if (f == Mesh::null_face() || loc.star.kept[f] || loc.patchSide[f]) {
+                    inPlane = false;
+                    break;
+                }
+                if (count == 0)
+                    n = loc.planeNormal[f];
+                else if (angleBetween(n, loc.planeNormal[f]) > kCoplanar)
+                    inPlane = false;
+                ring.push_back({S.target(S.next(g)), S.source(g)});
+                centre += pt(S, S.source(g));
+                ++count;
+            }
+            if (!inPlane || count < 3) continue;
+            centre /= double(count);
+            const Vec3 p0 = pt(S, v);
+            const Vec3 p1 = centre - n * n.dot(centre - p0);
+            Point2 uv;
+            double w;
+            if (!V_.project(p1, uv, w)) continue;
+            double oldMin = std::numbers::pi, newMin = std::numbers::pi;
+            bool valid = true;
+            for (const auto& [p, q] : ring) {
+                if (!leftTurn(uv, loc.uv[p], loc.uv[q]) ||
+                    CGAL::collinear(toPoint(p1), S.point(p), S.point(q))) {
+                    valid = false;
+                    break;
+                }
+                oldMin = std::min(oldMin, minAngle(p0, pt(S, p), pt(S, q)));
+                newMin = std::min(newMin, minAngle(p1, pt(S, p), pt(S, q)));
+            }
+            if (!valid || !(newMin > oldMin)) continue;
+            S.point(v) = toPoint(p1);
+            loc.uv[v] = uv;
+            ++moved;
+        }
+        return moved;
     }
 
     std::size_t refineOutside(Local& loc) {
@@ -1858,7 +2088,8 @@ private:
         const auto near = seamNeighbourhood(loc);
         auto within = near;
         for (EdgeIndex e : edgesAround(S, near))
-            for (VertexIndex v : {S.source(S.halfedge(e)), S.target(S.halfedge(e))}) within.insert(std::uint32_t(v));
+            for (VertexIndex v : {S.source(S.halfedge(e)), S.target(S.halfedge(e))})
+                within.insert(std::uint32_t(v));
         const auto dist = seamDistance(loc, within);
         auto distance = [&](VertexIndex v) {
             auto it = dist.find(std::uint32_t(v));
@@ -1868,11 +2099,13 @@ private:
         for (EdgeIndex e : edgesAround(S, near)) {
             const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
             const FaceIndex f = S.face(h), g = S.face(o);
-            if (f == Mesh::null_face() || g == Mesh::null_face() || loc.star.kept[f] || loc.star.kept[g]) continue;
+            if (f == Mesh::null_face() || g == Mesh::null_face() || loc.star.kept[f] || loc.star.kept[g])
+                continue;
             if (loc.patchSide[f] || loc.patchSide[g]) continue;
             const Vec3 a = pt(S, S.source(h)), b = pt(S, S.target(h));
             const double len = (a - b).norm();
-            const double target = h3_ + O_.seamGrading * 0.5 * (distance(S.source(h)) + distance(S.target(h)));
+            const double target =
+                h3_ + O_.seamGrading * 0.5 * (distance(S.source(h)) + distance(S.target(h)));
             if (len > 4.0 / 3.0 * target) cands.push_back({len, e});
         }
         std::sort(cands.begin(), cands.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
@@ -1893,8 +2126,8 @@ private:
                 continue;
             // ... and not make the smallest angle there worse.
             const Vec3 X = pt(S, x), Y = pt(S, y), Z = pt(S, z), U = pt(S, u);
-            if (std::min({minAngle(X, mid, Z), minAngle(mid, Y, Z), minAngle(Y, mid, U), minAngle(mid, X, U)}) <
-                std::min(minAngle(X, Y, Z), minAngle(Y, X, U)))
+            if (std::min({minAngle(X, mid, Z), minAngle(mid, Y, Z), minAngle(Y, mid, U),
+                          minAngle(mid, X, U)}) < 0.99 * std::min(minAngle(X, Y, Z), minAngle(Y, X, U)))
                 continue;
             const HalfedgeIndex hn = CGAL::Euler::split_edge(h, S);
             const VertexIndex v = S.target(hn);
@@ -1952,26 +2185,43 @@ private:
             if (S.is_removed(e)) continue;
             const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
             if (!isNewFace(S.face(h)) || !isNewFace(S.face(o))) continue;
-            const VertexIndex x = S.source(h), y = S.target(h), z1 = S.target(S.next(h)), z2 = S.target(S.next(o));
+            const VertexIndex x = S.source(h), y = S.target(h), z1 = S.target(S.next(h)),
+                              z2 = S.target(S.next(o));
             if (!near.count(std::uint32_t(x)) || !near.count(std::uint32_t(y))) continue;
             if (loc.seam.count(seamKey(x, y)) || z1 == z2) continue;
             if (S.degree(x) <= 3 || S.degree(y) <= 3) continue;
             if (S.halfedge(z1, z2) != Mesh::null_halfedge()) continue;
             // New faces (x, z2, z1) and (z2, y, z1).
-            if (!leftTurn(loc.uv[x], loc.uv[z2], loc.uv[z1]) || !leftTurn(loc.uv[z2], loc.uv[y], loc.uv[z1])) continue;
-            if (CGAL::collinear(S.point(x), S.point(z2), S.point(z1)) || CGAL::collinear(S.point(z2), S.point(y), S.point(z1))) continue;
+            if (!leftTurn(loc.uv[x], loc.uv[z2], loc.uv[z1]) || !leftTurn(loc.uv[z2], loc.uv[y], loc.uv[z1]))
+                continue;
+            if (CGAL::collinear(S.point(x), S.point(z2), S.point(z1)) ||
+                CGAL::collinear(S.point(z2), S.point(y), S.point(z1)))
+                continue;
             const Vec3 X = pt(S, x), Y = pt(S, y), Z1 = pt(S, z1), Z2 = pt(S, z2);
-            const Vec3 o1 = normalOf(X, Y, Z1), o2 = normalOf(Y, X, Z2), n1 = normalOf(X, Z2, Z1), n2 = normalOf(Z2, Y, Z1);
-            // Outside the patch a flip may not change the surface (the pieces must be coplanar); on the
-            // patch side it may not turn a normal more than maxNormalChangeDeg.
+            const Vec3 o1 = normalOf(X, Y, Z1), o2 = normalOf(Y, X, Z2), n1 = normalOf(X, Z2, Z1),
+                       n2 = normalOf(Z2, Y, Z1);
+            // On the patch side a flip may not turn a normal more than maxNormalChangeDeg. Outside the patch
+            // it may not change the surface: the pieces are coplanar, or they are pieces of one mesh face
+            // (tilted only where they reach a patch vertex) and the new ones are tilted no more.
             const bool patchSide = loc.patchSide[S.face(h)];
             if (patchSide != loc.patchSide[S.face(o)]) continue;
-            const double turn = std::max({angleBetween(o1, n1), angleBetween(o1, n2), angleBetween(o2, n1), angleBetween(o2, n2)});
-            if (turn > (patchSide ? maxTurn : kCoplanar)) continue;
+            const double turn = std::max(
+                {angleBetween(o1, n1), angleBetween(o1, n2), angleBetween(o2, n1), angleBetween(o2, n2)});
+            if (patchSide) {
+                if (turn > maxTurn) continue;
+            } else if (turn > kCoplanar) {
+                const Vec3 &p1 = loc.planeNormal[S.face(h)], &p2 = loc.planeNormal[S.face(o)];
+                if (angleBetween(p1, p2) > kCoplanar) continue;
+                const double tilt = std::max(angleBetween(o1, p1), angleBetween(o2, p1));
+                if (std::max(angleBetween(n1, p1), angleBetween(n2, p1)) > tilt + kCoplanar || turn > maxTurn)
+                    continue;
+            }
             const double oldMin = std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2));
             const double newMin = std::min(minAngle(X, Z2, Z1), minAngle(Z2, Y, Z1));
-            const int devOld = valenceCost(x, 0) + valenceCost(y, 0) + valenceCost(z1, 0) + valenceCost(z2, 0);
-            const int devNew = valenceCost(x, -1) + valenceCost(y, -1) + valenceCost(z1, 1) + valenceCost(z2, 1);
+            const int devOld =
+                valenceCost(x, 0) + valenceCost(y, 0) + valenceCost(z1, 0) + valenceCost(z2, 0);
+            const int devNew =
+                valenceCost(x, -1) + valenceCost(y, -1) + valenceCost(z1, 1) + valenceCost(z2, 1);
             // Score: smallest angle in degrees minus 3° per unit of valence deviation.
             const double gain = (newMin - oldMin) / kDeg - 3.0 * double(devNew - devOld);
             if (!(gain > 0.5) || newMin < std::min(oldMin, 20.0 * kDeg)) continue;
@@ -2039,13 +2289,16 @@ private:
         }
         auto faceBox = [&](FaceIndex f) {
             CGAL::Bbox_2 b;
-            for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(f), S)) b += loc.uv[v].bbox();
+            for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(f), S))
+                b += loc.uv[v].bbox();
             return b;
         };
         std::vector<FaceIndex> out, kept;
-        for (FaceIndex f : S.faces()) if (loc.star.kept[f]) kept.push_back(f);
+        for (FaceIndex f : S.faces())
+            if (loc.star.kept[f]) kept.push_back(f);
         BucketGrid keptGrid(4.0 * h2_, S.num_faces());
-        for (FaceIndex f : kept) keptGrid.insert(int(std::uint32_t(f)), faceBox(f));
+        for (FaceIndex f : kept)
+            keptGrid.insert(int(std::uint32_t(f)), faceBox(f));
         for (FaceIndex f : S.faces()) {
             bool take = loc.star.kept[f];
             if (!take)
@@ -2062,7 +2315,8 @@ private:
         return out;
     }
 
-    bool validate(Local& loc, const std::set<std::pair<std::uint32_t, std::uint32_t>>& bordersBefore, Attempt& a) {
+    bool validate(Local& loc, const std::set<std::pair<std::uint32_t, std::uint32_t>>& bordersBefore,
+                  Attempt& a) {
         Mesh& S = loc.star.S;
         std::vector<int> bad;
         auto badFace = [&](FaceIndex f) {
@@ -2081,18 +2335,21 @@ private:
             if (loc.star.kept[f]) continue;
             const HalfedgeIndex h = S.halfedge(f);
             const VertexIndex p = S.source(h), q = S.target(h), r = S.target(S.next(h));
-            if (CGAL::collinear(S.point(p), S.point(q), S.point(r)) || !leftTurn(loc.uv[p], loc.uv[q], loc.uv[r])) {
+            if (CGAL::collinear(S.point(p), S.point(q), S.point(r)) ||
+                !leftTurn(loc.uv[p], loc.uv[q], loc.uv[r])) {
                 badFace(f);
             } else if (minAngle(pt(S, p), pt(S, q), pt(S, r)) < loc.minAllowed[f]) {
                 badFace(f);
                 needles = true;
             }
         }
-        if (!bad.empty() && !needles) return fail(a, "it would create degenerate or back-facing faces", std::move(bad));
+        if (!bad.empty() && !needles)
+            return fail(a, "it would create degenerate or back-facing faces", std::move(bad));
         if (!bad.empty()) return fail(a, "it would create needle-like faces at its seam", std::move(bad));
         // Vertices: manifold (one umbrella) and no new border.
         std::vector<int> incoming(S.num_vertices(), 0);
-        for (HalfedgeIndex h : S.halfedges()) ++incoming[std::uint32_t(S.target(h))];
+        for (HalfedgeIndex h : S.halfedges())
+            ++incoming[std::uint32_t(S.target(h))];
         for (VertexIndex v : S.vertices()) {
             if (S.halfedge(v) == Mesh::null_halfedge() || !loc.star.isFull(v)) continue;
             int n = 0, borders = 0;
@@ -2117,7 +2374,10 @@ private:
                     if (!(set == &bordersAfter ? bordersBefore : bordersAfter).count(e)) {
                         Point2 uv;
                         double w;
-                        if (e.first != kNone && e.second != kNone && V_.project(0.5 * (toVec(M_.point(VertexIndex(e.first))) + toVec(M_.point(VertexIndex(e.second)))), uv, w))
+                        if (e.first != kNone && e.second != kNone &&
+                            V_.project(0.5 * (toVec(M_.point(VertexIndex(e.first))) +
+                                              toVec(M_.point(VertexIndex(e.second)))),
+                                       uv, w))
                             addNear(bad, uv);
                     }
         }
@@ -2138,10 +2398,12 @@ private:
 
     // An order of the new faces of S in which each is added next to what is already there: breadth first
     // from the faces next to kept faces (the hole's border) across S's edges.
-    static std::vector<std::size_t> growthOrderIn(const Mesh& S, const std::vector<FaceIndex>& sfaces, const Local& loc) {
+    static std::vector<std::size_t> growthOrderIn(const Mesh& S, const std::vector<FaceIndex>& sfaces,
+                                                  const Local& loc) {
         std::unordered_map<std::uint32_t, std::size_t> index;
         index.reserve(sfaces.size());
-        for (std::size_t i = 0; i < sfaces.size(); ++i) index[std::uint32_t(sfaces[i])] = i;
+        for (std::size_t i = 0; i < sfaces.size(); ++i)
+            index[std::uint32_t(sfaces[i])] = i;
         std::vector<char> done(sfaces.size(), 0);
         std::vector<std::size_t> order;
         order.reserve(sfaces.size());
@@ -2150,7 +2412,8 @@ private:
             for (HalfedgeIndex h : CGAL::halfedges_around_face(S.halfedge(sfaces[i]), S)) {
                 const FaceIndex g = S.face(S.opposite(h));
                 // Next to a face that exists before the additions (kept, or left unchanged).
-                if (!done[i] && (g == Mesh::null_face() || loc.star.kept[g] || !index.count(std::uint32_t(g)))) {
+                if (!done[i] &&
+                    (g == Mesh::null_face() || loc.star.kept[g] || !index.count(std::uint32_t(g)))) {
                     done[i] = 1;
                     queue.push_back(i);
                 }
@@ -2203,7 +2466,8 @@ private:
             if (!loc.star.kept[f]) {
                 const HalfedgeIndex h = S.halfedge(f);
                 const std::array<VertexIndex, 3> fv{S.source(h), S.target(h), S.target(S.next(h))};
-                const std::array<std::uint32_t, 3> c{loc.star.cur[fv[0]], loc.star.cur[fv[1]], loc.star.cur[fv[2]]};
+                const std::array<std::uint32_t, 3> c{loc.star.cur[fv[0]], loc.star.cur[fv[1]],
+                                                     loc.star.cur[fv[2]]};
                 if (c[0] != kNone && c[1] != kNone && c[2] != kNone) {
                     auto it = byCorners.find(corners(c));
                     if (it != byCorners.end()) {
@@ -2219,7 +2483,8 @@ private:
         std::unordered_set<std::uint32_t> reused;
         // Order faces for growth in the rehearsal mesh: build it first (same star, same removals).
         Star rehearsal;
-        if (!buildStar(M_, replaced_, rehearsal)) return fail(a, "internal error: the star could not be rebuilt");
+        if (!buildStar(M_, replaced_, rehearsal))
+            return fail(a, "internal error: the star could not be rebuilt");
         for (const auto& fv : faces)
             for (VertexIndex v : fv) {
                 const std::uint32_t c = loc.star.cur[v];
@@ -2237,15 +2502,18 @@ private:
             for (int k = 0; k < 3; ++k) {
                 const VertexIndex v = fv[std::size_t(k)];
                 const std::uint32_t c = loc.star.cur[v];
-                p[std::size_t(k)] = c != kNone ? PlanVertex{c, false} : PlanVertex{freshIndex.at(std::uint32_t(v)), true};
+                p[std::size_t(k)] =
+                    c != kNone ? PlanVertex{c, false} : PlanVertex{freshIndex.at(std::uint32_t(v)), true};
             }
             pf.push_back(p);
         }
         // Rehearse: add fresh vertices, remove the replaced faces, add the faces in growth order.
         std::vector<VertexIndex> fresh;
-        for (const Vec3& p : plan.freshPositions) fresh.push_back(rehearsal.S.add_vertex(toPoint(p)));
+        for (const Vec3& p : plan.freshPositions)
+            fresh.push_back(rehearsal.S.add_vertex(toPoint(p)));
         std::unordered_set<std::uint32_t> keep;
-        for (VertexIndex v : plan.reused) keep.insert(std::uint32_t(rehearsal.fromCurrent.at(std::uint32_t(v))));
+        for (VertexIndex v : plan.reused)
+            keep.insert(std::uint32_t(rehearsal.fromCurrent.at(std::uint32_t(v))));
         for (FaceIndex f : plan.removed)
             removeFaceKeeping(rehearsal.S, rehearsal.faceFromCurrent.at(std::uint32_t(f)),
                               [&](VertexIndex v) { return keep.count(std::uint32_t(v)) > 0; });
@@ -2253,8 +2521,9 @@ private:
         for (const auto& p : pf) {
             std::array<VertexIndex, 3> r;
             for (int k = 0; k < 3; ++k)
-                r[std::size_t(k)] = p[std::size_t(k)].fresh ? fresh[p[std::size_t(k)].index]
-                                                             : rehearsal.fromCurrent.at(p[std::size_t(k)].index);
+                r[std::size_t(k)] = p[std::size_t(k)].fresh
+                                        ? fresh[p[std::size_t(k)].index]
+                                        : rehearsal.fromCurrent.at(p[std::size_t(k)].index);
             rf.push_back(r);
         }
         const auto order = growthOrderIn(S, sfaces, loc);
@@ -2276,7 +2545,8 @@ private:
         }
         for (std::size_t i = 0; i < faces.size(); ++i) {
             const auto& fv = faces[i];
-            if (!seamVerts.count(std::uint32_t(fv[0])) && !seamVerts.count(std::uint32_t(fv[1])) && !seamVerts.count(std::uint32_t(fv[2])))
+            if (!seamVerts.count(std::uint32_t(fv[0])) && !seamVerts.count(std::uint32_t(fv[1])) &&
+                !seamVerts.count(std::uint32_t(fv[2])))
                 continue;
             plan.seamFaceMinAngles.push_back(minAngle(pt(S, fv[0]), pt(S, fv[1]), pt(S, fv[2])) / kDeg);
         }
@@ -2307,7 +2577,7 @@ private:
         std::vector<std::pair<double, int>> splits;
         std::vector<int> line;
     };
-    std::vector<int> compVerts_;                             // vertices of the component, sorted
+    std::vector<int> compVerts_;                            // vertices of the component, sorted
     std::unordered_map<int, std::vector<int>> vertexFaces_; // faces around each boundary vertex
     std::unordered_set<int> boundary_;
     std::vector<PEdge> pedges_;
@@ -2406,55 +2676,61 @@ std::vector<std::vector<int>> components(const PatchData& P, const std::vector<i
         if (fresh) out.emplace_back();
         out[it->second].push_back(f);
     }
-    std::stable_sort(out.begin(), out.end(), [](const auto& x, const auto& y) { return x.size() > y.size(); });
+    std::stable_sort(out.begin(), out.end(),
+                     [](const auto& x, const auto& y) { return x.size() > y.size(); });
     return out;
 }
 
 } // namespace
 
-StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCamera, const StitchOptions& options,
-                         std::span<const std::uint32_t> faceIds) {
+StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCamera,
+                         const StitchOptions& options, std::span<const std::uint32_t> faceIds) {
     const auto start = std::chrono::steady_clock::now();
     scanCamera.validate();
     if (patch.number_of_faces() == 0) throw InvalidInputError("The patch has no faces.");
     if (!faceIds.empty() && faceIds.size() != std::size_t(scanCamera.width) * std::size_t(scanCamera.height))
-        throw InvalidInputError("The ID buffer has " + std::to_string(faceIds.size()) + " pixels but the scan camera's image has " +
-                                std::to_string(std::size_t(scanCamera.width) * std::size_t(scanCamera.height)) + ".");
+        throw InvalidInputError(
+            "The ID buffer has " + std::to_string(faceIds.size()) +
+            " pixels but the scan camera's image has " +
+            std::to_string(std::size_t(scanCamera.width) * std::size_t(scanCamera.height)) + ".");
     if (!(options.collapseEdgeRatio >= 0 && options.collapseEdgeRatio < 0.5) || options.seamRings < 0 ||
-        !(options.maxViewAngleDeg > 0 && options.maxViewAngleDeg < 90) || !(options.maxNormalChangeDeg >= 0) ||
-        !(options.maxGapRatio > 0) || options.maxTrimRounds < 0 || !(options.seamGrading >= 0) || !(options.minAngleFloorDeg >= 0 && options.minAngleFloorDeg < 30))
-        throw InvalidInputError("The stitch options are out of range (collapseEdgeRatio in [0, 0.5), seamRings >= 0, "
-                                "maxViewAngleDeg in (0, 90), maxNormalChangeDeg >= 0, maxGapRatio > 0, maxTrimRounds >= 0, seamGrading >= 0, minAngleFloorDeg in [0, 30)).");
+        !(options.maxViewAngleDeg > 0 && options.maxViewAngleDeg < 90) ||
+        !(options.maxNormalChangeDeg >= 0) || !(options.maxGapRatio > 0) || options.maxTrimRounds < 0 ||
+        !(options.seamGrading >= 0) || !(options.minAngleFloorDeg >= 0 && options.minAngleFloorDeg < 30))
+        throw InvalidInputError(
+            "The stitch options are out of range (collapseEdgeRatio in [0, 0.5), seamRings >= 0, "
+            "maxViewAngleDeg in (0, 90), maxNormalChangeDeg >= 0, maxGapRatio > 0, maxTrimRounds >= 0, "
+            "seamGrading >= 0, minAngleFloorDeg in [0, 30)).");
 
     const View view(scanCamera);
     StitchReport report;
     std::size_t dropped = 0;
     const PatchData P = readPatch(patch, view, dropped);
     if (dropped > 0)
-        report.skipped.push_back(std::to_string(dropped) + " patch faces were behind the camera or not facing it and were left out.");
+        report.skipped.push_back(std::to_string(dropped) +
+                                 " patch faces were behind the camera or not facing it and were left out.");
     report.patchFacesTrimmed += dropped;
 
     std::vector<int> all(P.tri.size());
-    for (std::size_t i = 0; i < all.size(); ++i) all[i] = int(i);
+    for (std::size_t i = 0; i < all.size(); ++i)
+        all[i] = int(i);
     struct Work {
         std::vector<int> faces;
-        int name;    // number of the original component (1-based)
-        int rounds;  // trim rounds used
+        int name;   // number of the original component (1-based)
+        int rounds; // trim rounds used
     };
     std::deque<Work> work;
-    {
-        int n = 0;
-        for (auto& c : components(P, all)) work.push_back({std::move(c), ++n, 0});
+    std::vector<std::size_t> componentFaces; // faces of each original component
+    for (auto& c : components(P, all)) {
+        componentFaces.push_back(c.size());
+        work.push_back({std::move(c), int(componentFaces.size()), 0});
     }
-    const int componentCount = int(work.size());
-    std::string firstReason;
-    auto skip = [&](const Work& w, const std::string& why) {
-        ++report.componentsSkipped;
+    const int componentCount = int(componentFaces.size());
+    std::map<int, std::string> firstReason; // per original component: the first reason a piece was dropped
+    std::set<int> stitched;                 // original components with at least one piece glued in
+    auto drop = [&](const Work& w, const std::string& why) {
         report.patchFacesTrimmed += w.faces.size();
-        const std::string s = "Patch component " + std::to_string(w.name) + " (" + std::to_string(w.faces.size()) +
-                              " faces) was not stitched: " + why + ".";
-        report.skipped.push_back(s);
-        if (firstReason.empty()) firstReason = why;
+        firstReason.try_emplace(w.name, why);
     };
 
     bool propsReady = false;
@@ -2463,7 +2739,9 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
         Work w = std::move(work.front());
         work.pop_front();
         if (w.faces.size() < options.minComponentFaces) {
-            skip(w, "it has fewer than " + std::to_string(options.minComponentFaces) + " faces");
+            drop(w, w.rounds == 0
+                        ? "it has fewer than " + std::to_string(options.minComponentFaces) + " faces"
+                        : "what trimming left of it was too small");
             continue;
         }
         const bool curQ = current.property_map<FaceIndex, float>(props::faceQuality).second;
@@ -2478,10 +2756,6 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
             a.reason = "an internal consistency check failed (" + std::string(e.what()) + ")";
         }
         if (!a.ok) {
-            if (a.bad.empty() || w.rounds >= options.maxTrimRounds) {
-                skip(w, a.reason);
-                continue;
-            }
             // Trim the faces around the problem and retry what is left (it may fall apart).
             std::unordered_set<int> bad(a.bad.begin(), a.bad.end());
             std::vector<int> rest;
@@ -2489,24 +2763,20 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
                 const auto& t = P.tri[std::size_t(f)];
                 if (!bad.count(t[0]) && !bad.count(t[1]) && !bad.count(t[2])) rest.push_back(f);
             }
-            if (rest.size() == w.faces.size()) {
-                skip(w, a.reason);
+            if (rest.size() == w.faces.size() || w.rounds >= options.maxTrimRounds) {
+                drop(w, a.reason);
                 continue;
             }
             report.patchFacesTrimmed += w.faces.size() - rest.size();
-            if (rest.empty()) {
-                ++report.componentsSkipped;
-                const std::string why = a.reason;
-                report.skipped.push_back("Patch component " + std::to_string(w.name) + " was trimmed away: " + why + ".");
-                if (firstReason.empty()) firstReason = why;
-                continue;
-            }
-            for (auto& c : components(P, rest)) work.push_front({std::move(c), w.name, w.rounds + 1});
+            firstReason.try_emplace(w.name, a.reason);
+            for (auto& c : components(P, rest))
+                work.push_front({std::move(c), w.name, w.rounds + 1});
             continue;
         }
         // Apply: every check has passed on the local copy and the rehearsal succeeded.
         if (!propsReady) {
-            if (P.hasQuality) current.add_property_map<FaceIndex, float>(props::faceQuality, kInputFaceQuality);
+            if (P.hasQuality)
+                current.add_property_map<FaceIndex, float>(props::faceQuality, kInputFaceQuality);
             if (P.hasScanId) current.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1);
             propsReady = true;
         }
@@ -2520,7 +2790,8 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
                 if (s.second) s.first[f] = plan.scanId[i];
             });
         if (!applied) throw Error("Internal error: a rehearsed stitch could not be applied to the mesh.");
-        ++report.componentsStitched;
+        stitched.insert(w.name);
+        ++report.piecesStitched;
         report.facesRemoved += plan.removed.size();
         report.facesAdded += plan.faces.size();
         report.seamEdges += plan.seamEdges;
@@ -2533,11 +2804,21 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
         }
         report.seamFaces += plan.seamFaceMinAngles.size();
     }
-    report.seamFracMinAngleAbove25 = report.seamFaces ? double(seamFacesAbove25) / double(report.seamFaces) : 1.0;
+    report.componentsStitched = int(stitched.size());
+    for (int c = 1; c <= componentCount; ++c) {
+        if (stitched.count(c)) continue;
+        ++report.componentsSkipped;
+        report.skipped.push_back("Patch component " + std::to_string(c) + " (" +
+                                 std::to_string(componentFaces[std::size_t(c - 1)]) +
+                                 " faces) was not stitched: " + firstReason[c] + ".");
+    }
+    report.seamFracMinAngleAbove25 =
+        report.seamFaces ? double(seamFacesAbove25) / double(report.seamFaces) : 1.0;
     if (report.componentsStitched == 0)
-        throw InvalidInputError("No part of the patch could be stitched" +
-                                (componentCount > 1 ? " (" + std::to_string(componentCount) + " components)" : std::string()) +
-                                ": " + (firstReason.empty() ? std::string("it is empty") : firstReason) + ".");
+        throw InvalidInputError(
+            "No part of the patch could be stitched" +
+            (componentCount > 1 ? " (" + std::to_string(componentCount) + " components)" : std::string()) +
+            ": " + (firstReason.empty() ? std::string("it is empty") : firstReason.begin()->second) + ".");
     if (options.collectGarbage) current.collect_garbage();
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return report;

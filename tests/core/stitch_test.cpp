@@ -10,6 +10,7 @@
 #include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh/IO/OFF.h>
+#include <CGAL/boost/graph/Euler_operations.h>
 
 #include <gtest/gtest.h>
 
@@ -36,7 +37,9 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-Vec3 vec(const Point3& p) { return {p.x(), p.y(), p.z()}; }
+Vec3 vec(const Point3& p) {
+    return {p.x(), p.y(), p.z()};
+}
 
 // ---- analytic surfaces: the nearest hit of a view ray
 using Surface = std::function<std::optional<Vec3>(const fss::Ray&)>;
@@ -52,7 +55,7 @@ Surface planeZ0() {
     };
 }
 
-[[maybe_unused]] Surface sphere(double radius) {
+Surface sphere(double radius) {
     return [radius](const fss::Ray& r) -> std::optional<Vec3> {
         const double b = r.origin.dot(r.direction), c = r.origin.squaredNorm() - radius * radius;
         const double disc = b * b - c;
@@ -73,7 +76,8 @@ Mesh makePatch(const Camera& cam, const std::function<bool(int, int)>& mask, con
     std::vector<std::optional<Vec3>> pts(std::size_t(W) * std::size_t(H));
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x)
-            if (mask(x, y)) pts[std::size_t(y) * std::size_t(W) + std::size_t(x)] = surface(cam.ray(x + 0.5, y + 0.5));
+            if (mask(x, y))
+                pts[std::size_t(y) * std::size_t(W) + std::size_t(x)] = surface(cam.ray(x + 0.5, y + 0.5));
     Mesh m;
     std::vector<VertexIndex> vid(pts.size());
     auto vertex = [&](int x, int y) {
@@ -126,7 +130,8 @@ std::size_t boundaryLoops(const Mesh& m) {
 
 std::size_t nonManifoldVertices(const Mesh& m) {
     std::unordered_map<std::uint32_t, int> incoming;
-    for (auto h : m.halfedges()) ++incoming[std::uint32_t(m.target(h))];
+    for (auto h : m.halfedges())
+        ++incoming[std::uint32_t(m.target(h))];
     std::size_t bad = 0;
     for (auto v : m.vertices()) {
         if (m.halfedge(v) == Mesh::null_halfedge()) {
@@ -197,11 +202,13 @@ FaceKey faceKey(const Mesh& m, FaceIndex f) {
 
 std::string reportText(const fss::StitchReport& r) {
     std::ostringstream os;
-    os << "stitched " << r.componentsStitched << " skipped " << r.componentsSkipped << " removed " << r.facesRemoved
-       << " added " << r.facesAdded << " seam edges " << r.seamEdges << " seam faces " << r.seamFaces
-       << " min angle " << r.seamMinAngleDeg << " frac>=25 " << r.seamFracMinAngleAbove25 << " collapses "
-       << r.collapses << " flips " << r.flips << " trimmed " << r.patchFacesTrimmed << " time " << r.seconds;
-    for (const auto& s : r.skipped) os << "\n  " << s;
+    os << "stitched " << r.componentsStitched << " (" << r.piecesStitched << " pieces) skipped "
+       << r.componentsSkipped << " removed " << r.facesRemoved << " added " << r.facesAdded << " seam edges "
+       << r.seamEdges << " seam faces " << r.seamFaces << " min angle " << r.seamMinAngleDeg << " frac>=25 "
+       << r.seamFracMinAngleAbove25 << " collapses " << r.collapses << " flips " << r.flips << " trimmed "
+       << r.patchFacesTrimmed << " time " << r.seconds;
+    for (const auto& s : r.skipped)
+        os << "\n  " << s;
     return os.str();
 }
 
@@ -236,8 +243,10 @@ TEST(Stitch, PatchInsideFlatGrid) {
     EXPECT_EQ(r.patchFacesTrimmed, 0u);
     expectValid(grid, {false, 1});
     EXPECT_NEAR(PMP::area(grid), 400.0, 400.0 * 1e-9);
-    for (auto v : grid.vertices()) EXPECT_EQ(grid.point(v).z(), 0.0);
-    for (auto f : grid.faces()) EXPECT_GT(PMP::face_area(f, grid), 0.0);
+    for (auto v : grid.vertices())
+        EXPECT_EQ(grid.point(v).z(), 0.0);
+    for (auto f : grid.faces())
+        EXPECT_GT(PMP::face_area(f, grid), 0.0);
     EXPECT_EQ(facesNotFacing(grid, cam, {}), 0u);
 
     // Faces away from the patch footprint keep index, vertices and positions.
@@ -264,13 +273,15 @@ TEST(Stitch, PatchInsideFlatGrid) {
 
     // The patch's interior faces (two rings away from its boundary) are in the mesh as they were.
     std::set<FaceKey> result;
-    for (auto f : grid.faces()) result.insert(faceKey(grid, f));
+    for (auto f : grid.faces())
+        result.insert(faceKey(grid, f));
     std::set<std::uint32_t> nearBorder;
     for (auto v : patch.vertices())
         if (patch.is_border(v))
             for (auto w : CGAL::vertices_around_target(patch.halfedge(v), patch)) {
                 nearBorder.insert(std::uint32_t(w));
-                for (auto x : CGAL::vertices_around_target(patch.halfedge(w), patch)) nearBorder.insert(std::uint32_t(x));
+                for (auto x : CGAL::vertices_around_target(patch.halfedge(w), patch))
+                    nearBorder.insert(std::uint32_t(x));
             }
     std::size_t interior = 0, found = 0;
     for (auto f : patch.faces()) {
@@ -288,7 +299,8 @@ TEST(Stitch, PatchInsideFlatGrid) {
     auto sid = grid.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId);
     ASSERT_TRUE(sid.second);
     std::size_t scanned = 0;
-    for (auto f : grid.faces()) scanned += sid.first[f] == 1;
+    for (auto f : grid.faces())
+        scanned += sid.first[f] == 1;
     EXPECT_GE(scanned, patch.number_of_faces());
     EXPECT_GT(r.seamEdges, 100u);
     EXPECT_GT(r.seamMinAngleDeg, 0.0);
@@ -312,7 +324,9 @@ Camera orbitCamera(const Vec3& from, double distance, int res, double angleDeg =
 }
 
 std::function<bool(int, int)> disk(double cx, double cy, double r) {
-    return [=](int x, int y) { return (x + 0.5 - cx) * (x + 0.5 - cx) + (y + 0.5 - cy) * (y + 0.5 - cy) <= r * r; };
+    return [=](int x, int y) {
+        return (x + 0.5 - cx) * (x + 0.5 - cx) + (y + 0.5 - cy) * (y + 0.5 - cy) <= r * r;
+    };
 }
 
 // Largest distance of a point of a face of a sphere mesh (whose vertices lie on the sphere) from the
@@ -321,7 +335,8 @@ double sphereSag(const Mesh& m, double radius) {
     double sag = 0;
     for (auto f : m.faces()) {
         auto h = m.halfedge(f);
-        const Vec3 a = vec(m.point(m.source(h))), b = vec(m.point(m.target(h))), c = vec(m.point(m.target(m.next(h))));
+        const Vec3 a = vec(m.point(m.source(h))), b = vec(m.point(m.target(h))),
+                   c = vec(m.point(m.target(m.next(h))));
         const Vec3 n = (b - a).cross(c - a).normalized();
         sag = std::max(sag, radius - std::abs(n.dot(a)));
     }
@@ -330,7 +345,8 @@ double sphereSag(const Mesh& m, double radius) {
 
 void expectOnSphere(const Mesh& m, double radius, double tolerance) {
     double worst = 0;
-    for (auto v : m.vertices()) worst = std::max(worst, std::abs(vec(m.point(v)).norm() - radius));
+    for (auto v : m.vertices())
+        worst = std::max(worst, std::abs(vec(m.point(v)).norm() - radius));
     EXPECT_LE(worst, tolerance);
 }
 
@@ -370,14 +386,33 @@ void expectBitIdentical(const Mesh& a, const Mesh& b) {
     }
 }
 
-double sumArea(const Mesh& m) { return PMP::area(m); }
+double sumArea(const Mesh& m) {
+    return PMP::area(m);
+}
 
 } // namespace
+
+TEST(Stitch, ParallelCamera) {
+    Mesh grid = fss::shapes::grid(12, 12, 1.0);
+    Camera cam = downCamera(6.1, 5.8, 20, -9.0, 80);
+    cam.parallel = true;
+    cam.parallelScale = 5.0;
+    const fss::StitchReport r = fss::stitchPatch(grid, makePatch(cam, disk(40, 38, 22), planeZ0()), cam);
+    SCOPED_TRACE(reportText(r));
+    EXPECT_EQ(r.componentsStitched, 1);
+    EXPECT_EQ(r.patchFacesTrimmed, 0u);
+    expectValid(grid, {false, 1});
+    EXPECT_NEAR(sumArea(grid), 144.0, 144.0 * 1e-9);
+    for (auto v : grid.vertices())
+        EXPECT_EQ(grid.point(v).z(), 0.0);
+    EXPECT_EQ(facesNotFacing(grid, cam, {}), 0u);
+}
 
 TEST(Stitch, SphereChainedPatchesStayClosed) {
     Mesh m = fss::shapes::icosphere(3, 1.0);
     const double sag = sphereSag(m, 1.0);
-    const Vec3 dirs[] = {{0, 0, 1}, {1, 0.2, 0.3}, {-0.3, 1, 0.1}, {0.2, -0.4, -1}, {-1, -0.5, 0.4}, {0.6, 0.6, 0.5}};
+    const Vec3 dirs[] = {{0, 0, 1},       {1, 0.2, 0.3},   {-0.3, 1, 0.1},
+                         {0.2, -0.4, -1}, {-1, -0.5, 0.4}, {0.6, 0.6, 0.5}};
     double minAngle = 180, frac = 0;
     int n = 0;
     for (const Vec3& d : dirs) {
@@ -394,8 +429,8 @@ TEST(Stitch, SphereChainedPatchesStayClosed) {
         ++n;
     }
     EXPECT_GT(PMP::volume(m), 0.0);
-    std::printf("sphere chained: %d patches, seam min angle %.2f deg, mean frac >= 25 deg %.3f, faces %zu\n", n,
-                minAngle, frac / n, std::size_t(m.number_of_faces()));
+    std::printf("sphere chained: %d patches, seam min angle %.2f deg, mean frac >= 25 deg %.3f, faces %zu\n",
+                n, minAngle, frac / n, std::size_t(m.number_of_faces()));
 }
 
 TEST(Stitch, PatchOverlappingAnEarlierPatch) {
@@ -413,11 +448,13 @@ TEST(Stitch, PatchOverlappingAnEarlierPatch) {
     EXPECT_EQ(rb.componentsSkipped, 0);
     expectValid(grid, {false, 1});
     EXPECT_NEAR(sumArea(grid), 400.0, 400.0 * 1e-9);
-    for (auto v : grid.vertices()) EXPECT_EQ(grid.point(v).z(), 0.0);
+    for (auto v : grid.vertices())
+        EXPECT_EQ(grid.point(v).z(), 0.0);
     // Both scans are present: the second covers part of the first.
     auto sid = grid.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId).first;
     std::map<int, std::size_t> count;
-    for (auto f : grid.faces()) ++count[sid[f]];
+    for (auto f : grid.faces())
+        ++count[sid[f]];
     EXPECT_GT(count[1], 300u);
     EXPECT_GT(count[2], 1500u);
     EXPECT_EQ(facesNotFacing(grid, b, {}), 0u);
@@ -478,7 +515,8 @@ TEST(Stitch, PatchReachingTheMeshBorderIsTrimmed) {
     Mesh grid = fss::shapes::grid(12, 12, 1.0);
     // Looking at the corner (0, 0): the scan sees past two borders of the grid.
     const Camera cam = downCamera(1.5, 2.0, 25, 6.0, 96);
-    const Mesh patch = makePatch(cam, [](int x, int y) { return x >= 8 && x < 80 && y >= 10 && y < 85; }, planeZ0());
+    const Mesh patch = makePatch(
+        cam, [](int x, int y) { return x >= 8 && x < 80 && y >= 10 && y < 85; }, planeZ0());
     const fss::StitchReport r = fss::stitchPatch(grid, patch, cam);
     SCOPED_TRACE(reportText(r));
     EXPECT_EQ(r.componentsStitched, 1);
@@ -491,7 +529,8 @@ TEST(Stitch, PatchReachingTheMeshBorderIsTrimmed) {
     }
     auto sid = grid.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId).first;
     std::size_t scanned = 0;
-    for (auto f : grid.faces()) scanned += sid[f] == 1;
+    for (auto f : grid.faces())
+        scanned += sid[f] == 1;
     EXPECT_GT(scanned, patch.number_of_faces() / 4);
 }
 
@@ -500,7 +539,8 @@ TEST(Stitch, PatchPastTheSilhouetteIsTrimmed) {
     const double sag = sphereSag(m, 1.0);
     const Camera cam = orbitCamera({0.3, -1, 0.5}, 4.0, 96);
     // The whole image: the patch reaches the sphere's silhouette, where the mesh is seen edge-on.
-    const Mesh patch = makePatch(cam, [](int, int) { return true; }, sphere(1.0), 1, 85.0);
+    const Mesh patch = makePatch(
+        cam, [](int, int) { return true; }, sphere(1.0), 1, 85.0);
     const fss::StitchReport r = fss::stitchPatch(m, patch, cam);
     SCOPED_TRACE(reportText(r));
     EXPECT_EQ(r.componentsStitched, 1);
@@ -531,7 +571,8 @@ TEST(Stitch, FailureLeavesTheMeshBitIdentical) {
 
     // A patch beside the mesh: nothing to stitch to.
     const Camera away = orbitCamera({0, 0, 1}, 4.0, 96);
-    EXPECT_THROW(fss::stitchPatch(m, makePatch(away, disk(5, 5, 4), planeZ0()), away), fss::InvalidInputError);
+    EXPECT_THROW(fss::stitchPatch(m, makePatch(away, disk(5, 5, 4), planeZ0()), away),
+                 fss::InvalidInputError);
     expectBitIdentical(m, before);
 
     // Invalid input.
@@ -561,9 +602,12 @@ std::vector<std::uint32_t> rasterizeIds(const Mesh& m, const Camera& cam) {
             s[k++] = cam.project(p);
         }
         if (!ok) continue;
-        const double x0 = std::min({s[0].x(), s[1].x(), s[2].x()}), x1 = std::max({s[0].x(), s[1].x(), s[2].x()});
-        const double y0 = std::min({s[0].y(), s[1].y(), s[2].y()}), y1 = std::max({s[0].y(), s[1].y(), s[2].y()});
-        const double area = (s[1].x() - s[0].x()) * (s[2].y() - s[0].y()) - (s[1].y() - s[0].y()) * (s[2].x() - s[0].x());
+        const double x0 = std::min({s[0].x(), s[1].x(), s[2].x()}),
+                     x1 = std::max({s[0].x(), s[1].x(), s[2].x()});
+        const double y0 = std::min({s[0].y(), s[1].y(), s[2].y()}),
+                     y1 = std::max({s[0].y(), s[1].y(), s[2].y()});
+        const double area =
+            (s[1].x() - s[0].x()) * (s[2].y() - s[0].y()) - (s[1].y() - s[0].y()) * (s[2].x() - s[0].x());
         if (area == 0) continue;
         for (int y = std::max(0, int(std::floor(y0))); y <= std::min(H - 1, int(std::ceil(y1))); ++y)
             for (int x = std::max(0, int(std::floor(x0))); x <= std::min(W - 1, int(std::ceil(x1))); ++x) {
@@ -591,7 +635,8 @@ std::function<bool(int, int)> randomMask(std::mt19937& rng, int res) {
     const double cx = res * (0.25 + 0.5 * U(rng)), cy = res * (0.25 + 0.5 * U(rng));
     const double r = 3 + 0.2 * res * U(rng);
     switch (int(U(rng) * 4)) {
-    case 0: return disk(cx, cy, r);
+    case 0:
+        return disk(cx, cy, r);
     case 1: {
         const double inner = 0.25 * r + 1;
         return [=](int x, int y) {
@@ -601,7 +646,9 @@ std::function<bool(int, int)> randomMask(std::mt19937& rng, int res) {
     }
     case 2: {
         const double dx = r + 4 + 6 * U(rng);
-        return [=](int x, int y) { return disk(cx - dx, cy, 0.6 * r + 2)(x, y) || disk(cx + dx, cy, 0.5 * r + 2)(x, y); };
+        return [=](int x, int y) {
+            return disk(cx - dx, cy, 0.6 * r + 2)(x, y) || disk(cx + dx, cy, 0.5 * r + 2)(x, y);
+        };
     }
     default: {
         const int w = int(r) + 2, h = int(0.7 * r) + 2;
@@ -613,7 +660,8 @@ std::function<bool(int, int)> randomMask(std::mt19937& rng, int res) {
 Vec3 randomDirection(std::mt19937& rng) {
     std::normal_distribution<double> N(0, 1);
     Vec3 d;
-    do d = Vec3(N(rng), N(rng), N(rng));
+    do
+        d = Vec3(N(rng), N(rng), N(rng));
     while (d.norm() < 1e-3);
     return d.normalized();
 }
@@ -655,6 +703,16 @@ TEST(Stitch, RandomChainedScansKeepAllInvariants) {
             }
             expectValid(m, {true, 0});
             expectOnSphere(m, 1.0, sag * 1.0001);
+            // This scan's faces face its camera.
+            auto sid = m.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId);
+            if (sid.second) {
+                std::set<std::uint32_t> mine;
+                for (auto f : m.faces())
+                    if (sid.first[f] == i + 1) mine.insert(std::uint32_t(f));
+                if (!mine.empty()) {
+                    EXPECT_EQ(facesNotFacing(m, cam, mine), 0u);
+                }
+            }
             if (HasFailure()) return;
         }
     }
@@ -684,7 +742,8 @@ TEST(Stitch, RandomChainedScansKeepAllInvariants) {
             }
             expectValid(g, {false, 1});
             EXPECT_NEAR(sumArea(g), 256.0, 256.0 * 1e-9);
-            for (auto v : g.vertices()) ASSERT_EQ(g.point(v).z(), 0.0);
+            for (auto v : g.vertices())
+                ASSERT_EQ(g.point(v).z(), 0.0);
             if (HasFailure()) return;
         }
     }
@@ -705,7 +764,8 @@ Surface meshSurface(const Mesh& ref) {
     for (auto f : ref.faces()) {
         std::array<Vec3, 3> t;
         int k = 0;
-        for (auto v : CGAL::vertices_around_face(ref.halfedge(f), ref)) t[std::size_t(k++)] = vec(ref.point(v));
+        for (auto v : CGAL::vertices_around_face(ref.halfedge(f), ref))
+            t[std::size_t(k++)] = vec(ref.point(v));
         tris.push_back(t);
     }
     return [tris](const fss::Ray& r) -> std::optional<Vec3> {
@@ -739,12 +799,14 @@ TEST(Stitch, RealMeshChainedScans) {
     const std::size_t loops = boundaryLoops(ref);
     const double volume = closed ? PMP::volume(ref) : 0.0;
     Eigen::AlignedBox3d box;
-    for (auto v : ref.vertices()) box.extend(vec(ref.point(v)));
+    for (auto v : ref.vertices())
+        box.extend(vec(ref.point(v)));
     const Surface surface = meshSurface(ref);
     Mesh m = ref;
     const Vec3 dirs[] = {{0, 0, 1}, {1, 0.3, 0.2}, {-0.4, 1, 0.3}, {0.3, -0.5, -1}, {-1, -0.2, 0.5}};
     int n = 0;
     double minAngle = 180;
+    std::size_t patchFaces = 0, trimmed = 0;
     for (const Vec3& d : dirs) {
         Camera cam = Camera::standardView(fss::StandardView::PosZ, box, 96, 96);
         const double dist = (cam.eye - cam.focal).norm();
@@ -758,12 +820,14 @@ TEST(Stitch, RealMeshChainedScans) {
         EXPECT_GE(r.componentsStitched, 1);
         expectValid(m, {closed, loops});
         minAngle = std::min(minAngle, r.seamMinAngleDeg);
-        std::printf("  elephant scan %d: %s\n", n, reportText(r).c_str());
+        patchFaces += patch.number_of_faces();
+        trimmed += r.patchFacesTrimmed;
     }
     if (closed) {
         EXPECT_NEAR(PMP::volume(m), volume, 0.01 * volume);
     }
-    std::printf("elephant: %d scans, %zu faces, seam min angle %.2f deg\n", n, std::size_t(m.number_of_faces()), minAngle);
+    std::printf("elephant: %d scans, %zu of %zu patch faces stitched, %zu faces, seam min angle %.2f deg\n",
+                n, patchFaces - trimmed, patchFaces, std::size_t(m.number_of_faces()), minAngle);
 }
 
 TEST(Stitch, CollectGarbageOnRequest) {
@@ -771,10 +835,93 @@ TEST(Stitch, CollectGarbageOnRequest) {
     const Camera cam = downCamera(5.0, 5.0, 20, 5.0, 64);
     fss::StitchOptions o;
     o.collectGarbage = true;
-    const fss::StitchReport r =
-        fss::stitchPatch(grid, makePatch(cam, disk(32, 32, 12), planeZ0()), cam, o);
+    const fss::StitchReport r = fss::stitchPatch(grid, makePatch(cam, disk(32, 32, 12), planeZ0()), cam, o);
     EXPECT_EQ(r.componentsStitched, 1);
     EXPECT_FALSE(grid.has_garbage());
     expectValid(grid, {false, 1});
     EXPECT_NEAR(sumArea(grid), 100.0, 100.0 * 1e-9);
+}
+
+TEST(Stitch, PatchOverAHoleOfTheMeshKeepsTheHole) {
+    Mesh grid = fss::shapes::grid(20, 20, 1.0);
+    // Punch a 2 x 2 hole in the middle.
+    std::vector<FaceIndex> hole;
+    for (auto f : grid.faces()) {
+        const auto c = CGAL::centroid(grid.point(grid.source(grid.halfedge(f))),
+                                      grid.point(grid.target(grid.halfedge(f))),
+                                      grid.point(grid.target(grid.next(grid.halfedge(f)))));
+        if (c.x() > 9 && c.x() < 11 && c.y() > 9 && c.y() < 11) hole.push_back(f);
+    }
+    for (auto f : hole)
+        CGAL::Euler::remove_face(grid.halfedge(f), grid);
+    ASSERT_EQ(boundaryLoops(grid), 2u);
+    const double area = PMP::area(grid);
+    const Camera cam = downCamera(10.2, 9.9, 30, 6.0, 96);
+    const Mesh patch = makePatch(
+        cam, [](int x, int y) { return x >= 24 && x < 72 && y >= 24 && y < 72; }, planeZ0());
+    const fss::StitchReport r = fss::stitchPatch(grid, patch, cam);
+    SCOPED_TRACE(reportText(r));
+    EXPECT_EQ(r.componentsStitched, 1);
+    EXPECT_GT(r.patchFacesTrimmed, 0u);
+    expectValid(grid, {false, 2});
+    EXPECT_NEAR(PMP::area(grid), area, area * 1e-9);
+    // The hole is still there: no face covers its centre.
+    for (auto f : grid.faces()) {
+        auto h = grid.halfedge(f);
+        const fss::Kernel::Triangle_2 t(
+            {grid.point(grid.source(h)).x(), grid.point(grid.source(h)).y()},
+            {grid.point(grid.target(h)).x(), grid.point(grid.target(h)).y()},
+            {grid.point(grid.target(grid.next(h))).x(), grid.point(grid.target(grid.next(h))).y()});
+        EXPECT_FALSE(t.has_on_bounded_side({10.0, 10.0}));
+    }
+}
+
+TEST(Stitch, DegenerateAlignmentsWithTheMesh) {
+    // Parallel scans whose pixel centres fall exactly on the grid's vertices, on its edges' midpoints and
+    // on its diagonals: every kind of exact contact between patch and mesh elements.
+    for (const double offset : {0.0, 0.5, 0.25}) {
+        for (const bool flipDiagonal : {false, true}) {
+            SCOPED_TRACE("offset " + std::to_string(offset) + (flipDiagonal ? " flipped" : ""));
+            Mesh grid = fss::shapes::grid(16, 16, 1.0);
+            Camera cam;
+            cam.parallel = true;
+            cam.width = cam.height = 16;
+            cam.parallelScale = 8.0; // one pixel = one grid cell
+            cam.eye = {8.0 + offset, 8.0 + offset, 20.0};
+            cam.focal = {8.0 + offset, 8.0 + offset, 0.0};
+            cam.up = flipDiagonal ? Vec3(0, -1, 0) : Vec3(0, 1, 0);
+            cam.nearPlane = 1;
+            cam.farPlane = 40;
+            const Mesh patch = makePatch(
+                cam, [](int x, int y) { return x >= 3 && x < 13 && y >= 4 && y < 12; }, planeZ0());
+            ASSERT_GT(patch.number_of_faces(), 100u);
+            const fss::StitchReport r = fss::stitchPatch(grid, patch, cam);
+            SCOPED_TRACE(reportText(r));
+            EXPECT_EQ(r.componentsStitched, 1);
+            expectValid(grid, {false, 1});
+            EXPECT_NEAR(sumArea(grid), 256.0, 256.0 * 1e-9);
+            EXPECT_GE(r.seamMinAngleDeg, 1.0);
+            EXPECT_EQ(r.patchFacesTrimmed, 0u);
+        }
+    }
+}
+
+TEST(Stitch, TorusSeenObliquelyWithSelfOcclusion) {
+    // A coarse torus scanned from views where the tube hides parts of itself: several sheets under one
+    // view, occlusion contours inside the patch.
+    const Mesh reference = fss::shapes::torus(72, 36, 1.0, 0.35);
+    const Surface surface = meshSurface(reference);
+    Mesh m = fss::shapes::torus(24, 12, 1.0, 0.35);
+    const Vec3 dirs[] = {{0.2, 0.1, 1}, {1, 0.3, 0.45}, {-0.3, -1, 0.25}, {0.5, -0.4, -0.8}};
+    int n = 0;
+    for (const Vec3& d : dirs) {
+        const Camera cam = orbitCamera(d, 4.5, 96);
+        const Mesh patch = makePatch(cam, disk(48, 48, 30), surface, ++n, 75.0);
+        const fss::StitchReport r = fss::stitchPatch(m, patch, cam);
+        SCOPED_TRACE(reportText(r));
+        EXPECT_GE(r.componentsStitched, 1);
+        expectValid(m, {true, 0});
+        EXPECT_GT(PMP::volume(m), 0.0);
+        std::printf("torus scan %d: %s\n", n, reportText(r).c_str());
+    }
 }

@@ -4,13 +4,15 @@
 /// replaces the part of the current mesh it covers in the scan's view.
 ///
 /// In the scan camera's view the problem is two-dimensional. The current mesh's faces under the patch
-/// (front-facing, not grazing) are projected; the patch's boundary vertices and edges are inserted into
-/// that projected triangulation as constraints (a constrained Delaunay triangulation performs the paper's
-/// face / edge splits and edge flips); where a patch boundary edge crosses a mesh edge the new vertex lies
-/// *on that mesh edge in 3D*, so the geometry outside the patch does not move. The faces inside the patch
-/// boundary are removed, the patch is glued in sharing the boundary vertices, and the seam is optimised by
-/// collapsing short edges and flipping edges (never flipping a face in the view, folding the surface or
-/// moving a vertex). Every change is checked on the touched region before the mesh is modified.
+/// boundary (front-facing, not grazing, on the patch's sheet) are projected; the patch's boundary vertices
+/// and edges are inserted into that projected triangulation as constraints (a constrained Delaunay
+/// triangulation with exact predicates performs the paper's face / edge splits and edge flips); where a
+/// patch boundary edge crosses a mesh edge the new vertex lies *on that mesh edge in 3D*, so the geometry
+/// outside the patch does not move. The mesh faces inside the boundary are removed (those under the patch
+/// whole), the patch is glued in sharing the boundary vertices, and the seam is optimised: short edges
+/// collapsed, the pieces outside the patch refined towards the patch's edge length (new vertices on the old
+/// surface), edges flipped for angles and valence — never flipping a face in the view, folding the surface
+/// or moving a vertex. Every change is checked on a local copy before the mesh is modified.
 
 #include "fss/camera.h"
 #include "fss/mesh.h"
@@ -25,7 +27,8 @@ namespace fss {
 
 /// Options of stitchPatch. The defaults suit regular scans of 1 sample per pixel.
 struct StitchOptions {
-    /// Rings of vertices around the seam that the seam optimisation may change.
+    /// Rings of vertices around the seam that the seam optimisation may change; the seamRings − 1 rings of
+    /// mesh faces around the faces cut by the seam are opened to it too.
     int seamRings = 2;
     /// Collapse short seam edges and flip edges for quality after gluing.
     bool optimiseSeam = true;
@@ -52,8 +55,9 @@ struct StitchOptions {
     /// Rounds of trimming a component (removing the patch faces at places that cannot be stitched safely)
     /// before it is skipped.
     int maxTrimRounds = 16;
-    /// Components (or pieces left by trimming) with fewer faces are dropped and reported.
-    std::size_t minComponentFaces = 1;
+    /// Components (and pieces left by trimming) with fewer faces are not stitched: a few isolated triangles
+    /// only add seam.
+    std::size_t minComponentFaces = 8;
     /// Call collect_garbage() on the mesh at the end (renumbers all indices, O(mesh)). When false the
     /// removed elements stay as garbage that later additions reuse.
     bool collectGarbage = false;
@@ -63,20 +67,27 @@ struct StitchOptions {
 
 /// What stitchPatch did.
 struct StitchReport {
-    std::size_t facesRemoved = 0;      ///< faces of the current mesh replaced
-    std::size_t facesAdded = 0;        ///< faces added (patch faces, re-triangulated pieces around the seam)
-    std::size_t seamEdges = 0;         ///< edges of the final seam (patch boundary ↔ old mesh)
-    double seamLength = 0;             ///< 3D length of the seam
-    double seamMinAngleDeg = 180;      ///< smallest angle of the faces touching the seam (180 when none)
-    double seamFracMinAngleAbove25 = 1; ///< fraction of those faces whose smallest angle is ≥ 25°
-    std::size_t seamFaces = 0;         ///< number of faces touching the seam
-    int componentsStitched = 0;        ///< patch components (or pieces of them after trimming) glued in
-    int componentsSkipped = 0;         ///< components left out, each with a sentence in `skipped`
-    std::size_t patchFacesTrimmed = 0; ///< patch faces dropped so that the rest could be stitched
-    std::size_t collapses = 0;         ///< seam edge collapses performed
-    std::size_t flips = 0;             ///< seam edge flips performed
-    std::vector<std::string> skipped;  ///< one sentence per skipped component
-    double seconds = 0;                ///< wall time
+    std::size_t facesRemoved = 0; ///< faces of the current mesh replaced
+    std::size_t facesAdded = 0;   ///< faces added (patch faces, re-triangulated pieces around the seam)
+    std::size_t seamEdges = 0;    ///< edges of the final seam (patch boundary ↔ old mesh)
+    double seamLength = 0;        ///< 3D length of the seam
+    double seamMinAngleDeg = 180; ///< smallest angle of the faces touching the seam (180 when none)
+    /// Fraction of the faces touching the seam whose smallest angle is ≥ 25°.
+    double seamFracMinAngleAbove25 = 1;
+    std::size_t seamFaces = 0; ///< number of faces touching the seam
+    /// Patch components glued in (wholly or the part left by trimming).
+    int componentsStitched = 0;
+    /// Patch components left out entirely, each with a sentence in `skipped`.
+    int componentsSkipped = 0;
+    /// Pieces glued in (a component trimmed apart counts each piece).
+    int piecesStitched = 0;
+    /// Patch faces left out (trimmed, dropped, or in skipped components).
+    std::size_t patchFacesTrimmed = 0;
+    std::size_t collapses = 0; ///< seam edge collapses performed
+    std::size_t flips = 0;     ///< seam edge flips performed
+    /// One sentence per skipped component (and one for patch faces dropped as back-facing).
+    std::vector<std::string> skipped;
+    double seconds = 0; ///< wall time
 };
 
 /// Zippers \p patch into \p current (DESIGN.md §1 "Stitch", §6).
@@ -94,19 +105,23 @@ struct StitchReport {
 ///                 proportional to the patch. When empty, the faces are found by projecting all faces of
 ///                 \p current (O(mesh)).
 ///
-/// Each patch component is stitched on its own: the region under it is re-triangulated in the view, the
-/// result is validated (edge- and vertex-manifold, consistently oriented, no degenerate faces, no new
-/// self-intersections among the touched faces and their neighbours, every face facing the camera, border
-/// edges and so boundary loops unchanged, closed stays closed) and only then applied. Where a component
-/// cannot be stitched safely (it reaches past a silhouette, the current mesh's border, a grazing face or
-/// another sheet), its patch faces there are trimmed; a component that cannot be made stitchable is
-/// skipped and reported. Faces of \p current that do not touch the patch's view footprint keep their
-/// indices, vertices and positions. Removed elements are left as garbage (see StitchOptions::collectGarbage).
+/// Each patch component (connected through vertices) is stitched on its own: the region under it is
+/// re-triangulated in the view, the result is checked on a local copy (edge- and vertex-manifold,
+/// consistently oriented, no degenerate or needle faces, every new face facing the camera, no new
+/// self-intersections among the touched faces and their neighbours, border edges — so holes, boundary loops
+/// and closedness — unchanged), the exact sequence of edits is rehearsed on a second local copy, and only
+/// then applied. Where a component cannot be stitched safely (it reaches past a silhouette, the mesh's
+/// border or a hole, a grazing face, a fold or occlusion contour of the mesh in the view, another sheet),
+/// its patch faces there are trimmed and the rest retried; a component that cannot be made stitchable is
+/// skipped and reported. Faces of \p current not under the patch and not within seamRings of its seam keep
+/// their indices, vertices and positions. Removed elements are left as garbage that later additions reuse
+/// (see StitchOptions::collectGarbage); face indices of \p current therefore stay valid between calls.
 ///
 /// \return what was done, with seam quality figures.
-/// \throw InvalidInputError when the camera, the patch or the ID buffer is invalid, or when no component
-///        could be stitched (the sentence gives the first reason). Strong guarantee: every check runs before
-///        \p current is modified, so on any exception \p current is unchanged.
+/// \throw InvalidInputError when the camera, the patch, the options or the ID buffer are invalid, or when no
+///        component could be stitched (the sentence gives the first reason). Strong guarantee: all checks of
+///        a component run before \p current is touched, so an exception leaves \p current unchanged bit for
+///        bit (short of running out of memory while a checked component is being applied).
 StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCamera,
                          const StitchOptions& options = {}, std::span<const std::uint32_t> faceIds = {});
 
