@@ -77,12 +77,21 @@ void undoOrRedo(benchmark::State& state, bool timeUndo) {
     state.counters["faces"] = double(session.reference().number_of_faces());
 }
 
-void BM_SessionUndo(benchmark::State& state) { undoOrRedo(state, true); }
-void BM_SessionRedo(benchmark::State& state) { undoOrRedo(state, false); }
+void BM_SessionUndo(benchmark::State& state) {
+    undoOrRedo(state, true);
+}
+void BM_SessionRedo(benchmark::State& state) {
+    undoOrRedo(state, false);
+}
 
 } // namespace
 
-BENCHMARK(BM_SessionAccept)->Arg(10000)->Arg(100000)->Arg(300000)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_SessionAccept)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(300000)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(5);
 BENCHMARK(BM_SessionUndo)->Arg(10000)->Arg(100000)->Arg(300000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SessionRedo)->Arg(10000)->Arg(100000)->Arg(300000)->Unit(benchmark::kMillisecond);
 

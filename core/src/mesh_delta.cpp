@@ -24,7 +24,8 @@ bool same(const MeshDelta::HalfedgeRecord& a, const MeshDelta::HalfedgeRecord& b
     return a.next == b.next && a.prev == b.prev && a.target == b.target && a.face == b.face;
 }
 bool same(const MeshDelta::FaceRecord& a, const MeshDelta::FaceRecord& b) {
-    return a.halfedge == b.halfedge && std::bit_cast<std::uint32_t>(a.quality) == std::bit_cast<std::uint32_t>(b.quality) &&
+    return a.halfedge == b.halfedge &&
+           std::bit_cast<std::uint32_t>(a.quality) == std::bit_cast<std::uint32_t>(b.quality) &&
            a.scanId == b.scanId;
 }
 
@@ -55,8 +56,8 @@ struct Reader {
 };
 
 template <class Record, class ReadBefore, class ReadAfter>
-MeshDelta::ArrayDelta<Record> diff(std::size_t sizeBefore, std::size_t sizeAfter, const ReadBefore& readBefore,
-                                   const ReadAfter& readAfter) {
+MeshDelta::ArrayDelta<Record> diff(std::size_t sizeBefore, std::size_t sizeAfter,
+                                   const ReadBefore& readBefore, const ReadAfter& readAfter) {
     MeshDelta::ArrayDelta<Record> d;
     d.sizeBefore = sizeBefore;
     d.sizeAfter = sizeAfter;
@@ -93,8 +94,7 @@ void writeBack(const MeshDelta::ArrayDelta<Record>& d, bool forward, const Write
 
 } // namespace
 
-template <class Record>
-std::size_t MeshDelta::ArrayDelta<Record>::bytes() const {
+template <class Record> std::size_t MeshDelta::ArrayDelta<Record>::bytes() const {
     return index.capacity() * sizeof(std::uint32_t) +
            (before.capacity() + after.capacity() + tail.capacity()) * sizeof(Record);
 }
@@ -108,8 +108,8 @@ MeshDelta MeshDelta::between(const Mesh& before, const Mesh& after) {
         before.number_of_vertices(), after.number_of_vertices(), [&](std::size_t i) { return b.vertex(i); },
         [&](std::size_t i) { return a.vertex(i); });
     d.halfedges_ = diff<HalfedgeRecord>(
-        before.number_of_halfedges(), after.number_of_halfedges(), [&](std::size_t i) { return b.halfedge(i); },
-        [&](std::size_t i) { return a.halfedge(i); });
+        before.number_of_halfedges(), after.number_of_halfedges(),
+        [&](std::size_t i) { return b.halfedge(i); }, [&](std::size_t i) { return a.halfedge(i); });
     d.faces_ = diff<FaceRecord>(
         before.number_of_faces(), after.number_of_faces(), [&](std::size_t i) { return b.face(i); },
         [&](std::size_t i) { return a.face(i); });
@@ -176,8 +176,12 @@ void MeshDelta::apply(Mesh& mesh, bool forward) const {
     });
 }
 
-void MeshDelta::applyForward(Mesh& mesh) const { apply(mesh, true); }
-void MeshDelta::applyBackward(Mesh& mesh) const { apply(mesh, false); }
+void MeshDelta::applyForward(Mesh& mesh) const {
+    apply(mesh, true);
+}
+void MeshDelta::applyBackward(Mesh& mesh) const {
+    apply(mesh, false);
+}
 
 std::size_t MeshDelta::bytes() const {
     return sizeof(MeshDelta) + vertices_.bytes() + halfedges_.bytes() + faces_.bytes();

@@ -1,5 +1,5 @@
-// fss-remesh scan --into: chained scans stitched through PLY files keep the mesh invariants (checked here with
-// CGAL), raise the fraction of valence-6 vertices, respect better earlier scans; failures write nothing.
+// fss-remesh scan --into: chained scans stitched through PLY files keep the mesh invariants (checked here
+// with CGAL), raise the fraction of valence-6 vertices, respect better earlier scans; failures write nothing.
 #include "run_process.h"
 #include "test_data.h"
 
@@ -41,15 +41,18 @@ void expectInvariants(const fss::Mesh& m, const std::string& what) {
     std::set<std::pair<std::size_t, std::size_t>> pairs;
     for (auto e : m.edges()) {
         const std::size_t a = m.source(m.halfedge(e)), b = m.target(m.halfedge(e));
-        EXPECT_TRUE(pairs.emplace(std::min(a, b), std::max(a, b)).second) << "duplicate edge " << a << "-" << b;
+        EXPECT_TRUE(pairs.emplace(std::min(a, b), std::max(a, b)).second)
+            << "duplicate edge " << a << "-" << b;
     }
     std::size_t pinched = 0;
-    for (auto v : m.vertices()) pinched += PMP::is_non_manifold_vertex(v, m);
+    for (auto v : m.vertices())
+        pinched += PMP::is_non_manifold_vertex(v, m);
     EXPECT_EQ(pinched, 0u);
     // Consistent orientation is structural in a valid halfedge mesh; outward: positive enclosed volume.
     EXPECT_GT(PMP::volume(m), 0.0);
     std::size_t degenerate = 0;
-    for (auto f : m.faces()) degenerate += PMP::is_degenerate_triangle_face(f, m);
+    for (auto f : m.faces())
+        degenerate += PMP::is_degenerate_triangle_face(f, m);
     EXPECT_EQ(degenerate, 0u);
     EXPECT_FALSE(PMP::does_self_intersect(m));
 }
@@ -57,7 +60,8 @@ void expectInvariants(const fss::Mesh& m, const std::string& what) {
 // Fraction of the vertices of a closed mesh (all interior) with valence 6.
 double fracValence6(const fss::Mesh& m) {
     std::size_t six = 0;
-    for (auto v : m.vertices()) six += m.degree(v) == 6;
+    for (auto v : m.vertices())
+        six += m.degree(v) == 6;
     return double(six) / double(m.number_of_vertices());
 }
 
@@ -65,7 +69,8 @@ std::set<std::int32_t> scanIds(const fss::Mesh& m) {
     std::set<std::int32_t> ids;
     const auto [map, has] = m.property_map<fss::FaceIndex, std::int32_t>(fss::props::faceScanId);
     if (has)
-        for (auto f : m.faces()) ids.insert(map[f]);
+        for (auto f : m.faces())
+            ids.insert(map[f]);
     return ids;
 }
 
@@ -81,7 +86,8 @@ void chainTwoScans(const std::string& name, const std::string& view1, const std:
     expectInvariants(original, "input");
 
     // First scan: the reference is its own current mesh.
-    const auto r1 = remesh({"scan", input, "--into", input, "-o", step1, "--view", view1, "--resolution", resolution, "--json"});
+    const auto r1 = remesh(
+        {"scan", input, "--into", input, "-o", step1, "--view", view1, "--resolution", resolution, "--json"});
     ASSERT_EQ(r1.exitCode, 0) << r1.err;
     const auto j1 = nlohmann::json::parse(r1.out);
     EXPECT_EQ(j1.at("into"), input);
@@ -89,8 +95,8 @@ void chainTwoScans(const std::string& name, const std::string& view1, const std:
     EXPECT_GT(j1.at("stitch").at("faces_added").get<int>(), 1000);
     EXPECT_GE(j1.at("stitch").at("components_stitched").get<int>(), 1);
     for (const char* key : {"faces_removed", "seam_edges", "seam_length", "seam_min_angle_deg", "seam_faces",
-                            "components_skipped", "pieces_stitched", "patch_faces_trimmed", "collapses", "flips",
-                            "skipped", "seconds", "seam_frac_min_angle_above_25"})
+                            "components_skipped", "pieces_stitched", "patch_faces_trimmed", "collapses",
+                            "flips", "skipped", "seconds", "seam_frac_min_angle_above_25"})
         EXPECT_TRUE(j1.at("stitch").contains(key)) << key;
     EXPECT_GT(j1.at("counts").at("patch_faces").get<int>(), 0); // the patch counts are still there
     EXPECT_GE(j1.at("timings_s").at("stitch").get<double>(), 0.0);
@@ -100,7 +106,8 @@ void chainTwoScans(const std::string& name, const std::string& view1, const std:
     EXPECT_EQ(scanIds(mesh1), (std::set<std::int32_t>{-1, 0}));
 
     // Second scan from another view into the first result (PLY: quality and scan ids travel along).
-    const auto r2 = remesh({"scan", input, "--into", step1, "-o", step2, "--view", view2, "--resolution", resolution, "--json"});
+    const auto r2 = remesh(
+        {"scan", input, "--into", step1, "-o", step2, "--view", view2, "--resolution", resolution, "--json"});
     ASSERT_EQ(r2.exitCode, 0) << r2.err;
     const auto j2 = nlohmann::json::parse(r2.out);
     EXPECT_EQ(j2.at("scan_id"), 1); // the next free id
@@ -112,8 +119,8 @@ void chainTwoScans(const std::string& name, const std::string& view1, const std:
     EXPECT_EQ(scanIds(mesh2), (std::set<std::int32_t>{-1, 0, 1}));
 
     const double v0 = fracValence6(original), v1 = fracValence6(mesh1), v2 = fracValence6(mesh2);
-    std::printf("%s: valence-6 fraction %.3f -> %.3f -> %.3f, faces %u -> %u -> %u\n", name.c_str(), v0, v1, v2,
-                unsigned(original.number_of_faces()), unsigned(mesh1.number_of_faces()),
+    std::printf("%s: valence-6 fraction %.3f -> %.3f -> %.3f, faces %u -> %u -> %u\n", name.c_str(), v0, v1,
+                v2, unsigned(original.number_of_faces()), unsigned(mesh1.number_of_faces()),
                 unsigned(mesh2.number_of_faces()));
     EXPECT_GT(v1, v0 + 0.02);
     EXPECT_GT(v2, v0 + 0.02);
@@ -137,7 +144,8 @@ TEST(CliScanInto, FishboneScanStitchesToo) {
     const std::string input = meshPath("fandisk.off").string();
     const std::string step1 = tmpPath("cli_scan_into/fandisk_1.ply").string();
     const std::string step2 = tmpPath("cli_scan_into/fandisk_2.ply").string();
-    const auto r1 = remesh({"scan", input, "--into", input, "-o", step1, "--view", "iso", "--resolution", "128"});
+    const auto r1 =
+        remesh({"scan", input, "--into", input, "-o", step1, "--view", "iso", "--resolution", "128"});
     ASSERT_EQ(r1.exitCode, 0) << r1.err;
     EXPECT_NE(r1.out.find("stitched into"), std::string::npos) << r1.out;
     const auto r2 = remesh({"scan", input, "--into", step1, "-o", step2, "--view", "iso", "--fishbone",
@@ -157,9 +165,9 @@ TEST(CliScanInto, FailuresSaySoAndWriteNothing) {
     const auto out = tmpPath("cli_scan_into/never.ply");
     std::filesystem::remove(out);
     // CURRENT missing.
-    expectCleanFailure(remesh({"scan", input, "--into", tmpPath("cli_scan_into/missing.ply").string(), "-o",
-                               out.string()}),
-                       "missing.ply");
+    expectCleanFailure(
+        remesh({"scan", input, "--into", tmpPath("cli_scan_into/missing.ply").string(), "-o", out.string()}),
+        "missing.ply");
     EXPECT_FALSE(std::filesystem::exists(out));
     // CURRENT not a mesh.
     const auto bad = tmpPath("cli_scan_into/bad.off");
@@ -167,10 +175,12 @@ TEST(CliScanInto, FailuresSaySoAndWriteNothing) {
     expectCleanFailure(remesh({"scan", input, "--into", bad.string(), "-o", out.string()}), "bad.off");
     EXPECT_FALSE(std::filesystem::exists(out));
     // Nothing stitched: CURRENT (a small tetrahedron) is not where the elephant's patch lies.
-    expectCleanFailure(remesh({"scan", input, "--into", meshPath("tetrahedron.off").string(), "-o", out.string()}),
-                       "stitched");
+    expectCleanFailure(
+        remesh({"scan", input, "--into", meshPath("tetrahedron.off").string(), "-o", out.string()}),
+        "stitched");
     EXPECT_FALSE(std::filesystem::exists(out));
     // Unsupported output extension: a usage error before anything is read.
-    const auto usage = remesh({"scan", input, "--into", input, "-o", tmpPath("cli_scan_into/x.abc").string()});
+    const auto usage =
+        remesh({"scan", input, "--into", input, "-o", tmpPath("cli_scan_into/x.abc").string()});
     EXPECT_EQ(usage.exitCode, 2) << usage.err;
 }

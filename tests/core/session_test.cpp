@@ -24,18 +24,20 @@ namespace {
 std::string fingerprint(const fss::Mesh& mesh) {
     std::ostringstream out;
     out << std::hexfloat;
-    out << mesh.number_of_vertices() << ' ' << mesh.number_of_halfedges() << ' ' << mesh.number_of_faces() << ' '
-        << mesh.has_garbage() << '\n';
-    for (auto v : mesh.vertices()) out << mesh.point(v) << ' ' << std::size_t(mesh.halfedge(v)) << '\n';
+    out << mesh.number_of_vertices() << ' ' << mesh.number_of_halfedges() << ' ' << mesh.number_of_faces()
+        << ' ' << mesh.has_garbage() << '\n';
+    for (auto v : mesh.vertices())
+        out << mesh.point(v) << ' ' << std::size_t(mesh.halfedge(v)) << '\n';
     for (auto h : mesh.halfedges())
-        out << std::size_t(mesh.next(h)) << ' ' << std::size_t(mesh.prev(h)) << ' ' << std::size_t(mesh.target(h))
-            << ' ' << std::size_t(mesh.face(h)) << '\n';
+        out << std::size_t(mesh.next(h)) << ' ' << std::size_t(mesh.prev(h)) << ' '
+            << std::size_t(mesh.target(h)) << ' ' << std::size_t(mesh.face(h)) << '\n';
     const auto [quality, hasQuality] = mesh.property_map<fss::FaceIndex, float>(fss::props::faceQuality);
     const auto [scanId, hasScanId] = mesh.property_map<fss::FaceIndex, std::int32_t>(fss::props::faceScanId);
     out << "q" << hasQuality << " s" << hasScanId << '\n';
     for (auto f : mesh.faces()) {
         out << std::size_t(mesh.halfedge(f)) << ':';
-        for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) out << std::size_t(v) << ' ';
+        for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
+            out << std::size_t(v) << ' ';
         if (hasQuality) out << std::bit_cast<std::uint32_t>(quality[f]) << ' ';
         if (hasScanId) out << scanId[f];
         out << '\n';
@@ -45,14 +47,15 @@ std::string fingerprint(const fss::Mesh& mesh) {
 
 fss::ScanStep isoStep(const fss::Mesh& mesh, int resolution) {
     fss::ScanStep step;
-    step.params.camera = fss::Camera::standardView(fss::StandardView::Iso, fss::boundingBox(mesh), resolution,
-                                                   resolution);
+    step.params.camera =
+        fss::Camera::standardView(fss::StandardView::Iso, fss::boundingBox(mesh), resolution, resolution);
     return step;
 }
 
 // A perspective camera looking at the centre of \p box from a random direction, at a random distance
 // (close-ups included), with a random resolution in [minRes, maxRes].
-fss::ScanStep randomStep(std::mt19937& rng, const Eigen::AlignedBox3d& box, int minRes, int maxRes, int scanId) {
+fss::ScanStep randomStep(std::mt19937& rng, const Eigen::AlignedBox3d& box, int minRes, int maxRes,
+                         int scanId) {
     std::uniform_real_distribution<double> U(0, 1);
     std::normal_distribution<double> N(0, 1);
     Eigen::Vector3d dir(N(rng), N(rng), N(rng));
@@ -141,7 +144,8 @@ TEST(Session, TwentyChainedScansUndoAndRedoExactly) {
         EXPECT_NE(states.back(), states[states.size() - 2]) << "scan " << i + 1 << " changed nothing";
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("20 scans: %zu -> %zu faces, history %zu bytes, %.1f s\n", std::size_t(session.reference().number_of_faces()),
+    std::printf("20 scans: %zu -> %zu faces, history %zu bytes, %.1f s\n",
+                std::size_t(session.reference().number_of_faces()),
                 std::size_t(session.current().number_of_faces()), session.historyBytes(), seconds);
     // The history is far smaller than 40 whole copies (the first version's cost).
     EXPECT_LT(session.historyBytes(), 20 * meshArrayBytes(session.current()));
@@ -160,7 +164,8 @@ TEST(Session, TwentyChainedScansUndoAndRedoExactly) {
     const auto scanId = session.current().property_map<fss::FaceIndex, std::int32_t>(fss::props::faceScanId);
     ASSERT_TRUE(scanId.second);
     std::set<std::int32_t> ids;
-    for (auto f : session.current().faces()) ids.insert(scanId.first[f]);
+    for (auto f : session.current().faces())
+        ids.insert(scanId.first[f]);
     EXPECT_TRUE(ids.count(20));
 }
 
@@ -203,7 +208,8 @@ TEST(Session, AcceptAfterUndoDropsTheRedoSteps) {
                                   K::Undo,   K::Accept, K::Undo,   K::Redo};
     const auto& events = session.events();
     ASSERT_EQ(events.size(), expected.size());
-    for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(events[i].kind, expected[i]) << "event " << i;
+    for (std::size_t i = 0; i < expected.size(); ++i)
+        EXPECT_EQ(events[i].kind, expected[i]) << "event " << i;
     EXPECT_EQ(events[3].step.params.camera.eye, accepted[3].params.camera.eye);
     EXPECT_EQ(events[6].step.params.camera.eye, fresh.params.camera.eye);
     EXPECT_EQ(events[6].step.params.scan.scanId, 9);
@@ -266,16 +272,16 @@ TEST(Session, HistoryBytesFollowTheChangeNotTheMesh) {
         fss::Session session(fss::shapes::uvSphere(nu, nv));
         const std::string original = fingerprint(session.current());
         fss::ScanStep step;
-        step.params.camera = fss::Camera::standardView(fss::StandardView::PosX, fss::boundingBox(session.reference()),
-                                                       96, 96);
+        step.params.camera =
+            fss::Camera::standardView(fss::StandardView::PosX, fss::boundingBox(session.reference()), 96, 96);
         step.params.camera.zoom(8.0);
         step.params.scan.scanId = 1;
         EXPECT_EQ(session.historyBytes(), 0u);
         session.scan(step);
         const std::size_t patchFaces = session.preview()->patch.mesh.number_of_faces();
         const fss::StitchReport report = session.accept();
-        Result r{session.reference().number_of_faces(), meshArrayBytes(session.current()), session.historyBytes(),
-                 patchFaces, report.facesRemoved};
+        Result r{session.reference().number_of_faces(), meshArrayBytes(session.current()),
+                 session.historyBytes(), patchFaces, report.facesRemoved};
         session.undo();
         EXPECT_EQ(fingerprint(session.current()), original);
         EXPECT_EQ(session.historyBytes(), r.historyBytes); // the redo step is kept
@@ -330,7 +336,8 @@ TEST(Session, FailedAcceptChangesNothing) {
     step.stitch.failValidationForTesting = false;
     session.scan(step);
     // Cancelled at every stage the accept reports.
-    const std::vector<std::pair<std::string, double>> stages{{"stitch", 0.0}, {"record", 0.9}, {"stitch", 1.0}};
+    const std::vector<std::pair<std::string, double>> stages{
+        {"stitch", 0.0}, {"record", 0.9}, {"stitch", 1.0}};
     for (const auto& [stopAt, fraction] : stages) {
         bool asked = false;
         const fss::Progress cancel([&](double f, std::string_view stage) {

@@ -32,10 +32,9 @@ public:
         float quality;       // kInputFaceQuality when the mesh has no props::faceQuality
         std::int32_t scanId; // -1 when the mesh has no props::faceScanId
     };
-    template <class Record>
-    struct ArrayDelta {
+    template <class Record> struct ArrayDelta {
         std::size_t sizeBefore = 0, sizeAfter = 0;
-        std::vector<std::uint32_t> index; // differing indices below min(sizeBefore, sizeAfter)
+        std::vector<std::uint32_t> index;  // differing indices below min(sizeBefore, sizeAfter)
         std::vector<Record> before, after; // their records in each state
         std::vector<Record> tail;          // records of the larger state at [min, max)
         std::size_t bytes() const;
