@@ -29,8 +29,9 @@
 /// state only) its record(s) — 32 bytes per vertex record, 16 per halfedge record, 12 per face record,
 /// both the old and the new record plus a 4-byte index for an element present in both states, one record
 /// for an element present in one state only — plus a few hundred bytes for the ScanStep and StitchReport.
-/// A stitch adding F faces and removing R therefore costs roughly (F + R + seam) × 150 bytes whatever the
-/// mesh size. Finding the changed records compares the two states once per accept (linear in the mesh,
+/// A stitch adding F faces and removing R therefore costs roughly 90 × (F + R) bytes whatever the mesh size
+/// (measured: an 18k-face patch costs 1.6 MB in a 10k- and 1.7 MB in a 300k-face sphere, whose element
+/// arrays take 2.1 and 22 MB). Finding the changed records compares the two states once per accept (linear in the mesh,
 /// a few milliseconds per 100k faces); undo() and redo() write the records back in time proportional to
 /// the change.
 ///
