@@ -303,6 +303,26 @@ TEST(Session, HistoryBytesFollowTheChangeNotTheMesh) {
     EXPECT_LT(large.historyBytes, large.meshBytes / 5);
 }
 
+// A coarse scan of a fine mesh: the stitch removes more elements than it adds, so undo has to grow the
+// arrays back (and redo to shrink them) — still exactly.
+TEST(Session, UndoRestoresAMeshTheStitchShrank) {
+    fss::Session session(fss::shapes::uvSphere(160, 80));
+    const std::string original = fingerprint(session.current());
+    session.scan(isoStep(session.reference(), 32));
+    session.accept();
+    const std::string after = fingerprint(session.current());
+    std::printf("coarse scan: %u -> %u vertices, %u -> %u faces\n", unsigned(session.reference().number_of_vertices()),
+                unsigned(session.current().number_of_vertices()), unsigned(session.reference().number_of_faces()),
+                unsigned(session.current().number_of_faces()));
+    EXPECT_LT(session.current().number_of_faces(), session.reference().number_of_faces());
+    EXPECT_LT(session.current().number_of_halfedges(), session.reference().number_of_halfedges());
+    EXPECT_LT(session.current().number_of_vertices(), session.reference().number_of_vertices());
+    session.undo();
+    EXPECT_EQ(fingerprint(session.current()), original);
+    session.redo();
+    EXPECT_EQ(fingerprint(session.current()), after);
+}
+
 // A failing accept (validation failure, cancellation) leaves the current mesh, the preview, the history
 // and the event log as they were; the same preview can then be accepted.
 TEST(Session, FailedAcceptChangesNothing) {
