@@ -119,7 +119,7 @@ RendererFactory makeFactory(const std::string& kind, std::string& used, const st
 
 int runRun(const std::vector<std::string>& args) {
     const std::string command = "fss-remesh run";
-    std::string sessionPath, outPath, reportPath, snapshotPath, snapshotSize = "1024x768", snapshotView = "iso",
+    std::string sessionPath, outPath, reportPath, snapshotPath, snapshotSize = "1024x768", snapshotView = "iso", snapshotZoom = "1",
                                                                    rendererKind = "session";
     bool haveReport = false, haveSnapshot = false, json = false, noSelf = false, quiet = false;
     ArgParser p(command, "Replay the session file SESSION.json head-less: read its input mesh (checking its "
@@ -141,6 +141,8 @@ int runRun(const std::vector<std::string>& args) {
     p.option("--snapshot-size", "WxH", "Size of the snapshot in pixels (default 1024x768).", &snapshotSize);
     p.option("--snapshot-view", "V", "View of the snapshot: iso, +x, -x, +y, -y, +z, -z (default iso).",
              &snapshotView);
+    p.option("--snapshot-zoom", "F", "Zoom factor of the snapshot camera (> 0, default 1: the whole mesh).",
+             &snapshotZoom);
     p.option("--renderer", "R",
              "session (default: the renderer the session was recorded with), auto (GPU, else CPU), gpu or cpu. "
              "Another renderer than the recording's gives a slightly different mesh.",
@@ -163,6 +165,8 @@ int runRun(const std::vector<std::string>& args) {
         if (ext != ".png" && ext != ".PNG") throw UsageError("The snapshot " + snapshotPath + " must be a .png file.");
     }
     const auto [snapW, snapH] = parseResolution("--snapshot-size", snapshotSize, Camera::kMaxResolution);
+    const double zoom = parseDouble("--snapshot-zoom", snapshotZoom);
+    if (!(zoom > 0)) throw UsageError("The value of --snapshot-zoom must be positive.");
     const auto view = parseStandardView(snapshotView);
     if (!view)
         throw UsageError("The value '" + snapshotView + "' of --snapshot-view is not one of iso, +x, -x, +y, -y, +z, -z.");
@@ -215,7 +219,8 @@ int runRun(const std::vector<std::string>& args) {
     if (haveSnapshot) {
         if (showProgress) bar.update(1.0, "snapshot");
         t = Clock::now();
-        const Camera camera = Camera::standardView(*view, boundingBox(result), snapW, snapH);
+        Camera camera = Camera::standardView(*view, boundingBox(result), snapW, snapH);
+        camera.zoom(zoom);
         render::SnapshotOptions options;
         if (kind == "cpu") options.renderer = render::SnapshotOptions::Renderer::Cpu;
         shot = render::renderSnapshot(result, camera, options);
