@@ -207,10 +207,8 @@ int runRun(const std::vector<std::string>& args) {
         options.reference = &replay.session.reference();
         if (showProgress) bar.update(1.0, "metrics");
         metrics = computeMetrics(result, options);
-        if (wantReport) {
-            options.reference = nullptr;
-            inputMetrics = computeMetrics(replay.session.reference(), options);
-        }
+        options.reference = nullptr;
+        inputMetrics = computeMetrics(replay.session.reference(), options);
     }
     metricsSeconds = since(t);
 
@@ -222,7 +220,7 @@ int runRun(const std::vector<std::string>& args) {
         Camera camera = Camera::standardView(*view, boundingBox(result), snapW, snapH);
         camera.zoom(zoom);
         render::SnapshotOptions options;
-        if (kind == "cpu") options.renderer = render::SnapshotOptions::Renderer::Cpu;
+        if (rendererKind == "cpu") options.renderer = render::SnapshotOptions::Renderer::Cpu;
         shot = render::renderSnapshot(result, camera, options);
         render::writePng(shot.image, snapshotPath);
         snapshotSeconds = since(t);
@@ -300,6 +298,23 @@ int runRun(const std::vector<std::string>& args) {
                   << " redos; " << used << " renderer) in " << replaySeconds << " s: " << m.vertices << " vertices, "
                   << m.faces << " faces, written to " << outPath << "\n";
         std::cout << metricsToText(m);
+        if (inputMetrics) {
+            const Metrics& in = *inputMetrics;
+            char line[160];
+            std::cout << "  compared with the input        input      output\n";
+            auto row = [&](const char* label, double a, double b, const char* fmt) {
+                std::snprintf(line, sizeof line, fmt, label, a, b);
+                std::cout << line;
+            };
+            row("vertices", double(in.vertices), double(m.vertices), "    %-24s %10.0f  %10.0f\n");
+            row("faces", double(in.faces), double(m.faces), "    %-24s %10.0f  %10.0f\n");
+            row("valence-6 interior (%)", 100 * in.fracValence6Interior, 100 * m.fracValence6Interior,
+                "    %-24s %10.1f  %10.1f\n");
+            row("min angle (deg)", in.minAngleDeg, m.minAngleDeg, "    %-24s %10.2f  %10.2f\n");
+            row("mean min angle (deg)", in.meanMinAngleDeg, m.meanMinAngleDeg, "    %-24s %10.2f  %10.2f\n");
+            row("min angle < 30 deg (%)", 100 * in.fracMinAngleBelow30, 100 * m.fracMinAngleBelow30,
+                "    %-24s %10.2f  %10.2f\n");
+        }
         if (haveReport) std::cout << "report written to " << reportPath << "\n";
         if (haveSnapshot) std::cout << "snapshot (" << shot.renderer << ") written to " << snapshotPath << "\n";
     }

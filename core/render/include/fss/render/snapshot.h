@@ -47,10 +47,10 @@ std::vector<Rgb> minAngleFaceColors(const Mesh& mesh);
 /// How a snapshot is drawn.
 struct SnapshotOptions {
     Rgb background{255, 255, 255}; ///< colour of pixels no face covers
-    double ambient = 0.35;         ///< ambient share of the flat shading, in [0, 1]
+    double ambient = 0.45;         ///< ambient share of the flat shading, in [0, 1]
     /// Pixels where the face id changes to another face (to the right or below) are multiplied by this
     /// factor: the triangulation shows as thin dark lines. 1 = no outlines.
-    double outline = 0.7;
+    double outline = 0.8;
     /// Which renderer makes the ID buffer: the GPU Rasterizer with a fallback to the CPU (Auto), only the
     /// GPU (Gpu: no fallback), or CPU ray casting (Cpu).
     enum class Renderer { Auto, Gpu, Cpu } renderer = Renderer::Auto;
