@@ -189,4 +189,32 @@ TEST(CliRun, BadSessionFilesFailWithOneSentence) {
     EXPECT_EQ(badSnapshot.exitCode, 2);
 }
 
+// The bundled example session (the README's main job) replays into a closed, self-intersection-free mesh
+// that is more regular than the input and close to it.
+TEST(CliRun, ExampleSessionReplays) {
+    const fs::path session = fs::path(FSS_SOURCE_DIR) / "examples" / "fandisk.session.json";
+    const fs::path out = tmpPath("cli_run/example.off");
+    const fs::path report = tmpPath("cli_run/example_report.json");
+    const auto r = runProcess(remeshExe(), {"run", session.string(), "-o", out.string(), "--report", report.string()},
+                              tmpPath("cli_run"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(fss::test::slurp(report));
+    int fishbone = 0, regular = 0;
+    for (const auto& e : j["events"]) {
+        ASSERT_EQ(e["kind"], "accept");
+        (e["grid"] == "fishbone" ? fishbone : regular) += 1;
+        EXPECT_GT(e["stitch"]["faces_added"].get<int>(), 0);
+    }
+    EXPECT_EQ(fishbone, 2);
+    EXPECT_GE(regular, 5);
+    const auto& m = j["metrics"];
+    EXPECT_TRUE(m["closed"].get<bool>());
+    EXPECT_EQ(m["components"], 1);
+    EXPECT_EQ(m["self_intersections"], 0);
+    EXPECT_EQ(m["degenerate_faces"], 0);
+    EXPECT_GT(m["frac_valence6_interior"].get<double>(), j["input_metrics"]["frac_valence6_interior"].get<double>());
+    EXPECT_LT(m["hausdorff_to_ref_rel"].get<double>(), 0.01);
+    EXPECT_LT(m["hausdorff_from_ref_rel"].get<double>(), 0.01);
+}
+
 } // namespace
