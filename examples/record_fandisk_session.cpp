@@ -47,13 +47,14 @@ int main(int argc, char** argv) {
         fss::Session session(fss::readMesh(meshPath)); // CPU renderer (the SessionOptions default)
         const fss::Mesh& ref = session.reference();
         int id = 0;
-        for (fss::StandardView view : {fss::StandardView::PosZ, fss::StandardView::NegZ, fss::StandardView::PosY,
-                                       fss::StandardView::NegY, fss::StandardView::PosX, fss::StandardView::NegX,
-                                       fss::StandardView::Iso}) {
+        for (fss::StandardView view :
+             {fss::StandardView::PosZ, fss::StandardView::NegZ, fss::StandardView::PosY,
+              fss::StandardView::NegY, fss::StandardView::PosX, fss::StandardView::NegX,
+              fss::StandardView::Iso}) {
             session.scan(viewStep(ref, view, 160, ++id));
             const fss::StitchReport& r = session.accept();
-            std::cout << "regular scan " << id << " (" << fss::standardViewName(view) << "): +" << r.facesAdded
-                      << " / -" << r.facesRemoved << " faces\n";
+            std::cout << "regular scan " << id << " (" << fss::standardViewName(view) << "): +"
+                      << r.facesAdded << " / -" << r.facesRemoved << " faces\n";
         }
         // Seeds in pixels of the 256x256 +x view: the concave band below the top, and the rounded end of the
         // middle block.
@@ -63,19 +64,21 @@ int main(int argc, char** argv) {
                 session.scan(fishboneStep(ref, fss::StandardView::PosX, 256, ++id, seed, 2.0));
             const std::size_t ribs = preview.fishbone ? std::size_t(preview.fishbone->rows) : 0;
             const fss::StitchReport& r = session.accept();
-            std::cout << "fishbone scan " << id << " (+x, seed " << seed.x() << "," << seed.y() << "): " << ribs
-                      << " ribs, +" << r.facesAdded << " / -" << r.facesRemoved << " faces\n";
+            std::cout << "fishbone scan " << id << " (+x, seed " << seed.x() << "," << seed.y()
+                      << "): " << ribs << " ribs, +" << r.facesAdded << " / -" << r.facesRemoved
+                      << " faces\n";
         }
         fss::SessionFile file = fss::sessionFileFromSession(session, meshPath, "cpu");
-        file.description = "FSS example: CGAL's fandisk remeshed by seven regular scans (six axis views and iso, "
-                           "160x160) and two fishbone scans from +x on its cylindrical features. Written by "
-                           "examples/record_fandisk_session.cpp; replay with 'fss-remesh run'.";
+        file.description =
+            "FSS example: CGAL's fandisk remeshed by seven regular scans (six axis views and iso, "
+            "160x160) and two fishbone scans from +x on its cylindrical features. Written by "
+            "examples/record_fandisk_session.cpp; replay with 'fss-remesh run'.";
         fss::saveSessionFile(file, outPath);
         const double seconds =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        std::cout << "recorded " << session.events().size() << " events in " << seconds << " s: "
-                  << session.current().number_of_vertices() << " vertices, " << session.current().number_of_faces()
-                  << " faces; written to " << outPath << "\n";
+        std::cout << "recorded " << session.events().size() << " events in " << seconds
+                  << " s: " << session.current().number_of_vertices() << " vertices, "
+                  << session.current().number_of_faces() << " faces; written to " << outPath << "\n";
     } catch (const std::exception& e) {
         std::cerr << "record_fandisk_session: " << e.what() << "\n";
         return 1;

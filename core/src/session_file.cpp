@@ -53,7 +53,8 @@ struct Writer {
     }
     Json points(const std::vector<Eigen::Vector2d>& pts, const std::string& field) const {
         Json a = Json::array();
-        for (std::size_t i = 0; i < pts.size(); ++i) a.push_back(vec2(pts[i], field + "[" + std::to_string(i) + "]"));
+        for (std::size_t i = 0; i < pts.size(); ++i)
+            a.push_back(vec2(pts[i], field + "[" + std::to_string(i) + "]"));
         return a;
     }
 
@@ -79,8 +80,10 @@ struct Writer {
         Json j;
         j["step"] = number(s.step, f + ".step");
         j["min_step"] = number(s.minStep, f + ".min_step");
-        if (s.maxLength == std::numeric_limits<double>::infinity()) j["max_length"] = nullptr;
-        else j["max_length"] = number(s.maxLength, f + ".max_length");
+        if (s.maxLength == std::numeric_limits<double>::infinity())
+            j["max_length"] = nullptr;
+        else
+            j["max_length"] = number(s.maxLength, f + ".max_length");
         j["min_anisotropy"] = number(s.minAnisotropy, f + ".min_anisotropy");
         j["low_anisotropy"] = s.lowAnisotropy == LowAnisotropyPolicy::Stop ? "stop" : "continue_straight";
         j["max_turn_deg"] = number(s.maxTurnDeg, f + ".max_turn_deg");
@@ -133,16 +136,18 @@ struct Writer {
         j["lasso"] = p.lasso ? points(p.lasso->points, f + ".lasso") : Json(nullptr);
         j["erode_radius"] = p.erodeRadius;
         j["dilate_radius"] = p.dilateRadius;
-        j["scan"] = {{"scan_id", p.scan.scanId},
-                     {"quality_angle_limit_deg", number(p.scan.qualityAngleLimitDeg, f + ".scan.quality_angle_limit_deg")},
-                     {"max_snap_footprints", number(p.scan.maxSnapFootprints, f + ".scan.max_snap_footprints")}};
+        j["scan"] = {
+            {"scan_id", p.scan.scanId},
+            {"quality_angle_limit_deg",
+             number(p.scan.qualityAngleLimitDeg, f + ".scan.quality_angle_limit_deg")},
+            {"max_snap_footprints", number(p.scan.maxSnapFootprints, f + ".scan.max_snap_footprints")}};
         j["quality_mask"] = {{"margin", number(p.quality.margin, f + ".quality_mask.margin")},
                              {"force_replace", p.quality.forceReplace},
                              {"search_rings", p.quality.searchRings}};
-        j["triangulate"] = {
-            {"max_edge_footprints", number(p.triangulate.maxEdgeFootprints, f + ".triangulate.max_edge_footprints")},
-            {"max_sampling_angle_deg",
-             number(p.triangulate.maxSamplingAngleDeg, f + ".triangulate.max_sampling_angle_deg")}};
+        j["triangulate"] = {{"max_edge_footprints",
+                             number(p.triangulate.maxEdgeFootprints, f + ".triangulate.max_edge_footprints")},
+                            {"max_sampling_angle_deg", number(p.triangulate.maxSamplingAngleDeg,
+                                                              f + ".triangulate.max_sampling_angle_deg")}};
         j["grid"] = s.fishbone ? "fishbone" : "regular";
         if (s.fishbone) j["fishbone"] = fishbone(*s.fishbone, f + ".fishbone");
         j["stitch"] = stitch(s.stitch, f + ".stitch");
@@ -152,9 +157,12 @@ struct Writer {
 
 const char* kindName(SessionEvent::Kind kind) {
     switch (kind) {
-    case SessionEvent::Kind::Accept: return "accept";
-    case SessionEvent::Kind::Undo: return "undo";
-    case SessionEvent::Kind::Redo: return "redo";
+    case SessionEvent::Kind::Accept:
+        return "accept";
+    case SessionEvent::Kind::Undo:
+        return "undo";
+    case SessionEvent::Kind::Redo:
+        return "redo";
     }
     return "accept";
 }
@@ -165,17 +173,19 @@ Json toJson(const SessionFile& file, const std::string& meshPathText) {
         throw InvalidInputError("The session cannot be saved: its renderer '" + file.renderer +
                                 "' is not one of cpu, gpu.");
     if (!isSha256Hex(file.meshSha256))
-        throw InvalidInputError("The session cannot be saved: mesh.sha256 is not 64 lowercase hexadecimal digits.");
+        throw InvalidInputError(
+            "The session cannot be saved: mesh.sha256 is not 64 lowercase hexadecimal digits.");
     Json j;
     j["format"] = kFormatName;
     j["version"] = kSessionFileVersion;
     if (!file.description.empty()) j["description"] = file.description;
     j["mesh"] = {{"path", meshPathText}, {"sha256", file.meshSha256}};
     j["renderer"] = file.renderer;
-    j["curvature"] = {{"jet_degree", file.curvature.jetDegree},
-                      {"min_points", file.curvature.minPoints},
-                      {"max_rings", file.curvature.maxRings},
-                      {"anisotropy_epsilon", w.number(file.curvature.anisotropyEpsilon, "curvature.anisotropy_epsilon")}};
+    j["curvature"] = {
+        {"jet_degree", file.curvature.jetDegree},
+        {"min_points", file.curvature.minPoints},
+        {"max_rings", file.curvature.maxRings},
+        {"anisotropy_epsilon", w.number(file.curvature.anisotropyEpsilon, "curvature.anisotropy_epsilon")}};
     Json events = Json::array();
     for (std::size_t i = 0; i < file.events.size(); ++i) {
         const SessionEvent& e = file.events[i];
@@ -194,10 +204,13 @@ Json toJson(const SessionFile& file, const std::string& meshPathText) {
 // A JSON value with its path in the file ("events[3].step.camera"), for messages naming the field.
 class Node {
 public:
-    Node(const Json& value, std::string path, const std::string& file) : v_(value), path_(std::move(path)), file_(file) {}
+    Node(const Json& value, std::string path, const std::string& file)
+        : v_(value), path_(std::move(path)), file_(file) {}
 
     const std::string& path() const { return path_; }
-    [[noreturn]] void fail(const std::string& what) const { throw IoError(file_ + ": " + path_ + " " + what + "."); }
+    [[noreturn]] void fail(const std::string& what) const {
+        throw IoError(file_ + ": " + path_ + " " + what + ".");
+    }
 
     bool isNull() const { return v_.is_null(); }
 
@@ -214,7 +227,8 @@ public:
         requireObject();
         for (const auto& item : v_.items()) {
             bool known = false;
-            for (const char* a : allowed) known = known || item.key() == a;
+            for (const char* a : allowed)
+                known = known || item.key() == a;
             if (!known) fail("has an unknown field '" + item.key() + "'");
         }
     }
@@ -252,7 +266,8 @@ public:
     }
     std::int64_t integer(std::int64_t lo, std::int64_t hi, const std::string& what) const {
         if (!v_.is_number_integer()) fail("must be " + what);
-        if (v_.is_number_unsigned() && v_.get<std::uint64_t>() > std::uint64_t(std::numeric_limits<std::int64_t>::max()))
+        if (v_.is_number_unsigned() &&
+            v_.get<std::uint64_t>() > std::uint64_t(std::numeric_limits<std::int64_t>::max()))
             fail("must be " + what);
         const std::int64_t i = v_.get<std::int64_t>();
         if (i < lo || i > hi) fail("must be " + what);
@@ -269,7 +284,8 @@ public:
     /// One of \p choices (as a string).
     std::string choice(std::initializer_list<const char*> choices) const {
         std::string list;
-        for (const char* c : choices) list += std::string(list.empty() ? "" : ", ") + "\"" + c + "\"";
+        for (const char* c : choices)
+            list += std::string(list.empty() ? "" : ", ") + "\"" + c + "\"";
         if (!v_.is_string()) fail("must be one of " + list);
         const std::string s = v_.get<std::string>();
         for (const char* c : choices)
@@ -288,7 +304,8 @@ public:
         const std::size_t n = arraySize("an array of points [x, y]");
         std::vector<Eigen::Vector2d> pts;
         pts.reserve(n);
-        for (std::size_t i = 0; i < n; ++i) pts.push_back(element(i).vec2());
+        for (std::size_t i = 0; i < n; ++i)
+            pts.push_back(element(i).vec2());
         return pts;
     }
 
@@ -306,8 +323,8 @@ private:
 constexpr std::int64_t kIntMax = std::numeric_limits<int>::max();
 
 Camera readCamera(const Node& n) {
-    n.onlyKeys({"eye", "focal", "up", "projection", "view_angle_deg", "parallel_scale", "near", "far", "width",
-                "height"});
+    n.onlyKeys({"eye", "focal", "up", "projection", "view_angle_deg", "parallel_scale", "near", "far",
+                "width", "height"});
     Camera c;
     c.eye = n.at("eye").vec3();
     c.focal = n.at("focal").vec3();
@@ -321,7 +338,8 @@ Camera readCamera(const Node& n) {
     const std::string side = "a positive integer of at most " + std::to_string(Camera::kMaxResolution);
     c.width = int(n.at("width").integer(1, Camera::kMaxResolution, side));
     c.height = int(n.at("height").integer(1, Camera::kMaxResolution, side));
-    if ((c.eye - c.focal).norm() == 0) n.at("focal").fail("must differ from eye (the camera has no viewing direction)");
+    if ((c.eye - c.focal).norm() == 0)
+        n.at("focal").fail("must differ from eye (the camera has no viewing direction)");
     if (c.up.cross(c.focal - c.eye).norm() <= 1e-12 * c.up.norm() * (c.focal - c.eye).norm())
         n.at("up").fail("must not be zero or parallel to the viewing direction");
     try {
@@ -333,7 +351,8 @@ Camera readCamera(const Node& n) {
 }
 
 StreamlineOptions readStreamline(const Node& n) {
-    n.onlyKeys({"step", "min_step", "max_length", "min_anisotropy", "low_anisotropy", "max_turn_deg", "max_steps"});
+    n.onlyKeys(
+        {"step", "min_step", "max_length", "min_anisotropy", "low_anisotropy", "max_turn_deg", "max_steps"});
     StreamlineOptions s;
     s.step = n.at("step").positive();
     s.minStep = n.at("min_step").positive();
@@ -345,7 +364,8 @@ StreamlineOptions readStreamline(const Node& n) {
                           ? LowAnisotropyPolicy::Stop
                           : LowAnisotropyPolicy::ContinueStraight;
     s.maxTurnDeg = n.at("max_turn_deg").positive();
-    s.maxSteps = std::size_t(n.at("max_steps").integer(1, std::numeric_limits<std::int64_t>::max(), "a positive integer"));
+    s.maxSteps = std::size_t(
+        n.at("max_steps").integer(1, std::numeric_limits<std::int64_t>::max(), "a positive integer"));
     return s;
 }
 
@@ -355,7 +375,8 @@ FishboneParams readFishbone(const Node& n) {
     FishboneParams p;
     const Node seed = n.at("seed");
     if (!seed.isNull()) p.seed = seed.vec2();
-    p.direction = n.at("direction").choice({"min", "max"}) == "min" ? PrincipalDirection::Min : PrincipalDirection::Max;
+    p.direction =
+        n.at("direction").choice({"min", "max"}) == "min" ? PrincipalDirection::Min : PrincipalDirection::Max;
     p.spacing = n.at("h").positive();
     p.keyRibs = n.at("key_ribs").points();
     const Node drawn = n.at("drawn_key_ribs");
@@ -396,15 +417,15 @@ StitchOptions readStitch(const Node& n) {
     s.maxGapRatio = n.at("max_gap_ratio").positive();
     s.maxTrimRounds = int(n.at("max_trim_rounds").integer(0, kIntMax, "an integer of at least 0"));
     s.minComponentFaces =
-        std::size_t(n.at("min_component_faces").integer(0, std::numeric_limits<std::int64_t>::max(),
-                                                        "an integer of at least 0"));
+        std::size_t(n.at("min_component_faces")
+                        .integer(0, std::numeric_limits<std::int64_t>::max(), "an integer of at least 0"));
     s.collectGarbage = n.at("collect_garbage").boolean();
     return s;
 }
 
 ScanStep readStep(const Node& n) {
-    n.onlyKeys({"camera", "lasso", "erode_radius", "dilate_radius", "scan", "quality_mask", "triangulate", "grid",
-                "fishbone", "stitch"});
+    n.onlyKeys({"camera", "lasso", "erode_radius", "dilate_radius", "scan", "quality_mask", "triangulate",
+                "grid", "fishbone", "stitch"});
     ScanStep step;
     ScanParams& p = step.params;
     p.camera = readCamera(n.at("camera"));
@@ -436,8 +457,10 @@ ScanStep readStep(const Node& n) {
     p.triangulate.maxEdgeFootprints = tri.at("max_edge_footprints").positive();
     p.triangulate.maxSamplingAngleDeg = tri.at("max_sampling_angle_deg").inRange(0, 90, true, false);
     const bool fishbone = n.at("grid").choice({"regular", "fishbone"}) == "fishbone";
-    if (fishbone) step.fishbone = readFishbone(n.at("fishbone"));
-    else if (n.has("fishbone")) n.at("fishbone").fail("must not be given when grid is \"regular\"");
+    if (fishbone)
+        step.fishbone = readFishbone(n.at("fishbone"));
+    else if (n.has("fishbone"))
+        n.at("fishbone").fail("must not be given when grid is \"regular\"");
     step.stitch = readStitch(n.at("stitch"));
     return step;
 }
@@ -474,7 +497,8 @@ SessionFile sessionFileFromSession(const Session& session, const std::filesystem
     file.renderer = renderer;
     file.curvature = curvature;
     file.events = session.events();
-    (void)toJson(file, meshPath.generic_string()); // refuses what cannot be stored, before anything is written
+    (void)toJson(file,
+                 meshPath.generic_string()); // refuses what cannot be stored, before anything is written
     return file;
 }
 
@@ -493,8 +517,9 @@ void saveSessionFile(const SessionFile& file, const std::filesystem::path& path)
     const std::filesystem::path tmp = path.string() + ".tmp" + std::to_string(::getpid());
     {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw IoError("The session file " + path.string() + " cannot be written (cannot create " +
-                                tmp.string() + ").");
+        if (!out)
+            throw IoError("The session file " + path.string() + " cannot be written (cannot create " +
+                          tmp.string() + ").");
         out << text;
         out.flush();
         if (!out) {
@@ -511,20 +536,22 @@ void saveSessionFile(const SessionFile& file, const std::filesystem::path& path)
     }
 }
 
-SessionFile sessionFileFromJson(const std::string& text, const std::string& name, const std::filesystem::path& baseDir,
-                                const SessionFileLoadOptions& options) {
+SessionFile sessionFileFromJson(const std::string& text, const std::string& name,
+                                const std::filesystem::path& baseDir, const SessionFileLoadOptions& options) {
     Json json;
     try {
         json = Json::parse(text);
     } catch (const Json::parse_error& e) {
         if (text.find_first_not_of(" \t\r\n") == std::string::npos)
             throw IoError(name + " is empty, not a session file.");
-        throw IoError(name + " is not valid JSON (" + (e.byte >= text.size() ? "it ends early, at " : "error at ") +
+        throw IoError(name + " is not valid JSON (" +
+                      (e.byte >= text.size() ? "it ends early, at " : "error at ") +
                       lineColumn(text, e.byte > 0 ? e.byte - 1 : 0) + ").");
     }
     const Node root(json, "", name);
     if (!json.is_object()) throw IoError(name + " is not a session file: its JSON is not an object.");
-    if (!root.has("format")) throw IoError(name + ": format is missing (a session file has \"format\": \"fss-session\").");
+    if (!root.has("format"))
+        throw IoError(name + ": format is missing (a session file has \"format\": \"fss-session\").");
     if (root.at("format").string() != kFormatName)
         root.at("format").fail("must be \"fss-session\" (this is not an FSS session file)");
     const std::int64_t version = root.at("version").integer(1, kIntMax, "a positive integer");
@@ -550,7 +577,8 @@ SessionFile sessionFileFromJson(const std::string& text, const std::string& name
     const Node curvature = root.at("curvature");
     curvature.onlyKeys({"jet_degree", "min_points", "max_rings", "anisotropy_epsilon"});
     file.curvature.jetDegree = int(curvature.at("jet_degree").integer(2, 3, "2 or 3"));
-    file.curvature.minPoints = int(curvature.at("min_points").integer(6, kIntMax, "an integer of at least 6"));
+    file.curvature.minPoints =
+        int(curvature.at("min_points").integer(6, kIntMax, "an integer of at least 6"));
     file.curvature.maxRings = int(curvature.at("max_rings").integer(1, kIntMax, "an integer of at least 1"));
     file.curvature.anisotropyEpsilon = curvature.at("anisotropy_epsilon").positive();
 
@@ -594,7 +622,8 @@ SessionFile sessionFileFromJson(const std::string& text, const std::string& name
 
 SessionFile loadSessionFile(const std::filesystem::path& path, const SessionFileLoadOptions& options) {
     std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw IoError("The session file " + path.string() + " does not exist.");
+    if (!std::filesystem::exists(path, ec))
+        throw IoError("The session file " + path.string() + " does not exist.");
     if (!std::filesystem::is_regular_file(path, ec))
         throw IoError("The session file " + path.string() + " is not a regular file.");
     std::ifstream in(path, std::ios::binary);
@@ -605,7 +634,8 @@ SessionFile loadSessionFile(const std::filesystem::path& path, const SessionFile
     return sessionFileFromJson(text.str(), path.string(), absoluteNormal(path).parent_path(), options);
 }
 
-ReplayResult replaySession(const SessionFile& file, const RendererFactory& renderer, const Progress& progress) {
+ReplayResult replaySession(const SessionFile& file, const RendererFactory& renderer,
+                           const Progress& progress) {
     const auto start = std::chrono::steady_clock::now();
     const std::string name = file.source.empty() ? std::string("the session") : file.source.string();
     if (!file.meshSha256.empty() && sha256OfFile(file.meshPath) != file.meshSha256)
@@ -618,7 +648,8 @@ ReplayResult replaySession(const SessionFile& file, const RendererFactory& rende
     options.renderer = renderer;
     options.curvature = file.curvature;
     std::size_t accepts = 0;
-    for (const SessionEvent& e : file.events) accepts += e.kind == SessionEvent::Kind::Accept;
+    for (const SessionEvent& e : file.events)
+        accepts += e.kind == SessionEvent::Kind::Accept;
     options.maxUndoSteps = std::max<std::size_t>(options.maxUndoSteps, accepts);
     ReplayResult result{Session(std::move(reference), std::move(options)), {}, readSeconds, 0};
 

@@ -25,7 +25,9 @@ constexpr std::array<std::uint32_t, 64> kRound = {
 constexpr std::array<std::uint32_t, 8> kInitial = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
                                                    0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
 
-constexpr std::uint32_t rotr(std::uint32_t x, int n) { return (x >> n) | (x << (32 - n)); }
+constexpr std::uint32_t rotr(std::uint32_t x, int n) {
+    return (x >> n) | (x << (32 - n));
+}
 
 std::string toHex(const std::array<std::uint8_t, 32>& bytes) {
     static const char* digits = "0123456789abcdef";
@@ -94,7 +96,8 @@ void Sha256::update(const void* data, std::size_t size) {
         compress(buffer_.data());
         buffered_ = 0;
     }
-    for (; size >= 64; size -= 64, bytes += 64) compress(bytes);
+    for (; size >= 64; size -= 64, bytes += 64)
+        compress(bytes);
     if (size > 0) {
         std::memcpy(buffer_.data(), bytes, size);
         buffered_ = size;
@@ -112,15 +115,19 @@ std::array<std::uint8_t, 32> Sha256::digest() {
         buffered_ = 0;
     }
     std::fill(buffer_.begin() + std::ptrdiff_t(buffered_), buffer_.begin() + 56, 0);
-    for (int i = 0; i < 8; ++i) buffer_[std::size_t(56 + i)] = std::uint8_t(bits >> (56 - 8 * i));
+    for (int i = 0; i < 8; ++i)
+        buffer_[std::size_t(56 + i)] = std::uint8_t(bits >> (56 - 8 * i));
     compress(buffer_.data());
     for (int i = 0; i < 8; ++i)
-        for (int j = 0; j < 4; ++j) digest_[std::size_t(4 * i + j)] = std::uint8_t(state_[std::size_t(i)] >> (24 - 8 * j));
+        for (int j = 0; j < 4; ++j)
+            digest_[std::size_t(4 * i + j)] = std::uint8_t(state_[std::size_t(i)] >> (24 - 8 * j));
     finished_ = true;
     return digest_;
 }
 
-std::string Sha256::hexDigest() { return toHex(digest()); }
+std::string Sha256::hexDigest() {
+    return toHex(digest());
+}
 
 std::string sha256Hex(std::string_view bytes) {
     Sha256 hash;
@@ -130,8 +137,7 @@ std::string sha256Hex(std::string_view bytes) {
 
 std::string sha256OfFile(const std::filesystem::path& path) {
     std::error_code ec;
-    if (!std::filesystem::exists(path, ec))
-        throw IoError("The file " + path.string() + " does not exist.");
+    if (!std::filesystem::exists(path, ec)) throw IoError("The file " + path.string() + " does not exist.");
     if (!std::filesystem::is_regular_file(path, ec))
         throw IoError("The path " + path.string() + " is not a regular file.");
     std::ifstream in(path, std::ios::binary);

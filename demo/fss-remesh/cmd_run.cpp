@@ -32,7 +32,9 @@ namespace {
 using Json = nlohmann::ordered_json;
 using Clock = std::chrono::steady_clock;
 
-double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double since(Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
 // A one-line progress bar redrawn in place on stderr (only used when stderr is a terminal).
 class ProgressBar {
@@ -48,8 +50,9 @@ public:
         lastDraw_ = now;
         constexpr int kWidth = 30;
         const int filled = std::clamp(int(fraction * kWidth), 0, kWidth);
-        std::string text = "\r[" + std::string(std::size_t(filled), '#') + std::string(std::size_t(kWidth - filled), ' ') +
-                           "] " + std::to_string(percent) + "% " + lastStage_;
+        std::string text = "\r[" + std::string(std::size_t(filled), '#') +
+                           std::string(std::size_t(kWidth - filled), ' ') + "] " + std::to_string(percent) +
+                           "% " + lastStage_;
         if (text.size() > 100) text.resize(100);
         std::fprintf(stderr, "%s\x1b[K", text.c_str());
         std::fflush(stderr);
@@ -90,9 +93,12 @@ Json stitchJson(const StitchReport& r) {
 
 const char* kindName(SessionEvent::Kind kind) {
     switch (kind) {
-    case SessionEvent::Kind::Accept: return "accept";
-    case SessionEvent::Kind::Undo: return "undo";
-    case SessionEvent::Kind::Redo: return "redo";
+    case SessionEvent::Kind::Accept:
+        return "accept";
+    case SessionEvent::Kind::Undo:
+        return "undo";
+    case SessionEvent::Kind::Redo:
+        return "redo";
     }
     return "?";
 }
@@ -119,38 +125,45 @@ RendererFactory makeFactory(const std::string& kind, std::string& used, const st
 
 int runRun(const std::vector<std::string>& args) {
     const std::string command = "fss-remesh run";
-    std::string sessionPath, outPath, reportPath, snapshotPath, snapshotSize = "1024x768", snapshotView = "iso", snapshotZoom = "1",
-                                                                   rendererKind = "session";
+    std::string sessionPath, outPath, reportPath, snapshotPath,
+        snapshotSize = "1024x768", snapshotView = "iso", snapshotZoom = "1", rendererKind = "session";
     bool haveReport = false, haveSnapshot = false, json = false, noSelf = false, quiet = false;
-    ArgParser p(command, "Replay the session file SESSION.json head-less: read its input mesh (checking its "
-                         "SHA-256), apply every recorded scan, undo and redo in order, and write the resulting mesh "
-                         "to OUT. With the renderer the session was recorded with, OUT is identical to the mesh "
-                         "the recording session produced.");
-    p.positional("SESSION.json", "Session file (fss-session JSON, written by fss-demo or the C++ API).", &sessionPath);
-    p.option("-o", "OUT", "Output mesh (.off .obj .ply .stl; .ply keeps per-face quality and scan id).", &outPath);
+    ArgParser p(command,
+                "Replay the session file SESSION.json head-less: read its input mesh (checking its "
+                "SHA-256), apply every recorded scan, undo and redo in order, and write the resulting mesh "
+                "to OUT. With the renderer the session was recorded with, OUT is identical to the mesh "
+                "the recording session produced.");
+    p.positional("SESSION.json", "Session file (fss-session JSON, written by fss-demo or the C++ API).",
+                 &sessionPath);
+    p.option("-o", "OUT", "Output mesh (.off .obj .ply .stl; .ply keeps per-face quality and scan id).",
+             &outPath);
     p.option("--output", "OUT", "Same as -o.", &outPath);
-    p.option("--report", "R.json",
-             "Write a JSON report: every metric of 'fss-remesh info' for OUT (with Hausdorff distances to the "
-             "input) and for the input, and per event the scan and stitch times and the stitch report.",
-             &reportPath, &haveReport);
+    p.option(
+        "--report", "R.json",
+        "Write a JSON report: every metric of 'fss-remesh info' for OUT (with Hausdorff distances to the "
+        "input) and for the input, and per event the scan and stitch times and the stitch report.",
+        &reportPath, &haveReport);
     p.flag("--json", "Print the same JSON report on stdout instead of the text summary.", &json);
-    p.option("--snapshot", "S.png",
-             "Render OUT head-less into a PNG coloured by each triangle's minimum angle (red 0, yellow 30, green "
-             "60 degrees).",
-             &snapshotPath, &haveSnapshot);
+    p.option(
+        "--snapshot", "S.png",
+        "Render OUT head-less into a PNG coloured by each triangle's minimum angle (red 0, yellow 30, green "
+        "60 degrees).",
+        &snapshotPath, &haveSnapshot);
     p.option("--snapshot-size", "WxH", "Size of the snapshot in pixels (default 1024x768).", &snapshotSize);
     p.option("--snapshot-view", "V", "View of the snapshot: iso, +x, -x, +y, -y, +z, -z (default iso).",
              &snapshotView);
     p.option("--snapshot-zoom", "F", "Zoom factor of the snapshot camera (> 0, default 1: the whole mesh).",
              &snapshotZoom);
-    p.option("--renderer", "R",
-             "session (default: the renderer the session was recorded with), auto (GPU, else CPU), gpu or cpu. "
-             "Another renderer than the recording's gives a slightly different mesh.",
-             &rendererKind);
+    p.option(
+        "--renderer", "R",
+        "session (default: the renderer the session was recorded with), auto (GPU, else CPU), gpu or cpu. "
+        "Another renderer than the recording's gives a slightly different mesh.",
+        &rendererKind);
     p.flag("--no-self-intersections", "Skip the self-intersection count in the report (slow on huge meshes).",
            &noSelf);
     p.flag("--quiet", "No progress bar (it is shown only when stderr is a terminal anyway).", &quiet);
-    p.epilog("example:\n  fss-remesh run examples/fandisk.session.json -o fandisk_remeshed.ply --report report.json "
+    p.epilog("example:\n  fss-remesh run examples/fandisk.session.json -o fandisk_remeshed.ply --report "
+             "report.json "
              "--snapshot fandisk.png");
     if (!p.parse(args)) return 0;
 
@@ -158,18 +171,21 @@ int runRun(const std::vector<std::string>& args) {
     if (!isSupportedMeshFile(outPath))
         throw UsageError("The output file " + outPath + " has no supported extension (.off .obj .ply .stl).");
     if (rendererKind != "session" && rendererKind != "auto" && rendererKind != "gpu" && rendererKind != "cpu")
-        throw UsageError("The value '" + rendererKind + "' of --renderer is not one of session, auto, gpu, cpu.");
+        throw UsageError("The value '" + rendererKind +
+                         "' of --renderer is not one of session, auto, gpu, cpu.");
     if (haveReport && reportPath.empty()) throw UsageError("The option --report needs a file name.");
     if (haveSnapshot) {
         const std::string ext = std::filesystem::path(snapshotPath).extension().string();
-        if (ext != ".png" && ext != ".PNG") throw UsageError("The snapshot " + snapshotPath + " must be a .png file.");
+        if (ext != ".png" && ext != ".PNG")
+            throw UsageError("The snapshot " + snapshotPath + " must be a .png file.");
     }
     const auto [snapW, snapH] = parseResolution("--snapshot-size", snapshotSize, Camera::kMaxResolution);
     const double zoom = parseDouble("--snapshot-zoom", snapshotZoom);
     if (!(zoom > 0)) throw UsageError("The value of --snapshot-zoom must be positive.");
     const auto view = parseStandardView(snapshotView);
     if (!view)
-        throw UsageError("The value '" + snapshotView + "' of --snapshot-view is not one of iso, +x, -x, +y, -y, +z, -z.");
+        throw UsageError("The value '" + snapshotView +
+                         "' of --snapshot-view is not one of iso, +x, -x, +y, -y, +z, -z.");
 
     const auto start = Clock::now();
     const SessionFile file = loadSessionFile(sessionPath);
@@ -185,7 +201,8 @@ int runRun(const std::vector<std::string>& args) {
     const bool showProgress = !quiet && ::isatty(STDERR_FILENO) == 1;
     ProgressBar bar;
     Progress progress;
-    if (showProgress) progress = Progress([&bar](double f, std::string_view stage) { return bar.update(f, stage); });
+    if (showProgress)
+        progress = Progress([&bar](double f, std::string_view stage) { return bar.update(f, stage); });
 
     const auto replayStart = Clock::now();
     ReplayResult replay = replaySession(file, factory, progress);
@@ -270,19 +287,21 @@ int runRun(const std::vector<std::string>& args) {
         report["metrics"] = Json::parse(metricsToJson(*metrics));
         report["input_metrics"] = Json::parse(metricsToJson(*inputMetrics));
         if (haveSnapshot)
-            report["snapshot"] = {{"file", snapshotPath},
-                                  {"width", snapW},
-                                  {"height", snapH},
-                                  {"view", snapshotView},
-                                  {"renderer", shot.renderer},
-                                  {"covered_fraction", double(shot.covered) / (double(snapW) * double(snapH))}};
+            report["snapshot"] = {
+                {"file", snapshotPath},
+                {"width", snapW},
+                {"height", snapH},
+                {"view", snapshotView},
+                {"renderer", shot.renderer},
+                {"covered_fraction", double(shot.covered) / (double(snapW) * double(snapH))}};
         if (haveReport) {
             const std::string tmp = reportPath + ".tmp" + std::to_string(::getpid());
             {
                 std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
                 if (!out) throw IoError("The report " + reportPath + " cannot be written.");
                 out << report.dump(2) << "\n";
-                if (!out.flush()) throw IoError("The report " + reportPath + " could not be written completely.");
+                if (!out.flush())
+                    throw IoError("The report " + reportPath + " could not be written completely.");
             }
             std::error_code ec;
             std::filesystem::rename(tmp, reportPath, ec);
@@ -294,9 +313,9 @@ int runRun(const std::vector<std::string>& args) {
         std::cout << report.dump(2) << "\n";
     } else {
         const Metrics& m = *metrics;
-        std::cout << "replayed " << sessionPath << " (" << accepts << " scans, " << undos << " undos, " << redos
-                  << " redos; " << used << " renderer) in " << replaySeconds << " s: " << m.vertices << " vertices, "
-                  << m.faces << " faces, written to " << outPath << "\n";
+        std::cout << "replayed " << sessionPath << " (" << accepts << " scans, " << undos << " undos, "
+                  << redos << " redos; " << used << " renderer) in " << replaySeconds << " s: " << m.vertices
+                  << " vertices, " << m.faces << " faces, written to " << outPath << "\n";
         std::cout << metricsToText(m);
         if (inputMetrics) {
             const Metrics& in = *inputMetrics;
@@ -316,7 +335,8 @@ int runRun(const std::vector<std::string>& args) {
                 "    %-24s %10.2f  %10.2f\n");
         }
         if (haveReport) std::cout << "report written to " << reportPath << "\n";
-        if (haveSnapshot) std::cout << "snapshot (" << shot.renderer << ") written to " << snapshotPath << "\n";
+        if (haveSnapshot)
+            std::cout << "snapshot (" << shot.renderer << ") written to " << snapshotPath << "\n";
     }
     return 0;
 }

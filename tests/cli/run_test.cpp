@@ -83,8 +83,9 @@ TEST(CliRun, ReplayWritesTheRecordedMeshByteForByte) {
     fs::remove(out);
     fs::remove(report);
     fs::remove(png);
-    const auto r = runProcess(remeshExe(), {"run", rec.session.string(), "-o", out.string(), "--report", report.string(),
-                                            "--snapshot", png.string(), "--snapshot-size", "320x240"},
+    const auto r = runProcess(remeshExe(),
+                              {"run", rec.session.string(), "-o", out.string(), "--report", report.string(),
+                               "--snapshot", png.string(), "--snapshot-size", "320x240"},
                               tmpPath("cli_run"));
     ASSERT_EQ(r.exitCode, 0) << r.err;
     EXPECT_EQ(r.err, ""); // no progress bar when stderr is not a terminal
@@ -160,12 +161,18 @@ TEST(CliRun, BadSessionFilesFailWithOneSentence) {
         return copy.dump(2);
     };
     expectRejected("version", edited([](nlohmann::ordered_json& x) { x["version"] = 7; }), "version is 7");
-    expectRejected("missing", edited([](nlohmann::ordered_json& x) { x["events"][3]["step"]["camera"].erase("width"); }),
+    expectRejected("missing",
+                   edited([](nlohmann::ordered_json& x) { x["events"][3]["step"]["camera"].erase("width"); }),
                    "events[3].step.camera.width is missing");
-    expectRejected("type", edited([](nlohmann::ordered_json& x) { x["events"][3]["step"]["camera"]["width"] = -4; }),
+    expectRejected("type",
+                   edited([](nlohmann::ordered_json& x) { x["events"][3]["step"]["camera"]["width"] = -4; }),
                    "events[3].step.camera.width must be a positive integer");
-    expectRejected("mesh", edited([](nlohmann::ordered_json& x) { x["mesh"]["path"] = "does_not_exist.off"; }), "mesh.path");
-    expectRejected("sha", edited([](nlohmann::ordered_json& x) { x["mesh"]["sha256"] = std::string(64, 'a'); }), "mesh.sha256");
+    expectRejected("mesh",
+                   edited([](nlohmann::ordered_json& x) { x["mesh"]["path"] = "does_not_exist.off"; }),
+                   "mesh.path");
+    expectRejected("sha",
+                   edited([](nlohmann::ordered_json& x) { x["mesh"]["sha256"] = std::string(64, 'a'); }),
+                   "mesh.sha256");
     expectRejected("truncated", good.substr(0, good.size() / 3), "is not valid JSON");
     expectRejected("replay", edited([](nlohmann::ordered_json& x) {
                        auto& cam = x["events"][0]["step"]["camera"];
@@ -175,17 +182,19 @@ TEST(CliRun, BadSessionFilesFailWithOneSentence) {
                    "events[0] (accept)");
 
     // A missing session file, and command-line mistakes (exit 2).
-    const auto missing = runProcess(remeshExe(), {"run", tmpPath("cli_run/none.json").string(), "-o",
-                                                  tmpPath("cli_run/none.off").string()},
-                                    tmpPath("cli_run"));
+    const auto missing =
+        runProcess(remeshExe(),
+                   {"run", tmpPath("cli_run/none.json").string(), "-o", tmpPath("cli_run/none.off").string()},
+                   tmpPath("cli_run"));
     fss::test::expectCleanFailure(missing, "does not exist");
     const auto noOut = runProcess(remeshExe(), {"run", rec.session.string()}, tmpPath("cli_run"));
     EXPECT_EQ(noOut.exitCode, 2);
     const auto badRenderer =
-        runProcess(remeshExe(), {"run", rec.session.string(), "-o", "x.off", "--renderer", "vulkan"}, tmpPath("cli_run"));
+        runProcess(remeshExe(), {"run", rec.session.string(), "-o", "x.off", "--renderer", "vulkan"},
+                   tmpPath("cli_run"));
     EXPECT_EQ(badRenderer.exitCode, 2);
-    const auto badSnapshot =
-        runProcess(remeshExe(), {"run", rec.session.string(), "-o", "x.off", "--snapshot", "x.jpg"}, tmpPath("cli_run"));
+    const auto badSnapshot = runProcess(
+        remeshExe(), {"run", rec.session.string(), "-o", "x.off", "--snapshot", "x.jpg"}, tmpPath("cli_run"));
     EXPECT_EQ(badSnapshot.exitCode, 2);
 }
 
@@ -195,8 +204,9 @@ TEST(CliRun, ExampleSessionReplays) {
     const fs::path session = fs::path(FSS_SOURCE_DIR) / "examples" / "fandisk.session.json";
     const fs::path out = tmpPath("cli_run/example.off");
     const fs::path report = tmpPath("cli_run/example_report.json");
-    const auto r = runProcess(remeshExe(), {"run", session.string(), "-o", out.string(), "--report", report.string()},
-                              tmpPath("cli_run"));
+    const auto r =
+        runProcess(remeshExe(), {"run", session.string(), "-o", out.string(), "--report", report.string()},
+                   tmpPath("cli_run"));
     ASSERT_EQ(r.exitCode, 0) << r.err;
     const nlohmann::json j = nlohmann::json::parse(fss::test::slurp(report));
     int fishbone = 0, regular = 0;
@@ -212,7 +222,8 @@ TEST(CliRun, ExampleSessionReplays) {
     EXPECT_EQ(m["components"], 1);
     EXPECT_EQ(m["self_intersections"], 0);
     EXPECT_EQ(m["degenerate_faces"], 0);
-    EXPECT_GT(m["frac_valence6_interior"].get<double>(), j["input_metrics"]["frac_valence6_interior"].get<double>());
+    EXPECT_GT(m["frac_valence6_interior"].get<double>(),
+              j["input_metrics"]["frac_valence6_interior"].get<double>());
     EXPECT_LT(m["hausdorff_to_ref_rel"].get<double>(), 0.01);
     EXPECT_LT(m["hausdorff_from_ref_rel"].get<double>(), 0.01);
 }

@@ -30,7 +30,8 @@ using Json = nlohmann::ordered_json;
 
 // Bitwise equality of doubles (distinguishes -0.0 from 0.0).
 ::testing::AssertionResult sameBits(double a, double b) {
-    if (std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b)) return ::testing::AssertionSuccess();
+    if (std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b))
+        return ::testing::AssertionSuccess();
     std::ostringstream os;
     os.precision(17);
     os << a << " != " << b;
@@ -42,11 +43,13 @@ void expectSame(const Vector2d& a, const Vector2d& b) {
     EXPECT_TRUE(sameBits(a.y(), b.y()));
 }
 void expectSame(const Vector3d& a, const Vector3d& b) {
-    for (int i = 0; i < 3; ++i) EXPECT_TRUE(sameBits(a[i], b[i]));
+    for (int i = 0; i < 3; ++i)
+        EXPECT_TRUE(sameBits(a[i], b[i]));
 }
 void expectSame(const std::vector<Vector2d>& a, const std::vector<Vector2d>& b) {
     ASSERT_EQ(a.size(), b.size());
-    for (std::size_t i = 0; i < a.size(); ++i) expectSame(a[i], b[i]);
+    for (std::size_t i = 0; i < a.size(); ++i)
+        expectSame(a[i], b[i]);
 }
 
 void expectSame(const fss::StreamlineOptions& a, const fss::StreamlineOptions& b) {
@@ -94,7 +97,8 @@ void expectSame(const fss::ScanStep& a, const fss::ScanStep& b) {
         EXPECT_TRUE(sameBits(fa.spacing, fb.spacing));
         expectSame(fa.keyRibs, fb.keyRibs);
         ASSERT_EQ(fa.drawnKeyRibs.size(), fb.drawnKeyRibs.size());
-        for (std::size_t i = 0; i < fa.drawnKeyRibs.size(); ++i) expectSame(fa.drawnKeyRibs[i], fb.drawnKeyRibs[i]);
+        for (std::size_t i = 0; i < fa.drawnKeyRibs.size(); ++i)
+            expectSame(fa.drawnKeyRibs[i], fb.drawnKeyRibs[i]);
         expectSame(fa.drawnBackbone, fb.drawnBackbone);
         EXPECT_TRUE(sameBits(fa.tracing.spacing, fb.tracing.spacing));
         EXPECT_EQ(fa.tracing.extendBeyondKeyRibs, fb.tracing.extendBeyondKeyRibs);
@@ -268,14 +272,16 @@ TEST(SessionFile, DoublesRoundTripBitExactly) {
     std::vector<double> values;
     for (int i = 0; i < 3000; ++i) {
         double v;
-        do v = std::bit_cast<double>(rng());
+        do
+            v = std::bit_cast<double>(rng());
         while (!std::isfinite(v));
         values.push_back(v);
         values.push_back(moderate(rng));
     }
     fss::ScanStep step;
     step.params.lasso = fss::Lasso{};
-    for (std::size_t i = 0; i + 1 < values.size(); i += 2) step.params.lasso->points.emplace_back(values[i], values[i + 1]);
+    for (std::size_t i = 0; i + 1 < values.size(); i += 2)
+        step.params.lasso->points.emplace_back(values[i], values[i + 1]);
     // The lasso must enclose an area to load: these corners make sure it does whatever the random points are.
     step.params.lasso->points.emplace_back(0, 0);
     step.params.lasso->points.emplace_back(1, 0);
@@ -347,7 +353,8 @@ protected:
 };
 
 TEST_F(BadSessionFile, GoodFileLoads) {
-    good_["mesh"]["path"] = mesh_.filename().string(); // relative to the session file, which is in the same folder
+    good_["mesh"]["path"] =
+        mesh_.filename().string(); // relative to the session file, which is in the same folder
     EXPECT_EQ(load(good_), "(no error)");
 }
 
@@ -393,7 +400,9 @@ TEST_F(BadSessionFile, WrongTypesAndValues) {
          ": events[0].step.camera.width must be a positive integer of at most 8192."},
         {[](Json& j) { j["events"][0]["step"]["camera"]["height"] = 12.5; },
          ": events[0].step.camera.height must be a positive integer of at most 8192."},
-        {[](Json& j) { j["events"][0]["step"]["camera"]["eye"] = Json::array({1, 2}); },
+        {[](Json& j) {
+             j["events"][0]["step"]["camera"]["eye"] = Json::array({1, 2});
+         },
          ": events[0].step.camera.eye must be an array of 3 numbers."},
         {[](Json& j) { j["events"][0]["step"]["camera"]["up"][1] = "x"; },
          ": events[0].step.camera.up[1] must be a number."},
@@ -403,7 +412,9 @@ TEST_F(BadSessionFile, WrongTypesAndValues) {
          ": events[0].step.camera.far must be larger than near."},
         {[](Json& j) { j["events"][0]["step"]["camera"]["focal"] = j["events"][0]["step"]["camera"]["eye"]; },
          ": events[0].step.camera.focal must differ from eye (the camera has no viewing direction)."},
-        {[](Json& j) { j["events"][0]["step"]["lasso"] = Json::array({Json::array({0, 0}), Json::array({1, 1})}); },
+        {[](Json& j) {
+             j["events"][0]["step"]["lasso"] = Json::array({Json::array({0, 0}), Json::array({1, 1})});
+         },
          ": events[0].step.lasso must enclose an area (at least 3 points, not all collinear)."},
         {[](Json& j) { j["events"][0]["step"]["erode_radius"] = -1; },
          ": events[0].step.erode_radius must be an integer in [0, 1024]."},
@@ -419,27 +430,39 @@ TEST_F(BadSessionFile, WrongTypesAndValues) {
          ": events[1].step.fishbone.h must be a positive number."},
         {[](Json& j) { j["events"][1]["step"]["fishbone"]["direction"] = "sideways"; },
          ": events[1].step.fishbone.direction must be one of \"min\", \"max\", not \"sideways\"."},
-        {[](Json& j) { j["events"][1]["step"]["fishbone"]["key_ribs"][1] = Json::array({1, 2, 3}); },
+        {[](Json& j) {
+             j["events"][1]["step"]["fishbone"]["key_ribs"][1] = Json::array({1, 2, 3});
+         },
          ": events[1].step.fishbone.key_ribs[1] must be an array of 2 numbers [x, y]."},
-        {[](Json& j) { j["events"][1]["step"]["fishbone"]["seed"] = nullptr;
-                       j["events"][1]["step"]["fishbone"]["drawn_backbone"] = Json::array(); },
+        {[](Json& j) {
+             j["events"][1]["step"]["fishbone"]["seed"] = nullptr;
+             j["events"][1]["step"]["fishbone"]["drawn_backbone"] = Json::array();
+         },
          ": events[1].step.fishbone.seed must be given when drawn_backbone is empty."},
         {[](Json& j) { j["events"][1]["step"]["fishbone"]["tracing"]["backbone"]["low_anisotropy"] = true; },
-         ": events[1].step.fishbone.tracing.backbone.low_anisotropy must be one of \"stop\", \"continue_straight\"."},
+         ": events[1].step.fishbone.tracing.backbone.low_anisotropy must be one of \"stop\", "
+         "\"continue_straight\"."},
         {[](Json& j) { j["events"][1]["step"]["stitch"]["seam_rings"] = 1.5; },
          ": events[1].step.stitch.seam_rings must be an integer of at least 0."},
         {[](Json& j) { j["events"][0]["step"]["camera"]["eyes"] = 1; },
          ": events[0].step.camera has an unknown field 'eyes'."},
         {[](Json& j) { j["events"][2]["kind"] = "rotate"; },
          ": events[2].kind must be one of \"accept\", \"undo\", \"redo\", not \"rotate\"."},
-        {[](Json& j) { j["events"] = Json::array({Json{{"kind", "undo"}}}); },
+        {[](Json& j) {
+             j["events"] = Json::array({Json{{"kind", "undo"}}});
+         },
          ": events[0] is an undo with no accepted step left to undo."},
-        {[](Json& j) { j["events"][3]["kind"] = "redo"; j["events"][4]["kind"] = "redo"; },
+        {[](Json& j) {
+             j["events"][3]["kind"] = "redo";
+             j["events"][4]["kind"] = "redo";
+         },
          ": events[4] is a redo with no undone step to redo."},
         {[](Json& j) { j["events"] = Json::object(); }, ": events must be an array of events."},
-        {[](Json& j) { j["renderer"] = "vulkan"; }, ": renderer must be one of \"cpu\", \"gpu\", not \"vulkan\"."},
+        {[](Json& j) { j["renderer"] = "vulkan"; },
+         ": renderer must be one of \"cpu\", \"gpu\", not \"vulkan\"."},
         {[](Json& j) { j["curvature"]["jet_degree"] = 4; }, ": curvature.jet_degree must be 2 or 3."},
-        {[](Json& j) { j["mesh"]["sha256"] = "abc"; }, ": mesh.sha256 must be 64 lowercase hexadecimal digits."},
+        {[](Json& j) { j["mesh"]["sha256"] = "abc"; },
+         ": mesh.sha256 must be 64 lowercase hexadecimal digits."},
     };
     for (const auto& [edit, expected] : cases) {
         Json j = good_;
@@ -463,7 +486,9 @@ TEST_F(BadSessionFile, TruncatedJson) {
     const std::string text = good_.dump(2);
     const std::string message = load(text.substr(0, text.size() / 2));
     EXPECT_EQ(message.rfind(" is not valid JSON (it ends early, at line ", 0), 0u) << message;
-    EXPECT_EQ(load("{\"format\": \"fss-session\",, }").rfind(" is not valid JSON (error at line 1, column ", 0), 0u);
+    EXPECT_EQ(
+        load("{\"format\": \"fss-session\",, }").rfind(" is not valid JSON (error at line 1, column ", 0),
+        0u);
     // A missing file is an IoError too, naming it.
     EXPECT_THROW(fss::loadSessionFile(fss::test::tmpPath("no_such.session.json")), fss::IoError);
 }
@@ -476,7 +501,8 @@ TEST(SessionFile, SavingRefusesWhatCannotBeStored) {
         fss::sessionFileToJson(f);
         FAIL() << "no error";
     } catch (const fss::InvalidInputError& e) {
-        EXPECT_STREQ(e.what(), "The session cannot be saved: events[0].step.camera.eye is not a finite number.");
+        EXPECT_STREQ(e.what(),
+                     "The session cannot be saved: events[0].step.camera.eye is not a finite number.");
     }
     f = sampleFile(mesh);
     f.events[1].step.fishbone->tracing.ribTracing.insideRegion = [](const Vector2d&) { return true; };
@@ -495,9 +521,11 @@ TEST(SessionFile, SavingRefusesWhatCannotBeStored) {
 std::string fingerprint(const fss::Mesh& mesh) {
     std::ostringstream out;
     out << std::hexfloat;
-    for (auto v : mesh.vertices()) out << mesh.point(v) << '\n';
+    for (auto v : mesh.vertices())
+        out << mesh.point(v) << '\n';
     for (auto f : mesh.faces()) {
-        for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) out << std::size_t(v) << ' ';
+        for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
+            out << std::size_t(v) << ' ';
         out << '\n';
     }
     return out.str();
@@ -514,7 +542,8 @@ fss::ScanStep viewStep(const fss::Mesh& mesh, fss::StandardView view, int resolu
 // Records a session through the API (scans, a rejected preview, an undo, a redo, a fishbone scan), saves it,
 // loads it and replays it: the current meshes are identical, and so is every stitch report's face count.
 TEST(SessionFile, ReplayReproducesTheRecordedMesh) {
-    const auto meshFile = writeTestMesh("session_file_replay.off", fss::shapes::cylinder(48, 12, 1.0, 2.0, true));
+    const auto meshFile =
+        writeTestMesh("session_file_replay.off", fss::shapes::cylinder(48, 12, 1.0, 2.0, true));
     fss::Session recorded(fss::readMesh(meshFile));
     const fss::Mesh& ref = recorded.reference();
     recorded.scan(viewStep(ref, fss::StandardView::PosX, 96));
@@ -540,10 +569,11 @@ TEST(SessionFile, ReplayReproducesTheRecordedMesh) {
     fss::saveSessionFile(fss::sessionFileFromSession(recorded, meshFile), path);
     const fss::SessionFile loaded = fss::loadSessionFile(path);
     std::vector<std::pair<double, std::string>> reports;
-    fss::ReplayResult replay = fss::replaySession(loaded, {}, fss::Progress([&](double f, std::string_view stage) {
-                                                      reports.emplace_back(f, std::string(stage));
-                                                      return true;
-                                                  }));
+    fss::ReplayResult replay =
+        fss::replaySession(loaded, {}, fss::Progress([&](double f, std::string_view stage) {
+                               reports.emplace_back(f, std::string(stage));
+                               return true;
+                           }));
     EXPECT_NE(fingerprint(recorded.current()), fingerprint(recorded.reference())); // the scans changed it
     EXPECT_EQ(fingerprint(replay.session.current()), fingerprint(recorded.current()));
     EXPECT_EQ(replay.session.undoCount(), recorded.undoCount());
@@ -563,7 +593,8 @@ TEST(SessionFile, ReplayReproducesTheRecordedMesh) {
     EXPECT_EQ(accepted, 4u);
     // Progress is monotone from 0 to 1.
     ASSERT_FALSE(reports.empty());
-    for (std::size_t i = 1; i < reports.size(); ++i) EXPECT_GE(reports[i].first, reports[i - 1].first - 1e-12);
+    for (std::size_t i = 1; i < reports.size(); ++i)
+        EXPECT_GE(reports[i].first, reports[i - 1].first - 1e-12);
     EXPECT_EQ(reports.back().first, 1.0);
 
     // A scan that fails on replay names the event.

@@ -18,8 +18,9 @@ TEST(Sha256, FipsExampleVectors) {
     EXPECT_EQ(fss::sha256Hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
     EXPECT_EQ(fss::sha256Hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
               "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
-    EXPECT_EQ(fss::sha256Hex("abcdefghbcdefghicdefghijdefghijkefghijklfghijklmghijklmnhijklmnoijklmnopjklmnopqklmnop"
-                             "qrlmnopqrsmnopqrstnopqrstu"),
+    EXPECT_EQ(fss::sha256Hex(
+                  "abcdefghbcdefghicdefghijdefghijkefghijklfghijklmghijklmnhijklmnoijklmnopjklmnopqklmnop"
+                  "qrlmnopqrsmnopqrstnopqrstu"),
               "cf5b16a778af8380036ce59e7b0492370b249b11e8f07a51afac45037afee9d1");
     EXPECT_EQ(fss::sha256Hex(std::string(1000000, 'a')),
               "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
@@ -35,14 +36,16 @@ TEST(Sha256, PaddingBoundaries) {
         {65, "9537c5fdf120482f7d58d25e9ed583f52c02b4e304ea814db1633ad565aed7e9"},
         {119, "000b48d4edf0fa7bee3c6236ecd2785baa5db4eeb8bb54341b029e0d9fa5fb0c"},
         {120, "13f05a0b594787f5ecd315edc96141bd3243203d1b7d4f0836f37308b276ba98"}};
-    for (const auto& [n, hex] : cases) EXPECT_EQ(fss::sha256Hex(std::string(std::size_t(n), 'x')), hex) << n;
+    for (const auto& [n, hex] : cases)
+        EXPECT_EQ(fss::sha256Hex(std::string(std::size_t(n), 'x')), hex) << n;
 }
 
 // The digest does not depend on how the message is cut into update() calls.
 TEST(Sha256, IncrementalEqualsOneShot) {
     std::mt19937 rng(7);
     std::string message(5000, '\0');
-    for (char& c : message) c = char(rng() & 0xff);
+    for (char& c : message)
+        c = char(rng() & 0xff);
     const std::string expected = fss::sha256Hex(message);
     for (std::size_t piece : {1u, 3u, 63u, 64u, 65u, 1000u}) {
         fss::Sha256 hash;

@@ -35,7 +35,8 @@ TEST(Snapshot, ColorMap) {
 // the area of the projected disc (the icosphere's silhouette is inscribed: slightly less).
 TEST(Snapshot, CoverageMatchesTheProjectedDisc) {
     const fss::Mesh sphere = fss::shapes::icosphere(5); // 20480 faces, all near-equilateral
-    fss::Camera camera = fss::Camera::standardView(fss::StandardView::Iso, fss::boundingBox(sphere), 320, 240, true);
+    fss::Camera camera =
+        fss::Camera::standardView(fss::StandardView::Iso, fss::boundingBox(sphere), 320, 240, true);
     camera.parallelScale = 1.6; // half the image height in world units
     const fss::render::Snapshot shot = fss::render::renderSnapshot(sphere, camera);
     ASSERT_EQ(shot.image.width, 320);
@@ -113,8 +114,8 @@ TEST(Snapshot, ShadeFacesIsFlatAndOutlined) {
     fss::render::SnapshotOptions options;
     options.outline = 0.5;
     const fss::render::Image img = fss::render::shadeFaces(mesh, buffers, colors, options);
-    EXPECT_EQ(img.pixel(0, 0), (Rgb{200, 100, 50}));  // below it is background: no border
-    EXPECT_EQ(img.pixel(1, 0), (Rgb{100, 50, 25}));   // face 1 to its right: border
+    EXPECT_EQ(img.pixel(0, 0), (Rgb{200, 100, 50})); // below it is background: no border
+    EXPECT_EQ(img.pixel(1, 0), (Rgb{100, 50, 25}));  // face 1 to its right: border
     EXPECT_EQ(img.pixel(3, 0), (Rgb{10, 20, 255}));
     EXPECT_EQ(img.pixel(0, 1), (Rgb{255, 255, 255})); // background
     EXPECT_EQ(img.pixel(1, 1), (Rgb{100, 50, 25}));

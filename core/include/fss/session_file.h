@@ -15,7 +15,8 @@
 ///   "curvature": { "jet_degree": 2, "min_points": 24, "max_rings": 5, "anisotropy_epsilon": 0.001 },
 ///   "events": [
 ///     { "kind": "accept", "step": {
-///         "camera": { "eye": [x,y,z], "focal": [x,y,z], "up": [x,y,z], "projection": "perspective" | "parallel",
+///         "camera": { "eye": [x,y,z], "focal": [x,y,z], "up": [x,y,z],
+///                     "projection": "perspective" | "parallel",
 ///                     "view_angle_deg": 30, "parallel_scale": 1, "near": 0.01, "far": 1000,
 ///                     "width": 256, "height": 256 },
 ///         "lasso": null | [[x,y], ...],                    (pixels of the scan image)
@@ -26,15 +27,18 @@
 ///         "grid": "regular" | "fishbone",
 ///         "fishbone": {                                    (only with "grid": "fishbone")
 ///             "seed": null | [x,y], "direction": "min" | "max", "h": 4,
-///             "key_ribs": [[x,y], ...], "drawn_key_ribs": [[[x,y], ...], ...], "drawn_backbone": [[x,y], ...],
-///             "tracing": { "spacing": 4, "extend_beyond_key_ribs": true, "backbone": STREAMLINE, "ribs": STREAMLINE },
+///             "key_ribs": [[x,y], ...], "drawn_key_ribs": [[[x,y], ...], ...],
+///             "drawn_backbone": [[x,y], ...],
+///             "tracing": { "spacing": 4, "extend_beyond_key_ribs": true,
+///                          "backbone": STREAMLINE, "ribs": STREAMLINE },
 ///             "min_seed_anisotropy": 0.1, "raycast": { "rings": 2, "verify_unoccluded": false } },
 ///         "stitch": { "seam_rings": 2, "optimise_seam": true, "collapse_edge_ratio": 0.4, "seam_grading": 1,
 ///                     "min_angle_floor_deg": 1, "max_view_angle_deg": 85, "max_normal_change_deg": 20,
 ///                     "max_gap_ratio": 0.25, "max_trim_rounds": 16, "min_component_faces": 8,
 ///                     "collect_garbage": false } } },
 ///     { "kind": "undo" }, { "kind": "redo" } ] }
-/// STREAMLINE = { "step": 0.25, "min_step": 0.015625, "max_length": null (unbounded) | L, "min_anisotropy": 0.05,
+/// STREAMLINE = { "step": 0.25, "min_step": 0.015625, "max_length": null (unbounded) | L,
+///                "min_anisotropy": 0.05,
 ///                "low_anisotropy": "stop" | "continue_straight", "max_turn_deg": 10, "max_steps": 1000000 }
 /// \endcode
 /// Doubles are written in the shortest form that reads back to the same bits, so a loaded step is
@@ -64,9 +68,9 @@ struct SessionFile {
     /// of the file against the session file's folder; saveSessionFile writes a relative path relative to the
     /// session file's folder (an absolute path stays absolute).
     std::filesystem::path meshPath;
-    std::string meshSha256;   ///< SHA-256 of the mesh file's bytes, 64 lowercase hex digits
-    std::string renderer = "cpu"; ///< the renderer the session was recorded with: "cpu" or "gpu"
-    CurvatureOptions curvature;   ///< the session's curvature options (fishbone scans)
+    std::string meshSha256;           ///< SHA-256 of the mesh file's bytes, 64 lowercase hex digits
+    std::string renderer = "cpu";     ///< the renderer the session was recorded with: "cpu" or "gpu"
+    CurvatureOptions curvature;       ///< the session's curvature options (fishbone scans)
     std::vector<SessionEvent> events; ///< the event log (Session::events())
     /// The file this was loaded from (for messages); empty when made in memory.
     std::filesystem::path source;
@@ -78,7 +82,8 @@ struct SessionFile {
 /// \throw IoError when the mesh file cannot be read; InvalidInputError when \p renderer is not "cpu" or
 ///        "gpu" or a step cannot be stored (a streamline region mask).
 SessionFile sessionFileFromSession(const Session& session, const std::filesystem::path& meshPath,
-                                   const std::string& renderer = "cpu", const CurvatureOptions& curvature = {});
+                                   const std::string& renderer = "cpu",
+                                   const CurvatureOptions& curvature = {});
 
 /// The JSON text of \p file (see the file comment), ending with a newline. The mesh path is written as
 /// given (use saveSessionFile to make it relative to the session file).
@@ -105,7 +110,8 @@ struct SessionFileLoadOptions {
 /// and column), a wrong format or version, missing, unknown or mistyped fields, values out of range, an
 /// inconsistent event log, a missing mesh file, or a mesh whose SHA-256 differs from the recorded one.
 SessionFile sessionFileFromJson(const std::string& text, const std::string& name,
-                                const std::filesystem::path& baseDir, const SessionFileLoadOptions& options = {});
+                                const std::filesystem::path& baseDir,
+                                const SessionFileLoadOptions& options = {});
 
 /// Reads and validates the session file \p path (as sessionFileFromJson, named by \p path as given and
 /// resolving the mesh path against its folder). \throw IoError as sessionFileFromJson, or when the file
@@ -115,11 +121,11 @@ SessionFile loadSessionFile(const std::filesystem::path& path, const SessionFile
 /// What replaying one event took.
 struct ReplayedEvent {
     SessionEvent::Kind kind = SessionEvent::Kind::Accept;
-    bool fishbone = false;         ///< an accepted fishbone scan
-    double scanSeconds = 0;        ///< Session::scan (accepted scans)
-    double stitchSeconds = 0;      ///< Session::accept (accepted scans)
-    double seconds = 0;            ///< the whole event
-    std::size_t patchFaces = 0;    ///< faces of the scan's patch (accepted scans)
+    bool fishbone = false;              ///< an accepted fishbone scan
+    double scanSeconds = 0;             ///< Session::scan (accepted scans)
+    double stitchSeconds = 0;           ///< Session::accept (accepted scans)
+    double seconds = 0;                 ///< the whole event
+    std::size_t patchFaces = 0;         ///< faces of the scan's patch (accepted scans)
     std::optional<StitchReport> stitch; ///< the stitch report (accepted scans)
 };
 

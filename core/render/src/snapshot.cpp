@@ -23,7 +23,9 @@
 namespace fss::render {
 namespace {
 
-Eigen::Vector3d toEigen(const Point3& p) { return {p.x(), p.y(), p.z()}; }
+Eigen::Vector3d toEigen(const Point3& p) {
+    return {p.x(), p.y(), p.z()};
+}
 
 double cornerAngleDeg(const Eigen::Vector3d& at, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
     const Eigen::Vector3d u = a - at, v = b - at;
@@ -34,7 +36,9 @@ double cornerAngleDeg(const Eigen::Vector3d& at, const Eigen::Vector3d& a, const
 
 Rgb mix(const Rgb& a, const Rgb& b, double t) {
     Rgb c;
-    for (int i = 0; i < 3; ++i) c[std::size_t(i)] = std::uint8_t(std::lround(a[std::size_t(i)] + t * (b[std::size_t(i)] - a[std::size_t(i)])));
+    for (int i = 0; i < 3; ++i)
+        c[std::size_t(i)] =
+            std::uint8_t(std::lround(a[std::size_t(i)] + t * (b[std::size_t(i)] - a[std::size_t(i)])));
     return c;
 }
 
@@ -111,13 +115,16 @@ Image shadeFaces(const Mesh& mesh, const FrameBuffers& buffers, const std::vecto
             }
             const double cosine = std::abs(normal[id].dot(camera.ray(x + 0.5, y + 0.5).direction));
             double factor = ambient + (1 - ambient) * cosine;
-            const bool border = (x + 1 < w && buffers.faceId[i + 1] != id && buffers.faceId[i + 1] != FrameBuffers::kNoFace) ||
+            const bool border = (x + 1 < w && buffers.faceId[i + 1] != id &&
+                                 buffers.faceId[i + 1] != FrameBuffers::kNoFace) ||
                                 (y + 1 < h && buffers.faceId[i + std::size_t(w)] != id &&
                                  buffers.faceId[i + std::size_t(w)] != FrameBuffers::kNoFace);
             if (border) factor *= outline;
             const Rgb& c = faceColors[id];
-            for (int k = 0; k < 3; ++k) out[k] = std::uint8_t(std::lround(std::clamp(c[std::size_t(k)] * factor, 0.0, 255.0)));
-            if (out[0] == options.background[0] && out[1] == options.background[1] && out[2] == options.background[2])
+            for (int k = 0; k < 3; ++k)
+                out[k] = std::uint8_t(std::lround(std::clamp(c[std::size_t(k)] * factor, 0.0, 255.0)));
+            if (out[0] == options.background[0] && out[1] == options.background[1] &&
+                out[2] == options.background[2])
                 out[0] = std::uint8_t(out[0] == 0 ? 1 : out[0] - 1);
         }
     return image;
@@ -161,13 +168,15 @@ void writePng(const Image& image, const std::filesystem::path& path) {
     if (image.width <= 0 || image.height <= 0)
         throw InvalidInputError("The image to write to " + path.string() + " is empty.");
     if (image.rgb.size() != std::size_t(image.width) * std::size_t(image.height) * 3)
-        throw InvalidInputError("The image to write to " + path.string() + " has " + std::to_string(image.rgb.size()) +
-                                " bytes, not 3 per pixel.");
+        throw InvalidInputError("The image to write to " + path.string() + " has " +
+                                std::to_string(image.rgb.size()) + " bytes, not 3 per pixel.");
     const std::filesystem::path tmp = path.string() + ".tmp" + std::to_string(::getpid()) + ".png";
     {
         // VTK reports a failed open only through its error log: find out here, with a clear sentence.
         std::ofstream probe(tmp, std::ios::binary | std::ios::trunc);
-        if (!probe) throw IoError("The picture " + path.string() + " cannot be written (cannot create a file there).");
+        if (!probe)
+            throw IoError("The picture " + path.string() +
+                          " cannot be written (cannot create a file there).");
     }
     vtkNew<vtkImageData> data;
     data->SetDimensions(image.width, image.height, 1);
@@ -194,17 +203,19 @@ void writePng(const Image& image, const std::filesystem::path& path) {
 
 Image readPng(const std::filesystem::path& path) {
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) throw IoError("The picture " + path.string() + " does not exist.");
+    if (!std::filesystem::is_regular_file(path, ec))
+        throw IoError("The picture " + path.string() + " does not exist.");
     vtkNew<vtkPNGReader> reader;
-    if (reader->CanReadFile(path.c_str()) == 0) throw IoError("The file " + path.string() + " is not a PNG picture.");
+    if (reader->CanReadFile(path.c_str()) == 0)
+        throw IoError("The file " + path.string() + " is not a PNG picture.");
     reader->SetFileName(path.c_str());
     reader->Update();
     vtkImageData* data = reader->GetOutput();
     int dims[3] = {0, 0, 0};
     data->GetDimensions(dims);
     const int components = data->GetNumberOfScalarComponents();
-    if (reader->GetErrorCode() != 0 || dims[0] <= 0 || dims[1] <= 0 || data->GetScalarType() != VTK_UNSIGNED_CHAR ||
-        components < 1 || components > 4)
+    if (reader->GetErrorCode() != 0 || dims[0] <= 0 || dims[1] <= 0 ||
+        data->GetScalarType() != VTK_UNSIGNED_CHAR || components < 1 || components > 4)
         throw IoError("The picture " + path.string() + " is not a readable 8-bit PNG.");
     Image image;
     image.width = dims[0];
@@ -213,11 +224,14 @@ Image readPng(const std::filesystem::path& path) {
     const auto* src = static_cast<const std::uint8_t*>(data->GetScalarPointer());
     for (int y = 0; y < image.height; ++y)
         for (int x = 0; x < image.width; ++x) {
-            const std::uint8_t* s = src + (std::size_t(image.height - 1 - y) * std::size_t(image.width) + std::size_t(x)) *
-                                              std::size_t(components);
+            const std::uint8_t* s =
+                src + (std::size_t(image.height - 1 - y) * std::size_t(image.width) + std::size_t(x)) *
+                          std::size_t(components);
             std::uint8_t* d = &image.rgb[3 * (std::size_t(y) * std::size_t(image.width) + std::size_t(x))];
-            if (components <= 2) d[0] = d[1] = d[2] = s[0];
-            else std::copy_n(s, 3, d);
+            if (components <= 2)
+                d[0] = d[1] = d[2] = s[0];
+            else
+                std::copy_n(s, 3, d);
         }
     return image;
 }
