@@ -83,6 +83,12 @@ void setSampleOnSurface(Sample& sample, const Mesh& reference, const Camera& cam
               cosOfLimit(options.qualityAngleLimitDeg));
 }
 
+void setSampleOnSurface(Sample& sample, const Mesh& reference, const CameraProjector& camera, FaceIndex face,
+                        const Eigen::Vector3d& point, const ScanOptions& options) {
+    setSample(sample, camera, face, faceGeometry(reference, face), point,
+              cosOfLimit(options.qualityAngleLimitDeg));
+}
+
 SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& reference,
                              const ScanOptions& options, const Progress& progress) {
     const Camera& camera = referenceBuffers.camera;

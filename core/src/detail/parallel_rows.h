@@ -47,3 +47,20 @@ template <class Body> void parallelRows(int n, int blocks, Body&& body) {
 }
 
 } // namespace fss::detail
+
+namespace fss::detail {
+
+/// Calls body(i) for every i in [0, n) on up to fss::scanThreads() threads (at most one per
+/// \p minPerThread items), thread t taking items t, t + T, t + 2T, … (interleaved, so items of uneven
+/// cost — streamlines of different lengths — spread evenly). Waits for all; rethrows the exception of the
+/// lowest-numbered thread that threw. Deterministic when body(i) writes only the outputs of item i.
+template <class Body> void parallelItems(std::size_t n, std::size_t minPerThread, Body&& body) {
+    const std::size_t byWork = std::max<std::size_t>(1, n / std::max<std::size_t>(1, minPerThread));
+    const int threads = int(std::min<std::size_t>(std::size_t(scanThreads()), byWork));
+    parallelRows(threads, threads, [&](int t, int, int) {
+        for (std::size_t i = std::size_t(t); i < n; i += std::size_t(threads))
+            body(i);
+    });
+}
+
+} // namespace fss::detail
