@@ -10,6 +10,7 @@
 // measured once before the loop and reported as curvature_ms / aabb_ms, not in fishbone_ms.
 #include "fss/fishbone_scan.h"
 #include "fss/mesh_io.h"
+#include "fss/parallel.h"
 #include "fss/render/gpu_mesh_renderer.h"
 #include "fss/scan_pipeline.h"
 #include "fss/shapes.h"
@@ -18,13 +19,16 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <memory>
 #include <string>
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+double msSince(Clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
 
 struct Scene {
     fss::Mesh mesh;
@@ -34,7 +38,8 @@ struct Scene {
 
 Eigen::AlignedBox3d bbox(const fss::Mesh& m) {
     Eigen::AlignedBox3d b;
-    for (auto v : m.vertices()) b.extend(Eigen::Vector3d(m.point(v).x(), m.point(v).y(), m.point(v).z()));
+    for (auto v : m.vertices())
+        b.extend(Eigen::Vector3d(m.point(v).x(), m.point(v).y(), m.point(v).z()));
     return b;
 }
 
@@ -47,7 +52,8 @@ Scene makeScene(int which) {
     } else {
         s.mesh = fss::shapes::torus(250, 200, 1.0, 0.35);
         s.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(s.mesh), 512, 512);
-        const Eigen::Vector3d p = 1.35 * Eigen::Vector3d(1, 1, 0).normalized(); // outer equator, facing the eye
+        const Eigen::Vector3d p =
+            1.35 * Eigen::Vector3d(1, 1, 0).normalized(); // outer equator, facing the eye
         const Eigen::Vector3d q = s.camera.project(p);
         s.seed = {q.x(), q.y()};
     }
@@ -71,21 +77,24 @@ void BM_FishboneVsRegular(benchmark::State& state) {
     fss::FishboneParams fb;
     fb.seed = scene.seed;
     fb.spacing = 2.0;
-    const fss::FishboneScanResult probe = fss::scanFishbonePatch(scene.mesh, renderer, scene.mesh, renderer, fishParams, fb, cache);
+    const fss::FishboneScanResult probe =
+        fss::scanFishbonePatch(scene.mesh, renderer, scene.mesh, renderer, fishParams, fb, cache);
     const std::size_t fishSamples = probe.counts.covered;
 
     // Calibrate the regular scan's resolution to the same number of samples.
     fss::ScanParams regParams;
     regParams.camera = scene.camera;
     const fss::ScanResult full = fss::scanPatch(scene.mesh, renderer, scene.mesh, renderer, regParams);
-    const int res = std::max(8, int(std::lround(512.0 * std::sqrt(double(fishSamples) / double(full.counts.covered)))));
+    const int res =
+        std::max(8, int(std::lround(512.0 * std::sqrt(double(fishSamples) / double(full.counts.covered)))));
     regParams.camera.width = regParams.camera.height = res;
 
     double fishMs = 0, regMs = 0, dirMs = 0, traceMs = 0, castMs = 0, renderMs = 0, maskMs = 0, triMs = 0;
     std::size_t regSamples = 0;
     for (auto _ : state) {
         t = Clock::now();
-        const fss::FishboneScanResult f = fss::scanFishbonePatch(scene.mesh, renderer, scene.mesh, renderer, fishParams, fb, cache);
+        const fss::FishboneScanResult f =
+            fss::scanFishbonePatch(scene.mesh, renderer, scene.mesh, renderer, fishParams, fb, cache);
         fishMs += msSince(t);
         t = Clock::now();
         const fss::ScanResult r = fss::scanPatch(scene.mesh, renderer, scene.mesh, renderer, regParams);
@@ -115,10 +124,17 @@ void BM_FishboneVsRegular(benchmark::State& state) {
     state.counters["f_tri_ms"] = triMs / n;
     state.counters["curvature_ms"] = curvatureMs;
     state.counters["aabb_ms"] = aabbMs;
+    state.counters["threads"] = fss::scanThreads();
     state.SetLabel(state.range(0) == 0 ? "fandisk" : "torus 100k");
 }
 
 } // namespace
+
+// FSS_SCAN_THREADS=N sets fss::setScanThreads(N) before the benchmarks run (both scans use it).
+const bool threadsFromEnvironment = [] {
+    if (const char* v = std::getenv("FSS_SCAN_THREADS")) fss::setScanThreads(std::atoi(v));
+    return true;
+}();
 
 BENCHMARK(BM_FishboneVsRegular)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(10);
 

@@ -2,10 +2,14 @@
 // read-back (Rasterizer statistics) against our CPU stages (unprojection into the SampleGrid, lasso,
 // quality mask against the current mesh, erosion + dilation, grid triangulation). The paper claims the
 // sampling adds "only few overhead" to the render: target CPU stages ≤ 30 % of render + read-back.
-// Counters: render_ms, read_ms, sample_ms, lasso_ms, quality_ms, morph_ms, triangulate_ms, cpu_ms and
-// cpu_over_gpu = cpu_ms / (render_ms + read_ms).
+// Counters: render_ms, read_ms, sample_ms, lasso_ms, quality_ms, morph_ms, triangulate_ms (wall clock),
+// cpu_ms = their sum and cpu_over_gpu = cpu_ms / (render_ms + read_ms), the ratio; threads = the
+// threads our stages use (fss::scanThreads(); set FSS_SCAN_THREADS=1 for the serial figures) and
+// cpu_work_ms = the CPU time all threads of the process spent in our stages (unlike the wall-clock
+// figures, it hardly changes when other processes compete for the cores).
 #include "fss/camera.h"
 #include "fss/mask.h"
+#include "fss/parallel.h"
 #include "fss/render/rasterizer.h"
 #include "fss/scan.h"
 #include "fss/shapes.h"
@@ -14,13 +18,24 @@
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <cstdlib>
+#include <ctime>
 #include <map>
 #include <memory>
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+double msSince(Clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+// CPU time of all threads of the process, milliseconds.
+double processCpuMs() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
 
 struct Scene {
     fss::Mesh mesh;
@@ -52,13 +67,15 @@ void BM_ScanStages(benchmark::State& state) {
     const int faces = int(state.range(0)), res = int(state.range(1));
     Scene& scene = sceneWith(faces);
     const fss::Camera camera = fss::Camera::standardView(fss::StandardView::Iso, scene.box, res, res);
-    const fss::Lasso lasso{{{0.1 * res, 0.1 * res}, {0.9 * res, 0.15 * res}, {0.8 * res, 0.9 * res}, {0.15 * res, 0.8 * res}}};
-    double render = 0, read = 0, sample = 0, lassoMs = 0, quality = 0, morph = 0, tri = 0;
+    const fss::Lasso lasso{
+        {{0.1 * res, 0.1 * res}, {0.9 * res, 0.15 * res}, {0.8 * res, 0.9 * res}, {0.15 * res, 0.8 * res}}};
+    double render = 0, read = 0, sample = 0, lassoMs = 0, quality = 0, morph = 0, tri = 0, work = 0;
     std::size_t patchFaces = 0;
     for (auto _ : state) {
         const fss::FrameBuffers buffers = scene.rasterizer.render(camera);
         render += scene.rasterizer.lastStats().renderSeconds * 1e3;
         read += scene.rasterizer.lastStats().readSeconds * 1e3;
+        const double cpu0 = processCpuMs();
         auto t = Clock::now();
         fss::SampleGrid grid = fss::sampleRegularGrid(buffers, scene.mesh);
         sample += msSince(t);
@@ -76,6 +93,7 @@ void BM_ScanStages(benchmark::State& state) {
         t = Clock::now();
         const fss::Patch patch = fss::triangulateGrid(grid);
         tri += msSince(t);
+        work += processCpuMs() - cpu0;
         patchFaces = patch.mesh.number_of_faces();
         benchmark::DoNotOptimize(patchFaces);
     }
@@ -91,9 +109,17 @@ void BM_ScanStages(benchmark::State& state) {
     state.counters["cpu_ms"] = cpu;
     state.counters["cpu_over_gpu"] = cpu / ((render + read) / n);
     state.counters["patch_faces"] = double(patchFaces);
+    state.counters["threads"] = fss::scanThreads();
+    state.counters["cpu_work_ms"] = work / n;
 }
 
 } // namespace
+
+// FSS_SCAN_THREADS=N sets fss::setScanThreads(N) before the benchmarks run.
+const bool threadsFromEnvironment = [] {
+    if (const char* v = std::getenv("FSS_SCAN_THREADS")) fss::setScanThreads(std::atoi(v));
+    return true;
+}();
 
 BENCHMARK(BM_ScanStages)
     ->ArgsProduct({{100000, 1000000}, {256, 512, 1024}})

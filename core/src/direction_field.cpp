@@ -2,6 +2,8 @@
 
 #include "fss/error.h"
 
+#include "detail/parallel_rows.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -98,22 +100,28 @@ std::optional<DirectionSample> DirectionField::sample(const Eigen::Vector2d& pos
     const double gx = pos.x() - 0.5, gy = pos.y() - 0.5;
     const int x0 = int(std::floor(gx)), y0 = int(std::floor(gy));
     const double fx = gx - x0, fy = gy - y0;
-    const Eigen::Vector2d unitReference = reference.normalized();
+    // The unit reference is needed only where a low-anisotropy neighbour is bent towards it.
+    std::optional<Eigen::Vector2d> unitReference;
+    auto unitRef = [&]() -> const Eigen::Vector2d& {
+        if (!unitReference) unitReference = reference.normalized();
+        return *unitReference;
+    };
+    const bool interior = x0 >= 0 && y0 >= 0 && x0 + 1 < width && y0 + 1 < height;
     Eigen::Vector2d dir = Eigen::Vector2d::Zero();
     double aniso = 0, weight = 0;
     for (int j = 0; j < 2; ++j)
         for (int i = 0; i < 2; ++i) {
             const int x = x0 + i, y = y0 + j;
-            if (!isValid(x, y)) continue;
+            const std::size_t k = std::size_t(y) * std::size_t(width) + std::size_t(x);
+            if (!(interior ? valid[k] != 0 : isValid(x, y))) continue;
             const double w = (i ? fx : 1 - fx) * (j ? fy : 1 - fy);
             if (w <= 0) continue;
-            const std::size_t k = index(x, y);
             const double a = double(anisotropy[k]);
             Eigen::Vector2d d =
                 direction[k].dot(reference) < 0 ? Eigen::Vector2d(-direction[k]) : direction[k];
             if (straightBelow > 0 && a < 2 * straightBelow) {
                 const double f = std::clamp((a - straightBelow) / straightBelow, 0.0, 1.0);
-                d = f * d + (1 - f) * unitReference;
+                d = f * d + (1 - f) * unitRef();
             }
             // Well-defined directions dominate ill-defined ones; the floor keeps an all-isotropic
             // neighbourhood (a plane, anisotropy 0) a plain bilinear average.
@@ -125,7 +133,7 @@ std::optional<DirectionSample> DirectionField::sample(const Eigen::Vector2d& pos
         // pos sits exactly on the containing pixel's far edge with zero weight everywhere else.
         const std::size_t k = index(cx, cy);
         if (straightBelow > 0 && double(anisotropy[k]) < straightBelow)
-            return DirectionSample{unitReference, double(anisotropy[k])};
+            return DirectionSample{unitRef(), double(anisotropy[k])};
         const Eigen::Vector2d& d = direction[k];
         return DirectionSample{d.dot(reference) < 0 ? Eigen::Vector2d(-d) : d, double(anisotropy[k])};
     }
@@ -156,84 +164,93 @@ void fillDirectionFields(const Mesh& mesh, const CurvatureField& curvature, cons
     if (minField) *minField = DirectionField(camera.width, camera.height);
     if (maxField) *maxField = DirectionField(camera.width, camera.height);
     const Projector projector(camera);
-    for (int y = 0; y < camera.height; ++y)
-        for (int x = 0; x < camera.width; ++x) {
-            const std::uint32_t id = buffers.faceAt(x, y);
-            if (id == FrameBuffers::kNoFace) continue;
-            const FaceIndex f(id);
-            if (std::size_t(id) >= faceSlots || mesh.is_removed(f))
-                throw InvalidInputError("The face id " + std::to_string(id) + " at pixel " + pixelName(x, y) +
-                                        " is not a face of the mesh.");
-            std::array<VertexIndex, 3> v;
-            int nv = 0;
-            for (VertexIndex w : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
-                if (nv == 3) throw InvalidInputError("Face " + std::to_string(id) + " is not a triangle.");
-                v[std::size_t(nv++)] = w;
-            }
-            if (nv != 3) throw InvalidInputError("Face " + std::to_string(id) + " is not a triangle.");
-            const Eigen::Vector3d a = toEigen(mesh.point(v[0])), b = toEigen(mesh.point(v[1])),
-                                  c = toEigen(mesh.point(v[2]));
-            const Eigen::Vector3d n = (b - a).cross(c - a);
-            const double n2 = n.squaredNorm();
-            if (!(n2 > 0)) continue; // degenerate face: no plane, no direction
+    // Rows in blocks, one per thread (parallel.h): every pixel is computed on its own.
+    detail::parallelRows(
+        camera.height, detail::rowBlocks(camera.height, 16), [&](int, int rowBegin, int rowEnd) {
+            for (int y = rowBegin; y < rowEnd; ++y)
+                for (int x = 0; x < camera.width; ++x) {
+                    const std::uint32_t id = buffers.faceAt(x, y);
+                    if (id == FrameBuffers::kNoFace) continue;
+                    const FaceIndex f(id);
+                    if (std::size_t(id) >= faceSlots || mesh.is_removed(f))
+                        throw InvalidInputError("The face id " + std::to_string(id) + " at pixel " +
+                                                pixelName(x, y) + " is not a face of the mesh.");
+                    std::array<VertexIndex, 3> v;
+                    int nv = 0;
+                    for (VertexIndex w : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
+                        if (nv == 3)
+                            throw InvalidInputError("Face " + std::to_string(id) + " is not a triangle.");
+                        v[std::size_t(nv++)] = w;
+                    }
+                    if (nv != 3)
+                        throw InvalidInputError("Face " + std::to_string(id) + " is not a triangle.");
+                    const Eigen::Vector3d a = toEigen(mesh.point(v[0])), b = toEigen(mesh.point(v[1])),
+                                          c = toEigen(mesh.point(v[2]));
+                    const Eigen::Vector3d n = (b - a).cross(c - a);
+                    const double n2 = n.squaredNorm();
+                    if (!(n2 > 0)) continue; // degenerate face: no plane, no direction
 
-            // 3D point under the pixel centre: ray ∩ face plane (double), depth buffer as fallback.
-            const Ray ray = projector.ray(x + 0.5, y + 0.5);
-            const double denom = n.dot(ray.direction);
-            Eigen::Vector3d p;
-            if (std::abs(denom) > 1e-12 * std::sqrt(n2))
-                p = ray.origin + (n.dot(a - ray.origin) / denom) * ray.direction;
-            else
-                p = projector.unproject(x + 0.5, y + 0.5, double(buffers.depthAt(x, y)));
+                    // 3D point under the pixel centre: ray ∩ face plane (double), depth buffer as fallback.
+                    const Ray ray = projector.ray(x + 0.5, y + 0.5);
+                    const double denom = n.dot(ray.direction);
+                    Eigen::Vector3d p;
+                    if (std::abs(denom) > 1e-12 * std::sqrt(n2))
+                        p = ray.origin + (n.dot(a - ray.origin) / denom) * ray.direction;
+                    else
+                        p = projector.unproject(x + 0.5, y + 0.5, double(buffers.depthAt(x, y)));
 
-            // Barycentric coordinates, clamped to the triangle (the pixel centre may lie a hair outside).
-            std::array<double, 3> w = {n.dot((b - p).cross(c - p)) / n2, n.dot((c - p).cross(a - p)) / n2,
-                                       n.dot((a - p).cross(b - p)) / n2};
-            double sum = 0;
-            for (double& wi : w)
-                sum += (wi = std::max(0.0, wi));
-            if (!(sum > 0)) continue;
-            for (double& wi : w)
-                wi /= sum;
-            p = w[0] * a + w[1] * b + w[2] * c;
+                    // Barycentric coordinates, clamped to the triangle (the pixel centre may lie a hair
+                    // outside).
+                    std::array<double, 3> w = {n.dot((b - p).cross(c - p)) / n2,
+                                               n.dot((c - p).cross(a - p)) / n2,
+                                               n.dot((a - p).cross(b - p)) / n2};
+                    double sum = 0;
+                    for (double& wi : w)
+                        sum += (wi = std::max(0.0, wi));
+                    if (!(sum > 0)) continue;
+                    for (double& wi : w)
+                        wi /= sum;
+                    p = w[0] * a + w[1] * b + w[2] * c;
 
-            // Into the tangent plane of the interpolated vertex normal (the smooth surface's plane at p).
-            // The face plane would tilt D by up to half the dihedral angle of the faceting, which the
-            // foreshortening near silhouettes turns into screen errors of degrees.
-            Eigen::Vector3d N = Eigen::Vector3d::Zero();
-            double aniso = 0;
-            for (int k = 0; k < 3; ++k) {
-                N += w[std::size_t(k)] * curvature.normal[v[std::size_t(k)].idx()];
-                if (curvature.isDefined(v[std::size_t(k)]))
-                    aniso += w[std::size_t(k)] * curvature.anisotropy[v[std::size_t(k)].idx()];
-            }
-            if (!(N.norm() > 1e-9)) N = n;
-            N.normalize();
-            const double eps = 1e-3 * projector.pixelFootprint(p);
+                    // Into the tangent plane of the interpolated vertex normal (the smooth surface's plane at
+                    // p). The face plane would tilt D by up to half the dihedral angle of the faceting, which
+                    // the foreshortening near silhouettes turns into screen errors of degrees.
+                    Eigen::Vector3d N = Eigen::Vector3d::Zero();
+                    double aniso = 0;
+                    for (int k = 0; k < 3; ++k) {
+                        N += w[std::size_t(k)] * curvature.normal[v[std::size_t(k)].idx()];
+                        if (curvature.isDefined(v[std::size_t(k)]))
+                            aniso += w[std::size_t(k)] * curvature.anisotropy[v[std::size_t(k)].idx()];
+                    }
+                    if (!(N.norm() > 1e-9)) N = n;
+                    N.normalize();
+                    const double eps = 1e-3 * projector.pixelFootprint(p);
 
-            for (DirectionField* field : {minField, maxField}) {
-                if (!field) continue;
-                const bool useMax = field == maxField;
-                // Line field: align every vertex direction with the first defined one, then blend.
-                Eigen::Vector3d D = Eigen::Vector3d::Zero();
-                const Eigen::Vector3d* first = nullptr;
-                for (int k = 0; k < 3; ++k) {
-                    if (!curvature.isDefined(v[std::size_t(k)])) continue;
-                    const Eigen::Vector3d& d = curvature.direction(v[std::size_t(k)], useMax);
-                    if (!first) first = &d;
-                    D += (d.dot(*first) < 0 ? -w[std::size_t(k)] : w[std::size_t(k)]) * d;
+                    for (DirectionField* field : {minField, maxField}) {
+                        if (!field) continue;
+                        const bool useMax = field == maxField;
+                        // Line field: align every vertex direction with the first defined one, then blend.
+                        Eigen::Vector3d D = Eigen::Vector3d::Zero();
+                        const Eigen::Vector3d* first = nullptr;
+                        for (int k = 0; k < 3; ++k) {
+                            if (!curvature.isDefined(v[std::size_t(k)])) continue;
+                            const Eigen::Vector3d& d = curvature.direction(v[std::size_t(k)], useMax);
+                            if (!first) first = &d;
+                            D += (d.dot(*first) < 0 ? -w[std::size_t(k)] : w[std::size_t(k)]) * d;
+                        }
+                        D -= D.dot(N) * N;
+                        const double coherence = D.norm();
+                        if (!(coherence > 1e-9)) continue;
+                        const Eigen::Vector3d unit = D / coherence;
+                        const Eigen::Vector2d screen =
+                            projector.project(p + eps * unit) - projector.project(p - eps * unit);
+                        // A direction along the viewing ray projects to (almost) nothing: no screen
+                        // direction.
+                        if (!(screen.norm() > 1e-6 * 2e-3)) continue;
+                        field->setPixel(x, y, screen, aniso * std::min(1.0, coherence));
+                    }
                 }
-                D -= D.dot(N) * N;
-                const double coherence = D.norm();
-                if (!(coherence > 1e-9)) continue;
-                const Eigen::Vector3d unit = D / coherence;
-                const Eigen::Vector2d screen =
-                    projector.project(p + eps * unit) - projector.project(p - eps * unit);
-                // A direction along the viewing ray projects to (almost) nothing: no screen direction.
-                if (!(screen.norm() > 1e-6 * 2e-3)) continue;
-                field->setPixel(x, y, screen, aniso * std::min(1.0, coherence));
-            }
-        }
+        });
 }
 
 } // namespace

@@ -2,6 +2,8 @@
 
 #include "fss/error.h"
 
+#include "detail/parallel_rows.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -320,10 +322,10 @@ FishboneGrid automaticFishbone(const DirectionField& backboneField, const Direct
         throw InvalidInputError("The backbone and rib direction fields must have the same size.");
     const Backbone backbone = traceBackbone(backboneField, seed, options);
     requireBackbone(backbone);
-    std::vector<Rib> ribs;
-    ribs.reserve(backbone.samples.size());
-    for (std::size_t r = 0; r < backbone.samples.size(); ++r)
-        ribs.push_back(traceRib(ribField, backbone, r, options));
+    // The ribs are independent streamlines: traced on several threads, each into its own slot (parallel.h).
+    std::vector<Rib> ribs(backbone.samples.size());
+    detail::parallelItems(ribs.size(), 4,
+                          [&](std::size_t r) { ribs[r] = traceRib(ribField, backbone, r, options); });
     return assembleFishboneGrid(backbone, ribs, options.spacing, ribField.width, ribField.height);
 }
 

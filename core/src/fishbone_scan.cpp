@@ -1,11 +1,15 @@
 #include "fss/fishbone_scan.h"
 
+#include "fss/camera_projector.h"
 #include "fss/error.h"
+
+#include "detail/parallel_rows.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <numeric>
 #include <optional>
 #include <string>
 
@@ -14,7 +18,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double secondsSince(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 std::string fmt(double x) {
     char buf[64];
@@ -58,7 +64,8 @@ std::optional<Eigen::Vector3d> hitOnFace(const Mesh& mesh, FaceIndex f, const Ra
     const Eigen::Vector3d a = P(mesh.source(h)), b = P(mesh.target(h)), c = P(mesh.target(mesh.next(h)));
     const Eigen::Vector3d e1 = b - a, e2 = c - a, pv = ray.direction.cross(e2);
     const double det = e1.dot(pv);
-    if (std::abs(det) < 1e-14 * e1.norm() * e2.norm()) return std::nullopt; // ray in the plane: let the caster decide
+    if (std::abs(det) < 1e-14 * e1.norm() * e2.norm())
+        return std::nullopt; // ray in the plane: let the caster decide
     const Eigen::Vector3d tv = ray.origin - a;
     const double u = tv.dot(pv) / det;
     const Eigen::Vector3d qv = tv.cross(e1);
@@ -90,9 +97,13 @@ void FishboneCache::bind(const Mesh& reference) {
     faces_ = reference.number_of_faces();
 }
 
-bool FishboneCache::hasCurvature(const Mesh& reference) const { return holds(reference) && curvature_; }
+bool FishboneCache::hasCurvature(const Mesh& reference) const {
+    return holds(reference) && curvature_;
+}
 
-bool FishboneCache::hasRayCaster(const Mesh& reference) const { return holds(reference) && caster_; }
+bool FishboneCache::hasRayCaster(const Mesh& reference) const {
+    return holds(reference) && caster_;
+}
 
 const CurvatureField& FishboneCache::curvature(const Mesh& reference, const CurvatureOptions& options,
                                                const Progress& progress) {
@@ -148,60 +159,70 @@ SampleGrid rayCastFishbone(const FishboneGrid& fishbone, const FrameBuffers& ref
     grid.camera = camera;
     grid.scanId = options.scanId;
     const RayFactory rays(camera);
+    const CameraProjector projector(camera);
     const std::size_t faceCount = reference.number_of_faces() + reference.number_of_removed_faces();
-    std::size_t local = 0;
-    for (int r = 0; r < fishbone.rows; ++r)
-        for (int c = 0; c < fishbone.cols; ++c) {
-            Sample& s = grid.at(r, c);
-            if (!fishbone.isPresent(r, c)) continue;
-            const Eigen::Vector2d& p = fishbone.at(r, c);
-            s.screen = p;
-            const int px = std::clamp(int(std::floor(p.x())), 0, w - 1);
-            const int py = std::clamp(int(std::floor(p.y())), 0, h - 1);
-            const std::uint32_t id = referenceBuffers.faceAt(px, py);
-            const FaceIndex hint = (id != FrameBuffers::kNoFace && id < faceCount) ? FaceIndex(id) : Mesh::null_face();
-            const Ray ray = rays(p.x(), p.y());
-            if (hint != Mesh::null_face() && !search.verifyUnoccluded) {
-                if (const std::optional<Eigen::Vector3d> q = hitOnFace(reference, hint, ray)) {
-                    ++local;
-                    setSampleOnSurface(s, reference, camera, hint, *q, options);
-                    continue;
-                }
-                // The faces under the 8 neighbouring pixels (the vertex is near its pixel's border, or the
-                // faces are smaller than a pixel): nearest hit among them.
-                std::optional<Eigen::Vector3d> best;
-                FaceIndex bestFace;
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dx = -1; dx <= 1; ++dx) {
-                        const int x = px + dx, y = py + dy;
-                        if ((dx == 0 && dy == 0) || x < 0 || y < 0 || x >= w || y >= h) continue;
-                        const std::uint32_t nid = referenceBuffers.faceAt(x, y);
-                        if (nid == FrameBuffers::kNoFace || nid >= faceCount || nid == id) continue;
-                        if (const auto q = hitOnFace(reference, FaceIndex(nid), ray);
-                            q && (!best || (*q - ray.origin).squaredNorm() < (*best - ray.origin).squaredNorm())) {
-                            best = q;
-                            bestFace = FaceIndex(nid);
-                        }
+    // Rows (ribs) in blocks, one per thread (parallel.h): every rib vertex is cast on its own.
+    const int blocks = detail::rowBlocks(fishbone.rows, 8);
+    std::vector<std::size_t> localHits(static_cast<std::size_t>(blocks), 0);
+    detail::parallelRows(fishbone.rows, blocks, [&](int block, int rowBegin, int rowEnd) {
+        std::size_t& local = localHits[std::size_t(block)];
+        for (int r = rowBegin; r < rowEnd; ++r)
+            for (int c = 0; c < fishbone.cols; ++c) {
+                Sample& s = grid.at(r, c);
+                if (!fishbone.isPresent(r, c)) continue;
+                const Eigen::Vector2d& p = fishbone.at(r, c);
+                s.screen = p;
+                const int px = std::clamp(int(std::floor(p.x())), 0, w - 1);
+                const int py = std::clamp(int(std::floor(p.y())), 0, h - 1);
+                const std::uint32_t id = referenceBuffers.faceAt(px, py);
+                const FaceIndex hint =
+                    (id != FrameBuffers::kNoFace && id < faceCount) ? FaceIndex(id) : Mesh::null_face();
+                const Ray ray = rays(p.x(), p.y());
+                if (hint != Mesh::null_face() && !search.verifyUnoccluded) {
+                    if (const std::optional<Eigen::Vector3d> q = hitOnFace(reference, hint, ray)) {
+                        ++local;
+                        setSampleOnSurface(s, reference, projector, hint, *q, options);
+                        continue;
                     }
-                if (best) {
-                    setSampleOnSurface(s, reference, camera, bestFace, *best, options);
-                    continue;
+                    // The faces under the 8 neighbouring pixels (the vertex is near its pixel's border, or
+                    // the faces are smaller than a pixel): nearest hit among them.
+                    std::optional<Eigen::Vector3d> best;
+                    FaceIndex bestFace;
+                    for (int dy = -1; dy <= 1; ++dy)
+                        for (int dx = -1; dx <= 1; ++dx) {
+                            const int x = px + dx, y = py + dy;
+                            if ((dx == 0 && dy == 0) || x < 0 || y < 0 || x >= w || y >= h) continue;
+                            const std::uint32_t nid = referenceBuffers.faceAt(x, y);
+                            if (nid == FrameBuffers::kNoFace || nid >= faceCount || nid == id) continue;
+                            if (const auto q = hitOnFace(reference, FaceIndex(nid), ray);
+                                q && (!best ||
+                                      (*q - ray.origin).squaredNorm() < (*best - ray.origin).squaredNorm())) {
+                                best = q;
+                                bestFace = FaceIndex(nid);
+                            }
+                        }
+                    if (best) {
+                        setSampleOnSurface(s, reference, projector, bestFace, *best, options);
+                        continue;
+                    }
                 }
+                const SurfacePoint hit = caster.intersect(ray, hint, search);
+                if (!hit) continue;
+                if (hint != Mesh::null_face() && hit.face == hint) ++local;
+                setSampleOnSurface(s, reference, projector, hit.face, hit.point, options);
             }
-            const SurfacePoint hit = caster.intersect(ray, hint, search);
-            if (!hit) continue;
-            if (hint != Mesh::null_face() && hit.face == hint) ++local;
-            setSampleOnSurface(s, reference, camera, hit.face, hit.point, options);
-        }
+    });
+    const std::size_t local = std::accumulate(localHits.begin(), localHits.end(), std::size_t(0));
     if (hintHits) *hintHits = local;
     return grid;
 }
 
 // ---- The scan -------------------------------------------------------------------------------------------
 
-FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& referenceRenderer, const Mesh& current,
-                                     MeshRenderer& currentRenderer, const ScanParams& params,
-                                     const FishboneParams& fb, FishboneCache& cache, const Progress& progress) {
+FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& referenceRenderer,
+                                     const Mesh& current, MeshRenderer& currentRenderer,
+                                     const ScanParams& params, const FishboneParams& fb, FishboneCache& cache,
+                                     const Progress& progress) {
     const auto start = Clock::now();
     params.camera.validate();
     if (params.erodeRadius < 0 || params.dilateRadius < 0)
@@ -210,8 +231,8 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
     const double h = fb.spacing;
     const double maxH = std::min(params.camera.width, params.camera.height) / 4.0;
     if (!std::isfinite(h) || h < 0.5 || h > maxH)
-        throw InvalidInputError("The fishbone spacing h = " + fmt(h) + " pixels is outside [0.5, " + fmt(maxH) +
-                                "] for a " + std::to_string(params.camera.width) + "x" +
+        throw InvalidInputError("The fishbone spacing h = " + fmt(h) + " pixels is outside [0.5, " +
+                                fmt(maxH) + "] for a " + std::to_string(params.camera.width) + "x" +
                                 std::to_string(params.camera.height) + " scan.");
     const bool drawnBackbone = !fb.drawnBackbone.empty();
     if (!drawnBackbone && !fb.seed)
@@ -313,7 +334,8 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
     if (!keyRibMode) {
         std::vector<Rib> ribs;
         ribs.reserve(backbone.samples.size());
-        for (std::size_t r = 0; r < backbone.samples.size(); ++r) ribs.push_back(traceRib(ribField, backbone, r, options));
+        for (std::size_t r = 0; r < backbone.samples.size(); ++r)
+            ribs.push_back(traceRib(ribField, backbone, r, options));
         result.fishbone = assembleFishboneGrid(backbone, ribs, h, W, H);
     } else {
         std::vector<KeyRib> keys;
@@ -359,7 +381,8 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
     t = Clock::now();
     if (params.lasso) applyLasso(result.grid, *params.lasso);
     result.counts.afterLasso = result.grid.admissibleCount();
-    if (result.counts.afterLasso == 0) throw InvalidInputError("The lasso selects no part of the fishbone grid.");
+    if (result.counts.afterLasso == 0)
+        throw InvalidInputError("The lasso selects no part of the fishbone grid.");
     if (!currentIsReference) applyQualityMask(result.grid, current, result.currentBuffers, params.quality);
     result.counts.afterQuality = result.grid.admissibleCount();
     erode(result.grid, params.erodeRadius);
@@ -376,10 +399,12 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
     result.timings.triangulate = secondsSince(t);
     if (result.patch.mesh.number_of_faces() == 0) {
         if (result.counts.afterQuality == 0)
-            throw InvalidInputError("Every sample of this scan is worse than the mesh already there, so nothing "
-                                    "would change (use force-replace to override).");
-        throw InvalidInputError("Nothing is left to triangulate after the masks; enlarge the lasso, reduce the "
-                                "erosion or reduce h.");
+            throw InvalidInputError(
+                "Every sample of this scan is worse than the mesh already there, so nothing "
+                "would change (use force-replace to override).");
+        throw InvalidInputError(
+            "Nothing is left to triangulate after the masks; enlarge the lasso, reduce the "
+            "erosion or reduce h.");
     }
     result.timings.total = secondsSince(start);
     progress.report(1.0, "done");

@@ -3,12 +3,15 @@
 #include "fss/error.h"
 #include "fss/raycast.h"
 
+#include "detail/parallel_rows.h"
+
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <numeric>
 #include <string>
 #include <utility>
 
@@ -172,13 +175,18 @@ bool insideLasso(const Lasso& lasso, const Eigen::Vector2d& p) {
 std::size_t applyLasso(SampleGrid& grid, const Lasso& lasso) {
     validateLasso(lasso);
     const LassoIndex index(lasso);
-    std::size_t dropped = 0;
-    for (Sample& s : grid.samples) {
-        if (!s.admissible || index.inside(s.screen)) continue;
-        s.admissible = s.valid = false;
-        ++dropped;
-    }
-    return dropped;
+    // Rows in blocks, one per thread; each sample is decided on its own (parallel.h).
+    const int blocks = detail::rowBlocks(grid.rows, 16);
+    std::vector<std::size_t> dropped(std::size_t(blocks), 0);
+    detail::parallelRows(grid.rows, blocks, [&](int block, int rowBegin, int rowEnd) {
+        for (std::size_t i = grid.index(rowBegin, 0), end = grid.index(rowEnd, 0); i < end; ++i) {
+            Sample& s = grid.samples[i];
+            if (!s.admissible || index.inside(s.screen)) continue;
+            s.admissible = s.valid = false;
+            ++dropped[std::size_t(block)];
+        }
+    });
+    return std::accumulate(dropped.begin(), dropped.end(), std::size_t(0));
 }
 
 std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameBuffers& currentBuffers,
@@ -205,44 +213,52 @@ std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameB
 
     const auto [qualityMap, hasQuality] = current.property_map<FaceIndex, float>(props::faceQuality);
     const LocalSearchOptions search{.rings = options.searchRings, .verifyUnoccluded = false};
-    std::size_t dropped = 0;
-    FaceIndex cachedHint = Mesh::null_face();
-    std::array<Eigen::Vector3d, 3> hintCorner;
-    for (Sample& s : grid.samples) {
-        if (!s.admissible) continue;
-        const double fx = std::floor(s.screen.x()), fy = std::floor(s.screen.y());
-        if (!(fx >= 0 && fy >= 0 && fx < currentBuffers.width() && fy < currentBuffers.height())) continue;
-        const std::uint32_t id = currentBuffers.faceAt(int(fx), int(fy));
-        if (id == FrameBuffers::kNoFace) continue;
-        const FaceIndex hint(id);
-        if (hint != cachedHint) { // neighbouring samples mostly share the face under their pixels
-            if (std::size_t(id) >= current.num_faces() || current.is_removed(hint))
-                throw InvalidInputError("The current mesh's face-id buffer names face " +
-                                        std::to_string(id) + ", which the current mesh does not have.");
-            const HalfedgeIndex h = current.halfedge(hint);
-            for (const auto& [corner, v] : {std::pair{0, current.source(h)}, std::pair{1, current.target(h)},
-                                            std::pair{2, current.target(current.next(h))}}) {
-                const Point3& p = current.point(v);
-                hintCorner[std::size_t(corner)] = {p.x(), p.y(), p.z()};
+    // Rows in blocks, one per thread; each sample is decided on its own (parallel.h).
+    const int blocks = detail::rowBlocks(grid.rows, 16);
+    std::vector<std::size_t> dropped(std::size_t(blocks), 0);
+    detail::parallelRows(grid.rows, blocks, [&](int block, int rowBegin, int rowEnd) {
+        FaceIndex cachedHint = Mesh::null_face();
+        std::array<Eigen::Vector3d, 3> hintCorner;
+        for (std::size_t i = grid.index(rowBegin, 0), end = grid.index(rowEnd, 0); i < end; ++i) {
+            Sample& s = grid.samples[i];
+            if (!s.admissible) continue;
+            const double fx = std::floor(s.screen.x()), fy = std::floor(s.screen.y());
+            if (!(fx >= 0 && fy >= 0 && fx < currentBuffers.width() && fy < currentBuffers.height()))
+                continue;
+            const std::uint32_t id = currentBuffers.faceAt(int(fx), int(fy));
+            if (id == FrameBuffers::kNoFace) continue;
+            const FaceIndex hint(id);
+            if (hint != cachedHint) { // neighbouring samples mostly share the face under their pixels
+                if (std::size_t(id) >= current.num_faces() || current.is_removed(hint))
+                    throw InvalidInputError("The current mesh's face-id buffer names face " +
+                                            std::to_string(id) + ", which the current mesh does not have.");
+                const HalfedgeIndex h = current.halfedge(hint);
+                for (const auto& [corner, v] :
+                     {std::pair{0, current.source(h)}, std::pair{1, current.target(h)},
+                      std::pair{2, current.target(current.next(h))}}) {
+                    const Point3& p = current.point(v);
+                    hintCorner[std::size_t(corner)] = {p.x(), p.y(), p.z()};
+                }
+                cachedHint = hint;
             }
-            cachedHint = hint;
+            float faceQ = kInputFaceQuality;
+            if (hasQuality) { // without qualities every face has kInputFaceQuality: no need to know which
+                FaceIndex closest = hint;
+                // Fast path: the sample lies on the face under its pixel (up to rounding), as almost always
+                // where the current mesh is the reference; any closer face is closer by less than that.
+                const Eigen::Vector3d q =
+                    closestPointOnTriangle(s.point, hintCorner[0], hintCorner[1], hintCorner[2]);
+                if (!((q - s.point).norm() <= kOnFaceFootprints * double(s.footprint)))
+                    closest = closestPointNear(current, s.point, hint, search).face;
+                faceQ = qualityMap[closest];
+            }
+            if (std::isnan(faceQ)) faceQ = kInputFaceQuality;
+            if (double(s.quality) < (1.0 - options.margin) * double(faceQ)) continue;
+            s.admissible = s.valid = false;
+            ++dropped[std::size_t(block)];
         }
-        float faceQ = kInputFaceQuality;
-        if (hasQuality) { // without qualities every face has kInputFaceQuality: no need to know which
-            FaceIndex closest = hint;
-            // Fast path: the sample lies on the face under its pixel (up to rounding), as almost always
-            // where the current mesh is the reference; any closer face is closer by less than that.
-            const Eigen::Vector3d q = closestPointOnTriangle(s.point, hintCorner[0], hintCorner[1], hintCorner[2]);
-            if (!((q - s.point).norm() <= kOnFaceFootprints * double(s.footprint)))
-                closest = closestPointNear(current, s.point, hint, search).face;
-            faceQ = qualityMap[closest];
-        }
-        if (std::isnan(faceQ)) faceQ = kInputFaceQuality;
-        if (double(s.quality) < (1.0 - options.margin) * double(faceQ)) continue;
-        s.admissible = s.valid = false;
-        ++dropped;
-    }
-    return dropped;
+    });
+    return std::accumulate(dropped.begin(), dropped.end(), std::size_t(0));
 }
 
 namespace {
@@ -253,20 +269,31 @@ struct Flags {
     std::vector<std::uint8_t> valid, admissible;
 };
 
+// Calls body(begin, end) over blocks of the grid's samples (whole rows), one block per thread.
+template <class Body> void forSampleBlocks(const SampleGrid& grid, Body&& body) {
+    detail::parallelRows(grid.rows, detail::rowBlocks(grid.rows, 64), [&](int, int rowBegin, int rowEnd) {
+        body(grid.index(rowBegin, 0), grid.index(rowEnd, 0));
+    });
+}
+
 Flags flagsOf(const SampleGrid& grid) {
     Flags f;
     f.valid.resize(grid.samples.size());
     f.admissible.resize(grid.samples.size());
-    for (std::size_t i = 0; i < grid.samples.size(); ++i) {
-        f.valid[i] = grid.samples[i].valid ? 1 : 0;
-        f.admissible[i] = grid.samples[i].admissible ? 1 : 0;
-    }
+    forSampleBlocks(grid, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+            f.valid[i] = grid.samples[i].valid ? 1 : 0;
+            f.admissible[i] = grid.samples[i].admissible ? 1 : 0;
+        }
+    });
     return f;
 }
 
 void storeValid(SampleGrid& grid, const std::vector<std::uint8_t>& valid) {
-    for (std::size_t i = 0; i < grid.samples.size(); ++i)
-        grid.samples[i].valid = valid[i] != 0;
+    forSampleBlocks(grid, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i)
+            grid.samples[i].valid = valid[i] != 0;
+    });
 }
 
 std::size_t clearAll(std::vector<std::uint8_t>& valid) {
@@ -298,8 +325,8 @@ std::size_t erodeFlags(std::vector<std::uint8_t>& valid, int rows, int cols, int
     return removed;
 }
 
-std::size_t dilateFlags(std::vector<std::uint8_t>& valid, const std::vector<std::uint8_t>& admissible, int rows,
-                        int cols, int radius) {
+std::size_t dilateFlags(std::vector<std::uint8_t>& valid, const std::vector<std::uint8_t>& admissible,
+                        int rows, int cols, int radius) {
     if (radius == 0 || valid.empty()) return 0;
     radius = std::min(radius, std::max(rows, cols)); // larger squares cover the grid all the same
     std::vector<std::uint8_t> rowsAny(valid.size());

@@ -3,7 +3,10 @@
 #include "fss/camera_projector.h"
 #include "fss/error.h"
 
+#include "detail/parallel_rows.h"
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -47,7 +50,8 @@ double cosOfLimit(double qualityAngleLimitDeg) {
 void setSample(Sample& sample, const CameraProjector& camera, FaceIndex face, const FaceGeometry& g,
                const Eigen::Vector3d& point, double cosLimit) {
     const bool degenerate = !(g.normal.squaredNorm() > 0);
-    const double cosAngle = degenerate ? 0.0 : std::clamp(g.normal.dot(towardsViewer(camera, point)), -1.0, 1.0);
+    const double cosAngle =
+        degenerate ? 0.0 : std::clamp(g.normal.dot(towardsViewer(camera, point)), -1.0, 1.0);
     const bool frontFacing = !degenerate && cosAngle > 0;
     sample.point = point;
     sample.face = std::uint32_t(face.idx());
@@ -55,7 +59,8 @@ void setSample(Sample& sample, const CameraProjector& camera, FaceIndex face, co
     sample.samplingAngle = float(degenerate ? std::numbers::pi / 2 : std::acos(cosAngle));
     sample.footprint = float(camera.pixelFootprint(point));
     // sampleQuality of the stored (float) angle, with cos of the limit computed once per grid.
-    sample.quality = float(double(sample.footprint) / std::max(std::cos(double(sample.samplingAngle)), cosLimit));
+    sample.quality =
+        float(double(sample.footprint) / std::max(std::cos(double(sample.samplingAngle)), cosLimit));
     sample.hit = true;
     sample.admissible = frontFacing;
     sample.valid = frontFacing;
@@ -78,6 +83,12 @@ void setSampleOnSurface(Sample& sample, const Mesh& reference, const Camera& cam
               cosOfLimit(options.qualityAngleLimitDeg));
 }
 
+void setSampleOnSurface(Sample& sample, const Mesh& reference, const CameraProjector& camera, FaceIndex face,
+                        const Eigen::Vector3d& point, const ScanOptions& options) {
+    setSample(sample, camera, face, faceGeometry(reference, face), point,
+              cosOfLimit(options.qualityAngleLimitDeg));
+}
+
 SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& reference,
                              const ScanOptions& options, const Progress& progress) {
     const Camera& camera = referenceBuffers.camera;
@@ -91,44 +102,56 @@ SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& r
                                 std::to_string(w) + "x" + std::to_string(h) + " camera.");
     SampleGrid grid(h, w);
     grid.camera = camera;
+    grid.scanId = options.scanId;
     const CameraProjector projector(camera);
     const double cosLimit = cosOfLimit(options.qualityAngleLimitDeg);
-    // Neighbouring pixels mostly show the same face: keep the last face's geometry.
-    FaceIndex cachedFace = Mesh::null_face();
-    FaceGeometry g;
-    grid.scanId = options.scanId;
-    for (int r = 0; r < h; ++r) {
-        progress.report(double(r) / h, "Sampling");
-        for (int c = 0; c < w; ++c) {
-            Sample& s = grid.at(r, c);
-            s.screen = {c + 0.5, r + 0.5};
-            const std::uint32_t id = referenceBuffers.faceAt(c, r);
-            if (id == FrameBuffers::kNoFace) continue;
-            const FaceIndex f(id);
-            if (f != cachedFace) { // checked once per run of pixels showing the same face
-                if (std::size_t(id) >= reference.num_faces() || reference.is_removed(f) ||
-                    reference.degree(f) != 3)
-                    throw InvalidInputError("The face-id buffer names face " + std::to_string(id) +
-                                            ", which is not a triangle of the reference mesh: the buffers "
-                                            "were not rendered from this mesh.");
-                g = faceGeometry(reference, f);
-                cachedFace = f;
+    // Rows in contiguous blocks, one per thread (parallel.h); every sample depends only on its pixel, so
+    // the grid is the same for any number of blocks. Block 0 runs on this thread and reports progress.
+    std::atomic<bool> stop{false};
+    const int blocks = detail::rowBlocks(h, 16);
+    detail::parallelRows(h, blocks, [&](int block, int rowBegin, int rowEnd) {
+        // Neighbouring pixels mostly show the same face: keep the last face's geometry.
+        FaceIndex cachedFace = Mesh::null_face();
+        FaceGeometry g;
+        try {
+            for (int r = rowBegin; r < rowEnd && !stop.load(std::memory_order_relaxed); ++r) {
+                if (block == 0) progress.report(double(r - rowBegin) / double(rowEnd - rowBegin), "Sampling");
+                for (int c = 0; c < w; ++c) {
+                    Sample& s = grid.at(r, c);
+                    s.screen = {c + 0.5, r + 0.5};
+                    const std::uint32_t id = referenceBuffers.faceAt(c, r);
+                    if (id == FrameBuffers::kNoFace) continue;
+                    const FaceIndex f(id);
+                    if (f != cachedFace) { // checked once per run of pixels showing the same face
+                        if (std::size_t(id) >= reference.num_faces() || reference.is_removed(f) ||
+                            reference.degree(f) != 3)
+                            throw InvalidInputError("The face-id buffer names face " + std::to_string(id) +
+                                                    ", which is not a triangle of the reference mesh: the "
+                                                    "buffers were not rendered from this mesh.");
+                        g = faceGeometry(reference, f);
+                        cachedFace = f;
+                    }
+                    const Eigen::Vector3d unprojected =
+                        projector.unprojectPixelCentre(c, r, referenceBuffers.depthAt(c, r));
+                    // Snap along the viewing ray onto the face's plane (removes depth quantisation).
+                    Eigen::Vector3d point = unprojected;
+                    const Ray ray = projector.ray(s.screen.x(), s.screen.y());
+                    const double denom = g.normal.dot(ray.direction);
+                    if (g.normal.squaredNorm() > 0 && std::abs(denom) > 1e-12) {
+                        const Eigen::Vector3d snapped =
+                            ray.origin + (g.normal.dot(g.a - ray.origin) / denom) * ray.direction;
+                        const double limit =
+                            options.maxSnapFootprints * projector.pixelFootprint(unprojected);
+                        if (snapped.allFinite() && (snapped - unprojected).norm() <= limit) point = snapped;
+                    }
+                    setSample(s, projector, f, g, point, cosLimit);
+                }
             }
-            const Eigen::Vector3d unprojected =
-                projector.unprojectPixelCentre(c, r, referenceBuffers.depthAt(c, r));
-            // Snap along the viewing ray onto the face's plane (removes depth quantisation).
-            Eigen::Vector3d point = unprojected;
-            const Ray ray = projector.ray(s.screen.x(), s.screen.y());
-            const double denom = g.normal.dot(ray.direction);
-            if (g.normal.squaredNorm() > 0 && std::abs(denom) > 1e-12) {
-                const Eigen::Vector3d snapped =
-                    ray.origin + (g.normal.dot(g.a - ray.origin) / denom) * ray.direction;
-                const double limit = options.maxSnapFootprints * projector.pixelFootprint(unprojected);
-                if (snapped.allFinite() && (snapped - unprojected).norm() <= limit) point = snapped;
-            }
-            setSample(s, projector, f, g, point, cosLimit);
+        } catch (...) {
+            stop.store(true, std::memory_order_relaxed); // the other blocks stop early; this one rethrows
+            throw;
         }
-    }
+    });
     progress.report(1.0, "Sampling");
     return grid;
 }

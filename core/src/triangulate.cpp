@@ -3,6 +3,8 @@
 #include "fss/error.h"
 #include "fss/scan.h"
 
+#include "detail/parallel_rows.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -50,9 +52,8 @@ struct JudgeLimits {
     double cosMaxAngle; // cos(maxAngle)
 };
 
-Verdict judge(const SampleGrid& grid, const Triangle& t, CGAL::Orientation gridOrientation, const Viewer& viewer,
-              const JudgeLimits& limits) {
-    if (screenOrientation(grid, t) != gridOrientation) return Verdict::Flipped;
+// The 3D tests of a candidate whose screen orientation is already known to be the grid's.
+Verdict judge(const SampleGrid& grid, const Triangle& t, const Viewer& viewer, const JudgeLimits& limits) {
     const Sample& a = grid.samples[t[0]];
     const Sample& b = grid.samples[t[1]];
     const Sample& c = grid.samples[t[2]];
@@ -178,121 +179,174 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
     patch.vertexOfSample.assign(grid.samples.size(), Mesh::null_vertex());
     TriangulateReport& report = patch.report;
 
+    // Usable samples as one byte each: every sample is a corner of up to four quads.
+    const std::size_t sampleCount = grid.samples.size();
+    std::vector<std::uint8_t> usableSample(sampleCount);
+    detail::parallelRows(grid.rows, detail::rowBlocks(grid.rows, 64), [&](int, int rowBegin, int rowEnd) {
+        for (std::size_t i = grid.index(rowBegin, 0), e = grid.index(rowEnd, 0); i < e; ++i)
+            usableSample[i] = usable(grid.samples[i]) ? 1 : 0;
+    });
+
     // Candidates: both triangles of every quad with four usable corners, split along (r,c)–(r+1,c+1),
-    // in the vertex order that is counter-clockwise on the screen for a regular grid.
-    std::vector<Triangle> candidates;
-    std::size_t rightTurns = 0, leftTurns = 0;
-    for (int r = 0; r + 1 < grid.rows; ++r) {
-        for (int c = 0; c + 1 < grid.cols; ++c) {
-            const auto i00 = std::uint32_t(grid.index(r, c)), i01 = std::uint32_t(grid.index(r, c + 1)),
-                       i10 = std::uint32_t(grid.index(r + 1, c)),
-                       i11 = std::uint32_t(grid.index(r + 1, c + 1));
-            if (!usable(grid.samples[i00]) || !usable(grid.samples[i01]) || !usable(grid.samples[i10]) ||
-                !usable(grid.samples[i11]))
-                continue;
-            ++report.quads;
-            for (const Triangle& t : {Triangle{i00, i10, i11}, Triangle{i00, i11, i01}}) {
-                candidates.push_back(t);
-                const CGAL::Orientation o = screenOrientation(grid, t);
-                rightTurns += (o == CGAL::RIGHT_TURN);
-                leftTurns += (o == CGAL::LEFT_TURN);
+    // in the vertex order that is counter-clockwise on the screen for a regular grid. Quad rows in
+    // blocks, one per thread (parallel.h); the blocks' candidates are concatenated in row order, so the
+    // result does not depend on the number of blocks.
+    const int quadRows = std::max(grid.rows - 1, 0);
+    const int blocks = detail::rowBlocks(quadRows, 16);
+    struct Block {
+        std::vector<Triangle> candidates;
+        std::vector<CGAL::Orientation> orientation; // of each candidate, as listed
+        std::size_t quads = 0;
+    };
+    std::vector<Block> block(static_cast<std::size_t>(blocks));
+    detail::parallelRows(quadRows, blocks, [&](int b, int rowBegin, int rowEnd) {
+        Block& out = block[std::size_t(b)];
+        for (int r = rowBegin; r < rowEnd; ++r) {
+            const std::uint8_t* top = usableSample.data() + grid.index(r, 0);
+            const std::uint8_t* bottom = usableSample.data() + grid.index(r + 1, 0);
+            for (int c = 0; c + 1 < grid.cols; ++c) {
+                if (!(top[c] & top[c + 1] & bottom[c] & bottom[c + 1])) continue;
+                const auto i00 = std::uint32_t(grid.index(r, c)), i01 = std::uint32_t(grid.index(r, c + 1)),
+                           i10 = std::uint32_t(grid.index(r + 1, c)),
+                           i11 = std::uint32_t(grid.index(r + 1, c + 1));
+                ++out.quads;
+                for (const Triangle& t : {Triangle{i00, i10, i11}, Triangle{i00, i11, i01}}) {
+                    out.candidates.push_back(t);
+                    out.orientation.push_back(screenOrientation(grid, t));
+                }
             }
+        }
+    });
+    std::size_t rightTurns = 0, leftTurns = 0;
+    for (const Block& b : block) {
+        report.quads += b.quads;
+        for (const CGAL::Orientation o : b.orientation) {
+            rightTurns += (o == CGAL::RIGHT_TURN);
+            leftTurns += (o == CGAL::LEFT_TURN);
         }
     }
     // A fishbone grid may be mirrored on the screen: its majority orientation is the grid's, and the
-    // vertex order is reversed so that the faces still face the camera.
+    // vertex order is reversed so that the faces still face the camera (which reverses the exact
+    // orientation too: the grid's orientation is then RIGHT_TURN again).
     const bool mirrored = leftTurns > rightTurns;
-    if (mirrored)
-        for (Triangle& t : candidates)
-            std::swap(t[1], t[2]);
 
-    std::vector<Triangle> triangles;
-    triangles.reserve(candidates.size());
     const Viewer viewer(grid.camera);
     const double maxAngle = options.maxSamplingAngleDeg * std::numbers::pi / 180.0;
     const JudgeLimits limits{options.maxEdgeFootprints, maxAngle, std::cos(maxAngle)};
-    for (const Triangle& t : candidates) {
-        switch (judge(grid, t, CGAL::RIGHT_TURN, viewer, limits)) {
-        case Verdict::Keep:
-            triangles.push_back(t);
-            break;
-        case Verdict::Flipped:
-            ++report.flipped;
-            break;
-        case Verdict::BackFacing:
-            ++report.backFacing;
-            break;
-        case Verdict::LongEdge:
-            ++report.longEdges;
-            break;
-        case Verdict::Grazing:
-            ++report.grazing;
-            break;
+    // Judge each block's candidates in place (kept ones compacted to the front), then concatenate.
+    std::vector<std::array<std::size_t, 5>> verdicts(std::size_t(blocks), std::array<std::size_t, 5>{});
+    detail::parallelRows(blocks, blocks, [&](int b, int, int) {
+        Block& in = block[std::size_t(b)];
+        std::size_t kept = 0;
+        for (std::size_t k = 0; k < in.candidates.size(); ++k) {
+            Triangle t = in.candidates[k];
+            CGAL::Orientation o = in.orientation[k];
+            if (mirrored) std::swap(t[1], t[2]), o = CGAL::Orientation(-int(o));
+            const Verdict v = o != CGAL::RIGHT_TURN ? Verdict::Flipped : judge(grid, t, viewer, limits);
+            ++verdicts[std::size_t(b)][std::size_t(v)];
+            if (v == Verdict::Keep) in.candidates[kept++] = t;
         }
+        in.candidates.resize(kept);
+        in.orientation = {};
+    });
+    std::vector<Triangle> triangles;
+    {
+        std::size_t total = 0;
+        for (const Block& b : block)
+            total += b.candidates.size();
+        triangles.reserve(total);
+        for (Block& b : block) {
+            triangles.insert(triangles.end(), b.candidates.begin(), b.candidates.end());
+            b.candidates = {};
+        }
+    }
+    for (const auto& v : verdicts) {
+        report.flipped += v[std::size_t(Verdict::Flipped)];
+        report.backFacing += v[std::size_t(Verdict::BackFacing)];
+        report.longEdges += v[std::size_t(Verdict::LongEdge)];
+        report.grazing += v[std::size_t(Verdict::Grazing)];
     }
 
     std::vector<bool> alive(triangles.size(), true);
     report.nonManifoldVertices =
         makeVerticesManifold(triangles, alive, grid.samples.size(), report.nonManifoldTriangles);
 
-    Mesh& mesh = patch.mesh;
-    {
-        std::size_t faces = 0;
-        for (bool a : alive)
-            faces += a ? 1 : 0;
-        // Euler: about two faces per vertex and three edges per face pair in a grid patch.
-        mesh.reserve(Mesh::size_type(faces / 2 + 2 * std::size_t(grid.cols + grid.rows) + 4),
-                     Mesh::size_type(faces * 3 / 2 + std::size_t(grid.cols + grid.rows) + 4),
-                     Mesh::size_type(faces));
-    }
-    auto gridIndex = mesh.add_property_map<VertexIndex, GridIndex>(props::vertexGridIndex, GridIndex{}).first;
-    auto quality = mesh.add_property_map<FaceIndex, float>(props::faceQuality, kInputFaceQuality).first;
-    auto scanId = mesh.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1).first;
-    // Vertices in order of first use, as Euler-style add_face would create them.
-    std::vector<std::uint32_t> sampleOf; // sample of each patch vertex
-    for (std::size_t k = 0; k < triangles.size(); ++k) {
-        if (!alive[k]) continue;
-        for (std::uint32_t i : triangles[k]) {
-            VertexIndex& v = patch.vertexOfSample[i];
-            if (v != Mesh::null_vertex()) continue;
-            const Eigen::Vector3d& p = grid.samples[i].point;
-            v = mesh.add_vertex(Point3(p.x(), p.y(), p.z()));
-            gridIndex[v] = {std::int32_t(i / std::size_t(grid.cols)), std::int32_t(i % std::size_t(grid.cols))};
-            sampleOf.push_back(i);
-        }
-    }
-    // The halfedge structure directly (Surface_mesh::add_face searches each new edge around its vertex):
-    // every triangle edge joins two grid neighbours, so an edge is found in O(1) at slot 3·(patch vertex
-    // of its smaller sample) + (horizontal, vertical or diagonal).
+    // The halfedge structure directly (Surface_mesh::add_face searches each new edge around its vertex,
+    // and add_vertex / add_edge / add_face grow every property array one element at a time). Pass 1
+    // numbers vertices in order of first use and edges in order of first use by the faces — the numbering
+    // Euler-style add_face would give — so the mesh can be sized once; pass 2 fills it. Every triangle
+    // edge joins two grid neighbours, so an edge is found in O(1) at slot 3·(patch vertex of its smaller
+    // sample) + (horizontal, vertical or diagonal).
     auto fail = [](std::uint32_t sample) {
         return Error("Internal error: the grid triangulation produced a non-manifold patch at sample " +
                      std::to_string(sample) + ".");
     };
+    constexpr std::uint32_t kNone = std::uint32_t(-1);
+    std::vector<std::uint32_t> vertexOf(sampleCount, kNone); // patch vertex of each sample
+    std::vector<std::uint32_t> sampleOf;                     // sample of each patch vertex
+    std::size_t faceCount = 0;
+    for (std::size_t k = 0; k < triangles.size(); ++k) {
+        if (!alive[k]) continue;
+        ++faceCount;
+        for (std::uint32_t i : triangles[k]) {
+            if (vertexOf[i] != kNone) continue;
+            vertexOf[i] = std::uint32_t(sampleOf.size());
+            sampleOf.push_back(i);
+        }
+    }
     const auto cols = std::uint32_t(grid.cols);
-    std::vector<HalfedgeIndex> edgeSlot(3 * sampleOf.size());
-    auto slotOf = [&](std::uint32_t i, std::uint32_t j) -> HalfedgeIndex& {
+    std::vector<std::uint32_t> edgeSlot(3 * sampleOf.size(), kNone); // edge index per slot
+    auto slotOf = [&](std::uint32_t i, std::uint32_t j) -> std::uint32_t& {
         const std::uint32_t lo = std::min(i, j), d = std::max(i, j) - lo;
         const std::size_t type = d == 1 ? 0 : d == cols ? 1 : d == cols + 1 ? 2 : 3;
         if (type == 3) throw fail(lo); // not grid neighbours: cannot happen for grid triangles
-        return edgeSlot[3 * std::size_t(patch.vertexOfSample[lo].idx()) + type];
+        return edgeSlot[3 * std::size_t(vertexOf[lo]) + type];
     };
+    std::uint32_t edgeCount = 0;
     for (std::size_t k = 0; k < triangles.size(); ++k) {
         if (!alive[k]) continue;
         const Triangle& t = triangles[k];
-        const FaceIndex f = mesh.add_face();
+        for (std::size_t j = 0; j < 3; ++j) {
+            std::uint32_t& slot = slotOf(t[j], t[(j + 1) % 3]);
+            if (slot == kNone) slot = edgeCount++;
+        }
+    }
+
+    Mesh& mesh = patch.mesh;
+    mesh.resize(Mesh::size_type(sampleOf.size()), Mesh::size_type(edgeCount), Mesh::size_type(faceCount));
+    auto gridIndex = mesh.add_property_map<VertexIndex, GridIndex>(props::vertexGridIndex, GridIndex{}).first;
+    auto quality = mesh.add_property_map<FaceIndex, float>(props::faceQuality, kInputFaceQuality).first;
+    auto scanId = mesh.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1).first;
+    for (std::uint32_t v = 0; v < sampleOf.size(); ++v) {
+        const std::uint32_t i = sampleOf[v];
+        const Eigen::Vector3d& p = grid.samples[i].point;
+        const VertexIndex vi(v);
+        mesh.point(vi) = Point3(p.x(), p.y(), p.z());
+        gridIndex[vi] = {std::int32_t(i / std::size_t(grid.cols)), std::int32_t(i % std::size_t(grid.cols))};
+        patch.vertexOfSample[i] = vi;
+    }
+    // An edge's first halfedge (2e) runs the way the first face that used it traverses it; the second
+    // face finds it already made and takes the opposite halfedge, which must run the other way round.
+    std::vector<std::uint8_t> edgeMade(edgeCount, 0);
+    std::uint32_t faceIndex = 0;
+    for (std::size_t k = 0; k < triangles.size(); ++k) {
+        if (!alive[k]) continue;
+        const Triangle& t = triangles[k];
+        const FaceIndex f(faceIndex++);
         std::array<HalfedgeIndex, 3> h;
         for (std::size_t j = 0; j < 3; ++j) {
             const std::uint32_t from = t[j], to = t[(j + 1) % 3];
-            HalfedgeIndex& slot = slotOf(from, to);
-            if (slot == HalfedgeIndex()) {
-                slot = mesh.add_edge();
-                mesh.set_target(slot, patch.vertexOfSample[to]);
-                mesh.set_target(mesh.opposite(slot), patch.vertexOfSample[from]);
-                h[j] = slot;
+            const std::uint32_t e = slotOf(from, to);
+            const HalfedgeIndex first(2 * e);
+            const VertexIndex toVertex(vertexOf[to]);
+            if (!edgeMade[e]) {
+                edgeMade[e] = 1;
+                mesh.set_target(first, toVertex);
+                mesh.set_target(mesh.opposite(first), VertexIndex(vertexOf[from]));
+                h[j] = first;
             } else {
-                h[j] = mesh.opposite(slot); // the other face's halfedge runs to → from
-                if (mesh.target(h[j]) != patch.vertexOfSample[to] || mesh.face(h[j]) != Mesh::null_face())
-                    throw fail(from);
+                h[j] = mesh.opposite(first); // the other face's halfedge runs to → from
+                if (mesh.target(h[j]) != toVertex || mesh.face(h[j]) != Mesh::null_face()) throw fail(from);
             }
         }
         mesh.set_halfedge(f, h[0]);
@@ -308,8 +362,9 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
     // incoming one. Vertex-manifold: at most one border halfedge leaves each vertex.
     std::vector<HalfedgeIndex> borderFrom(sampleOf.size());
     std::vector<HalfedgeIndex> borders;
-    for (const HalfedgeIndex slot : edgeSlot) {
-        if (slot == HalfedgeIndex()) continue;
+    for (const std::uint32_t e : edgeSlot) {
+        if (e == kNone) continue;
+        const HalfedgeIndex slot(2 * e);
         for (const HalfedgeIndex b : {slot, mesh.opposite(slot)}) {
             if (mesh.face(b) != Mesh::null_face()) continue;
             HalfedgeIndex& out = borderFrom[mesh.source(b).idx()];

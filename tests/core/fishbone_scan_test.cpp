@@ -8,6 +8,7 @@
 #include "fss/mesh_io.h"
 #include "fss/raycast.h"
 #include "fss/shapes.h"
+#include "patch_picture.h"
 #include "test_data.h"
 
 #include <CGAL/boost/graph/helpers.h>
@@ -27,13 +28,14 @@
 
 namespace {
 
-using fss::Mesh;
 using Eigen::Vector2d;
 using Eigen::Vector3d;
+using fss::Mesh;
 
 Eigen::AlignedBox3d bbox(const Mesh& m) {
     Eigen::AlignedBox3d b;
-    for (auto v : m.vertices()) b.extend(Vector3d(m.point(v).x(), m.point(v).y(), m.point(v).z()));
+    for (auto v : m.vertices())
+        b.extend(Vector3d(m.point(v).x(), m.point(v).y(), m.point(v).z()));
     return b;
 }
 
@@ -52,7 +54,9 @@ std::string point(const Vector2d& p) {
     return buf;
 }
 
-Vector3d pt(const Mesh& m, fss::VertexIndex v) { return {m.point(v).x(), m.point(v).y(), m.point(v).z()}; }
+Vector3d pt(const Mesh& m, fss::VertexIndex v) {
+    return {m.point(v).x(), m.point(v).y(), m.point(v).z()};
+}
 
 // ---- The creased ring -----------------------------------------------------------------------------------
 // A surface of revolution around z whose cross-section is two circular arcs (radius rho, centres at
@@ -94,18 +98,21 @@ Mesh creasedRing(int nu, int nzHalf, bool alternateDiagonals = true) {
 }
 
 // Distance of a point to the ridge circle.
-double distanceToRidge(const Vector3d& p) { return std::hypot(std::hypot(p.x(), p.y()) - kRidge, p.z()); }
+double distanceToRidge(const Vector3d& p) {
+    return std::hypot(std::hypot(p.x(), p.y()) - kRidge, p.z());
+}
 
 struct PatchError {
-    std::size_t faces = 0;      // faces within 2h of the ridge
-    double meanAngleDeg = 0;    // mean angle between their normals and the closest reference faces' normals
-    double hausdorff = 0;       // two-sided, near the ridge (see below)
+    std::size_t faces = 0;   // faces within 2h of the ridge
+    double meanAngleDeg = 0; // mean angle between their normals and the closest reference faces' normals
+    double hausdorff = 0;    // two-sided, near the ridge (see below)
 };
 
 Vector3d faceNormal(const Mesh& m, fss::FaceIndex f) {
     std::array<Vector3d, 3> p;
     int k = 0;
-    for (auto v : CGAL::vertices_around_face(m.halfedge(f), m)) p[std::size_t(k++)] = pt(m, v);
+    for (auto v : CGAL::vertices_around_face(m.halfedge(f), m))
+        p[std::size_t(k++)] = pt(m, v);
     return (p[1] - p[0]).cross(p[2] - p[0]).normalized();
 }
 
@@ -120,7 +127,8 @@ PatchError measure(const fss::Patch& patch, const fss::RayCaster& reference, dou
     for (auto f : m.faces()) {
         std::array<Vector3d, 3> p;
         int k = 0;
-        for (auto v : CGAL::vertices_around_face(m.halfedge(f), m)) p[std::size_t(k++)] = pt(m, v);
+        for (auto v : CGAL::vertices_around_face(m.halfedge(f), m))
+            p[std::size_t(k++)] = pt(m, v);
         const Vector3d centroid = (p[0] + p[1] + p[2]) / 3;
         if (distanceToRidge(centroid) > 2 * hWorld) continue;
         const fss::SurfacePoint closest = reference.closestPoint(centroid);
@@ -139,120 +147,13 @@ PatchError measure(const fss::Patch& patch, const fss::RayCaster& reference, dou
     for (int i = 0; i < 20000; ++i) {
         const double phi = 2 * std::numbers::pi * i / 20000;
         const Vector3d q(kRidge * std::cos(phi), kRidge * std::sin(phi), 0);
-        if (camera.viewDepth(q) <= 0 || (q - camera.eye).dot(Vector3d(q.x(), q.y(), 0)) > 0) continue; // far side
+        if (camera.viewDepth(q) <= 0 || (q - camera.eye).dot(Vector3d(q.x(), q.y(), 0)) > 0)
+            continue; // far side
         const Vector3d s = camera.project(q);
         if (!inner.contains(Vector2d(s.x(), s.y()))) continue;
         e.hausdorff = std::max(e.hausdorff, patchCaster.closestPoint(q).distance);
     }
     return e;
-}
-
-// ---- A tiny software renderer + PNG writer for the picture -----------------------------------------------
-
-std::uint32_t crc32(const std::uint8_t* data, std::size_t n, std::uint32_t crc = 0) {
-    crc = ~crc;
-    for (std::size_t i = 0; i < n; ++i) {
-        crc ^= data[i];
-        for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
-    }
-    return ~crc;
-}
-
-void put32(std::vector<std::uint8_t>& out, std::uint32_t x) {
-    for (int s = 24; s >= 0; s -= 8) out.push_back(std::uint8_t(x >> s));
-}
-
-void chunk(std::vector<std::uint8_t>& out, const char* type, const std::vector<std::uint8_t>& data) {
-    put32(out, std::uint32_t(data.size()));
-    std::vector<std::uint8_t> body(type, type + 4);
-    body.insert(body.end(), data.begin(), data.end());
-    out.insert(out.end(), body.begin(), body.end());
-    put32(out, crc32(body.data(), body.size()));
-}
-
-// An RGB PNG with "stored" (uncompressed) deflate blocks: no zlib needed.
-void writePng(const std::string& path, int w, int h, const std::vector<std::uint8_t>& rgb) {
-    std::vector<std::uint8_t> raw;
-    for (int y = 0; y < h; ++y) {
-        raw.push_back(0);
-        raw.insert(raw.end(), rgb.begin() + std::ptrdiff_t(y) * w * 3, rgb.begin() + std::ptrdiff_t(y + 1) * w * 3);
-    }
-    std::vector<std::uint8_t> z{0x78, 0x01};
-    for (std::size_t pos = 0; pos < raw.size();) {
-        const std::size_t n = std::min<std::size_t>(65535, raw.size() - pos);
-        z.push_back(pos + n == raw.size() ? 1 : 0);
-        z.push_back(std::uint8_t(n & 0xff));
-        z.push_back(std::uint8_t(n >> 8));
-        z.push_back(std::uint8_t(~n & 0xff));
-        z.push_back(std::uint8_t((~n >> 8) & 0xff));
-        z.insert(z.end(), raw.begin() + std::ptrdiff_t(pos), raw.begin() + std::ptrdiff_t(pos + n));
-        pos += n;
-    }
-    std::uint32_t a = 1, b = 0;
-    for (std::uint8_t c : raw) {
-        a = (a + c) % 65521;
-        b = (b + a) % 65521;
-    }
-    put32(z, (b << 16) | a);
-    std::vector<std::uint8_t> out{0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    std::vector<std::uint8_t> ihdr;
-    put32(ihdr, std::uint32_t(w));
-    put32(ihdr, std::uint32_t(h));
-    ihdr.insert(ihdr.end(), {8, 2, 0, 0, 0});
-    chunk(out, "IHDR", ihdr);
-    chunk(out, "IDAT", z);
-    chunk(out, "IEND", {});
-    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(out.data()), std::streamsize(out.size()));
-}
-
-// Flat-shaded z-buffered rendering of \p mesh with \p camera into the rgb image at x offset \p x0, with
-// the mesh edges darkened (so the grid's alignment with the crease is visible).
-void renderShaded(const Mesh& mesh, const fss::Camera& camera, std::vector<std::uint8_t>& rgb,
-                  std::vector<double>& zbuf, int imageWidth, int x0, const Vector3d& tint) {
-    const Vector3d light = Vector3d(1.0, 0.25, 0.6).normalized();
-    const Eigen::Matrix4d vp = camera.viewProjectionMatrix();
-    auto project = [&](const Vector3d& p) {
-        const Eigen::Vector4d c = vp * Eigen::Vector4d(p.x(), p.y(), p.z(), 1);
-        return Vector3d((c.x() / c.w() + 1) * 0.5 * camera.width, (1 - c.y() / c.w()) * 0.5 * camera.height,
-                        c.z() / c.w());
-    };
-    for (auto f : mesh.faces()) {
-        std::array<Vector3d, 3> p, s;
-        int k = 0;
-        for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
-            p[std::size_t(k)] = pt(mesh, v);
-            s[std::size_t(k)] = project(p[std::size_t(k)]);
-            ++k;
-        }
-        const Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
-        const double shade = 0.15 + 0.85 * std::max(0.0, n.dot(light));
-        const int xmin = std::max(0, int(std::floor(std::min({s[0].x(), s[1].x(), s[2].x()}))));
-        const int xmax = std::min(camera.width - 1, int(std::ceil(std::max({s[0].x(), s[1].x(), s[2].x()}))));
-        const int ymin = std::max(0, int(std::floor(std::min({s[0].y(), s[1].y(), s[2].y()}))));
-        const int ymax = std::min(camera.height - 1, int(std::ceil(std::max({s[0].y(), s[1].y(), s[2].y()}))));
-        const double area = (s[1].x() - s[0].x()) * (s[2].y() - s[0].y()) - (s[2].x() - s[0].x()) * (s[1].y() - s[0].y());
-        if (std::abs(area) < 1e-12) continue;
-        for (int y = ymin; y <= ymax; ++y)
-            for (int x = xmin; x <= xmax; ++x) {
-                const double px = x + 0.5, py = y + 0.5;
-                std::array<double, 3> w;
-                for (int i = 0; i < 3; ++i) {
-                    const Vector3d& a = s[std::size_t((i + 1) % 3)];
-                    const Vector3d& b = s[std::size_t((i + 2) % 3)];
-                    w[std::size_t(i)] = ((b.x() - a.x()) * (py - a.y()) - (px - a.x()) * (b.y() - a.y())) / area;
-                }
-                if (w[0] < 0 || w[1] < 0 || w[2] < 0) continue;
-                const double z = w[0] * s[0].z() + w[1] * s[1].z() + w[2] * s[2].z();
-                const std::size_t idx = std::size_t(y) * std::size_t(imageWidth) + std::size_t(x0 + x);
-                if (z >= zbuf[idx]) continue;
-                zbuf[idx] = z;
-                const bool edge = std::min({w[0], w[1], w[2]}) * std::abs(area) /
-                                      std::max({(s[0] - s[1]).head<2>().norm(), (s[1] - s[2]).head<2>().norm(),
-                                                (s[2] - s[0]).head<2>().norm()}) < 0.5;
-                for (int c = 0; c < 3; ++c)
-                    rgb[idx * 3 + std::size_t(c)] = std::uint8_t(std::clamp(255.0 * shade * tint[c] * (edge ? 0.75 : 1.0), 0.0, 255.0));
-            }
-    }
 }
 
 // ---- The crease scene -----------------------------------------------------------------------------------
@@ -297,7 +198,8 @@ TEST(FishboneScan, AutomaticScanOfTheCreasedRingIsAManifoldPatch) {
     fb.seed = scene.ridgeSeed();
     fb.spacing = 3;
     fss::FishboneCache cache;
-    const fss::FishboneScanResult r = fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+    const fss::FishboneScanResult r =
+        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
     EXPECT_GT(r.counts.rows, 30);
     EXPECT_GT(r.counts.cols, 10);
     EXPECT_GT(r.counts.covered, r.counts.ribVertices * 9 / 10);
@@ -308,9 +210,11 @@ TEST(FishboneScan, AutomaticScanOfTheCreasedRingIsAManifoldPatch) {
     EXPECT_GT(r.timings.rayCasting, 0.0);
     // Every sample lies on the reference surface.
     const fss::RayCaster& caster = cache.rayCaster(scene.ring);
-    for (auto v : r.patch.mesh.vertices()) EXPECT_LT(caster.closestPoint(pt(r.patch.mesh, v)).distance, 1e-9);
+    for (auto v : r.patch.mesh.vertices())
+        EXPECT_LT(caster.closestPoint(pt(r.patch.mesh, v)).distance, 1e-9);
     // The second scan reuses the cached curvature.
-    const fss::FishboneScanResult again = fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+    const fss::FishboneScanResult again =
+        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
     EXPECT_EQ(again.timings.curvature, 0.0);
     EXPECT_EQ(again.patch.mesh.number_of_faces(), r.patch.mesh.number_of_faces());
 
@@ -319,7 +223,8 @@ TEST(FishboneScan, AutomaticScanOfTheCreasedRingIsAManifoldPatch) {
     const Vector2d seed = *fb.seed;
     keys.keyRibs = {r.fishbone.at(r.counts.rows / 4, r.fishbone.backboneColumn),
                     r.fishbone.at(3 * r.counts.rows / 4, r.fishbone.backboneColumn)};
-    const fss::FishboneScanResult k = fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, keys, cache);
+    const fss::FishboneScanResult k =
+        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, keys, cache);
     EXPECT_GT(k.patch.mesh.number_of_faces(), 500u);
     (void)seed;
 }
@@ -332,7 +237,8 @@ TEST(FishboneScan, BadFishbonesGiveOneSentence) {
     params.camera = scene.camera;
     fss::FishboneCache cache;
     auto scan = [&](const fss::FishboneParams& fb) {
-        return messageOf([&] { fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache); });
+        return messageOf(
+            [&] { fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache); });
     };
     fss::FishboneParams fb;
     EXPECT_EQ(scan(fb), "A fishbone scan needs a seed point or a drawn backbone.");
@@ -343,7 +249,8 @@ TEST(FishboneScan, BadFishbonesGiveOneSentence) {
             if (!buffers.covered(x, y)) background = Vector2d(x + 0.5, y + 0.5);
     ASSERT_GE(background.x(), 0);
     fb.seed = background;
-    EXPECT_EQ(scan(fb), "The fishbone seed " + point(background) + " lies on the background; pick a point on the surface.");
+    EXPECT_EQ(scan(fb), "The fishbone seed " + point(background) +
+                            " lies on the background; pick a point on the surface.");
     fb.seed = Vector2d(500, 1);
     EXPECT_EQ(scan(fb), "The fishbone seed (500.0, 1.0) lies outside the 160x160 scan image.");
     fb.seed = scene.ridgeSeed();
@@ -365,9 +272,11 @@ TEST(FishboneScan, BadFishbonesGiveOneSentence) {
     cubeParams.camera = fss::Camera::standardView(fss::StandardView::PosZ, bbox(cube), 160, 160);
     fss::FishboneParams flat;
     flat.seed = Vector2d(80.5, 80.5);
-    EXPECT_EQ(messageOf([&] { fss::scanFishbonePatch(cube, cubeRenderer, cube, cubeRenderer, cubeParams, flat, cache); }),
-              "The fishbone seed (80.5, 80.5) lies on a flat or isotropic region where no principal direction "
-              "is defined; pick a point on a curved feature.");
+    EXPECT_EQ(
+        messageOf(
+            [&] { fss::scanFishbonePatch(cube, cubeRenderer, cube, cubeRenderer, cubeParams, flat, cache); }),
+        "The fishbone seed (80.5, 80.5) lies on a flat or isotropic region where no principal direction "
+        "is defined; pick a point on a curved feature.");
 }
 
 namespace {
@@ -394,7 +303,8 @@ AliasingRun runAliasing(const CreaseScene& scene, const char* name) {
     fss::FishboneParams traced;
     traced.seed = scene.ridgeSeed();
     traced.spacing = 1.0;
-    const fss::FishboneScanResult fish = fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, traced, cache);
+    const fss::FishboneScanResult fish =
+        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, traced, cache);
     // Hand-drawn backbone (the user's alternative to tracing, DESIGN.md §1); ribs traced.
     fss::FishboneParams drawn;
     drawn.spacing = 1.0;
@@ -403,13 +313,15 @@ AliasingRun runAliasing(const CreaseScene& scene, const char* name) {
         const Vector3d q = scene.camera.project(Vector3d(kRidge * std::cos(phi), kRidge * std::sin(phi), 0));
         drawn.drawnBackbone.push_back(q.head<2>());
     }
-    const fss::FishboneScanResult hand = fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, drawn, cache);
+    const fss::FishboneScanResult hand =
+        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, drawn, cache);
 
     const double hWorld = scene.camera.pixelFootprint(Vector3d(kRidge, 0, 0));
     auto drift = [&](const fss::FishboneScanResult& r) {
         double worst = 0;
         for (int row = 0; row < r.grid.rows; ++row)
-            if (const fss::Sample& s = r.grid.at(row, r.fishbone.backboneColumn); s.hit && scene.inner.contains(s.screen))
+            if (const fss::Sample& s = r.grid.at(row, r.fishbone.backboneColumn);
+                s.hit && scene.inner.contains(s.screen))
                 worst = std::max(worst, distanceToRidge(s.point) / hWorld);
         return worst;
     };
@@ -420,11 +332,14 @@ AliasingRun runAliasing(const CreaseScene& scene, const char* name) {
     run.tracedDrift = drift(fish);
     run.drawnDrift = drift(hand);
     auto line = [&](const char* what, const PatchError& e) {
-        std::printf("[ aliasing, %s ] %-16s %4zu faces within 2h: mean normal error %6.3f deg, Hausdorff %.2e "
-                    "(%.3f h)\n", name, what, e.faces, e.meanAngleDeg, e.hausdorff, e.hausdorff / hWorld);
+        std::printf(
+            "[ aliasing, %s ] %-16s %4zu faces within 2h: mean normal error %6.3f deg, Hausdorff %.2e "
+            "(%.3f h)\n",
+            name, what, e.faces, e.meanAngleDeg, e.hausdorff, e.hausdorff / hWorld);
     };
     std::printf("[ aliasing, %s ] h = 1 pixel = %.4f; backbone off the ridge by at most %.3f h (traced), "
-                "%.3f h (drawn)\n", name, hWorld, run.tracedDrift, run.drawnDrift);
+                "%.3f h (drawn)\n",
+                name, hWorld, run.tracedDrift, run.drawnDrift);
     line("pixel grid", run.grid);
     line("traced fishbone", run.traced);
     line("drawn fishbone", run.drawn);
@@ -455,12 +370,14 @@ TEST(FishboneScan, FishboneRemovesTheAliasingOfACurvedCrease) {
     view.zoom(3.0);
     const int W = 2 * view.width;
     std::vector<std::uint8_t> rgb(std::size_t(W) * std::size_t(view.height) * 3, 255);
-    std::vector<double> zbuf(std::size_t(W) * std::size_t(view.height), std::numeric_limits<double>::infinity());
-    renderShaded(run.gridPatch.mesh, view, rgb, zbuf, W, 0, Vector3d(1.0, 0.85, 0.7));
-    renderShaded(run.tracedPatch.mesh, view, rgb, zbuf, W, view.width, Vector3d(0.7, 0.85, 1.0));
+    std::vector<double> zbuf(std::size_t(W) * std::size_t(view.height),
+                             std::numeric_limits<double>::infinity());
+    fss::test::renderShaded(run.gridPatch.mesh, view, rgb, zbuf, W, 0, Vector3d(1.0, 0.85, 0.7));
+    fss::test::renderShaded(run.tracedPatch.mesh, view, rgb, zbuf, W, view.width, Vector3d(0.7, 0.85, 1.0));
     for (int y = 0; y < view.height; ++y)
-        for (int c = 0; c < 3; ++c) rgb[(std::size_t(y) * std::size_t(W) + std::size_t(view.width)) * 3 + std::size_t(c)] = 0;
-    writePng(fss::test::tmpPath("fishbone_vs_grid.png").string(), W, view.height, rgb);
+        for (int c = 0; c < 3; ++c)
+            rgb[(std::size_t(y) * std::size_t(W) + std::size_t(view.width)) * 3 + std::size_t(c)] = 0;
+    fss::test::writePng(fss::test::tmpPath("fishbone_vs_grid.png").string(), W, view.height, rgb);
 }
 
 // One diagonal direction throughout: the jet fits across the sharp ridge tilt the principal directions and

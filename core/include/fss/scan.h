@@ -20,6 +20,7 @@
 /// the same kind of number (an expected edge length in world units) and the quality mask compares them
 /// directly.
 
+#include "fss/camera_projector.h"
 #include "fss/frame_buffers.h"
 #include "fss/mesh.h"
 #include "fss/progress.h"
@@ -58,6 +59,11 @@ float triangleQuality(const Sample& a, const Sample& b, const Sample& c);
 /// reference. The screen position is left as it is. Shared by the regular and the fishbone scan.
 /// \pre \p face is a triangle of \p reference.
 void setSampleOnSurface(Sample& sample, const Mesh& reference, const Camera& camera, FaceIndex face,
+                        const Eigen::Vector3d& point, const ScanOptions& options = {});
+
+/// As setSampleOnSurface above, with the camera's matrices already computed (CameraProjector of the scan
+/// camera): the same result, without inverting the camera's matrix for every sample.
+void setSampleOnSurface(Sample& sample, const Mesh& reference, const CameraProjector& camera, FaceIndex face,
                         const Eigen::Vector3d& point, const ScanOptions& options = {});
 
 /// The regular-grid scan: a SampleGrid of rows = image height, cols = image width, sample (r, c) at the
