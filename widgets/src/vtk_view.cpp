@@ -291,11 +291,16 @@ struct VtkView::Impl {
     vtkMTimeType cameraTime = 0;
 
     void applyColorMap() {
+        vtkProperty* property = actor->GetProperty();
         if (colorMap == ColorMap::None || polyData->GetNumberOfCells() == 0) {
             polyData->GetCellData()->SetScalars(nullptr);
             mapper->ScalarVisibilityOff();
+            property->SetSpecularColor(kSurface[0], kSurface[1], kSurface[2]);
             return;
         }
+        // The face colours replace ambient and diffuse colour; a white highlight keeps them true (a tan
+        // one would tint the neutral grey of input faces in the scan-id map).
+        property->SetSpecularColor(1.0, 1.0, 1.0);
         vtkNew<vtkUnsignedCharArray> colors;
         colors->SetName("face colour");
         colors->SetNumberOfComponents(3);
@@ -427,7 +432,9 @@ VtkView::VtkView(QWidget* parent) : QOpenGLWidget(parent), impl_(std::make_uniqu
     d.actor->VisibilityOff();
     d.renderer->AddActor(d.actor);
 
-    // Ghost: translucent, unlit edges off; pushed back where it coincides with the mesh so the mesh wins.
+    // Ghost: translucent, pushed back where it coincides with the mesh so that the mesh wins. VTK applies
+    // an actor's polygon offset only when its edges are drawn (or globally, which would also offset the
+    // scan renders' depth): the ghost's edges are drawn in its own colour, a faint wireframe.
     d.ghostMapper->ScalarVisibilityOff();
     d.ghostMapper->SetRelativeCoincidentTopologyPolygonOffsetParameters(2, 40);
     d.ghostActor->SetMapper(d.ghostMapper);
@@ -437,7 +444,8 @@ VtkView::VtkView(QWidget* parent) : QOpenGLWidget(parent), impl_(std::make_uniqu
     ghost->SetAmbient(0.3);
     ghost->SetDiffuse(0.7);
     ghost->SetSpecular(0.0);
-    ghost->EdgeVisibilityOff();
+    ghost->EdgeVisibilityOn();
+    ghost->SetEdgeColor(kGhost[0], kGhost[1], kGhost[2]);
     ghost->SetInterpolationToFlat();
     d.ghostActor->VisibilityOff();
     d.ghostActor->PickableOff();
