@@ -46,11 +46,13 @@ Eigen::Vector3d centroid(const fss::Mesh& mesh, fss::FaceIndex f) {
 fss::Mesh selectFaces(const fss::Mesh& mesh, const std::function<bool(const Eigen::Vector3d&)>& keep) {
     fss::Mesh out;
     std::vector<fss::VertexIndex> map(mesh.num_vertices());
-    for (fss::VertexIndex v : mesh.vertices()) map[std::size_t(v)] = out.add_vertex(mesh.point(v));
+    for (fss::VertexIndex v : mesh.vertices())
+        map[std::size_t(v)] = out.add_vertex(mesh.point(v));
     for (fss::FaceIndex f : mesh.faces()) {
         if (!keep(centroid(mesh, f))) continue;
         std::vector<fss::VertexIndex> corners;
-        for (fss::VertexIndex v : mesh.vertices_around_face(mesh.halfedge(f))) corners.push_back(map[std::size_t(v)]);
+        for (fss::VertexIndex v : mesh.vertices_around_face(mesh.halfedge(f)))
+            corners.push_back(map[std::size_t(v)]);
         out.add_face(corners);
     }
     return out;
@@ -66,10 +68,13 @@ QPoint pixelOf(const fss::Camera& camera, const Eigen::Vector3d& p) {
     return {int(std::floor(s.x())), int(std::floor(s.y()))};
 }
 
-QRgb at(const QImage& image, QPoint p) { return image.pixel(p); }
+QRgb at(const QImage& image, QPoint p) {
+    return image.pixel(p);
+}
 
 int maxChannelDiff(QRgb a, QRgb b) {
-    return std::max({std::abs(qRed(a) - qRed(b)), std::abs(qGreen(a) - qGreen(b)), std::abs(qBlue(a) - qBlue(b))});
+    return std::max(
+        {std::abs(qRed(a) - qRed(b)), std::abs(qGreen(a) - qGreen(b)), std::abs(qBlue(a) - qBlue(b))});
 }
 
 // A shown view of \p mesh at \p size widget pixels looking from +z.
@@ -102,7 +107,8 @@ private slots:
         QCOMPARE(fss::widgets::parseColorMap("scan-id"), std::optional<ColorMap>(ColorMap::ScanId));
         QCOMPARE(fss::widgets::colorMapName(ColorMap::ScanId), QStringLiteral("scan-id"));
         for (ColorMap m : {ColorMap::None, ColorMap::MinAngle, ColorMap::Valence, ColorMap::ScanId})
-            QCOMPARE(fss::widgets::parseColorMap(fss::widgets::colorMapName(m).toStdString()), std::optional(m));
+            QCOMPARE(fss::widgets::parseColorMap(fss::widgets::colorMapName(m).toStdString()),
+                     std::optional(m));
         QVERIFY(!fss::widgets::parseColorMap("scanid"));
         // Input faces grey; the first 12 scan ids saturated and pairwise at least 20° of hue apart.
         const QColor grey = fss::widgets::scanIdColor(-1);
@@ -112,7 +118,8 @@ private slots:
             QVERIFY(fss::widgets::scanIdColor(a).hsvSaturationF() > 0.5);
             QCOMPARE(fss::widgets::scanIdColor(a), fss::widgets::scanIdColor(a)); // stable
             for (int b = a + 1; b < 12; ++b) {
-                const int d = std::abs(fss::widgets::scanIdColor(a).hsvHue() - fss::widgets::scanIdColor(b).hsvHue());
+                const int d =
+                    std::abs(fss::widgets::scanIdColor(a).hsvHue() - fss::widgets::scanIdColor(b).hsvHue());
                 QVERIFY2(std::min(d, 360 - d) >= 20, qPrintable(QString("ids %1 and %2").arg(a).arg(b)));
             }
         }
@@ -155,9 +162,12 @@ private slots:
         QCOMPARE(greyFaces, 64);
         QCOMPARE(hueFaces, 64);
         // Whole-image statistics: the left half of the mesh is grey, the right half coloured.
-        const QPoint lo = pixelOf(camera, {0, 8, 0}), mid = pixelOf(camera, {4, 0, 0}), hi = pixelOf(camera, {8, 0, 0});
+        const QPoint lo = pixelOf(camera, {0, 8, 0}), mid = pixelOf(camera, {4, 0, 0}),
+                     hi = pixelOf(camera, {8, 0, 0});
         const QRect left(lo, QPoint(mid.x() - 1, mid.y())), right(QPoint(mid.x() + 1, lo.y()), hi);
-        auto grey = [](QRgb p) { return std::abs(qRed(p) - qGreen(p)) <= 4 && std::abs(qGreen(p) - qBlue(p)) <= 4; };
+        auto grey = [](QRgb p) {
+            return std::abs(qRed(p) - qGreen(p)) <= 4 && std::abs(qGreen(p) - qBlue(p)) <= 4;
+        };
         auto saturated = [](QRgb p) { return QColor(p).hsvSaturation() > 100; };
         const double greyLeft = fss::test::pixelFraction(image, grey, left);
         const double colouredRight = fss::test::pixelFraction(image, saturated, right);
@@ -188,7 +198,8 @@ private slots:
                 const QPointF p = a + t * (b - a);
                 const QPointF q = view->toImagePixels(p);
                 QCOMPARE(q, p * dpr);
-                QVERIFY2(isRed(after.pixel(q.toPoint())), qPrintable(QString("(%1, %2)").arg(q.x()).arg(q.y())));
+                QVERIFY2(isRed(after.pixel(q.toPoint())),
+                         qPrintable(QString("(%1, %2)").arg(q.x()).arg(q.y())));
             }
         }
         QVERIFY(!isRed(after.pixel((QPointF(170, 80) * dpr).toPoint()))); // off the line: not painted
@@ -196,7 +207,8 @@ private slots:
         auto isGreen = [](QRgb p) { return qGreen(p) > 230 && qRed(p) < 30 && qBlue(p) < 30; };
         QVERIFY(isGreen(after.pixel((QPointF(100, 330) * dpr).toPoint())));
         QVERIFY(isGreen(after.pixel((QPointF(200, 330) * dpr).toPoint())));
-        QCOMPARE(after.pixel((QPointF(150, 330) * dpr).toPoint()), before.pixel((QPointF(150, 330) * dpr).toPoint()));
+        QCOMPARE(after.pixel((QPointF(150, 330) * dpr).toPoint()),
+                 before.pixel((QPointF(150, 330) * dpr).toPoint()));
         // Every changed pixel is near the paths (half the pen or the dot radius, plus antialiasing).
         long changed = 0, far = 0;
         for (int y = 0; y < after.height(); ++y)
@@ -204,7 +216,8 @@ private slots:
                 if (after.pixel(x, y) == before.pixel(x, y)) continue;
                 ++changed;
                 const QPointF w = QPointF(x + 0.5, y + 0.5) / dpr; // pixel centre in widget pixels
-                const double dLine = std::min(distanceToSegment(w, line[0], line[1]), distanceToSegment(w, line[1], line[2]));
+                const double dLine =
+                    std::min(distanceToSegment(w, line[0], line[1]), distanceToSegment(w, line[1], line[2]));
                 const double dDots = std::min(distanceToSegment(w, {100, 330}, {100, 330}),
                                               distanceToSegment(w, {200, 330}, {200, 330}));
                 if (dLine > 1.5 + 1.5 && dDots > 1.5 + 1.5) ++far;
@@ -219,7 +232,8 @@ private slots:
 
     void ghostShowsWhereTheMeshIsMissing() {
         const fss::Mesh full = fss::shapes::grid(8, 8);
-        const fss::Mesh holed = selectFaces(full, [](const Eigen::Vector3d& c) { return !inSquare(c, 3, 5); });
+        const fss::Mesh holed =
+            selectFaces(full, [](const Eigen::Vector3d& c) { return !inSquare(c, 3, 5); });
         auto view = shownView(holed);
         QVERIFY(view);
         const fss::Camera camera = view->camera();
@@ -234,7 +248,8 @@ private slots:
         // In the hole: the ghost colour blended over the background (bluer and brighter).
         auto ghostly = [](QRgb p) {
             const double* bg = VtkView::kBackground;
-            return qBlue(p) > std::lround(bg[2] * 255) + 15 && qBlue(p) > qRed(p) + 20 && fss::test::notBackground(p);
+            return qBlue(p) > std::lround(bg[2] * 255) + 15 && qBlue(p) > qRed(p) + 20 &&
+                   fss::test::notBackground(p);
         };
         QVERIFY2(fss::test::pixelFraction(ghost, ghostly, hole) > 0.99,
                  qPrintable(QString::number(fss::test::pixelFraction(ghost, ghostly, hole))));
@@ -243,13 +258,15 @@ private slots:
         for (fss::FaceIndex f : holed.faces()) {
             const QPoint p = pixelOf(camera, centroid(holed, f));
             QVERIFY2(maxChannelDiff(ghost.pixel(p), before.pixel(p)) <= 2,
-                     qPrintable(QString("face %1: %2 -> %3").arg(std::size_t(f)).arg(QColor(before.pixel(p)).name(),
-                                                                                   QColor(ghost.pixel(p)).name())));
+                     qPrintable(QString("face %1: %2 -> %3")
+                                    .arg(std::size_t(f))
+                                    .arg(QColor(before.pixel(p)).name(), QColor(ghost.pixel(p)).name())));
             ++faces;
         }
         QCOMPARE(faces, 128 - 8);
         // Nothing changes outside the hole [3, 5]² (the whole image but it, with 2 pixels of margin).
-        const QRect wholeHole = QRect(pixelOf(camera, {3, 5, 0}), pixelOf(camera, {5, 3, 0})).adjusted(-2, -2, 2, 2);
+        const QRect wholeHole =
+            QRect(pixelOf(camera, {3, 5, 0}), pixelOf(camera, {5, 3, 0})).adjusted(-2, -2, 2, 2);
         long changedOutside = 0;
         for (int y = 0; y < ghost.height(); ++y)
             for (int x = 0; x < ghost.width(); ++x)
@@ -311,11 +328,13 @@ private slots:
         fss::Mesh patch;
         {
             std::vector<fss::VertexIndex> map(fandisk().num_vertices());
-            for (fss::VertexIndex v : fandisk().vertices()) map[std::size_t(v)] = patch.add_vertex(fandisk().point(v));
+            for (fss::VertexIndex v : fandisk().vertices())
+                map[std::size_t(v)] = patch.add_vertex(fandisk().point(v));
             for (fss::FaceIndex f : fandisk().faces())
                 if (inPatch[std::size_t(f)]) {
                     std::vector<fss::VertexIndex> c;
-                    for (fss::VertexIndex v : fandisk().vertices_around_face(fandisk().halfedge(f))) c.push_back(map[std::size_t(v)]);
+                    for (fss::VertexIndex v : fandisk().vertices_around_face(fandisk().halfedge(f)))
+                        c.push_back(map[std::size_t(v)]);
                     patch.add_face(c);
                 }
         }
@@ -336,9 +355,11 @@ private slots:
                 }
             }
         const double blueFraction = double(blue) / double(patchPixels);
-        QVERIFY2(blueFraction > 0.9, qPrintable(QString("%1 of %2 patch pixels blue").arg(blue).arg(patchPixels)));
+        QVERIFY2(blueFraction > 0.9,
+                 qPrintable(QString("%1 of %2 patch pixels blue").arg(blue).arg(patchPixels)));
         // The patch's border edges may spill a pixel over its neighbours, nothing more.
-        QVERIFY2(changedElsewhere < 0.02 * elsewhere, qPrintable(QString("%1 of %2").arg(changedElsewhere).arg(elsewhere)));
+        QVERIFY2(changedElsewhere < 0.02 * elsewhere,
+                 qPrintable(QString("%1 of %2").arg(changedElsewhere).arg(elsewhere)));
     }
 
     void meshRendererAgreesWithCpuAndLeavesTheViewAlone() {
@@ -368,7 +389,8 @@ private slots:
         const fss::FrameBuffers cpu = cpuRenderer.render(camera);
         std::size_t covered = 0, agree = 0;
         for (std::size_t i = 0; i < gpu.faceId.size(); ++i) {
-            if (gpu.faceId[i] == fss::FrameBuffers::kNoFace && cpu.faceId[i] == fss::FrameBuffers::kNoFace) continue;
+            if (gpu.faceId[i] == fss::FrameBuffers::kNoFace && cpu.faceId[i] == fss::FrameBuffers::kNoFace)
+                continue;
             ++covered;
             agree += gpu.faceId[i] == cpu.faceId[i] ? 1 : 0;
         }
@@ -430,7 +452,8 @@ private slots:
         auto view = shownView(grid, {400, 300}, fss::StandardView::Iso);
         QVERIFY(view);
         const qreal dpr = view->devicePixelRatioF();
-        qInfo("device pixel ratio %.2f (QT_SCALE_FACTOR=%s)", dpr, scale.isEmpty() ? "unset" : scale.constData());
+        qInfo("device pixel ratio %.2f (QT_SCALE_FACTOR=%s)", dpr,
+              scale.isEmpty() ? "unset" : scale.constData());
         if (!scale.isEmpty()) QCOMPARE(dpr, scale.toDouble());
         const fss::Camera camera = view->camera();
         QCOMPARE(camera.width, int(std::lround(400 * dpr)));
@@ -443,21 +466,25 @@ private slots:
         // non-background pixels (within the edge lines' width).
         double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
         for (const Eigen::Vector3d& corner : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(8, 0, 0),
-                                             Eigen::Vector3d(0, 8, 0), Eigen::Vector3d(8, 8, 0)}) {
+                                              Eigen::Vector3d(0, 8, 0), Eigen::Vector3d(8, 8, 0)}) {
             const Eigen::Vector3d s = camera.project(corner);
-            x0 = std::min(x0, s.x()), x1 = std::max(x1, s.x()), y0 = std::min(y0, s.y()), y1 = std::max(y1, s.y());
+            x0 = std::min(x0, s.x()), x1 = std::max(x1, s.x()), y0 = std::min(y0, s.y()),
+            y1 = std::max(y1, s.y());
         }
         int px0 = image.width(), px1 = -1, py0 = image.height(), py1 = -1;
         for (int y = 0; y < image.height(); ++y)
             for (int x = 0; x < image.width(); ++x)
                 if (fss::test::notBackground(image.pixel(x, y))) {
-                    px0 = std::min(px0, x), px1 = std::max(px1, x), py0 = std::min(py0, y), py1 = std::max(py1, y);
+                    px0 = std::min(px0, x), px1 = std::max(px1, x), py0 = std::min(py0, y),
+                    py1 = std::max(py1, y);
                 }
-        qInfo("projected corners x %.1f..%.1f y %.1f..%.1f; drawn x %d..%d y %d..%d", x0, x1, y0, y1, px0, px1, py0, py1);
+        qInfo("projected corners x %.1f..%.1f y %.1f..%.1f; drawn x %d..%d y %d..%d", x0, x1, y0, y1, px0,
+              px1, py0, py1);
         QVERIFY(std::abs(px0 - x0) < 2.5 && std::abs(px1 + 1 - x1) < 2.5);
         QVERIFY(std::abs(py0 - y0) < 2.5 && std::abs(py1 + 1 - y1) < 2.5);
 
-        // Picking: a widget point over a face's centroid → image pixel → that face in the view's scan buffers.
+        // Picking: a widget point over a face's centroid → image pixel → that face in the view's scan
+        // buffers.
         auto renderer = view->createMeshRenderer();
         renderer->setMesh(grid);
         const fss::FrameBuffers ids = renderer->render(camera);

@@ -91,11 +91,16 @@ Rgb minAngleColor(double deg) {
 
 Rgb valenceColor(int deviation) {
     switch (deviation) {
-    case -1: return kGrey;
-    case 0: return kGreen;
-    case 1: return kYellow;
-    case 2: return kOrange;
-    default: return kRed;
+    case -1:
+        return kGrey;
+    case 0:
+        return kGreen;
+    case 1:
+        return kYellow;
+    case 2:
+        return kOrange;
+    default:
+        return kRed;
     }
 }
 
@@ -106,7 +111,9 @@ double cornerAngleDeg(const Point3& at, const Point3& a, const Point3& b) {
     return std::acos(std::clamp((u * v) / (lu * lv), -1.0, 1.0)) * 180.0 / M_PI;
 }
 
-Eigen::Vector3d toEigen(const double* p) { return {p[0], p[1], p[2]}; }
+Eigen::Vector3d toEigen(const double* p) {
+    return {p[0], p[1], p[2]};
+}
 
 // The live vertices and faces of \p mesh as VTK points and polygons (dense VTK ids, faces in the order of
 // mesh.faces(), so VTK cell i is the i-th live face). Extends \p bounds by every point when given.
@@ -172,7 +179,8 @@ public:
         previous_ = nullptr;
         previousSurface_ = nullptr;
         if (previous && previousSurface && previous->makeCurrent(previousSurface)) return;
-        if (link_->context && QOpenGLContext::currentContext() == link_->context) link_->context->doneCurrent();
+        if (link_->context && QOpenGLContext::currentContext() == link_->context)
+            link_->context->doneCurrent();
     }
 
 private:
@@ -248,10 +256,14 @@ std::optional<ColorMap> parseColorMap(std::string_view name) {
 
 QString colorMapName(ColorMap map) {
     switch (map) {
-    case ColorMap::None: return QStringLiteral("none");
-    case ColorMap::MinAngle: return QStringLiteral("angle");
-    case ColorMap::Valence: return QStringLiteral("valence");
-    case ColorMap::ScanId: return QStringLiteral("scan-id");
+    case ColorMap::None:
+        return QStringLiteral("none");
+    case ColorMap::MinAngle:
+        return QStringLiteral("angle");
+    case ColorMap::Valence:
+        return QStringLiteral("valence");
+    case ColorMap::ScanId:
+        return QStringLiteral("scan-id");
     }
     return {};
 }
@@ -310,15 +322,20 @@ struct VtkView::Impl {
             const std::size_t i = std::size_t(f);
             Rgb c;
             switch (colorMap) {
-            case ColorMap::MinAngle: c = minAngleColor(faceMinAngle[i]); break;
-            case ColorMap::Valence: c = valenceColor(faceValenceDeviation[i]); break;
+            case ColorMap::MinAngle:
+                c = minAngleColor(faceMinAngle[i]);
+                break;
+            case ColorMap::Valence:
+                c = valenceColor(faceValenceDeviation[i]);
+                break;
             default: {
                 const QColor q = scanIdColor(faceScanId[i]);
                 c = {q.redF(), q.greenF(), q.blueF()};
             }
             }
             for (int k = 0; k < 3; ++k)
-                colors->SetTypedComponent(f, k, static_cast<unsigned char>(std::lround(c[std::size_t(k)] * 255)));
+                colors->SetTypedComponent(f, k,
+                                          static_cast<unsigned char>(std::lround(c[std::size_t(k)] * 255)));
         }
         polyData->GetCellData()->SetScalars(colors);
         mapper->ScalarVisibilityOn();
@@ -333,7 +350,8 @@ struct VtkView::Impl {
         view->makeCurrent();
         // Copy: a renderer's release must not invalidate the iteration.
         const std::vector<ViewMeshRenderer*> renderers = gl->renderers;
-        for (ViewMeshRenderer* r : renderers) r->releaseGl();
+        for (ViewMeshRenderer* r : renderers)
+            r->releaseGl();
         if (initialized) {
             window->Finalize();
             window->SetReadyForRendering(false);
@@ -361,7 +379,9 @@ QSurfaceFormat VtkView::surfaceFormat() {
     return format;
 }
 
-void VtkView::setDefaultSurfaceFormat() { QSurfaceFormat::setDefaultFormat(surfaceFormat()); }
+void VtkView::setDefaultSurfaceFormat() {
+    QSurfaceFormat::setDefaultFormat(surfaceFormat());
+}
 
 VtkView::VtkView(QWidget* parent) : QOpenGLWidget(parent), impl_(std::make_unique<Impl>()) {
     auto& d = *impl_;
@@ -476,7 +496,8 @@ VtkView::~VtkView() {
     // QOpenGLWidget's destructor deletes the context after this one ran: no callback into impl_ then.
     QObject::disconnect(impl_->contextDestroyed);
     impl_->releaseGraphics(this);
-    for (unsigned long tag : impl_->windowObservers) impl_->window->RemoveObserver(tag);
+    for (unsigned long tag : impl_->windowObservers)
+        impl_->window->RemoveObserver(tag);
     impl_->interactor->RemoveObserver(impl_->renderObserver);
 }
 
@@ -550,14 +571,17 @@ void VtkView::paintOverlay() {
             QPen pen(path.color, path.width, Qt::SolidLine, Qt::RoundCap, Qt::RoundJoin);
             painter.setPen(pen);
             painter.setBrush(Qt::NoBrush);
-            if (path.closed) painter.drawPolygon(path.points.data(), int(path.points.size()));
-            else painter.drawPolyline(path.points.data(), int(path.points.size()));
+            if (path.closed)
+                painter.drawPolygon(path.points.data(), int(path.points.size()));
+            else
+                painter.drawPolyline(path.points.data(), int(path.points.size()));
         }
         if (path.markers) {
             painter.setPen(Qt::NoPen);
             painter.setBrush(path.color);
             const qreal r = path.width + 1.5;
-            for (const QPointF& p : path.points) painter.drawEllipse(p, r, r);
+            for (const QPointF& p : path.points)
+                painter.drawEllipse(p, r, r);
         }
     }
 }
@@ -576,7 +600,8 @@ void VtkView::setMesh(const Mesh& mesh) {
     d.faceScanId.reserve(mesh.number_of_faces());
     std::vector<int> deviation(mesh.num_vertices(), -1); // |valence − 6| of interior vertices, else −1
     for (VertexIndex v : mesh.vertices())
-        if (!mesh.is_border(v) && !mesh.is_isolated(v)) deviation[std::size_t(v)] = std::abs(int(mesh.degree(v)) - 6);
+        if (!mesh.is_border(v) && !mesh.is_isolated(v))
+            deviation[std::size_t(v)] = std::abs(int(mesh.degree(v)) - 6);
     const auto scanIds = mesh.property_map<FaceIndex, std::int32_t>(props::faceScanId);
     std::vector<Point3> corners;
     for (FaceIndex f : mesh.faces()) {
@@ -589,7 +614,8 @@ void VtkView::setMesh(const Mesh& mesh) {
         double minAngle = 180;
         const std::size_t n = corners.size();
         for (std::size_t i = 0; i < n; ++i)
-            minAngle = std::min(minAngle, cornerAngleDeg(corners[i], corners[(i + n - 1) % n], corners[(i + 1) % n]));
+            minAngle = std::min(minAngle,
+                                cornerAngleDeg(corners[i], corners[(i + n - 1) % n], corners[(i + 1) % n]));
         d.faceMinAngle.push_back(minAngle);
         d.faceValenceDeviation.push_back(worst);
         d.faceScanId.push_back(scanIds.second ? scanIds.first[f] : -1);
@@ -601,9 +627,13 @@ void VtkView::setMesh(const Mesh& mesh) {
     setStandardView(d.initialView);
 }
 
-void VtkView::clearMesh() { setMesh(Mesh{}); }
+void VtkView::clearMesh() {
+    setMesh(Mesh{});
+}
 
-bool VtkView::hasMesh() const { return impl_->polyData->GetNumberOfCells() > 0; }
+bool VtkView::hasMesh() const {
+    return impl_->polyData->GetNumberOfCells() > 0;
+}
 
 void VtkView::setColorMap(ColorMap map) {
     impl_->colorMap = map;
@@ -612,7 +642,9 @@ void VtkView::setColorMap(ColorMap map) {
     update();
 }
 
-ColorMap VtkView::colorMap() const { return impl_->colorMap; }
+ColorMap VtkView::colorMap() const {
+    return impl_->colorMap;
+}
 
 Camera VtkView::camera() const {
     vtkCamera* c = impl_->renderer->GetActiveCamera();
@@ -653,27 +685,38 @@ void VtkView::setCamera(const Camera& camera) {
 
 void VtkView::setStandardView(StandardView view) {
     Eigen::AlignedBox3d box = impl_->bounds;
-    if (box.isEmpty()) box = Eigen::AlignedBox3d(Eigen::Vector3d(-0.5, -0.5, -0.5), Eigen::Vector3d(0.5, 0.5, 0.5));
+    if (box.isEmpty())
+        box = Eigen::AlignedBox3d(Eigen::Vector3d(-0.5, -0.5, -0.5), Eigen::Vector3d(0.5, 0.5, 0.5));
     const Camera current = camera();
     vtkCamera* c = impl_->renderer->GetActiveCamera();
     setCamera(Camera::standardView(view, box, current.width, current.height, c->GetParallelProjection() != 0,
                                    c->GetViewAngle()));
 }
 
-void VtkView::setInitialView(StandardView view) { impl_->initialView = view; }
+void VtkView::setInitialView(StandardView view) {
+    impl_->initialView = view;
+}
 
-QImage VtkView::grabImage() { return grabFramebuffer(); }
+QImage VtkView::grabImage() {
+    return grabFramebuffer();
+}
 
-QPointF VtkView::toImagePixels(QPointF widgetPoint) const { return widgetPoint * devicePixelRatioF(); }
+QPointF VtkView::toImagePixels(QPointF widgetPoint) const {
+    return widgetPoint * devicePixelRatioF();
+}
 
 void VtkView::setOverlay(std::vector<OverlayPath> paths) {
     impl_->overlay = std::move(paths);
     update();
 }
 
-void VtkView::clearOverlay() { setOverlay({}); }
+void VtkView::clearOverlay() {
+    setOverlay({});
+}
 
-const std::vector<OverlayPath>& VtkView::overlay() const { return impl_->overlay; }
+const std::vector<OverlayPath>& VtkView::overlay() const {
+    return impl_->overlay;
+}
 
 void VtkView::setGhostMesh(const Mesh& reference) {
     auto& d = *impl_;
@@ -700,7 +743,9 @@ void VtkView::setGhostVisible(bool visible) {
     update();
 }
 
-bool VtkView::ghostVisible() const { return impl_->ghostActor->GetVisibility() != 0; }
+bool VtkView::ghostVisible() const {
+    return impl_->ghostActor->GetVisibility() != 0;
+}
 
 void VtkView::setPreviewMesh(const Mesh& patch) {
     auto& d = *impl_;
@@ -720,7 +765,9 @@ void VtkView::clearPreviewMesh() {
     update();
 }
 
-bool VtkView::hasPreviewMesh() const { return impl_->previewActor->GetVisibility() != 0; }
+bool VtkView::hasPreviewMesh() const {
+    return impl_->previewActor->GetVisibility() != 0;
+}
 
 std::unique_ptr<MeshRenderer> VtkView::createMeshRenderer() {
     return std::make_unique<ViewMeshRenderer>(impl_->gl);
@@ -739,10 +786,14 @@ EventInfo eventInfo(const QPointF& pos, Qt::KeyboardModifiers modifiers, qreal d
 }
 unsigned long buttonEvent(Qt::MouseButton button, bool press) {
     switch (button) {
-    case Qt::LeftButton: return press ? vtkCommand::LeftButtonPressEvent : vtkCommand::LeftButtonReleaseEvent;
-    case Qt::MiddleButton: return press ? vtkCommand::MiddleButtonPressEvent : vtkCommand::MiddleButtonReleaseEvent;
-    case Qt::RightButton: return press ? vtkCommand::RightButtonPressEvent : vtkCommand::RightButtonReleaseEvent;
-    default: return vtkCommand::NoEvent;
+    case Qt::LeftButton:
+        return press ? vtkCommand::LeftButtonPressEvent : vtkCommand::LeftButtonReleaseEvent;
+    case Qt::MiddleButton:
+        return press ? vtkCommand::MiddleButtonPressEvent : vtkCommand::MiddleButtonReleaseEvent;
+    case Qt::RightButton:
+        return press ? vtkCommand::RightButtonPressEvent : vtkCommand::RightButtonReleaseEvent;
+    default:
+        return vtkCommand::NoEvent;
     }
 }
 } // namespace
@@ -757,7 +808,9 @@ void VtkView::mousePressEvent(QMouseEvent* event) {
     event->accept();
 }
 
-void VtkView::mouseDoubleClickEvent(QMouseEvent* event) { mousePressEvent(event); }
+void VtkView::mouseDoubleClickEvent(QMouseEvent* event) {
+    mousePressEvent(event);
+}
 
 void VtkView::mouseReleaseEvent(QMouseEvent* event) {
     const EventInfo e = eventInfo(event->position(), event->modifiers(), devicePixelRatioF());
@@ -785,8 +838,10 @@ void VtkView::wheelEvent(QWheelEvent* event) {
     iren.SetAltKey(e.alt);
     const QPoint delta = event->angleDelta();
     const int steps = delta.y() != 0 ? delta.y() : delta.x();
-    if (steps > 0) iren.InvokeEvent(vtkCommand::MouseWheelForwardEvent, event);
-    else if (steps < 0) iren.InvokeEvent(vtkCommand::MouseWheelBackwardEvent, event);
+    if (steps > 0)
+        iren.InvokeEvent(vtkCommand::MouseWheelForwardEvent, event);
+    else if (steps < 0)
+        iren.InvokeEvent(vtkCommand::MouseWheelBackwardEvent, event);
     event->accept();
 }
 

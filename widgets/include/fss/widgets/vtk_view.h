@@ -130,10 +130,10 @@ public:
     const std::vector<OverlayPath>& overlay() const;
 
     /// Shows \p reference (copied) as a translucent ghost (kGhost, opacity kGhostOpacity, its edges a
-    /// faint wireframe in the same colour) in the same world coordinates as the mesh. Where it coincides with the shown mesh the mesh wins
-    /// (polygon offset pushes the ghost back), so the ghost shows where the current mesh departs from it
-    /// or has no surface. Visible unless setGhostVisible(false). An empty mesh clears the ghost. The
-    /// camera is not moved. \pre every face is a triangle.
+    /// faint wireframe in the same colour) in the same world coordinates as the mesh. Where it coincides with
+    /// the shown mesh the mesh wins (polygon offset pushes the ghost back), so the ghost shows where the
+    /// current mesh departs from it or has no surface. Visible unless setGhostVisible(false). An empty mesh
+    /// clears the ghost. The camera is not moved. \pre every face is a triangle.
     void setGhostMesh(const Mesh& reference);
     /// Removes the ghost mesh.
     void clearGhostMesh();
