@@ -86,6 +86,7 @@ int main(int argc, char** argv) {
     format.setStencilBufferSize(8);
     format.setAlphaBufferSize(8);
     format.setSamples(0);
+    // FSS_TEST_QT_DEFAULT_FORMAT=1 keeps Qt's default format instead, as Designer itself does.
     if (!qEnvironmentVariableIsSet("FSS_TEST_QT_DEFAULT_FORMAT")) QSurfaceFormat::setDefaultFormat(format);
     QApplication app(argc, argv);
     DesignerPluginTest test;
