@@ -65,8 +65,10 @@ struct OverlayPath {
 };
 
 /// A QOpenGLWidget showing one triangle mesh with VTK: flat shaded with its edges, optionally coloured
-/// per face by a quality measure (ColorMap), navigated with VTK's trackball camera (left drag rotates,
-/// middle drag or Shift+left drag pans, right drag or the wheel zooms, 'r' resets the camera).
+/// per face by a quality measure or the scan id (ColorMap), navigated with VTK's trackball camera (left
+/// drag rotates, middle drag or Shift+left drag pans, right drag or the wheel zooms, 'r' resets the
+/// camera). Optionally also a translucent ghost of the reference mesh, a preview patch and 2D overlays;
+/// createMeshRenderer() renders scan buffers in the widget's GL context.
 ///
 /// Every view has its own render window, renderer and camera: several views per process are fine.
 /// Before the QApplication is created the application must call setDefaultSurfaceFormat() once (VTK
