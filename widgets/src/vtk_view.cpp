@@ -1,6 +1,7 @@
 #include "fss/widgets/vtk_view.h"
 
 #include "fss/error.h"
+#include "fss/render/gpu_mesh_renderer.h"
 
 // GL constants come from Qt's qopengl.h (through QOpenGLWidget); vtk_glew.h cannot be combined with it
 // and is not needed: every GL call goes through VTK (vtkOpenGLState, the render window).
@@ -14,6 +15,7 @@
 #include <vtkInteractorStyleTrackballCamera.h>
 #include <vtkNew.h>
 #include <vtkObjectFactory.h>
+#include <vtkOpenGLShaderCache.h>
 #include <vtkOpenGLState.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -26,6 +28,9 @@
 #include <QKeyEvent>
 #include <QMouseEvent>
 #include <QOpenGLContext>
+#include <QPainter>
+#include <QPainterPath>
+#include <QPointer>
 #include <QSurfaceFormat>
 #include <QWheelEvent>
 #include <QtDebug>
@@ -33,6 +38,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <string>
@@ -85,11 +91,16 @@ Rgb minAngleColor(double deg) {
 
 Rgb valenceColor(int deviation) {
     switch (deviation) {
-    case -1: return kGrey;
-    case 0: return kGreen;
-    case 1: return kYellow;
-    case 2: return kOrange;
-    default: return kRed;
+    case -1:
+        return kGrey;
+    case 0:
+        return kGreen;
+    case 1:
+        return kYellow;
+    case 2:
+        return kOrange;
+    default:
+        return kRed;
     }
 }
 
@@ -100,22 +111,159 @@ double cornerAngleDeg(const Point3& at, const Point3& a, const Point3& b) {
     return std::acos(std::clamp((u * v) / (lu * lv), -1.0, 1.0)) * 180.0 / M_PI;
 }
 
-Eigen::Vector3d toEigen(const double* p) { return {p[0], p[1], p[2]}; }
+Eigen::Vector3d toEigen(const double* p) {
+    return {p[0], p[1], p[2]};
+}
+
+// The live vertices and faces of \p mesh as VTK points and polygons (dense VTK ids, faces in the order of
+// mesh.faces(), so VTK cell i is the i-th live face). Extends \p bounds by every point when given.
+vtkSmartPointer<vtkPolyData> toPolyData(const Mesh& mesh, Eigen::AlignedBox3d* bounds = nullptr) {
+    vtkNew<vtkPoints> points;
+    points->SetDataTypeToDouble();
+    points->Allocate(vtkIdType(mesh.number_of_vertices()));
+    std::vector<vtkIdType> pointId(mesh.num_vertices(), -1); // num_vertices counts removed ones too
+    for (VertexIndex v : mesh.vertices()) {
+        const Point3& p = mesh.point(v);
+        pointId[std::size_t(v)] = points->InsertNextPoint(p.x(), p.y(), p.z());
+        if (bounds) bounds->extend(Eigen::Vector3d(p.x(), p.y(), p.z()));
+    }
+    vtkNew<vtkCellArray> polys;
+    polys->AllocateEstimate(vtkIdType(mesh.number_of_faces()), 3);
+    std::vector<vtkIdType> ids;
+    for (FaceIndex f : mesh.faces()) {
+        ids.clear();
+        for (VertexIndex v : mesh.vertices_around_face(mesh.halfedge(f)))
+            ids.push_back(pointId[std::size_t(v)]);
+        polys->InsertNextCell(vtkIdType(ids.size()), ids.data());
+    }
+    auto polyData = vtkSmartPointer<vtkPolyData>::New();
+    polyData->SetPoints(points);
+    polyData->SetPolys(polys);
+    return polyData;
+}
+
+// What a VtkView shares with the MeshRenderers it created: its GL context while VTK lives in it, and the
+// renderers to tell when that context goes away. Owned jointly, so a renderer may outlive the view.
+class ViewMeshRenderer;
+struct GlLink {
+    QOpenGLContext* context = nullptr; // the widget's context while VTK is initialised in it
+    QSurface* surface = nullptr;       // the surface the widget makes that context current with
+    std::vector<ViewMeshRenderer*> renderers;
+};
+
+// render::GlContext on a VtkView's QOpenGLContext. makeCurrent() uses QOpenGLContext::makeCurrent (never
+// QOpenGLWidget::makeCurrent, which would rebind the widget's framebuffer) and doneCurrent() makes the
+// previously current context current again (another view's, typically), or releases the context.
+class ViewGlContext final : public render::GlContext {
+public:
+    explicit ViewGlContext(std::shared_ptr<GlLink> link) : link_(std::move(link)) {}
+
+    void makeCurrent() override {
+        QOpenGLContext* context = link_->context;
+        if (!context)
+            throw Error("The 3D view has no OpenGL context: scans from the view need the widget shown "
+                        "(and not destroyed).");
+        QOpenGLContext* current = QOpenGLContext::currentContext();
+        if (current == context) return;
+        previous_ = current;
+        previousSurface_ = current ? current->surface() : nullptr;
+        if (!context->makeCurrent(link_->surface))
+            throw Error("The 3D view's OpenGL context could not be made current.");
+    }
+    bool isCurrent() const override {
+        return link_->context && QOpenGLContext::currentContext() == link_->context;
+    }
+    void doneCurrent() override {
+        QOpenGLContext* previous = previous_;
+        QSurface* previousSurface = previousSurface_;
+        previous_ = nullptr;
+        previousSurface_ = nullptr;
+        if (previous && previousSurface && previous->makeCurrent(previousSurface)) return;
+        if (link_->context && QOpenGLContext::currentContext() == link_->context)
+            link_->context->doneCurrent();
+    }
+
+private:
+    std::shared_ptr<GlLink> link_;
+    QPointer<QOpenGLContext> previous_;
+    QSurface* previousSurface_ = nullptr;
+};
+
+// The MeshRenderer of VtkView::createMeshRenderer: a GpuMeshRenderer in the view's context. Its GL
+// resources belong to one QOpenGLContext: when the view drops that context (re-parenting, destruction) it
+// calls releaseGl() with the context current, and the next render() builds a new GpuMeshRenderer in the
+// view's new context from the mesh of setMesh() (which MeshRenderer's contract keeps alive).
+class ViewMeshRenderer final : public MeshRenderer {
+public:
+    explicit ViewMeshRenderer(std::shared_ptr<GlLink> link) : link_(std::move(link)), context_(link_) {
+        link_->renderers.push_back(this);
+    }
+    ~ViewMeshRenderer() override {
+        auto& list = link_->renderers;
+        list.erase(std::remove(list.begin(), list.end(), this), list.end());
+        // GpuMeshRenderer frees its GL resources making the view's context current when it still exists.
+        gpu_.reset();
+    }
+    ViewMeshRenderer(const ViewMeshRenderer&) = delete;
+    ViewMeshRenderer& operator=(const ViewMeshRenderer&) = delete;
+
+    void setMesh(const Mesh& mesh) override {
+        if (mesh.number_of_faces() == 0) throw InvalidInputError("Cannot render a mesh without faces.");
+        if (!gpu_) gpu_ = std::make_unique<render::GpuMeshRenderer>(context_);
+        gpu_->setMesh(mesh); // copies and checks the mesh; touches GL only when GL was initialised
+        mesh_ = &mesh;
+    }
+
+    FrameBuffers render(const Camera& camera) override {
+        if (!mesh_) throw InvalidInputError("Cannot render a scan before a mesh was given (setMesh).");
+        if (!link_->context)
+            throw Error("The 3D view has no OpenGL context: scans from the view need the widget shown "
+                        "(and not destroyed).");
+        if (!gpu_) {
+            auto gpu = std::make_unique<render::GpuMeshRenderer>(context_);
+            gpu->setMesh(*mesh_);
+            gpu_ = std::move(gpu);
+        }
+        return gpu_->render(camera);
+    }
+
+    // Frees the GL resources in the view's context, which the caller has made current.
+    void releaseGl() { gpu_.reset(); }
+
+private:
+    std::shared_ptr<GlLink> link_;
+    ViewGlContext context_;
+    const Mesh* mesh_ = nullptr;
+    std::unique_ptr<render::GpuMeshRenderer> gpu_;
+};
 
 } // namespace
+
+QColor scanIdColor(int scanId) {
+    if (scanId < 0) return QColor::fromRgbF(0.6f, 0.6f, 0.6f);
+    // Golden-ratio hue steps: any two ids among the first dozen differ by at least ~20° of hue.
+    const double hue = std::fmod(0.05 + 0.6180339887498949 * double(scanId), 1.0);
+    return QColor::fromHsvF(float(hue), 0.80f, 0.95f);
+}
 
 std::optional<ColorMap> parseColorMap(std::string_view name) {
     if (name == "none") return ColorMap::None;
     if (name == "angle" || name == "min-angle") return ColorMap::MinAngle;
     if (name == "valence") return ColorMap::Valence;
+    if (name == "scan-id") return ColorMap::ScanId;
     return std::nullopt;
 }
 
 QString colorMapName(ColorMap map) {
     switch (map) {
-    case ColorMap::None: return QStringLiteral("none");
-    case ColorMap::MinAngle: return QStringLiteral("angle");
-    case ColorMap::Valence: return QStringLiteral("valence");
+    case ColorMap::None:
+        return QStringLiteral("none");
+    case ColorMap::MinAngle:
+        return QStringLiteral("angle");
+    case ColorMap::Valence:
+        return QStringLiteral("valence");
+    case ColorMap::ScanId:
+        return QStringLiteral("scan-id");
     }
     return {};
 }
@@ -131,8 +279,16 @@ struct VtkView::Impl {
     std::vector<unsigned long> windowObservers;
     unsigned long renderObserver = 0;
 
-    QOpenGLContext* context = nullptr; // the widget's context while VTK is initialised in it
-    QSurface* surface = nullptr;       // the surface the widget makes that context current with
+    // The translucent reference (ghost) and the pending patch (preview).
+    vtkNew<vtkPolyDataMapper> ghostMapper;
+    vtkNew<vtkActor> ghostActor;
+    bool ghostVisible = true;
+    vtkNew<vtkPolyDataMapper> previewMapper;
+    vtkNew<vtkActor> previewActor;
+    std::vector<OverlayPath> overlay;
+
+    // The widget's GL context (while VTK is initialised in it), shared with createMeshRenderer()'s.
+    std::shared_ptr<GlLink> gl = std::make_shared<GlLink>();
     QMetaObject::Connection contextDestroyed;
     bool initialized = false;
     bool inPaint = false;
@@ -140,27 +296,46 @@ struct VtkView::Impl {
     // Per-face measures of the shown mesh (kept so that switching the colour map needs no mesh).
     std::vector<double> faceMinAngle;
     std::vector<int> faceValenceDeviation;
+    std::vector<std::int32_t> faceScanId; // −1 for input faces
     Eigen::AlignedBox3d bounds;
     ColorMap colorMap = ColorMap::None;
     StandardView initialView = StandardView::Iso;
     vtkMTimeType cameraTime = 0;
 
     void applyColorMap() {
+        vtkProperty* property = actor->GetProperty();
         if (colorMap == ColorMap::None || polyData->GetNumberOfCells() == 0) {
             polyData->GetCellData()->SetScalars(nullptr);
             mapper->ScalarVisibilityOff();
+            property->SetSpecularColor(kSurface[0], kSurface[1], kSurface[2]);
             return;
         }
+        // The face colours replace ambient and diffuse colour; a white highlight keeps them true (a tan
+        // one would tint the neutral grey of input faces in the scan-id map).
+        property->SetSpecularColor(1.0, 1.0, 1.0);
         vtkNew<vtkUnsignedCharArray> colors;
         colors->SetName("face colour");
         colors->SetNumberOfComponents(3);
         const auto n = static_cast<vtkIdType>(faceMinAngle.size());
         colors->SetNumberOfTuples(n);
         for (vtkIdType f = 0; f < n; ++f) {
-            const Rgb c = colorMap == ColorMap::MinAngle ? minAngleColor(faceMinAngle[std::size_t(f)])
-                                                         : valenceColor(faceValenceDeviation[std::size_t(f)]);
+            const std::size_t i = std::size_t(f);
+            Rgb c;
+            switch (colorMap) {
+            case ColorMap::MinAngle:
+                c = minAngleColor(faceMinAngle[i]);
+                break;
+            case ColorMap::Valence:
+                c = valenceColor(faceValenceDeviation[i]);
+                break;
+            default: {
+                const QColor q = scanIdColor(faceScanId[i]);
+                c = {q.redF(), q.greenF(), q.blueF()};
+            }
+            }
             for (int k = 0; k < 3; ++k)
-                colors->SetTypedComponent(f, k, static_cast<unsigned char>(std::lround(c[std::size_t(k)] * 255)));
+                colors->SetTypedComponent(f, k,
+                                          static_cast<unsigned char>(std::lround(c[std::size_t(k)] * 255)));
         }
         polyData->GetCellData()->SetScalars(colors);
         mapper->ScalarVisibilityOn();
@@ -168,15 +343,23 @@ struct VtkView::Impl {
         mapper->SetColorModeToDirectScalars();
     }
 
+    // Frees every GL resource held in the widget's context (VTK's and those of the MeshRenderers made
+    // by createMeshRenderer) while it still exists; afterwards nothing refers to it.
     void releaseGraphics(VtkView* view) {
-        if (!initialized) return;
+        if (!gl->context) return;
         view->makeCurrent();
-        window->Finalize();
-        window->SetReadyForRendering(false);
+        // Copy: a renderer's release must not invalidate the iteration.
+        const std::vector<ViewMeshRenderer*> renderers = gl->renderers;
+        for (ViewMeshRenderer* r : renderers)
+            r->releaseGl();
+        if (initialized) {
+            window->Finalize();
+            window->SetReadyForRendering(false);
+        }
         view->doneCurrent();
         initialized = false;
-        context = nullptr;
-        surface = nullptr;
+        gl->context = nullptr;
+        gl->surface = nullptr;
     }
 };
 
@@ -196,7 +379,9 @@ QSurfaceFormat VtkView::surfaceFormat() {
     return format;
 }
 
-void VtkView::setDefaultSurfaceFormat() { QSurfaceFormat::setDefaultFormat(surfaceFormat()); }
+void VtkView::setDefaultSurfaceFormat() {
+    QSurfaceFormat::setDefaultFormat(surfaceFormat());
+}
 
 VtkView::VtkView(QWidget* parent) : QOpenGLWidget(parent), impl_(std::make_unique<Impl>()) {
     auto& d = *impl_;
@@ -219,12 +404,13 @@ VtkView::VtkView(QWidget* parent) : QOpenGLWidget(parent), impl_(std::make_uniqu
     // Trap (PLATFORM-NOTES): QOpenGLContext::makeCurrent, not QOpenGLWidget::makeCurrent — the latter
     // rebinds Qt's framebuffer while VTK sets up its own and the image comes out garbage.
     observe(vtkCommand::WindowMakeCurrentEvent, [this](void*) {
-        auto& dd = *impl_;
-        if (dd.context && dd.surface && QOpenGLContext::currentContext() != dd.context)
-            dd.context->makeCurrent(dd.surface);
+        const GlLink& gl = *impl_->gl;
+        if (gl.context && gl.surface && QOpenGLContext::currentContext() != gl.context)
+            gl.context->makeCurrent(gl.surface);
     });
     observe(vtkCommand::WindowIsCurrentEvent, [this](void* callData) {
-        *static_cast<bool*>(callData) = impl_->context && QOpenGLContext::currentContext() == impl_->context;
+        const GlLink& gl = *impl_->gl;
+        *static_cast<bool*>(callData) = gl.context && QOpenGLContext::currentContext() == gl.context;
     });
     // A render started outside paintGL (by code holding the render window) must reach the screen.
     observe(vtkCommand::WindowFrameEvent, [this](void*) {
@@ -265,19 +451,60 @@ VtkView::VtkView(QWidget* parent) : QOpenGLWidget(parent), impl_(std::make_uniqu
     property->SetLineWidth(1.0f);
     d.actor->VisibilityOff();
     d.renderer->AddActor(d.actor);
+
+    // Ghost: translucent, pushed back where it coincides with the mesh so that the mesh wins. VTK applies
+    // an actor's polygon offset only when its edges are drawn (or globally, which would also offset the
+    // scan renders' depth): the ghost's edges are drawn in its own colour, a faint wireframe.
+    d.ghostMapper->ScalarVisibilityOff();
+    d.ghostMapper->SetRelativeCoincidentTopologyPolygonOffsetParameters(2, 40);
+    d.ghostActor->SetMapper(d.ghostMapper);
+    vtkProperty* ghost = d.ghostActor->GetProperty();
+    ghost->SetColor(kGhost[0], kGhost[1], kGhost[2]);
+    ghost->SetOpacity(kGhostOpacity);
+    ghost->SetAmbient(0.3);
+    ghost->SetDiffuse(0.7);
+    ghost->SetSpecular(0.0);
+    ghost->EdgeVisibilityOn();
+    ghost->SetEdgeColor(kGhost[0], kGhost[1], kGhost[2]);
+    ghost->SetInterpolationToFlat();
+    d.ghostActor->VisibilityOff();
+    d.ghostActor->PickableOff();
+    d.renderer->AddActor(d.ghostActor);
+
+    // Preview: opaque, its own colour with edges; pulled towards the viewer so that it shows where it
+    // coincides with the mesh (a scan patch lies on the surface it was sampled from).
+    d.previewMapper->ScalarVisibilityOff();
+    d.previewMapper->SetRelativeCoincidentTopologyPolygonOffsetParameters(-2, -40);
+    d.previewMapper->SetRelativeCoincidentTopologyLineOffsetParameters(-2, -40);
+    d.previewActor->SetMapper(d.previewMapper);
+    vtkProperty* preview = d.previewActor->GetProperty();
+    preview->SetColor(kPreview[0], kPreview[1], kPreview[2]);
+    preview->SetAmbient(0.2);
+    preview->SetDiffuse(0.8);
+    preview->SetSpecular(0.1);
+    preview->SetInterpolationToFlat();
+    preview->EdgeVisibilityOn();
+    preview->SetEdgeColor(0.02, 0.08, 0.25);
+    preview->SetLineWidth(1.0f);
+    d.previewActor->VisibilityOff();
+    d.previewActor->PickableOff();
+    d.renderer->AddActor(d.previewActor);
     setStandardView(d.initialView);
 }
 
 VtkView::~VtkView() {
+    // QOpenGLWidget's destructor deletes the context after this one ran: no callback into impl_ then.
+    QObject::disconnect(impl_->contextDestroyed);
     impl_->releaseGraphics(this);
-    for (unsigned long tag : impl_->windowObservers) impl_->window->RemoveObserver(tag);
+    for (unsigned long tag : impl_->windowObservers)
+        impl_->window->RemoveObserver(tag);
     impl_->interactor->RemoveObserver(impl_->renderObserver);
 }
 
 void VtkView::initializeGL() {
     auto& d = *impl_;
-    d.context = context();
-    d.surface = context()->surface();
+    d.gl->context = context();
+    d.gl->surface = context()->surface();
     // QOpenGLWidget recreates its context when it is re-parented into another window: release VTK's
     // resources in the old one (initializeGL then runs again in the new one).
     QObject::disconnect(d.contextDestroyed);
@@ -285,8 +512,8 @@ void VtkView::initializeGL() {
                                  [this] { impl_->releaseGraphics(this); });
     if (!d.window->InitializeFromCurrentContext()) {
         qWarning("VtkView: VTK could not initialise OpenGL in the widget's context.");
-        d.context = nullptr;
-        d.surface = nullptr;
+        d.gl->context = nullptr;
+        d.gl->surface = nullptr;
         return;
     }
     d.window->SetReadyForRendering(true);
@@ -309,6 +536,9 @@ void VtkView::paintGL() {
     vtkOpenGLState* state = d.window->GetState();
     // Qt changes GL state behind VTK's back: resynchronise VTK's cache, and restore Qt's afterwards.
     state->Reset();
+    // Other VTK render windows in this context (the scan renderers of createMeshRenderer) bind their own
+    // shader programs: forget which one VTK believes is bound so that ours is bound again.
+    d.window->GetShaderCache()->ReleaseCurrentShader();
     state->Push();
     state->vtkglDepthFunc(GL_LEQUAL); // Qt leaves GL_LESS, VTK expects GL_LEQUAL
     d.inPaint = true;
@@ -325,51 +555,71 @@ void VtkView::paintGL() {
                                      GL_NEAREST);
     state->PopDrawFramebufferBinding();
     state->Pop();
+    paintOverlay();
+}
+
+void VtkView::paintOverlay() {
+    const auto& paths = impl_->overlay;
+    if (paths.empty()) return;
+    // QPainter on a QOpenGLWidget paints into its framebuffer in widget pixels (the device pixel ratio is
+    // applied by Qt), over the image blitted above.
+    QPainter painter(this);
+    painter.setRenderHint(QPainter::Antialiasing);
+    for (const OverlayPath& path : paths) {
+        if (path.points.empty()) continue;
+        if (path.width > 0 && path.points.size() > 1) {
+            QPen pen(path.color, path.width, Qt::SolidLine, Qt::RoundCap, Qt::RoundJoin);
+            painter.setPen(pen);
+            painter.setBrush(Qt::NoBrush);
+            if (path.closed)
+                painter.drawPolygon(path.points.data(), int(path.points.size()));
+            else
+                painter.drawPolyline(path.points.data(), int(path.points.size()));
+        }
+        if (path.markers) {
+            painter.setPen(Qt::NoPen);
+            painter.setBrush(path.color);
+            const qreal r = path.width + 1.5;
+            for (const QPointF& p : path.points)
+                painter.drawEllipse(p, r, r);
+        }
+    }
 }
 
 void VtkView::setMesh(const Mesh& mesh) {
     auto& d = *impl_;
-    vtkNew<vtkPoints> points;
-    points->SetDataTypeToDouble();
-    points->Allocate(vtkIdType(mesh.number_of_vertices()));
-    std::vector<vtkIdType> pointId(mesh.num_vertices(), -1); // num_vertices counts removed ones too
     d.bounds.setEmpty();
-    for (VertexIndex v : mesh.vertices()) {
-        const Point3& p = mesh.point(v);
-        pointId[std::size_t(v)] = points->InsertNextPoint(p.x(), p.y(), p.z());
-        d.bounds.extend(Eigen::Vector3d(p.x(), p.y(), p.z()));
-    }
-    vtkNew<vtkCellArray> polys;
-    polys->AllocateEstimate(vtkIdType(mesh.number_of_faces()), 3);
+    vtkSmartPointer<vtkPolyData> fresh = toPolyData(mesh, &d.bounds);
+
+    // Per-face measures for the colour maps, in the order of mesh.faces() (= VTK cell order).
     d.faceMinAngle.clear();
     d.faceValenceDeviation.clear();
+    d.faceScanId.clear();
     d.faceMinAngle.reserve(mesh.number_of_faces());
     d.faceValenceDeviation.reserve(mesh.number_of_faces());
+    d.faceScanId.reserve(mesh.number_of_faces());
     std::vector<int> deviation(mesh.num_vertices(), -1); // |valence − 6| of interior vertices, else −1
     for (VertexIndex v : mesh.vertices())
-        if (!mesh.is_border(v) && !mesh.is_isolated(v)) deviation[std::size_t(v)] = std::abs(int(mesh.degree(v)) - 6);
-    std::vector<vtkIdType> ids;
+        if (!mesh.is_border(v) && !mesh.is_isolated(v))
+            deviation[std::size_t(v)] = std::abs(int(mesh.degree(v)) - 6);
+    const auto scanIds = mesh.property_map<FaceIndex, std::int32_t>(props::faceScanId);
     std::vector<Point3> corners;
     for (FaceIndex f : mesh.faces()) {
-        ids.clear();
         corners.clear();
         int worst = -1;
         for (VertexIndex v : mesh.vertices_around_face(mesh.halfedge(f))) {
-            ids.push_back(pointId[std::size_t(v)]);
             corners.push_back(mesh.point(v));
             worst = std::max(worst, deviation[std::size_t(v)]);
         }
-        polys->InsertNextCell(vtkIdType(ids.size()), ids.data());
         double minAngle = 180;
         const std::size_t n = corners.size();
         for (std::size_t i = 0; i < n; ++i)
-            minAngle = std::min(minAngle, cornerAngleDeg(corners[i], corners[(i + n - 1) % n], corners[(i + 1) % n]));
+            minAngle = std::min(minAngle,
+                                cornerAngleDeg(corners[i], corners[(i + n - 1) % n], corners[(i + 1) % n]));
         d.faceMinAngle.push_back(minAngle);
         d.faceValenceDeviation.push_back(worst);
+        d.faceScanId.push_back(scanIds.second ? scanIds.first[f] : -1);
     }
-    vtkNew<vtkPolyData> fresh;
-    fresh->SetPoints(points);
-    fresh->SetPolys(polys);
     d.polyData->ShallowCopy(fresh);
     d.applyColorMap();
     d.polyData->Modified();
@@ -377,9 +627,13 @@ void VtkView::setMesh(const Mesh& mesh) {
     setStandardView(d.initialView);
 }
 
-void VtkView::clearMesh() { setMesh(Mesh{}); }
+void VtkView::clearMesh() {
+    setMesh(Mesh{});
+}
 
-bool VtkView::hasMesh() const { return impl_->polyData->GetNumberOfCells() > 0; }
+bool VtkView::hasMesh() const {
+    return impl_->polyData->GetNumberOfCells() > 0;
+}
 
 void VtkView::setColorMap(ColorMap map) {
     impl_->colorMap = map;
@@ -388,7 +642,9 @@ void VtkView::setColorMap(ColorMap map) {
     update();
 }
 
-ColorMap VtkView::colorMap() const { return impl_->colorMap; }
+ColorMap VtkView::colorMap() const {
+    return impl_->colorMap;
+}
 
 Camera VtkView::camera() const {
     vtkCamera* c = impl_->renderer->GetActiveCamera();
@@ -429,16 +685,93 @@ void VtkView::setCamera(const Camera& camera) {
 
 void VtkView::setStandardView(StandardView view) {
     Eigen::AlignedBox3d box = impl_->bounds;
-    if (box.isEmpty()) box = Eigen::AlignedBox3d(Eigen::Vector3d(-0.5, -0.5, -0.5), Eigen::Vector3d(0.5, 0.5, 0.5));
+    if (box.isEmpty())
+        box = Eigen::AlignedBox3d(Eigen::Vector3d(-0.5, -0.5, -0.5), Eigen::Vector3d(0.5, 0.5, 0.5));
     const Camera current = camera();
     vtkCamera* c = impl_->renderer->GetActiveCamera();
     setCamera(Camera::standardView(view, box, current.width, current.height, c->GetParallelProjection() != 0,
                                    c->GetViewAngle()));
 }
 
-void VtkView::setInitialView(StandardView view) { impl_->initialView = view; }
+void VtkView::setInitialView(StandardView view) {
+    impl_->initialView = view;
+}
 
-QImage VtkView::grabImage() { return grabFramebuffer(); }
+QImage VtkView::grabImage() {
+    return grabFramebuffer();
+}
+
+QPointF VtkView::toImagePixels(QPointF widgetPoint) const {
+    return widgetPoint * devicePixelRatioF();
+}
+
+void VtkView::setOverlay(std::vector<OverlayPath> paths) {
+    impl_->overlay = std::move(paths);
+    update();
+}
+
+void VtkView::clearOverlay() {
+    setOverlay({});
+}
+
+const std::vector<OverlayPath>& VtkView::overlay() const {
+    return impl_->overlay;
+}
+
+void VtkView::setGhostMesh(const Mesh& reference) {
+    auto& d = *impl_;
+    if (reference.number_of_faces() == 0) {
+        clearGhostMesh();
+        return;
+    }
+    d.ghostMapper->SetInputData(toPolyData(reference));
+    d.ghostActor->SetVisibility(d.ghostVisible);
+    update();
+}
+
+void VtkView::clearGhostMesh() {
+    auto& d = *impl_;
+    d.ghostMapper->SetInputData(nullptr);
+    d.ghostActor->VisibilityOff();
+    update();
+}
+
+void VtkView::setGhostVisible(bool visible) {
+    auto& d = *impl_;
+    d.ghostVisible = visible;
+    d.ghostActor->SetVisibility(visible && d.ghostMapper->GetInput() != nullptr);
+    update();
+}
+
+bool VtkView::ghostVisible() const {
+    return impl_->ghostActor->GetVisibility() != 0;
+}
+
+void VtkView::setPreviewMesh(const Mesh& patch) {
+    auto& d = *impl_;
+    if (patch.number_of_faces() == 0) {
+        clearPreviewMesh();
+        return;
+    }
+    d.previewMapper->SetInputData(toPolyData(patch));
+    d.previewActor->VisibilityOn();
+    update();
+}
+
+void VtkView::clearPreviewMesh() {
+    auto& d = *impl_;
+    d.previewMapper->SetInputData(nullptr);
+    d.previewActor->VisibilityOff();
+    update();
+}
+
+bool VtkView::hasPreviewMesh() const {
+    return impl_->previewActor->GetVisibility() != 0;
+}
+
+std::unique_ptr<MeshRenderer> VtkView::createMeshRenderer() {
+    return std::make_unique<ViewMeshRenderer>(impl_->gl);
+}
 
 // ---- events: forwarded to VTK's interactor in device pixels, y flipped (VTK's origin is bottom-left) ----
 
@@ -453,10 +786,14 @@ EventInfo eventInfo(const QPointF& pos, Qt::KeyboardModifiers modifiers, qreal d
 }
 unsigned long buttonEvent(Qt::MouseButton button, bool press) {
     switch (button) {
-    case Qt::LeftButton: return press ? vtkCommand::LeftButtonPressEvent : vtkCommand::LeftButtonReleaseEvent;
-    case Qt::MiddleButton: return press ? vtkCommand::MiddleButtonPressEvent : vtkCommand::MiddleButtonReleaseEvent;
-    case Qt::RightButton: return press ? vtkCommand::RightButtonPressEvent : vtkCommand::RightButtonReleaseEvent;
-    default: return vtkCommand::NoEvent;
+    case Qt::LeftButton:
+        return press ? vtkCommand::LeftButtonPressEvent : vtkCommand::LeftButtonReleaseEvent;
+    case Qt::MiddleButton:
+        return press ? vtkCommand::MiddleButtonPressEvent : vtkCommand::MiddleButtonReleaseEvent;
+    case Qt::RightButton:
+        return press ? vtkCommand::RightButtonPressEvent : vtkCommand::RightButtonReleaseEvent;
+    default:
+        return vtkCommand::NoEvent;
     }
 }
 } // namespace
@@ -471,7 +808,9 @@ void VtkView::mousePressEvent(QMouseEvent* event) {
     event->accept();
 }
 
-void VtkView::mouseDoubleClickEvent(QMouseEvent* event) { mousePressEvent(event); }
+void VtkView::mouseDoubleClickEvent(QMouseEvent* event) {
+    mousePressEvent(event);
+}
 
 void VtkView::mouseReleaseEvent(QMouseEvent* event) {
     const EventInfo e = eventInfo(event->position(), event->modifiers(), devicePixelRatioF());
@@ -499,8 +838,10 @@ void VtkView::wheelEvent(QWheelEvent* event) {
     iren.SetAltKey(e.alt);
     const QPoint delta = event->angleDelta();
     const int steps = delta.y() != 0 ? delta.y() : delta.x();
-    if (steps > 0) iren.InvokeEvent(vtkCommand::MouseWheelForwardEvent, event);
-    else if (steps < 0) iren.InvokeEvent(vtkCommand::MouseWheelBackwardEvent, event);
+    if (steps > 0)
+        iren.InvokeEvent(vtkCommand::MouseWheelForwardEvent, event);
+    else if (steps < 0)
+        iren.InvokeEvent(vtkCommand::MouseWheelBackwardEvent, event);
     event->accept();
 }
 

@@ -10,17 +10,23 @@
 /// Coordinates: mouse positions are in Qt's device-independent pixels; the view multiplies them by the
 /// device pixel ratio before handing them to VTK, and camera() reports the image size in device pixels,
 /// so a camera taken from the view matches the pixels of grabImage() on HiDPI screens as well.
+/// toImagePixels() does that conversion for tools (lasso, picking); overlays are given in widget pixels
+/// and scaled when painted.
 
 #include "fss/camera.h"
 #include "fss/mesh.h"
+#include "fss/scan_pipeline.h"
 
+#include <QColor>
 #include <QImage>
 #include <QOpenGLWidget>
+#include <QPointF>
 #include <QString>
 
 #include <memory>
 #include <optional>
 #include <string_view>
+#include <vector>
 
 namespace fss::widgets {
 
@@ -31,16 +37,38 @@ enum class ColorMap {
     /// each face's worst vertex valence: the largest |valence − 6| over its interior corners; green 0
     /// (regular), yellow 1, orange 2, red ≥ 3; faces whose corners are all on the boundary are grey
     Valence,
+    /// the scan that made each face (props::faceScanId): faces of the input mesh (id −1, or no such
+    /// property) neutral grey (scanIdColor(-1)), every scan id its own saturated colour (scanIdColor)
+    ScanId,
 };
 
-/// Parses "none", "angle" (or "min-angle") and "valence"; std::nullopt for anything else.
+/// Parses "none", "angle" (or "min-angle"), "valence" and "scan-id"; std::nullopt for anything else.
 std::optional<ColorMap> parseColorMap(std::string_view name);
-/// The name accepted by parseColorMap ("none", "angle", "valence").
+/// The name accepted by parseColorMap ("none", "angle", "valence", "scan-id").
 QString colorMapName(ColorMap map);
 
+/// Colour of the faces of scan \p scanId in ColorMap::ScanId (before shading): neutral grey
+/// (0.6, 0.6, 0.6) for ids < 0 (input faces); otherwise a saturated colour whose hue steps by the golden
+/// ratio per id, so that consecutive ids differ clearly. Stable: depends on the id only.
+QColor scanIdColor(int scanId);
+
+/// A 2D path painted over the 3D image (VtkView::setOverlay): a lasso, a fishbone curve, grid preview
+/// points. Coordinates are device-independent widget pixels (those of QMouseEvent::position()), origin
+/// at the widget's top-left corner, y down.
+struct OverlayPath {
+    std::vector<QPointF> points; ///< the path's corners, in widget pixels
+    QColor color;                ///< pen (and marker) colour; its alpha is honoured
+    bool closed = false;         ///< join the last point to the first (a polygon, not filled)
+    bool markers = false;        ///< draw a dot of diameter 2·width + 3 at every point; with a single
+                                 ///< point or width 0 lines, only the dots show
+    qreal width = 2;             ///< pen width in widget pixels; 0 draws no line (markers only)
+};
+
 /// A QOpenGLWidget showing one triangle mesh with VTK: flat shaded with its edges, optionally coloured
-/// per face by a quality measure (ColorMap), navigated with VTK's trackball camera (left drag rotates,
-/// middle drag or Shift+left drag pans, right drag or the wheel zooms, 'r' resets the camera).
+/// per face by a quality measure or the scan id (ColorMap), navigated with VTK's trackball camera (left
+/// drag rotates, middle drag or Shift+left drag pans, right drag or the wheel zooms, 'r' resets the
+/// camera). Optionally also a translucent ghost of the reference mesh, a preview patch and 2D overlays;
+/// createMeshRenderer() renders scan buffers in the widget's GL context.
 ///
 /// Every view has its own render window, renderer and camera: several views per process are fine.
 /// Before the QApplication is created the application must call setDefaultSurfaceFormat() once (VTK
@@ -84,9 +112,69 @@ public:
     /// The standard view used for a newly set mesh; Iso unless changed.
     void setInitialView(StandardView view);
 
-    /// Renders the current frame and returns it (size × device pixel ratio). Returns a null QImage when
-    /// the widget has never been shown (no GL context yet).
+    /// Renders the current frame and returns it (size × device pixel ratio), overlays included. Returns a
+    /// null QImage when the widget has never been shown (no GL context yet).
     QImage grabImage();
+
+    /// Widget position (device-independent pixels, as in mouse events and OverlayPath) → position in
+    /// the image of camera() and grabImage() (device pixels, origin top-left, y down): \p widgetPoint times
+    /// the device pixel ratio. Feed the result to Camera::ray / FrameBuffers lookups / Lasso.
+    QPointF toImagePixels(QPointF widgetPoint) const;
+
+    // ---- overlays and extra meshes ----
+
+    /// Replaces the overlay: \p paths are painted with QPainter over the 3D image (after VTK's frame), in
+    /// the order given, antialiased. An empty list shows no overlay. Repaints the widget.
+    void setOverlay(std::vector<OverlayPath> paths);
+    /// Removes every overlay path (setOverlay({})).
+    void clearOverlay();
+    /// The overlay paths currently shown.
+    const std::vector<OverlayPath>& overlay() const;
+
+    /// Shows \p reference (copied) as a translucent ghost (kGhost, opacity kGhostOpacity, its edges a
+    /// faint wireframe in the same colour) in the same world coordinates as the mesh. Where it coincides with
+    /// the shown mesh the mesh wins (polygon offset pushes the ghost back), so the ghost shows where the
+    /// current mesh departs from it or has no surface. Visible unless setGhostVisible(false). An empty mesh
+    /// clears the ghost. The camera is not moved. \pre every face is a triangle.
+    void setGhostMesh(const Mesh& reference);
+    /// Removes the ghost mesh.
+    void clearGhostMesh();
+    /// Shows or hides the ghost mesh (kept while hidden). Visible by default.
+    void setGhostVisible(bool visible);
+    /// Whether a ghost mesh is set and visible.
+    bool ghostVisible() const;
+
+    /// Shows \p patch (copied), e.g. a scan waiting to be accepted, in kPreview with dark edges, drawn over
+    /// the mesh: polygon offset pulls it towards the viewer so it stays visible where it coincides with the
+    /// mesh. An empty mesh clears the preview. The camera is not moved. \pre every face is a triangle.
+    void setPreviewMesh(const Mesh& patch);
+    /// Removes the preview mesh.
+    void clearPreviewMesh();
+    /// Whether a preview mesh is shown.
+    bool hasPreviewMesh() const;
+
+    // ---- scan buffers from the view ----
+
+    /// A MeshRenderer (FSS::render's GpuMeshRenderer) that renders in this widget's QOpenGLContext into
+    /// its own off-screen framebuffer at the requested camera's width × height, so scans taken with
+    /// camera() use the view's exact projection. The visible image is not disturbed, and nothing is
+    /// repainted. GUI thread only.
+    ///
+    /// setMesh() may be called before the widget was ever shown: the mesh is uploaded by the first
+    /// render(). The renderer keeps a reference to that mesh (MeshRenderer's contract: it must stay alive
+    /// and unchanged until the next setMesh()) so that it can upload it again when the widget's context
+    /// is replaced (re-parenting); GL resources are released when the context goes away or the widget is
+    /// destroyed, whichever comes first. The renderer may outlive the widget (render() then throws).
+    /// \throw (from render()) fss::Error when the widget has no GL context (never shown, or destroyed) or
+    ///         the GL / VTK fail; InvalidInputError as MeshRenderer::render.
+    std::unique_ptr<MeshRenderer> createMeshRenderer();
+
+    /// RGB colour of the ghost mesh (components in [0, 1]).
+    static constexpr double kGhost[3] = {0.55, 0.75, 1.00};
+    /// Opacity of the ghost mesh.
+    static constexpr double kGhostOpacity = 0.35;
+    /// RGB colour of the preview mesh (components in [0, 1]): a saturated blue, unlike every colour map.
+    static constexpr double kPreview[3] = {0.15, 0.45, 0.95};
 
     /// RGB background colour of the view (components in [0, 1]).
     static constexpr double kBackground[3] = {0.32, 0.34, 0.43};
@@ -112,6 +200,8 @@ protected:
     void leaveEvent(QEvent* event) override;
 
 private:
+    void paintOverlay();
+
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
