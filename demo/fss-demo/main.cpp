@@ -131,6 +131,7 @@ int main(int argc, char** argv) {
 
     fss::widgets::VtkView::setDefaultSurfaceFormat(); // before the QApplication exists
     QApplication app(argc, argv);
+    QApplication::setOrganizationName(QStringLiteral("FSS"));
     QApplication::setApplicationName(QStringLiteral("fss-demo"));
     QApplication::setApplicationVersion(QStringLiteral(FSS_VERSION));
 
