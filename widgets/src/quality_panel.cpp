@@ -103,7 +103,7 @@ void QualityPanel::paintEvent(QPaintEvent*) {
     colors[3] = QColor(70, 170, 70);
     colors[2] = colors[4] = QColor(230, 200, 60);
     const double regular = interior ? 100.0 * double(valence_.count(6) ? valence_.at(6) : 0) / double(interior) : 0;
-    drawBars(painter, top, tr("Valence (%1 interior vertices, %2 % regular)").arg(interior).arg(regular, 0, 'f', 1),
+    drawBars(painter, top, tr("Valence: %1 % of %2 regular").arg(regular, 0, 'f', 1).arg(interior),
              values, labels, colors);
 
     std::vector<double> angles(minAngle_.begin(), minAngle_.end());
@@ -116,7 +116,7 @@ void QualityPanel::paintEvent(QPaintEvent*) {
         angleColors.push_back(t < 0.5 ? QColor::fromRgbF(0.9f, float(0.2 + 1.4 * t), 0.2f)
                                       : QColor::fromRgbF(float(0.9 - 1.4 * (t - 0.5)), 0.85f, 0.25f));
     }
-    drawBars(painter, bottom, tr("Smallest angle (%1 triangles), degrees").arg(faces_), angles, angleLabels,
+    drawBars(painter, bottom, tr("Smallest angle (°) of %1 faces").arg(faces_), angles, angleLabels,
              angleColors);
 }
 

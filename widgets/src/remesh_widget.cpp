@@ -137,7 +137,7 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     d.scanModeAction = addTool(d.scanTool);
     d.fishboneAction = addTool(d.fishbone);
     d.toolBar->addSeparator();
-    d.scanAction = d.toolBar->addAction(tr("Scan"), this, [this] { scan(); });
+    d.scanAction = d.toolBar->addAction(tr("Take scan"), this, [this] { scan(); });
     d.scanAction->setToolTip(tr("Scan the view at the panel's resolution (inside the lasso, if any)"));
     d.acceptAction = d.toolBar->addAction(tr("Accept"), this, [this] { accept(); });
     d.rejectAction = d.toolBar->addAction(tr("Reject"), this, [this] { reject(); });
@@ -176,6 +176,7 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     d.ghostAction = d.toolBar->addAction(tr("Ghost"));
     d.ghostAction->setCheckable(true);
     d.ghostAction->setToolTip(tr("Show the input mesh as a translucent ghost"));
+    d.ghostAction->setEnabled(bridge::features().contains(QLatin1String("ghost")));
     connect(d.ghostAction, &QAction::toggled, this, &RemeshWidget::setGhostVisible);
 
     d.undoAction = d.undoStack->createUndoAction(this, tr("&Undo"));

@@ -142,7 +142,7 @@ void ScanPanel::refreshEdgeLength() {
         return;
     }
     edgeLength_ = camera.pixelFootprint(at_);
-    edgeLabel_->setText(tr("%1 (regular grid, at the mesh centre); fishbone %2")
+    edgeLabel_->setText(tr("%1 (fishbone %2) at the mesh centre")
                             .arg(edgeLength_, 0, 'g', 3)
                             .arg(edgeLength_ * fishboneSpacing(), 0, 'g', 3));
 }
