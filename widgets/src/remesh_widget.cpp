@@ -14,6 +14,7 @@
 #include <QAction>
 #include <QActionGroup>
 #include <QCoreApplication>
+#include <QElapsedTimer>
 #include <QEventLoop>
 #include <QGroupBox>
 #include <QHBoxLayout>
@@ -99,6 +100,7 @@ struct RemeshWidget::Impl {
     std::shared_ptr<Job> job;
     QThread* thread = nullptr;
     QString busyWhat;
+    QElapsedTimer busyClock;
     bool updatingView = false;
     bool fishbonePending = false;
     std::int32_t nextScanId = 0;
@@ -213,6 +215,12 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     d.progress->hide();
     d.cancelButton = new QPushButton(tr("Cancel"), this);
     d.cancelButton->hide();
+    // Showing them must not change the layout: a resize of the view re-renders the whole mesh.
+    for (QWidget* w : {static_cast<QWidget*>(d.progress), static_cast<QWidget*>(d.cancelButton)}) {
+        QSizePolicy policy = w->sizePolicy();
+        policy.setRetainSizeWhenHidden(true);
+        w->setSizePolicy(policy);
+    }
     connect(d.cancelButton, &QPushButton::clicked, this, &RemeshWidget::cancel);
     auto* statusRow = new QHBoxLayout;
     statusRow->addWidget(d.status, 1);
@@ -226,11 +234,14 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     layout->addLayout(statusRow);
 
     d.progressTimer = new QTimer(this);
-    d.progressTimer->setInterval(50);
+    d.progressTimer->setInterval(250);
     connect(d.progressTimer, &QTimer::timeout, this, [this] {
         if (!d_->job) return;
-        const double f = d_->job->fraction.load();
-        if (d_->progress->maximum() > 0) d_->progress->setValue(int(1000 * f));
+        if (d_->progress->maximum() == 0x7fffffff) {
+            d_->progress->setValue(int(d_->busyClock.elapsed() / 1000)); // elapsed seconds
+            return;
+        }
+        d_->progress->setValue(int(1000 * d_->job->fraction.load()));
     });
 
     // Wiring.
@@ -493,7 +504,10 @@ void RemeshWidget::accept() {
     auto report = std::make_shared<StitchReport>();
     setBusy(true, tr("Stitching the scan into the mesh"));
     auto job = d_->job;
-    d_->progress->setRange(0, 0); // Session::accept reports only its start and end: indeterminate
+    // Session::accept reports only its start and end: the bar shows the elapsed time instead of a busy
+    // animation (which would repaint the whole GL-composed window many times a second on a software GL).
+    d_->progress->setFormat(tr("stitching… %v s"));
+    d_->progress->setRange(0, 0x7fffffff);
     d_->thread = QThread::create([job, s, report] {
         const Progress progress([job](double f, std::string_view) {
             job->fraction = f;
@@ -607,6 +621,8 @@ void RemeshWidget::setBusy(bool busy, const QString& what) {
     if (busy) {
         d_->job = std::make_shared<Job>();
         d_->busyWhat = what;
+        d_->busyClock.start();
+        d_->progress->setFormat(QStringLiteral("%p%"));
         d_->progress->setRange(0, 1000);
         d_->progress->setValue(0);
         d_->progress->show();
