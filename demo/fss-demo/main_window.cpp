@@ -68,8 +68,8 @@ void MainWindow::createMenus() {
 
     QMenu* viewMenu = menuBar()->addMenu(tr("&View"));
     const std::pair<StandardView, const char*> views[] = {
-        {StandardView::Iso, "&Iso"},    {StandardView::PosX, "From +&X"}, {StandardView::NegX, "From −X"},
-        {StandardView::PosY, "From +&Y"}, {StandardView::NegY, "From −Y"}, {StandardView::PosZ, "From +&Z"},
+        {StandardView::Iso, "&Iso"},      {StandardView::PosX, "From +&X"}, {StandardView::NegX, "From −X"},
+        {StandardView::PosY, "From +&Y"}, {StandardView::NegY, "From −Y"},  {StandardView::PosZ, "From +&Z"},
         {StandardView::NegZ, "From −Z"}};
     for (const auto& [v, label] : views)
         viewMenu->addAction(tr(label), this, [this, v = v] { view()->setStandardView(v); });
@@ -88,13 +88,18 @@ void MainWindow::createMenus() {
     }
 }
 
-widgets::VtkView* MainWindow::view() const { return remesh_->view(); }
+widgets::VtkView* MainWindow::view() const {
+    return remesh_->view();
+}
 
-const Mesh& MainWindow::mesh() const { return remesh_->mesh(); }
+const Mesh& MainWindow::mesh() const {
+    return remesh_->mesh();
+}
 
 void MainWindow::setColorMap(widgets::ColorMap map) {
     view()->setColorMap(map);
-    for (auto& [m, action] : colorActions_) action->setChecked(m == map);
+    for (auto& [m, action] : colorActions_)
+        action->setChecked(m == map);
 }
 
 bool MainWindow::openMesh(const QString& path) {
@@ -111,7 +116,8 @@ bool MainWindow::openMesh(const QString& path) {
     if (!remesh_->setMesh(mesh)) {
         meshPath_ = previousPath;
         meshName_ = previousName;
-        reportError(tr("Open mesh"), tr("%1 cannot be remeshed: %2").arg(QFileInfo(path).fileName(), remesh_->statusText()));
+        reportError(tr("Open mesh"),
+                    tr("%1 cannot be remeshed: %2").arg(QFileInfo(path).fileName(), remesh_->statusText()));
         return false;
     }
     addRecentFile(path);
@@ -147,7 +153,8 @@ void MainWindow::addRecentFile(const QString& path) {
     QStringList files = recentFiles();
     files.removeAll(absolute);
     files.prepend(absolute);
-    while (files.size() > kMaxRecentFiles) files.removeLast();
+    while (files.size() > kMaxRecentFiles)
+        files.removeLast();
     QSettings().setValue(QStringLiteral("recentFiles"), files);
     updateRecentMenu();
 }
@@ -157,14 +164,17 @@ void MainWindow::updateRecentMenu() {
     const QStringList files = recentFiles();
     for (int i = 0; i < files.size(); ++i) {
         const QString path = files[i];
-        recentMenu_->addAction(QStringLiteral("&%1 %2").arg(i + 1).arg(QFileInfo(path).fileName()), this,
-                               [this, path] { openMesh(path); })
+        recentMenu_
+            ->addAction(QStringLiteral("&%1 %2").arg(i + 1).arg(QFileInfo(path).fileName()), this,
+                        [this, path] { openMesh(path); })
             ->setToolTip(path);
     }
     recentMenu_->setEnabled(!files.isEmpty());
 }
 
-QString MainWindow::statisticsText() const { return statistics_->text(); }
+QString MainWindow::statisticsText() const {
+    return statistics_->text();
+}
 
 void MainWindow::reportError(const QString& title, const QString& message) {
     statusBar()->showMessage(message, 10000);
@@ -173,7 +183,8 @@ void MainWindow::reportError(const QString& title, const QString& message) {
 }
 
 void MainWindow::updateStatistics() {
-    setWindowTitle(meshName_.isEmpty() ? QStringLiteral("FSS demo") : meshName_ + QStringLiteral(" — FSS demo"));
+    setWindowTitle(meshName_.isEmpty() ? QStringLiteral("FSS demo")
+                                       : meshName_ + QStringLiteral(" — FSS demo"));
     if (mesh().is_empty()) {
         statistics_->setText(tr("No mesh"));
         return;
@@ -181,24 +192,27 @@ void MainWindow::updateStatistics() {
     MetricsOptions options;
     options.selfIntersections = false;
     const Metrics m = computeMetrics(mesh(), options);
-    statistics_->setText(tr("%1: %2 vertices, %3 faces, valence 6: %4 % of %5 interior vertices, min angle %6°")
-                             .arg(meshName_)
-                             .arg(m.vertices)
-                             .arg(m.faces)
-                             .arg(100.0 * m.fracValence6Interior, 0, 'f', 1)
-                             .arg(m.interiorVertices)
-                             .arg(m.minAngleDeg, 0, 'f', 1));
+    statistics_->setText(
+        tr("%1: %2 vertices, %3 faces, valence 6: %4 % of %5 interior vertices, min angle %6°")
+            .arg(meshName_)
+            .arg(m.vertices)
+            .arg(m.faces)
+            .arg(100.0 * m.fracValence6Interior, 0, 'f', 1)
+            .arg(m.interiorVertices)
+            .arg(m.minAngleDeg, 0, 'f', 1));
 }
 
 void MainWindow::openDialog() {
     const QString path = QFileDialog::getOpenFileName(this, tr("Open mesh"), QFileInfo(meshPath_).path(),
-                                                      tr("Meshes (*.off *.obj *.ply *.stl);;OFF (*.off);;OBJ (*.obj);;PLY (*.ply);;STL (*.stl);;All files (*)"));
+                                                      tr("Meshes (*.off *.obj *.ply *.stl);;OFF (*.off);;OBJ "
+                                                         "(*.obj);;PLY (*.ply);;STL (*.stl);;All files (*)"));
     if (!path.isEmpty()) openMesh(path);
 }
 
 void MainWindow::saveDialog() {
-    const QString path = QFileDialog::getSaveFileName(this, tr("Save mesh"), meshPath_,
-                                                      tr("PLY, keeps scan ids and quality (*.ply);;OFF (*.off);;OBJ (*.obj);;STL (*.stl)"));
+    const QString path = QFileDialog::getSaveFileName(
+        this, tr("Save mesh"), meshPath_,
+        tr("PLY, keeps scan ids and quality (*.ply);;OFF (*.off);;OBJ (*.obj);;STL (*.stl)"));
     if (!path.isEmpty()) saveMesh(path);
 }
 

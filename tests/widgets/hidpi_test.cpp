@@ -56,13 +56,15 @@ private slots:
         // A circle of radius 60 DIP, centred 40 DIP right of the view's centre.
         const QPointF centre(view->width() / 2.0 + 40, view->height() / 2.0);
         const double radius = 60;
-        sendMouse(view, QEvent::MouseButtonPress, centre + QPointF(radius, 0), Qt::LeftButton, Qt::LeftButton);
+        sendMouse(view, QEvent::MouseButtonPress, centre + QPointF(radius, 0), Qt::LeftButton,
+                  Qt::LeftButton);
         for (int i = 1; i <= 40; ++i) {
             const double a = 2 * std::numbers::pi * i / 40;
-            sendMouse(view, QEvent::MouseMove, centre + radius * QPointF(std::cos(a), std::sin(a)), Qt::NoButton,
-                      Qt::LeftButton);
+            sendMouse(view, QEvent::MouseMove, centre + radius * QPointF(std::cos(a), std::sin(a)),
+                      Qt::NoButton, Qt::LeftButton);
         }
-        sendMouse(view, QEvent::MouseButtonRelease, centre + QPointF(radius, 0), Qt::LeftButton, Qt::NoButton);
+        sendMouse(view, QEvent::MouseButtonRelease, centre + QPointF(radius, 0), Qt::LeftButton,
+                  Qt::NoButton);
         QVERIFY(w->lassoTool()->hasLasso());
         QVERIFY(w->scan());
         const fss::ScanPreview& preview = *w->session()->preview();
@@ -83,7 +85,10 @@ private slots:
         const Eigen::Vector2d expected(centre.x() * sx, centre.y() * sy);
         QVERIFY2((centroid - expected).norm() < 2.0,
                  qPrintable(QString("patch centre (%1, %2), lasso centre (%3, %4) scan px")
-                                .arg(centroid.x()).arg(centroid.y()).arg(expected.x()).arg(expected.y())));
+                                .arg(centroid.x())
+                                .arg(centroid.y())
+                                .arg(expected.x())
+                                .arg(expected.y())));
         const double discSamples = std::numbers::pi * radius * sx * radius * sy;
         QVERIFY2(double(n) > 0.75 * discSamples && double(n) < 1.05 * discSamples,
                  qPrintable(QString("%1 samples for a disc of %2 px²").arg(n).arg(discSamples)));
@@ -103,11 +108,13 @@ private slots:
         const fss::ScanPreview& preview = *w->session()->preview();
         QVERIFY(preview.step.fishbone && preview.step.fishbone->seed);
         const fss::Camera& camera = preview.step.params.camera;
-        const Eigen::Vector2d expected(seed.x() * camera.width / view->width(), seed.y() * camera.height / view->height());
+        const Eigen::Vector2d expected(seed.x() * camera.width / view->width(),
+                                       seed.y() * camera.height / view->height());
         QVERIFY((*preview.step.fishbone->seed - expected).norm() < 1e-9);
         // The backbone shown passes through the clicked point.
         double nearest = 1e9;
-        for (const QPointF& p : w->fishboneTool()->backbone()) nearest = std::min(nearest, QLineF(p, seed).length());
+        for (const QPointF& p : w->fishboneTool()->backbone())
+            nearest = std::min(nearest, QLineF(p, seed).length());
         QVERIFY2(nearest < 2.0, qPrintable(QString::number(nearest)));
     }
 };

@@ -27,6 +27,7 @@
 #include <QApplication>
 #include <QElapsedTimer>
 #include <QMouseEvent>
+#include <QPushButton>
 #include <QSignalSpy>
 #include <QTest>
 #include <QTimer>
@@ -86,11 +87,14 @@ std::unique_ptr<RemeshWidget> shownWidget(const fss::Mesh& mesh, QSize size = {1
 bool waitIdle(RemeshWidget& w, int timeoutMs = 120000) {
     QElapsedTimer t;
     t.start();
-    while (w.isBusy() && t.elapsed() < timeoutMs) QTest::qWait(5);
+    while (w.isBusy() && t.elapsed() < timeoutMs)
+        QTest::qWait(5);
     return !w.isBusy();
 }
 
-Eigen::Vector3d vec(const fss::Point3& p) { return {p.x(), p.y(), p.z()}; }
+Eigen::Vector3d vec(const fss::Point3& p) {
+    return {p.x(), p.y(), p.z()};
+}
 
 using Triangle = std::array<std::array<double, 3>, 3>;
 
@@ -110,13 +114,15 @@ Triangle triangle(const fss::Mesh& m, fss::FaceIndex f) {
 double longestEdge(const fss::Mesh& m) {
     double l = 0;
     for (fss::EdgeIndex e : m.edges())
-        l = std::max(l, (vec(m.point(m.source(m.halfedge(e)))) - vec(m.point(m.target(m.halfedge(e))))).norm());
+        l = std::max(l,
+                     (vec(m.point(m.source(m.halfedge(e)))) - vec(m.point(m.target(m.halfedge(e))))).norm());
     return l;
 }
 
 std::size_t borderEdges(const fss::Mesh& m) {
     std::size_t n = 0;
-    for (fss::EdgeIndex e : m.edges()) n += m.is_border(e) ? 1 : 0;
+    for (fss::EdgeIndex e : m.edges())
+        n += m.is_border(e) ? 1 : 0;
     return n;
 }
 
@@ -129,9 +135,11 @@ std::size_t checkInvariants(const fss::Mesh& before, const fss::Mesh& after, con
         QCOMPARE(borderEdges(after), borderEdges(before)); // no new holes; closed stays closed
         if (CGAL::is_closed(before)) {
             QVERIFY(CGAL::is_closed(after));
-            QCOMPARE(PMP::is_outward_oriented(after), PMP::is_outward_oriented(before)); // consistent orientation
+            QCOMPARE(PMP::is_outward_oriented(after),
+                     PMP::is_outward_oriented(before)); // consistent orientation
         }
-        for (fss::VertexIndex v : after.vertices()) QVERIFY2(!after.is_isolated(v), "isolated vertex");
+        for (fss::VertexIndex v : after.vertices())
+            QVERIFY2(!after.is_isolated(v), "isolated vertex");
         for (fss::FaceIndex f : after.faces())
             QVERIFY2(!PMP::is_degenerate_triangle_face(f, after), "degenerate face");
         QVERIFY2(!PMP::does_self_intersect(after), "self-intersection");
@@ -142,12 +150,14 @@ std::size_t checkInvariants(const fss::Mesh& before, const fss::Mesh& after, con
     // Faces away from the patch (farther than 4 of the mesh's longest edges from its bounding box) are
     // untouched: the same corners in the same order.
     Eigen::AlignedBox3d box;
-    for (fss::VertexIndex v : patch.vertices()) box.extend(vec(patch.point(v)));
+    for (fss::VertexIndex v : patch.vertices())
+        box.extend(vec(patch.point(v)));
     const double margin = 4 * std::max(longestEdge(before), longestEdge(patch));
     box.min().array() -= margin;
     box.max().array() += margin;
     std::set<Triangle> afterFaces;
-    for (fss::FaceIndex f : after.faces()) afterFaces.insert(triangle(after, f));
+    for (fss::FaceIndex f : after.faces())
+        afterFaces.insert(triangle(after, f));
     std::size_t far = 0, missing = 0;
     for (fss::FaceIndex f : before.faces()) {
         bool inside = false;
@@ -205,15 +215,18 @@ Counts independentCounts(const fss::Mesh& m) {
         if (!onBorder.count(v)) ++c.valence[count];
     for (fss::FaceIndex f : m.faces()) {
         std::vector<Eigen::Vector3d> p;
-        for (fss::VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m)) p.push_back(vec(m.point(v)));
+        for (fss::VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m))
+            p.push_back(vec(m.point(v)));
         const double a = (p[1] - p[2]).norm(), b = (p[0] - p[2]).norm(), cc = (p[0] - p[1]).norm();
         auto corner = [](double opposite, double s1, double s2) {
-            return std::acos(std::clamp((s1 * s1 + s2 * s2 - opposite * opposite) / (2 * s1 * s2), -1.0, 1.0)) * 180 /
-                   std::numbers::pi;
+            return std::acos(
+                       std::clamp((s1 * s1 + s2 * s2 - opposite * opposite) / (2 * s1 * s2), -1.0, 1.0)) *
+                   180 / std::numbers::pi;
         };
         const double smallest = std::min({corner(a, b, cc), corner(b, a, cc), corner(cc, a, b)});
         const double bin = smallest / 5.0;
-        if (std::abs(bin - std::round(bin)) < 1e-6 / 5.0 && smallest > 1e-6 && smallest < 60 - 1e-6) ++c.ambiguous;
+        if (std::abs(bin - std::round(bin)) < 1e-6 / 5.0 && smallest > 1e-6 && smallest < 60 - 1e-6)
+            ++c.ambiguous;
         ++c.angle[std::size_t(std::clamp(int(bin), 0, 11))];
     }
     return c;
@@ -225,8 +238,10 @@ void compareQuality(const fss::widgets::QualityPanel& panel, const fss::Mesh& me
     QCOMPARE(panel.faceCount(), mesh.number_of_faces());
     std::size_t differ = 0;
     for (int i = 0; i < 12; ++i)
-        differ += std::size_t(std::abs(long(panel.minAngleHistogram()[std::size_t(i)]) - long(c.angle[std::size_t(i)])));
-    QVERIFY2(differ <= 2 * c.ambiguous, qPrintable(QString("%1 differences, %2 ambiguous").arg(differ).arg(c.ambiguous)));
+        differ += std::size_t(
+            std::abs(long(panel.minAngleHistogram()[std::size_t(i)]) - long(c.angle[std::size_t(i)])));
+    QVERIFY2(differ <= 2 * c.ambiguous,
+             qPrintable(QString("%1 differences, %2 ambiguous").arg(differ).arg(c.ambiguous)));
 }
 
 } // namespace
@@ -303,7 +318,8 @@ private slots:
             std::vector<Eigen::Vector2d> q;
             for (fss::VertexIndex v : CGAL::vertices_around_face(patch.halfedge(f), patch))
                 q.push_back(scanCamera.project(vec(patch.point(v))).head<2>());
-            patchArea += std::abs((q[1] - q[0]).x() * (q[2] - q[0]).y() - (q[1] - q[0]).y() * (q[2] - q[0]).x()) / 2;
+            patchArea +=
+                std::abs((q[1] - q[0]).x() * (q[2] - q[0]).y() - (q[1] - q[0]).y() * (q[2] - q[0]).x()) / 2;
         }
         QVERIFY2(patchArea > 0.7 * lassoArea && patchArea < lassoArea,
                  qPrintable(QString("patch %1 px², lasso %2 px²").arg(patchArea).arg(lassoArea)));
@@ -371,7 +387,8 @@ private slots:
         QVERIFY(QLineF(backbone[i0], centre).length() < 3.0);
         QVERIFY(i0 >= 15 && i0 + 15 < backbone.size());
         QPolygonF side;
-        for (qsizetype i = i0 - 15; i <= i0 + 15; ++i) side << backbone[i];
+        for (qsizetype i = i0 - 15; i <= i0 + 15; ++i)
+            side << backbone[i];
         const QRectF bb = side.boundingRect();
         QVERIFY2(bb.height() > 100 && bb.width() < 2,
                  qPrintable(QString("backbone near the seed %1 x %2").arg(bb.width()).arg(bb.height())));
@@ -391,15 +408,17 @@ private slots:
         QVERIFY(preview.fishbone->rows > 10 && preview.fishbone->cols > 10);
         QVERIFY(preview.patch.mesh.number_of_faces() > 100);
         // The key-ribs were converted to scan pixels: each lies on a backbone sample of the grid.
-        const fss::widgets::ScreenMapping mapping{QSizeF(view->size()),
-                                                  QSize(preview.step.params.camera.width, preview.step.params.camera.height)};
+        const fss::widgets::ScreenMapping mapping{
+            QSizeF(view->size()), QSize(preview.step.params.camera.width, preview.step.params.camera.height)};
         for (std::size_t k = 0; k < 2; ++k) {
             const Eigen::Vector2d expected = mapping.toImage(tool->keyRibs()[k]);
             QVERIFY((preview.step.fishbone->keyRibs[k] - expected).norm() < 1e-9);
             double nearest = 1e9;
             for (int r = 0; r < preview.fishbone->rows; ++r)
                 if (preview.fishbone->isPresent(r, preview.fishbone->backboneColumn))
-                    nearest = std::min(nearest, (preview.fishbone->at(r, preview.fishbone->backboneColumn) - expected).norm());
+                    nearest = std::min(
+                        nearest,
+                        (preview.fishbone->at(r, preview.fishbone->backboneColumn) - expected).norm());
             QVERIFY2(nearest < 0.5, qPrintable(QString::number(nearest)));
         }
         // Ribs run around the cylinder: horizontal on the screen (the rib through the seed's row).
@@ -419,9 +438,9 @@ private slots:
                 last = preview.fishbone->at(mid, c);
             }
         QVERIFY(std::abs((last - first).x()) > 5 * std::abs((last - first).y()));
-        qInfo("fishbone: %d x %d grid, %zu rib vertices shown as %zu ribs, patch %zu faces", preview.fishbone->rows,
-              preview.fishbone->cols, preview.fishbone->presentCount(), tool->ribCount(),
-              std::size_t(preview.patch.mesh.number_of_faces()));
+        qInfo("fishbone: %d x %d grid, %zu rib vertices shown as %zu ribs, patch %zu faces",
+              preview.fishbone->rows, preview.fishbone->cols, preview.fishbone->presentCount(),
+              tool->ribCount(), std::size_t(preview.patch.mesh.number_of_faces()));
 
         // Dragging a key-rib along the backbone rescans.
         const QPointF from = tool->keyRibs()[0];
@@ -431,7 +450,8 @@ private slots:
         sendMouse(view, QEvent::MouseButtonRelease, to, Qt::LeftButton, Qt::NoButton);
         QVERIFY(std::hypot(tool->keyRibs()[0].x() - to.x(), tool->keyRibs()[0].y() - to.y()) < 1e-9);
         QVERIFY(tool->hasGridPreview());
-        if (qEnvironmentVariableIsSet("FSS_TEST_SCREENSHOTS")) w->grab().save(QStringLiteral("/tmp/fishbone_widget.png"));
+        if (qEnvironmentVariableIsSet("FSS_TEST_SCREENSHOTS"))
+            w->grab().save(QStringLiteral("/tmp/fishbone_widget.png"));
 
         // Accept: the fishbone patch is stitched in.
         const fss::Mesh before = w->mesh();
@@ -442,6 +462,61 @@ private slots:
         QVERIFY(!identical(before, w->mesh()));
         checkInvariants(before, w->mesh(), patch);
         compareQuality(*w->qualityPanel(), w->mesh());
+    }
+
+    void aLassoOverTheBackgroundFailsWithOneSentence() {
+        auto w = shownWidget(fss::shapes::icosphere(3));
+        QVERIFY(w);
+        w->view()->setStandardView(fss::StandardView::PosZ);
+        w->setActiveTool(w->lassoTool());
+        drawLasso(w->view(), QPointF(30, 30), 15); // in the corner: background only
+        QSignalSpy errors(w.get(), &RemeshWidget::errorOccurred);
+        QVERIFY(!w->scan());
+        QCOMPARE(errors.count(), 1);
+        const QString message = errors.at(0).at(0).toString();
+        QVERIFY2(message.endsWith('.') && !message.contains('\n'), qPrintable(message));
+        QVERIFY(!w->hasPreview());
+        QCOMPARE(w->statusText(), message);
+        w->accept(); // nothing to accept: a sentence, no work started
+        QCOMPARE(errors.count(), 2);
+        QVERIFY(!w->isBusy());
+        QCOMPARE(w->undoStack()->count(), 0);
+    }
+
+    void cancelStopsTheCurvatureEstimate() {
+        auto w =
+            shownWidget(fss::shapes::torus(320, 160, 1.0, 0.4)); // 100k faces: the estimate takes a while
+        QVERIFY(w);
+        w->view()->setStandardView(fss::StandardView::PosZ);
+        w->setActiveTool(w->fishboneTool());
+        QWidget* view = w->view();
+        click(view, QPointF(view->width() / 2.0 + view->height() / 3.0, view->height() / 2.0));
+        QVERIFY(w->isBusy());
+        QVERIFY(!w->fishboneTool()->isEnabled());
+        QVERIFY(w->statusText().contains("curvature"));
+        QPushButton* cancel = nullptr;
+        for (QPushButton* b : w->findChildren<QPushButton*>())
+            if (b->text() == "Cancel") cancel = b;
+        QVERIFY(cancel && cancel->isVisible());
+        QTest::mouseClick(cancel, Qt::LeftButton);
+        QVERIFY(waitIdle(*w));
+        QVERIFY(!w->session()->preview());
+        QVERIFY(!const_cast<fss::Session*>(w->session())
+                     ->fishboneCache()
+                     .hasCurvature(w->session()->reference()));
+        QVERIFY(!w->fishboneTool()->hasInput());
+        QVERIFY2(w->statusText().contains("cancelled"), qPrintable(w->statusText()));
+        QVERIFY(w->fishboneTool()->isEnabled());
+    }
+
+    void destroyingTheWidgetWhileItStitchesWaits() {
+        auto w = shownWidget(fss::shapes::icosphere(4));
+        QVERIFY(w);
+        QVERIFY(w->scan());
+        w->accept();
+        QVERIFY(w->isBusy());
+        w.reset(); // must wait for the worker (which uses the session) instead of crashing
+        QVERIFY(!w);
     }
 
     void guiKeepsProcessingEventsWhileA100kFaceStitchRuns() {
@@ -489,13 +564,16 @@ private slots:
         timer.stop();
         QCOMPARE(accepted.count(), 1);
         QVERIFY(w->mesh().number_of_faces() != before.number_of_faces());
-        QVERIFY2(ticks >= 3, qPrintable(QString("only %1 timer events during %2 ms of stitching").arg(ticks).arg(workMs)));
+        QVERIFY2(
+            ticks >= 3,
+            qPrintable(QString("only %1 timer events during %2 ms of stitching").arg(ticks).arg(workMs)));
         std::sort(gaps.begin(), gaps.end());
-        qInfo("100k torus: setMesh %lld ms, scan %lld ms (%zu patch faces), stitch %lld ms on the worker; GUI "
-              "timer (2 ms) events during it: %d, gap median %lld ms, 90th percentile %lld ms, longest %lld ms "
-              "(ending %lld ms after the start)",
-              setMs, scanMs, patchFaces, workMs, ticks, gaps[gaps.size() / 2], gaps[gaps.size() * 9 / 10], maxGap,
-              maxGapAt);
+        qInfo(
+            "100k torus: setMesh %lld ms, scan %lld ms (%zu patch faces), stitch %lld ms on the worker; GUI "
+            "timer (2 ms) events during it: %d, gap median %lld ms, 90th percentile %lld ms, longest %lld ms "
+            "(ending %lld ms after the start)",
+            setMs, scanMs, patchFaces, workMs, ticks, gaps[gaps.size() / 2], gaps[gaps.size() * 9 / 10],
+            maxGap, maxGapAt);
     }
 };
 

@@ -13,7 +13,9 @@
 namespace fss::widgets {
 
 namespace {
-double distance(const QPointF& a, const QPointF& b) { return std::hypot(a.x() - b.x(), a.y() - b.y()); }
+double distance(const QPointF& a, const QPointF& b) {
+    return std::hypot(a.x() - b.x(), a.y() - b.y());
+}
 
 QString directionName(PrincipalDirection d) {
     return d == PrincipalDirection::Min ? FishboneTool::tr("minimal") : FishboneTool::tr("maximal");
@@ -33,7 +35,9 @@ FishboneTool::FishboneTool(VtkView* view, QObject* parent) : Tool(view, parent) 
 
 FishboneTool::~FishboneTool() = default;
 
-QString FishboneTool::name() const { return tr("Fishbone"); }
+QString FishboneTool::name() const {
+    return tr("Fishbone");
+}
 
 QString FishboneTool::statusText() const {
     if (!isEnabled()) return tr("Please wait until the current work has finished.");
@@ -41,19 +45,22 @@ QString FishboneTool::statusText() const {
     if (drawing_)
         return inputMode_ == InputMode::DrawBackbone ? tr("Release the button to finish the drawn backbone.")
                                                      : tr("Release the button to finish the drawn key-rib.");
-    if (inputMode_ == InputMode::DrawBackbone) return tr("Drag along the feature to draw the backbone by hand.");
+    if (inputMode_ == InputMode::DrawBackbone)
+        return tr("Drag along the feature to draw the backbone by hand.");
     if (inputMode_ == InputMode::DrawRib && !hasInput())
         return tr("Seed or draw a backbone first, then drag across it to draw key-ribs.");
     if (inputMode_ == InputMode::DrawRib) return tr("Drag across the backbone to draw a key-rib by hand.");
     if (!hasInput())
-        return tr("Click a point on the mesh to seed the backbone along the %1 curvature direction (D switches).")
+        return tr("Click a point on the mesh to seed the backbone along the %1 curvature direction (D "
+                  "switches).")
             .arg(directionName(direction_));
     if (ribMode_ == RibMode::KeyRibs && backboneOnly())
         return tr("Click on the backbone to place key-rib %1 of at least 2 (Shift+click for a new seed).")
             .arg(keyRibs_.size() + drawnRibs_.size() + 1);
     if (!gridShown_) return tr("Computing the fishbone grid…");
     if (ribMode_ == RibMode::KeyRibs)
-        return tr("Grid from %1 key-ribs previewed: drag a key-rib along the backbone, click to add one, Enter "
+        return tr("Grid from %1 key-ribs previewed: drag a key-rib along the backbone, click to add one, "
+                  "Enter "
                   "accepts.")
             .arg(keyRibs_.size() + drawnRibs_.size());
     return tr("Fishbone grid previewed: Enter accepts; click for a new seed, D switches direction, K places "
@@ -164,14 +171,17 @@ std::optional<FishboneParams> FishboneTool::params(QSize imageSize, double spaci
     p.direction = direction_;
     p.spacing = spacing;
     if (drawnBackbone_.size() >= 2)
-        for (const QPointF& q : drawnBackbone_) p.drawnBackbone.push_back(mapping.toImage(q));
+        for (const QPointF& q : drawnBackbone_)
+            p.drawnBackbone.push_back(mapping.toImage(q));
     else
         p.seed = mapping.toImage(*seed_);
     if (ribMode_ == RibMode::KeyRibs && !backboneOnly()) {
-        for (const QPointF& q : keyRibs_) p.keyRibs.push_back(mapping.toImage(q));
+        for (const QPointF& q : keyRibs_)
+            p.keyRibs.push_back(mapping.toImage(q));
         for (const QPolygonF& rib : drawnRibs_) {
             Polyline2 line;
-            for (const QPointF& q : rib) line.push_back(mapping.toImage(q));
+            for (const QPointF& q : rib)
+                line.push_back(mapping.toImage(q));
             p.drawnKeyRibs.push_back(std::move(line));
         }
     }
@@ -206,7 +216,9 @@ void FishboneTool::setProblem(const QString& message) {
     notifyStatus();
 }
 
-void FishboneTool::onActivated() { show(); }
+void FishboneTool::onActivated() {
+    show();
+}
 
 void FishboneTool::changed() {
     problem_.clear();
@@ -217,15 +229,20 @@ void FishboneTool::changed() {
 
 void FishboneTool::show() {
     std::vector<bridge::Stroke> strokes;
-    for (const QPolygonF& rib : ribs_) strokes.push_back(stroke(rib, QColor(80, 220, 255), 1.0));
+    for (const QPolygonF& rib : ribs_)
+        strokes.push_back(stroke(rib, QColor(80, 220, 255), 1.0));
     if (!backbone_.isEmpty()) strokes.push_back(stroke(backbone_, QColor(255, 60, 200), 3.0));
     if (drawnBackbone_.size() >= 2) strokes.push_back(stroke(drawnBackbone_, QColor(255, 230, 80), 1.5));
-    for (const QPolygonF& rib : drawnRibs_) strokes.push_back(stroke(rib, QColor(255, 230, 80), 1.5));
+    for (const QPolygonF& rib : drawnRibs_)
+        strokes.push_back(stroke(rib, QColor(255, 230, 80), 1.5));
     if (!stroke_.isEmpty()) strokes.push_back(stroke(stroke_, QColor(255, 255, 120), 2.0));
     if (seed_) strokes.push_back(stroke(QPolygonF{*seed_}, QColor(255, 60, 200), 3.0, true));
-    for (const QPointF& k : keyRibs_) strokes.push_back(stroke(QPolygonF{k}, QColor(255, 160, 0), 3.0, true));
-    if (strokes.empty()) bridge::clearLayer(view(), bridge::Layer::Fishbone);
-    else bridge::setLayer(view(), bridge::Layer::Fishbone, std::move(strokes));
+    for (const QPointF& k : keyRibs_)
+        strokes.push_back(stroke(QPolygonF{k}, QColor(255, 160, 0), 3.0, true));
+    if (strokes.empty())
+        bridge::clearLayer(view(), bridge::Layer::Fishbone);
+    else
+        bridge::setLayer(view(), bridge::Layer::Fishbone, std::move(strokes));
 }
 
 QPointF FishboneTool::snapToBackbone(const QPointF& p, double* dist) const {

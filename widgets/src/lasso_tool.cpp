@@ -15,12 +15,15 @@ LassoTool::LassoTool(VtkView* view, QObject* parent) : Tool(view, parent) {}
 
 LassoTool::~LassoTool() = default;
 
-QString LassoTool::name() const { return tr("Lasso"); }
+QString LassoTool::name() const {
+    return tr("Lasso");
+}
 
 QString LassoTool::statusText() const {
     if (!isEnabled()) return tr("Please wait until the current work has finished.");
     if (drawing_) return tr("Drag around the region to scan and release the button to close the lasso.");
-    if (hasLasso()) return tr("Lasso set: press Scan to sample inside it, draw a new one, or press Esc to clear it.");
+    if (hasLasso())
+        return tr("Lasso set: press Scan to sample inside it, draw a new one, or press Esc to clear it.");
     return tr("Drag with the left button around the region to scan (other buttons navigate).");
 }
 
@@ -29,7 +32,8 @@ std::optional<Lasso> LassoTool::scanLasso(QSize imageSize) const {
     const ScreenMapping mapping{QSizeF(view()->size()), imageSize};
     if (!mapping.isValid()) return std::nullopt;
     Lasso lasso;
-    for (const QPointF& p : polygon_) lasso.points.push_back(mapping.toImage(p));
+    for (const QPointF& p : polygon_)
+        lasso.points.push_back(mapping.toImage(p));
     return lasso;
 }
 
@@ -53,7 +57,9 @@ void LassoTool::clear() {
     }
 }
 
-void LassoTool::onActivated() { show(); }
+void LassoTool::onActivated() {
+    show();
+}
 
 void LassoTool::show() {
     if (polygon_.isEmpty()) {

@@ -20,7 +20,9 @@ double smallestAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b, cons
     return std::min({A, B, C}) * 180.0 / std::numbers::pi;
 }
 
-Eigen::Vector3d toEigen(const Point3& p) { return {p.x(), p.y(), p.z()}; }
+Eigen::Vector3d toEigen(const Point3& p) {
+    return {p.x(), p.y(), p.z()};
+}
 
 // Draws one bar chart into \p area: bars with their labels below and the largest count above.
 void drawBars(QPainter& painter, const QRectF& area, const QString& title, const std::vector<double>& values,
@@ -61,8 +63,9 @@ void QualityPanel::setMesh(const Mesh& mesh) {
     }
     for (FaceIndex f : mesh.faces()) {
         const HalfedgeIndex h = mesh.halfedge(f);
-        const double angle = smallestAngleDeg(toEigen(mesh.point(mesh.source(h))), toEigen(mesh.point(mesh.target(h))),
-                                              toEigen(mesh.point(mesh.target(mesh.next(h)))));
+        const double angle =
+            smallestAngleDeg(toEigen(mesh.point(mesh.source(h))), toEigen(mesh.point(mesh.target(h))),
+                             toEigen(mesh.point(mesh.target(mesh.next(h)))));
         const int bin = std::isfinite(angle) ? std::clamp(int(angle / kAngleBinDeg), 0, kAngleBins - 1) : 0;
         ++minAngle_[std::size_t(bin)];
         ++faces_;
@@ -80,8 +83,12 @@ void QualityPanel::clear() {
     emit updated();
 }
 
-QSize QualityPanel::sizeHint() const { return {260, 260}; }
-QSize QualityPanel::minimumSizeHint() const { return {160, 160}; }
+QSize QualityPanel::sizeHint() const {
+    return {260, 260};
+}
+QSize QualityPanel::minimumSizeHint() const {
+    return {160, 160};
+}
 
 void QualityPanel::paintEvent(QPaintEvent*) {
     QPainter painter(this);
@@ -97,14 +104,16 @@ void QualityPanel::paintEvent(QPaintEvent*) {
         values[std::size_t(std::clamp(valence, 3, 9) - 3)] += double(count);
         interior += count;
     }
-    std::vector<QString> labels{QStringLiteral("≤3"), QStringLiteral("4"), QStringLiteral("5"), QStringLiteral("6"),
-                                QStringLiteral("7"),  QStringLiteral("8"), QStringLiteral("≥9")};
+    std::vector<QString> labels{QStringLiteral("≤3"), QStringLiteral("4"), QStringLiteral("5"),
+                                QStringLiteral("6"),  QStringLiteral("7"), QStringLiteral("8"),
+                                QStringLiteral("≥9")};
     std::vector<QColor> colors(7, QColor(230, 120, 60));
     colors[3] = QColor(70, 170, 70);
     colors[2] = colors[4] = QColor(230, 200, 60);
-    const double regular = interior ? 100.0 * double(valence_.count(6) ? valence_.at(6) : 0) / double(interior) : 0;
-    drawBars(painter, top, tr("Valence: %1 % of %2 regular").arg(regular, 0, 'f', 1).arg(interior),
-             values, labels, colors);
+    const double regular =
+        interior ? 100.0 * double(valence_.count(6) ? valence_.at(6) : 0) / double(interior) : 0;
+    drawBars(painter, top, tr("Valence: %1 % of %2 regular").arg(regular, 0, 'f', 1).arg(interior), values,
+             labels, colors);
 
     std::vector<double> angles(minAngle_.begin(), minAngle_.end());
     std::vector<QString> angleLabels;

@@ -45,11 +45,13 @@ struct Job {
     std::atomic<double> fraction{0.0};
     std::mutex mutex;
     std::string stage;
-    std::string error;  // set by the worker on failure
+    std::string error; // set by the worker on failure
     bool cancelled = false;
 };
 
-QString sentence(const std::exception& e) { return QString::fromStdString(e.what()); }
+QString sentence(const std::exception& e) {
+    return QString::fromStdString(e.what());
+}
 
 } // namespace
 
@@ -146,7 +148,8 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     d.toolBar->addSeparator();
     d.directionAction = d.toolBar->addAction(tr("Max direction"));
     d.directionAction->setCheckable(true);
-    d.directionAction->setToolTip(tr("Fishbone backbone along the maximal (checked) or minimal curvature (D)"));
+    d.directionAction->setToolTip(
+        tr("Fishbone backbone along the maximal (checked) or minimal curvature (D)"));
     connect(d.directionAction, &QAction::toggled, this, [this](bool max) {
         d_->fishbone->setDirection(max ? PrincipalDirection::Max : PrincipalDirection::Min);
     });
@@ -162,8 +165,10 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     d.drawRibAction->setCheckable(true);
     auto inputChanged = [this] {
         FishboneTool::InputMode mode = FishboneTool::InputMode::Pick;
-        if (d_->drawBackboneAction->isChecked()) mode = FishboneTool::InputMode::DrawBackbone;
-        else if (d_->drawRibAction->isChecked()) mode = FishboneTool::InputMode::DrawRib;
+        if (d_->drawBackboneAction->isChecked())
+            mode = FishboneTool::InputMode::DrawBackbone;
+        else if (d_->drawRibAction->isChecked())
+            mode = FishboneTool::InputMode::DrawRib;
         d_->fishbone->setInputMode(mode);
     };
     connect(d.drawBackboneAction, &QAction::toggled, this, [this, inputChanged](bool on) {
@@ -245,8 +250,8 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     });
 
     // Wiring.
-    for (Tool* tool : {static_cast<Tool*>(d.navigate), static_cast<Tool*>(d.lasso), static_cast<Tool*>(d.scanTool),
-                       static_cast<Tool*>(d.fishbone)})
+    for (Tool* tool : {static_cast<Tool*>(d.navigate), static_cast<Tool*>(d.lasso),
+                       static_cast<Tool*>(d.scanTool), static_cast<Tool*>(d.fishbone)})
         connect(tool, &Tool::statusChanged, this, [this, tool] {
             if (tool == d_->active) updateStatus();
         });
@@ -260,7 +265,8 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
         d_->directionAction->setChecked(d_->fishbone->direction() == PrincipalDirection::Max);
         d_->keyRibAction->setChecked(d_->fishbone->ribMode() == FishboneTool::RibMode::KeyRibs);
     });
-    connect(d.lasso, &LassoTool::lassoChanged, this, [this] { d_->scanTool->setPreviewPending(hasPreview()); });
+    connect(d.lasso, &LassoTool::lassoChanged, this,
+            [this] { d_->scanTool->setPreviewPending(hasPreview()); });
     connect(d.scanPanel, &ScanPanel::settingsChanged, this, [this] {
         if (d_->fishbone->hasInput() && !isBusy()) runFishbone();
         updateStatus();
@@ -272,7 +278,8 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
         if (d_->fishbone->hasInput()) d_->fishbone->clear();
         bridge::refreshPreview(d_->view);
         if (d_->session)
-            d_->scanPanel->updateEdgeLength(d_->view->camera(), boundingBox(d_->session->reference()).center());
+            d_->scanPanel->updateEdgeLength(d_->view->camera(),
+                                            boundingBox(d_->session->reference()).center());
     });
 
     d.navigateAction->setChecked(true);
@@ -282,7 +289,11 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
 
 RemeshWidget::~RemeshWidget() {
     if (d_->job) d_->job->cancel = true;
-    if (d_->thread) d_->thread->wait();
+    if (d_->thread) {
+        d_->thread->wait();
+        delete d_->thread; // its finished() handler will not run any more
+        d_->thread = nullptr;
+    }
     for (Tool* tool : {static_cast<Tool*>(d_->navigate), static_cast<Tool*>(d_->lasso),
                        static_cast<Tool*>(d_->scanTool), static_cast<Tool*>(d_->fishbone)})
         tool->deactivate();
@@ -335,8 +346,12 @@ bool RemeshWidget::openMesh(const QString& path) {
     return setMesh(mesh);
 }
 
-const Mesh& RemeshWidget::mesh() const { return d_->session ? d_->session->current() : d_->empty; }
-const Mesh& RemeshWidget::referenceMesh() const { return d_->session ? d_->session->reference() : d_->empty; }
+const Mesh& RemeshWidget::mesh() const {
+    return d_->session ? d_->session->current() : d_->empty;
+}
+const Mesh& RemeshWidget::referenceMesh() const {
+    return d_->session ? d_->session->reference() : d_->empty;
+}
 
 bool RemeshWidget::saveMesh(const QString& path) {
     try {
@@ -349,25 +364,63 @@ bool RemeshWidget::saveMesh(const QString& path) {
     return true;
 }
 
-QUndoStack* RemeshWidget::undoStack() const { return d_->undoStack; }
-QAction* RemeshWidget::undoAction() const { return d_->undoAction; }
-QAction* RemeshWidget::redoAction() const { return d_->redoAction; }
-QAction* RemeshWidget::scanAction() const { return d_->scanAction; }
-QAction* RemeshWidget::acceptAction() const { return d_->acceptAction; }
-QAction* RemeshWidget::rejectAction() const { return d_->rejectAction; }
-VtkView* RemeshWidget::view() const { return d_->view; }
-ScanPanel* RemeshWidget::scanPanel() const { return d_->scanPanel; }
-QualityPanel* RemeshWidget::qualityPanel() const { return d_->qualityPanel; }
-QUndoView* RemeshWidget::historyView() const { return d_->historyView; }
-NavigateTool* RemeshWidget::navigateTool() const { return d_->navigate; }
-LassoTool* RemeshWidget::lassoTool() const { return d_->lasso; }
-ScanTool* RemeshWidget::scanTool() const { return d_->scanTool; }
-FishboneTool* RemeshWidget::fishboneTool() const { return d_->fishbone; }
-Tool* RemeshWidget::activeTool() const { return d_->active; }
-const Session* RemeshWidget::session() const { return d_->session.get(); }
-bool RemeshWidget::hasPreview() const { return d_->session && !isBusy() && d_->session->preview(); }
-bool RemeshWidget::isBusy() const { return d_->thread != nullptr; }
-QString RemeshWidget::statusText() const { return d_->status->text(); }
+QUndoStack* RemeshWidget::undoStack() const {
+    return d_->undoStack;
+}
+QAction* RemeshWidget::undoAction() const {
+    return d_->undoAction;
+}
+QAction* RemeshWidget::redoAction() const {
+    return d_->redoAction;
+}
+QAction* RemeshWidget::scanAction() const {
+    return d_->scanAction;
+}
+QAction* RemeshWidget::acceptAction() const {
+    return d_->acceptAction;
+}
+QAction* RemeshWidget::rejectAction() const {
+    return d_->rejectAction;
+}
+VtkView* RemeshWidget::view() const {
+    return d_->view;
+}
+ScanPanel* RemeshWidget::scanPanel() const {
+    return d_->scanPanel;
+}
+QualityPanel* RemeshWidget::qualityPanel() const {
+    return d_->qualityPanel;
+}
+QUndoView* RemeshWidget::historyView() const {
+    return d_->historyView;
+}
+NavigateTool* RemeshWidget::navigateTool() const {
+    return d_->navigate;
+}
+LassoTool* RemeshWidget::lassoTool() const {
+    return d_->lasso;
+}
+ScanTool* RemeshWidget::scanTool() const {
+    return d_->scanTool;
+}
+FishboneTool* RemeshWidget::fishboneTool() const {
+    return d_->fishbone;
+}
+Tool* RemeshWidget::activeTool() const {
+    return d_->active;
+}
+const Session* RemeshWidget::session() const {
+    return d_->session.get();
+}
+bool RemeshWidget::hasPreview() const {
+    return d_->session && !isBusy() && d_->session->preview();
+}
+bool RemeshWidget::isBusy() const {
+    return d_->thread != nullptr;
+}
+QString RemeshWidget::statusText() const {
+    return d_->status->text();
+}
 
 void RemeshWidget::setActiveTool(Tool* tool) {
     if (!tool || tool == d_->active) return;
@@ -634,11 +687,11 @@ void RemeshWidget::setBusy(bool busy, const QString& what) {
         d_->cancelButton->hide();
         d_->busyWhat.clear();
     }
-    for (Tool* tool : {static_cast<Tool*>(d_->lasso), static_cast<Tool*>(d_->scanTool),
-                       static_cast<Tool*>(d_->fishbone)})
+    for (Tool* tool :
+         {static_cast<Tool*>(d_->lasso), static_cast<Tool*>(d_->scanTool), static_cast<Tool*>(d_->fishbone)})
         tool->setEnabled(!busy);
-    for (QAction* a : {d_->lassoAction, d_->scanModeAction, d_->fishboneAction, d_->scanAction, d_->directionAction,
-                       d_->keyRibAction, d_->drawBackboneAction, d_->drawRibAction})
+    for (QAction* a : {d_->lassoAction, d_->scanModeAction, d_->fishboneAction, d_->scanAction,
+                       d_->directionAction, d_->keyRibAction, d_->drawBackboneAction, d_->drawRibAction})
         a->setEnabled(!busy);
     const bool preview = !busy && d_->session && d_->session->preview();
     d_->acceptAction->setEnabled(preview);
@@ -653,9 +706,12 @@ void RemeshWidget::setBusy(bool busy, const QString& what) {
 
 void RemeshWidget::updateStatus() {
     QString text;
-    if (isBusy() || !d_->busyWhat.isEmpty()) text = d_->busyWhat + tr("… (Cancel stops it)");
-    else if (!d_->session) text = tr("Open a mesh to start.");
-    else if (d_->active) text = d_->active->statusText();
+    if (isBusy() || !d_->busyWhat.isEmpty())
+        text = d_->busyWhat + tr("… (Cancel stops it)");
+    else if (!d_->session)
+        text = tr("Open a mesh to start.");
+    else if (d_->active)
+        text = d_->active->statusText();
     if (text == d_->status->text()) return;
     d_->status->setText(text);
     emit statusChanged(text);

@@ -77,22 +77,54 @@ ScanPanel::ScanPanel(QWidget* parent) : QWidget(parent) {
 
 ScanPanel::~ScanPanel() = default;
 
-int ScanPanel::resolution() const { return resolution_->value(); }
-void ScanPanel::setResolution(int pixels) { resolution_->setValue(pixels); }
-int ScanPanel::erodeRadius() const { return erode_->value(); }
-void ScanPanel::setErodeRadius(int radius) { erode_->setValue(radius); }
-int ScanPanel::dilateRadius() const { return dilate_->value(); }
-void ScanPanel::setDilateRadius(int radius) { dilate_->setValue(radius); }
-double ScanPanel::maxEdgeFootprints() const { return maxEdge_->value(); }
-void ScanPanel::setMaxEdgeFootprints(double footprints) { maxEdge_->setValue(footprints); }
-double ScanPanel::maxSamplingAngleDeg() const { return maxAngle_->value(); }
-void ScanPanel::setMaxSamplingAngleDeg(double degrees) { maxAngle_->setValue(degrees); }
-double ScanPanel::qualityMargin() const { return margin_->value(); }
-void ScanPanel::setQualityMargin(double margin) { margin_->setValue(margin); }
-bool ScanPanel::forceReplace() const { return force_->isChecked(); }
-void ScanPanel::setForceReplace(bool force) { force_->setChecked(force); }
-double ScanPanel::fishboneSpacing() const { return spacing_->value(); }
-void ScanPanel::setFishboneSpacing(double pixels) { spacing_->setValue(pixels); }
+int ScanPanel::resolution() const {
+    return resolution_->value();
+}
+void ScanPanel::setResolution(int pixels) {
+    resolution_->setValue(pixels);
+}
+int ScanPanel::erodeRadius() const {
+    return erode_->value();
+}
+void ScanPanel::setErodeRadius(int radius) {
+    erode_->setValue(radius);
+}
+int ScanPanel::dilateRadius() const {
+    return dilate_->value();
+}
+void ScanPanel::setDilateRadius(int radius) {
+    dilate_->setValue(radius);
+}
+double ScanPanel::maxEdgeFootprints() const {
+    return maxEdge_->value();
+}
+void ScanPanel::setMaxEdgeFootprints(double footprints) {
+    maxEdge_->setValue(footprints);
+}
+double ScanPanel::maxSamplingAngleDeg() const {
+    return maxAngle_->value();
+}
+void ScanPanel::setMaxSamplingAngleDeg(double degrees) {
+    maxAngle_->setValue(degrees);
+}
+double ScanPanel::qualityMargin() const {
+    return margin_->value();
+}
+void ScanPanel::setQualityMargin(double margin) {
+    margin_->setValue(margin);
+}
+bool ScanPanel::forceReplace() const {
+    return force_->isChecked();
+}
+void ScanPanel::setForceReplace(bool force) {
+    force_->setChecked(force);
+}
+double ScanPanel::fishboneSpacing() const {
+    return spacing_->value();
+}
+void ScanPanel::setFishboneSpacing(double pixels) {
+    spacing_->setValue(pixels);
+}
 
 QSize ScanPanel::scanSize(QSizeF viewSize) const {
     const int r = resolution();
@@ -128,7 +160,9 @@ void ScanPanel::updateEdgeLength(const std::optional<Camera>& viewCamera, const 
     refreshEdgeLength();
 }
 
-QString ScanPanel::edgeLengthText() const { return edgeLabel_->text(); }
+QString ScanPanel::edgeLengthText() const {
+    return edgeLabel_->text();
+}
 
 void ScanPanel::refreshEdgeLength() {
     edgeLength_ = 0;

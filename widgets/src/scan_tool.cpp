@@ -14,11 +14,14 @@ ScanTool::ScanTool(VtkView* view, const ScanPanel* panel, const LassoTool* lasso
 
 ScanTool::~ScanTool() = default;
 
-QString ScanTool::name() const { return tr("Scan"); }
+QString ScanTool::name() const {
+    return tr("Scan");
+}
 
 QString ScanTool::statusText() const {
     if (!isEnabled()) return tr("Please wait until the current work has finished.");
-    if (previewPending_) return tr("Scan preview shown: press Accept (Enter) to stitch it in or Reject (Esc).");
+    if (previewPending_)
+        return tr("Scan preview shown: press Accept (Enter) to stitch it in or Reject (Esc).");
     const QSize size = panel_->scanSize(QSizeF(view()->size()));
     const QString where = lasso_ && lasso_->hasLasso() ? tr("inside the lasso") : tr("of the whole view");
     return tr("Navigate to a view, then press Scan (Enter) for a %1×%2 scan %3.")
@@ -43,14 +46,18 @@ void ScanTool::setPreviewPending(bool pending) {
     notifyStatus();
 }
 
-void ScanTool::requestScan() { emit scanRequested(); }
+void ScanTool::requestScan() {
+    emit scanRequested();
+}
 
 bool ScanTool::handleEvent(QEvent* event) {
     if (event->type() != QEvent::KeyPress) return false;
     auto* e = static_cast<QKeyEvent*>(event);
     if (e->key() == Qt::Key_Return || e->key() == Qt::Key_Enter) {
-        if (previewPending_) emit acceptRequested();
-        else emit scanRequested();
+        if (previewPending_)
+            emit acceptRequested();
+        else
+            emit scanRequested();
         return true;
     }
     if (e->key() == Qt::Key_Escape && previewPending_) {

@@ -34,9 +34,13 @@ void Tool::setEnabled(bool enabled) {
     notifyStatus();
 }
 
-void Tool::notifyStatus() { emit statusChanged(statusText()); }
+void Tool::notifyStatus() {
+    emit statusChanged(statusText());
+}
 
-bool Tool::handleEvent(QEvent*) { return false; }
+bool Tool::handleEvent(QEvent*) {
+    return false;
+}
 
 bool Tool::eventFilter(QObject* watched, QEvent* event) {
     if (watched != view_ || !active_ || !enabled_) return false;
@@ -45,7 +49,9 @@ bool Tool::eventFilter(QObject* watched, QEvent* event) {
 
 NavigateTool::NavigateTool(VtkView* view, QObject* parent) : Tool(view, parent) {}
 
-QString NavigateTool::name() const { return tr("Navigate"); }
+QString NavigateTool::name() const {
+    return tr("Navigate");
+}
 
 QString NavigateTool::statusText() const {
     return tr("Drag with the left button to rotate, the middle button (or Shift) to pan, the wheel to zoom.");

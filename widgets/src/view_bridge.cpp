@@ -41,7 +41,9 @@ concept HasRenderer = requires(V& v) {
     { v.createMeshRenderer() } -> std::convertible_to<std::unique_ptr<MeshRenderer>>;
 };
 template <class E>
-concept HasScanIdMap = requires { E::ScanId; };
+concept HasScanIdMap = requires {
+    E::ScanId;
+};
 
 constexpr const char* kStateName = "fss_widgets_bridge_overlay";
 
@@ -57,8 +59,10 @@ public:
         setFocusPolicy(Qt::NoFocus);
         setGeometry(view->rect());
         view->installEventFilter(this);
-        if constexpr (HasOverlay<VtkView>) hide();
-        else show();
+        if constexpr (HasOverlay<VtkView>)
+            hide();
+        else
+            show();
     }
 
     std::array<std::vector<Stroke>, std::size_t(Layer::Count)> layers;
@@ -67,7 +71,8 @@ public:
 
     std::vector<Stroke> all() const {
         std::vector<Stroke> out;
-        for (const auto& layer : layers) out.insert(out.end(), layer.begin(), layer.end());
+        for (const auto& layer : layers)
+            out.insert(out.end(), layer.begin(), layer.end());
         return out;
     }
 
@@ -90,12 +95,14 @@ protected:
             painter.setPen(pen);
             painter.setBrush(Qt::NoBrush);
             QPainterPath path(s.points.front());
-            for (std::size_t i = 1; i < s.points.size(); ++i) path.lineTo(s.points[i]);
+            for (std::size_t i = 1; i < s.points.size(); ++i)
+                path.lineTo(s.points[i]);
             if (s.closed) path.closeSubpath();
             painter.drawPath(path);
             if (s.markers) {
                 painter.setBrush(s.color);
-                for (const QPointF& p : s.points) painter.drawEllipse(p, s.width + 2, s.width + 2);
+                for (const QPointF& p : s.points)
+                    painter.drawEllipse(p, s.width + 2, s.width + 2);
             }
         }
     }
@@ -118,8 +125,10 @@ template <class V> void pushOverlay(V* view, QWidget* fallback, const std::vecto
             p.width = s.width;
             paths.push_back(std::move(p));
         }
-        if (paths.empty()) view->clearOverlay();
-        else view->setOverlay(std::move(paths));
+        if (paths.empty())
+            view->clearOverlay();
+        else
+            view->setOverlay(std::move(paths));
     } else {
         (void)view;
         (void)all;
@@ -128,7 +137,9 @@ template <class V> void pushOverlay(V* view, QWidget* fallback, const std::vecto
     }
 }
 
-void OverlayState::changed() { pushOverlay(view_, this, all()); }
+void OverlayState::changed() {
+    pushOverlay(view_, this, all());
+}
 
 OverlayState* state(const VtkView* view) {
     for (QObject* child : view->children())
@@ -152,7 +163,10 @@ void projectPreview(VtkView* view, OverlayState& s) {
             if (camera.viewDepth(a) <= 0 || camera.viewDepth(b) <= 0) continue;
             const Eigen::Vector3d pa = camera.project(a), pb = camera.project(b);
             strokes.push_back({{QPointF(pa.x() * sx, pa.y() * sy), QPointF(pb.x() * sx, pb.y() * sy)},
-                               QColor(40, 200, 255), false, false, 2.0});
+                               QColor(40, 200, 255),
+                               false,
+                               false,
+                               2.0});
         }
     }
     s.layers[std::size_t(Layer::Preview)] = std::move(strokes);
@@ -192,8 +206,10 @@ void showMeshKeepCamera(VtkView* view, const Mesh& mesh) {
 namespace {
 template <class V> void setGhostImpl(V* view, const Mesh* reference) {
     if constexpr (HasGhost<V>) {
-        if (reference) view->setGhostMesh(*reference);
-        else view->clearGhostMesh();
+        if (reference)
+            view->setGhostMesh(*reference);
+        else
+            view->clearGhostMesh();
     } else {
         (void)view;
         (void)reference;
@@ -202,8 +218,10 @@ template <class V> void setGhostImpl(V* view, const Mesh* reference) {
 
 template <class V> void setPreviewImpl(V* view, const Mesh* patch) {
     if constexpr (HasPreview<V>) {
-        if (patch) view->setPreviewMesh(*patch);
-        else view->clearPreviewMesh();
+        if (patch)
+            view->setPreviewMesh(*patch);
+        else
+            view->clearPreviewMesh();
     } else {
         OverlayState* s = ensureState(view);
         s->previewBorder.clear();
@@ -252,11 +270,21 @@ template <class E> bool setScanIdImpl(VtkView* view) {
 
 } // namespace
 
-void setGhost(VtkView* view, const Mesh* reference) { setGhostImpl(view, reference); }
-void setPreview(VtkView* view, const Mesh* patch) { setPreviewImpl(view, patch); }
-void refreshPreview(VtkView* view) { refreshPreviewImpl(view); }
-std::unique_ptr<MeshRenderer> createRenderer(VtkView* view) { return createRendererImpl(view); }
-bool setScanIdColorMap(VtkView* view) { return setScanIdImpl<ColorMap>(view); }
+void setGhost(VtkView* view, const Mesh* reference) {
+    setGhostImpl(view, reference);
+}
+void setPreview(VtkView* view, const Mesh* patch) {
+    setPreviewImpl(view, patch);
+}
+void refreshPreview(VtkView* view) {
+    refreshPreviewImpl(view);
+}
+std::unique_ptr<MeshRenderer> createRenderer(VtkView* view) {
+    return createRendererImpl(view);
+}
+bool setScanIdColorMap(VtkView* view) {
+    return setScanIdImpl<ColorMap>(view);
+}
 
 QString features() {
     QStringList f;

@@ -127,10 +127,10 @@ private:
     std::vector<QPointF> keyRibs_;
     QPolygonF drawnBackbone_;
     std::vector<QPolygonF> drawnRibs_;
-    QPolygonF stroke_;       // a drawing in progress
+    QPolygonF stroke_; // a drawing in progress
     bool drawing_ = false;
-    int dragIndex_ = -1;     // key-rib being dragged
-    QPolygonF backbone_;     // shown (from the last grid)
+    int dragIndex_ = -1; // key-rib being dragged
+    QPolygonF backbone_; // shown (from the last grid)
     std::vector<QPolygonF> ribs_;
     bool gridShown_ = false;
     QString problem_;

@@ -16,12 +16,13 @@ namespace fss::widgets {
 
 /// Maps between view DIP and scan-image pixels (see the file comment).
 struct ScreenMapping {
-    QSizeF view;  ///< the view's size in device-independent pixels (QWidget::size())
-    QSize image;  ///< the scan image's size in pixels (Camera::width × Camera::height)
+    QSizeF view; ///< the view's size in device-independent pixels (QWidget::size())
+    QSize image; ///< the scan image's size in pixels (Camera::width × Camera::height)
 
     /// Whether both sizes are non-empty.
     bool isValid() const { return !view.isEmpty() && !image.isEmpty(); }
-    /// A view position (DIP) → scan-image pixel position (sub-pixel; pixel (i, j) covers [i, i+1) × [j, j+1)).
+    /// A view position (DIP) → scan-image pixel position (sub-pixel; pixel (i, j) covers [i, i+1) × [j,
+    /// j+1)).
     Eigen::Vector2d toImage(const QPointF& p) const {
         return {p.x() * image.width() / view.width(), p.y() * image.height() / view.height()};
     }
