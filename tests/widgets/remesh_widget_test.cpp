@@ -26,12 +26,14 @@
 
 #include <QApplication>
 #include <QElapsedTimer>
+#include <QLineF>
 #include <QMouseEvent>
 #include <QPushButton>
 #include <QSignalSpy>
 #include <QTest>
 #include <QTimer>
 #include <QUndoStack>
+#include <QUndoView>
 
 #include <algorithm>
 #include <array>
@@ -343,6 +345,7 @@ private slots:
         QCOMPARE(w->qualityPanel()->updateCount(), panelUpdates + 1);
         compareQuality(*w->qualityPanel(), after);
         QCOMPARE(w->undoStack()->count(), 1);
+        QCOMPARE(w->historyView()->model()->rowCount(), 2); // "Input mesh" and the scan
         qInfo("lasso scan: %zu patch faces; stitch removed %zu, added %zu faces; %zu far faces untouched",
               std::size_t(patch.number_of_faces()), report.facesRemoved, report.facesAdded, far);
 
@@ -462,6 +465,41 @@ private slots:
         QVERIFY(!identical(before, w->mesh()));
         checkInvariants(before, w->mesh(), patch);
         compareQuality(*w->qualityPanel(), w->mesh());
+    }
+
+    void aDrawnBackboneGivesAGridAlongIt() {
+        auto w = shownWidget(fss::shapes::cylinder(96, 48, 1.0, 2.0, true));
+        QVERIFY(w);
+        w->view()->setStandardView(fss::StandardView::PosX);
+        w->scanPanel()->setResolution(256);
+        w->scanPanel()->setFishboneSpacing(3.0);
+        w->setActiveTool(w->fishboneTool());
+        FishboneTool* tool = w->fishboneTool();
+        tool->setInputMode(FishboneTool::InputMode::DrawBackbone);
+        QVERIFY(w->statusText().contains("draw the backbone"));
+        QWidget* view = w->view();
+        // A slanted stroke across the side of the cylinder.
+        const QPointF a(view->width() / 2.0 - 40, view->height() / 2.0 - 80);
+        const QPointF b(view->width() / 2.0 + 40, view->height() / 2.0 + 80);
+        sendMouse(view, QEvent::MouseButtonPress, a, Qt::LeftButton, Qt::LeftButton);
+        for (int i = 1; i <= 20; ++i)
+            sendMouse(view, QEvent::MouseMove, a + (b - a) * (i / 20.0), Qt::NoButton, Qt::LeftButton);
+        sendMouse(view, QEvent::MouseButtonRelease, b, Qt::LeftButton, Qt::NoButton);
+        QVERIFY(tool->drawnBackbone().size() >= 10);
+        QVERIFY(!tool->seed());
+        QVERIFY(waitIdle(*w));
+        QTRY_VERIFY_WITH_TIMEOUT(tool->hasGridPreview(), 30000);
+        const fss::ScanPreview& preview = *w->session()->preview();
+        QVERIFY(preview.step.fishbone && !preview.step.fishbone->drawnBackbone.empty());
+        QVERIFY(preview.patch.mesh.number_of_faces() > 100);
+        // The grid's backbone follows the stroke: every backbone sample lies on the segment a–b (DIP).
+        for (const QPointF& p : tool->backbone()) {
+            const QPointF d = b - a;
+            const double t = std::clamp(QPointF::dotProduct(p - a, d) / QPointF::dotProduct(d, d), 0.0, 1.0);
+            QVERIFY2(QLineF(p, a + t * d).length() < 1.5,
+                     qPrintable(QString("(%1, %2)").arg(p.x()).arg(p.y())));
+        }
+        QVERIFY(tool->backbone().size() > 20);
     }
 
     void aLassoOverTheBackgroundFailsWithOneSentence() {

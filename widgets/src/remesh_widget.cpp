@@ -77,6 +77,9 @@ private:
 struct RemeshWidget::Impl {
     std::unique_ptr<Session> session;
     Mesh empty;
+    // The GUI thread's copy of the session's current mesh: the worker may be replacing the session's
+    // own while the GUI reads this one.
+    Mesh mesh;
     VtkView* view = nullptr;
     ScanPanel* scanPanel = nullptr;
     QualityPanel* qualityPanel = nullptr;
@@ -318,15 +321,16 @@ bool RemeshWidget::setMesh(const Mesh& mesh) {
     }
     d_->undoStack->clear();
     d_->session = std::move(session);
+    d_->mesh = d_->session->current();
     d_->nextScanId = 0;
     d_->lasso->clear();
     d_->fishbone->clear();
     bridge::setPreview(d_->view, nullptr);
     d_->updatingView = true;
-    d_->view->setMesh(d_->session->current());
+    d_->view->setMesh(d_->mesh);
     d_->updatingView = false;
     setGhostVisible(ghost_);
-    d_->qualityPanel->setMesh(d_->session->current());
+    d_->qualityPanel->setMesh(d_->mesh);
     d_->scanPanel->updateEdgeLength(d_->view->camera(), boundingBox(d_->session->reference()).center());
     d_->scanTool->setPreviewPending(false);
     updateStatus();
@@ -347,7 +351,7 @@ bool RemeshWidget::openMesh(const QString& path) {
 }
 
 const Mesh& RemeshWidget::mesh() const {
-    return d_->session ? d_->session->current() : d_->empty;
+    return d_->mesh;
 }
 const Mesh& RemeshWidget::referenceMesh() const {
     return d_->session ? d_->session->reference() : d_->empty;
@@ -647,10 +651,11 @@ void RemeshWidget::redoStep() {
 }
 
 void RemeshWidget::afterMeshChange() {
+    d_->mesh = d_->session->current();
     d_->updatingView = true;
-    bridge::showMeshKeepCamera(d_->view, d_->session->current());
+    bridge::showMeshKeepCamera(d_->view, d_->mesh);
     d_->updatingView = false;
-    d_->qualityPanel->setMesh(d_->session->current());
+    d_->qualityPanel->setMesh(d_->mesh);
     showPreview();
     emit meshChanged();
 }

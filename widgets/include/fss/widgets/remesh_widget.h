@@ -58,7 +58,8 @@ public:
     /// mesh stays and errorOccurred() carries the reader's sentence. \return success
     bool openMesh(const QString& path);
     /// The current mesh (the reference with the accepted scans stitched in); empty before the first mesh.
-    /// While isBusy() it is the mesh before the running accept.
+    /// A copy owned by the GUI thread, safe to read at any time: while isBusy() it is the mesh before the
+    /// running accept.
     const Mesh& mesh() const;
     /// The reference mesh of the session (empty before the first mesh).
     const Mesh& referenceMesh() const;
