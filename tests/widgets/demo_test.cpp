@@ -102,6 +102,20 @@ private slots:
         QVERIFY(!QFile::exists(out));
     }
 
+    void screenshotAfterAScan() {
+        const QString out = tmp("demo_scanned.png");
+        QFile::remove(out);
+        const RunResult r = runDemo({"--screenshot", out, "--size", "800x600", "--scan", "+z", "--resolution", "96",
+                                     "--colormap", "angle",
+                                     QString::fromStdString(fss::test::meshPath("fandisk.off").string())});
+        QVERIFY2(r.exitCode == 0, qPrintable(r.err));
+        QImage image;
+        QVERIFY(image.load(out));
+        QVERIFY(fss::test::pixelFraction(image, fss::test::qualityGreen) > 0.02);
+        QCOMPARE(runDemo({"--screenshot", out, "--scan", "sideways"}).exitCode, 2);
+        QCOMPARE(runDemo({"--screenshot", out, "--resolution", "3"}).exitCode, 2);
+    }
+
     void wrongCommandLineIsRefused() {
         const RunResult r = runDemo({"--screenshot", tmp("x.png"), "--view", "sideways"});
         QCOMPARE(r.exitCode, 2);
