@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Sets up, builds and runs FSS's main job on the bundled default input (CGAL's fandisk.off): the metrics
-# of the input, one 256² virtual range scan from the iso view into a regular patch (written to
-# build/out/fandisk_iso_patch.ply), and the metrics of that patch against the input.
+# Sets up, builds and runs FSS's main job on the bundled default input (CGAL's fandisk.off): replays the
+# example session examples/fandisk.session.json (seven regular scans and two fishbone scans, recorded by
+# examples/record_fandisk_session.cpp) head-less, writes the remeshed mesh, a JSON report (every metric
+# against the input, per-scan timings and stitch reports) and a minimum-angle snapshot to build/out/.
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 "$here/scripts/setup.sh"
@@ -13,8 +14,6 @@ mkdir -p "$out"
 echo "== input: $mesh"
 "$build/bin/fss-remesh" info "$mesh"
 echo
-echo "== scan (iso view, 256x256)"
-"$build/bin/fss-remesh" scan "$mesh" -o "$out/fandisk_iso_patch.ply" --view iso --resolution 256
-echo
-echo "== patch against the input"
-"$build/bin/fss-remesh" info "$out/fandisk_iso_patch.ply" --ref "$mesh"
+echo "== replay of examples/fandisk.session.json"
+"$build/bin/fss-remesh" run "$here/examples/fandisk.session.json" -o "$out/fandisk_remeshed.ply" \
+  --report "$out/fandisk_report.json" --snapshot "$out/fandisk_remeshed.png"

@@ -1,9 +1,13 @@
 // Session: reference, current mesh, preview, history (session.h).
 //
-// FIRST VERSION: the history keeps whole copies of the mesh before and after each step. It is exact and
-// correct but its memory grows with the mesh; it is to be replaced by per-step change records.
+// The current mesh is kept garbage-free (collect_garbage after every stitch, which is deterministic), so
+// it is fully described by its element arrays. Each history step stores the index-wise difference of those
+// arrays between the states before and after the stitch (detail::MeshDelta); undo / redo write one side
+// back. Finding the differing records compares the two states once per accept (O(mesh), a few ms per
+// 100k faces); the record itself, and undo / redo, are O(change).
 #include "fss/session.h"
 
+#include "detail/mesh_delta.h"
 #include "fss/error.h"
 
 #include <chrono>
@@ -16,9 +20,19 @@ namespace {
 struct HistoryItem {
     ScanStep step;
     StitchReport report;
-    Mesh before;
-    Mesh after;
+    detail::MeshDelta delta; // before → after of the current mesh
 };
+
+// Heap bytes of the parts of a step that are not the mesh delta.
+std::size_t stepBytes(const ScanStep& step, const StitchReport& report) {
+    std::size_t bytes = 0;
+    if (step.params.lasso) bytes += step.params.lasso->points.capacity() * sizeof(step.params.lasso->points[0]);
+    if (step.fishbone)
+        bytes += (step.fishbone->keyRibs.capacity() + step.fishbone->drawnBackbone.capacity()) *
+                 sizeof(Eigen::Vector2d);
+    for (const std::string& s : report.skipped) bytes += sizeof(std::string) + s.capacity();
+    return bytes;
+}
 
 std::unique_ptr<MeshRenderer> makeRenderer(const RendererFactory& factory) {
     if (factory) {
@@ -39,7 +53,8 @@ struct Session::Impl {
     bool currentRendererValid = false;
     std::optional<ScanPreview> preview;
     std::deque<HistoryItem> history;
-    std::size_t applied = 0; // history[0, applied) is applied
+    std::size_t applied = 0;   // history[0, applied) is applied
+    std::size_t forgotten = 0; // oldest steps dropped beyond maxUndoSteps
     std::vector<SessionEvent> events;
     FishboneCache fishboneCache;
 
@@ -59,6 +74,9 @@ Session::Session(Mesh reference, SessionOptions options) : impl_(std::make_uniqu
     if (!reference.is_valid(false)) throw InvalidInputError("The session's input mesh is not a valid halfedge mesh.");
     if (options.maxUndoSteps < 50) options.maxUndoSteps = 50;
     impl_->options = std::move(options);
+    // The history needs a garbage-free current mesh (collect_garbage renumbers: do it on the reference
+    // too so that the two agree index for index).
+    if (reference.has_garbage()) reference.collect_garbage();
     impl_->reference = std::move(reference);
     impl_->current = impl_->reference;
     impl_->referenceRenderer = makeRenderer(impl_->options.renderer);
@@ -76,7 +94,8 @@ const Mesh& Session::current() const { return impl_->current; }
 const ScanPreview& Session::scan(const ScanStep& step, const Progress& progress) {
     Impl& d = *impl_;
     const auto start = std::chrono::steady_clock::now();
-    const bool first = d.applied == 0;
+    // Until the first step the current mesh is the reference itself: scan with the one renderer.
+    const bool first = d.applied == 0 && d.forgotten == 0;
     const Mesh& current = first ? d.reference : d.current;
     MeshRenderer& currentRenderer = first ? *d.referenceRenderer : d.rendererOfCurrent();
     ScanPreview preview;
@@ -108,20 +127,31 @@ const StitchReport& Session::accept(const Progress& progress) {
     Impl& d = *impl_;
     if (!d.preview) throw InvalidInputError("There is no scan to accept: take a scan first.");
     progress.report(0.0, "stitch");
+    // Everything is computed on a copy; the session's state changes only after the last step that can
+    // throw (strong guarantee).
     Mesh next = d.current;
     const ScanPreview& p = *d.preview;
-    StitchReport report = stitchPatch(next, p.patch.mesh, p.step.params.camera, p.step.stitch,
-                                      p.currentBuffers.faceId);
-    HistoryItem item{p.step, std::move(report), d.current, std::move(next)};
-    d.history.erase(d.history.begin() + std::ptrdiff_t(d.applied), d.history.end());
-    d.history.push_back(std::move(item));
-    d.current = d.history.back().after;
+    StitchOptions options = p.step.stitch;
+    options.collectGarbage = true;
+    StitchReport report = stitchPatch(next, p.patch.mesh, p.step.params.camera, options, p.currentBuffers.faceId);
+    if (next.has_garbage()) next.collect_garbage();
+    progress.report(0.9, "record");
+    HistoryItem item{p.step, std::move(report), detail::MeshDelta::between(d.current, next)};
+    d.events.reserve(d.events.size() + 1);
+    progress.report(1.0, "stitch");
+    SessionEvent event{SessionEvent::Kind::Accept, p.step};
+    d.history.push_back(std::move(item)); // strong guarantee of deque::push_back
+    // No allocation from here on.
+    d.history.erase(d.history.begin() + std::ptrdiff_t(d.applied), d.history.end() - 1); // drop redo steps
+    d.current = std::move(next);
     d.currentRendererValid = false;
-    d.events.push_back({SessionEvent::Kind::Accept, p.step});
-    while (d.history.size() > d.options.maxUndoSteps) d.history.pop_front();
+    d.events.push_back(std::move(event)); // capacity reserved above: no allocation
+    while (d.history.size() > d.options.maxUndoSteps) {
+        d.history.pop_front();
+        ++d.forgotten;
+    }
     d.applied = d.history.size();
     d.preview.reset();
-    progress.report(1.0, "stitch");
     return d.history.back().report;
 }
 
@@ -133,8 +163,9 @@ std::size_t Session::redoCount() const { return impl_->history.size() - impl_->a
 void Session::undo() {
     Impl& d = *impl_;
     if (!canUndo()) throw InvalidInputError("There is nothing to undo.");
+    d.events.reserve(d.events.size() + 1);
+    d.history[d.applied - 1].delta.applyBackward(d.current);
     d.preview.reset();
-    d.current = d.history[d.applied - 1].before;
     --d.applied;
     d.currentRendererValid = false;
     d.events.push_back({SessionEvent::Kind::Undo, {}});
@@ -143,8 +174,9 @@ void Session::undo() {
 void Session::redo() {
     Impl& d = *impl_;
     if (!canRedo()) throw InvalidInputError("There is nothing to redo.");
+    d.events.reserve(d.events.size() + 1);
+    d.history[d.applied].delta.applyForward(d.current);
     d.preview.reset();
-    d.current = d.history[d.applied].after;
     ++d.applied;
     d.currentRendererValid = false;
     d.events.push_back({SessionEvent::Kind::Redo, {}});
@@ -164,8 +196,7 @@ const StitchReport& Session::report(std::size_t i) const {
 std::size_t Session::historyBytes() const {
     std::size_t bytes = 0;
     for (const HistoryItem& item : impl_->history)
-        bytes += (item.before.number_of_vertices() + item.after.number_of_vertices()) * 40 +
-                 (item.before.number_of_faces() + item.after.number_of_faces()) * 80;
+        bytes += sizeof(HistoryItem) - sizeof(detail::MeshDelta) + item.delta.bytes() + stepBytes(item.step, item.report);
     return bytes;
 }
 

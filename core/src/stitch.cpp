@@ -128,6 +128,22 @@ double minAngle(const Vec3& a, const Vec3& b, const Vec3& c) {
     }
     return best;
 }
+// Distance between the segments pq and rs.
+double segmentGap(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& s) {
+    const Vec3 d1 = q - p, d2 = s - r, w = p - r;
+    const double a = d1.dot(d1), b = d1.dot(d2), c = d2.dot(d2), d = d1.dot(w), e = d2.dot(w);
+    const double den = a * c - b * b;
+    double t = den > 1e-300 ? std::clamp((b * e - c * d) / den, 0.0, 1.0) : 0.0;
+    double u = c > 0 ? std::clamp((b * t + e) / c, 0.0, 1.0) : 0.0;
+    t = a > 0 ? std::clamp((b * u - d) / a, 0.0, 1.0) : 0.0;
+    return (p + t * d1 - (r + u * d2)).norm();
+}
+// A flip outside the patch between pieces of two mesh faces may move the surface by this × the patch's
+// median edge length.
+constexpr double kNearPlanarFlipGap = 0.05;
+// Faces near the seam with a smaller angle (degrees) get a collapse of their shortest edge tried.
+constexpr double kNeedleDeg = 20.0;
+
 Vec3 normalOf(const Vec3& a, const Vec3& b, const Vec3& c) {
     return (b - a).cross(c - a);
 }
@@ -1972,6 +1988,48 @@ private:
             if (smoothOutside(loc) == 0) break;
             flipPass(loc, plan);
         }
+        // -- needles: a face near the seam with a small angle loses its shortest edge when collapsing it
+        // (either way, with every check of tryCollapse: no fold, no flip in the view, pieces outside stay
+        // in their planes) raises the smallest angle around; then flip again.
+        for (int pass = 0; pass < 3; ++pass) {
+            const auto near = seamNeighbourhood(loc);
+            std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
+            for (FaceIndex f : S.faces()) {
+                if (loc.star.kept[f]) continue;
+                const HalfedgeIndex h0 = S.halfedge(f);
+                const VertexIndex v[3] = {S.source(h0), S.target(h0), S.target(S.next(h0))};
+                if (!near.count(std::uint32_t(v[0])) && !near.count(std::uint32_t(v[1])) &&
+                    !near.count(std::uint32_t(v[2])))
+                    continue;
+                const double ang = minAngle(pt(S, v[0]), pt(S, v[1]), pt(S, v[2]));
+                if (ang >= kNeedleDeg * kDeg) continue;
+                int best = 0;
+                double bestLen = std::numeric_limits<double>::infinity();
+                for (int k = 0; k < 3; ++k) {
+                    const double len = (pt(S, v[k]) - pt(S, v[(k + 1) % 3])).norm();
+                    if (len < bestLen) {
+                        bestLen = len;
+                        best = k;
+                    }
+                }
+                cands.push_back({ang, {v[best], v[(best + 1) % 3]}});
+            }
+            std::sort(cands.begin(), cands.end());
+            std::size_t done = 0;
+            for (const auto& c : cands) {
+                const auto [a, b] = c.second;
+                if (S.is_removed(a) || S.is_removed(b) || S.halfedge(a, b) == Mesh::null_halfedge()) continue;
+                double s1 = -1, s2 = -1;
+                const bool ok1 = tryCollapse(a, b, s1), ok2 = tryCollapse(b, a, s2);
+                if (!ok1 && !ok2) continue;
+                const VertexIndex from = (ok1 && (!ok2 || s1 >= s2)) ? a : b, to = from == a ? b : a;
+                collapse(loc, from, to);
+                ++done;
+            }
+            plan.collapses += done;
+            if (done == 0) break;
+            flipPass(loc, plan);
+        }
     }
 
     // A seam vertex on a mesh edge (a crossing, a snapped patch vertex) slides along that edge towards the
@@ -2205,16 +2263,25 @@ private:
             // (tilted only where they reach a patch vertex) and the new ones are tilted no more.
             const bool patchSide = loc.patchSide[S.face(h)];
             if (patchSide != loc.patchSide[S.face(o)]) continue;
+            bool nearPlanar = false;
             const double turn = std::max(
                 {angleBetween(o1, n1), angleBetween(o1, n2), angleBetween(o2, n1), angleBetween(o2, n2)});
             if (patchSide) {
                 if (turn > maxTurn) continue;
             } else if (turn > kCoplanar) {
                 const Vec3 &p1 = loc.planeNormal[S.face(h)], &p2 = loc.planeNormal[S.face(o)];
-                if (angleBetween(p1, p2) > kCoplanar) continue;
-                const double tilt = std::max(angleBetween(o1, p1), angleBetween(o2, p1));
-                if (std::max(angleBetween(n1, p1), angleBetween(n2, p1)) > tilt + kCoplanar || turn > maxTurn)
-                    continue;
+                bool allowed = false;
+                if (angleBetween(p1, p2) <= kCoplanar) {
+                    const double tilt = std::max(angleBetween(o1, p1), angleBetween(o2, p1));
+                    allowed = std::max(angleBetween(n1, p1), angleBetween(n2, p1)) <= tilt + kCoplanar &&
+                              turn <= maxTurn;
+                }
+                // Pieces of two mesh faces that are nearly coplanar (a smoothly curved part of the mesh): the
+                // flip moves the surface by the gap between the two diagonals, allowed up to a small
+                // fraction of the patch's edge length (far below a pixel footprint).
+                nearPlanar = !allowed && turn <= maxTurn &&
+                             segmentGap(X, Y, Z1, Z2) <= kNearPlanarFlipGap * h3_;
+                if (!allowed && !nearPlanar) continue;
             }
             const double oldMin = std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2));
             const double newMin = std::min(minAngle(X, Z2, Z1), minAngle(Z2, Y, Z1));
@@ -2227,6 +2294,13 @@ private:
             if (!(gain > 0.5) || newMin < std::min(oldMin, 20.0 * kDeg)) continue;
             CGAL::Euler::flip_edge(h, S);
             ++flips;
+            if (nearPlanar) // the new pieces keep their own planes from now on
+                for (HalfedgeIndex g : {h, o}) {
+                    const FaceIndex f = S.face(g);
+                    const HalfedgeIndex k = S.halfedge(f);
+                    loc.planeNormal[f] =
+                        normalOf(pt(S, S.source(k)), pt(S, S.target(k)), pt(S, S.target(S.next(k)))).normalized();
+                }
             for (HalfedgeIndex g : {S.next(h), S.prev(h), S.next(o), S.prev(o)}) {
                 const EdgeIndex ge = S.edge(g);
                 if (queued.insert(std::uint32_t(ge)).second) queue.push_back(ge);

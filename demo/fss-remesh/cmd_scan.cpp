@@ -1,4 +1,4 @@
-// fss-remesh scan MESH -o OUT [--view V | --camera ...] [--parallel] [--resolution W[xH]] [--zoom F]
+// fss-remesh scan MESH -o OUT [--into CURRENT] [--view V | --camera ...] [--parallel] [--resolution W[xH]] [--zoom F]
 //                  [--lasso "x,y;x,y;..."] [--erode N] [--dilate N] [--json] ...
 //                  [--fishbone "seed=X,Y[;dir=min|max][;h=PIXELS][;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...]"]
 #include "args.h"
@@ -10,12 +10,16 @@
 #include "fss/mesh_io.h"
 #include "fss/render/gpu_mesh_renderer.h"
 #include "fss/scan_pipeline.h"
+#include "fss/stitch.h"
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 
 namespace fss::cli {
 namespace {
@@ -166,50 +170,125 @@ std::unique_ptr<MeshRenderer> makeRenderer(const std::string& kind, std::string&
     }
 }
 
-int runFishboneScan(const Mesh& reference, MeshRenderer& renderer, std::string rendererUsed, const ScanParams& params,
-                    const FishboneParams& fishbone, const std::string& meshPath, const std::string& outPath, bool json) {
+// What either kind of scan produced, with its part of the JSON report and of the text summary.
+struct ScanRun {
+    Patch patch;
+    FrameBuffers currentBuffers; // the current mesh from the scan camera (for the stitch)
+    nlohmann::json json;         // everything but input / output / renderer
+    std::string summary;         // "fishbone-scanned ... in 0.1 s"
+};
+
+ScanRun fishboneScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& current,
+                     MeshRenderer& currentRenderer, const ScanParams& params, const FishboneParams& fishbone,
+                     const std::string& meshPath, const std::string& rendererUsed) {
     FishboneCache cache;
-    const FishboneScanResult result = scanFishbonePatch(reference, renderer, reference, renderer, params, fishbone, cache);
-    if (auto* gpu = dynamic_cast<render::GpuMeshRenderer*>(&renderer))
-        rendererUsed = "gpu (" + gpu->rasterizer().glRenderer() + ")";
-    writeMesh(result.patch.mesh, outPath, WriteOptions{.binary = false});
+    FishboneScanResult result =
+        scanFishbonePatch(reference, renderer, current, currentRenderer, params, fishbone, cache);
     const FishboneCounts& c = result.counts;
     const FishboneTimings& t = result.timings;
-    if (json) {
-        nlohmann::json j;
-        j["input"] = meshPath;
-        j["output"] = outPath;
-        j["renderer"] = rendererUsed;
-        j["grid"] = "fishbone";
-        j["resolution"] = {params.camera.width, params.camera.height};
-        j["fishbone"] = {{"direction", fishbone.direction == PrincipalDirection::Min ? "min" : "max"},
-                         {"h_pixels", fishbone.spacing},
-                         {"key_ribs", fishbone.keyRibs.size()},
-                         {"drawn_backbone", !fishbone.drawnBackbone.empty()}};
-        j["counts"] = {{"rows", c.rows},
-                       {"cols", c.cols},
-                       {"rib_vertices", c.ribVertices},
-                       {"covered", c.covered},
-                       {"front_facing", c.frontFacing},
-                       {"on_hint_face", c.onHintFace},
-                       {"after_lasso", c.afterLasso},
-                       {"after_quality", c.afterQuality},
-                       {"after_morphology", c.afterMorphology}};
-        addPatchCounts(j["counts"], result.patch);
-        j["timings_s"] = {{"curvature", t.curvature},          {"ray_caster_build", t.rayCasterBuild},
-                          {"render_reference", t.renderReference}, {"direction_field", t.directionField},
-                          {"tracing", t.tracing},              {"ray_casting", t.rayCasting},
-                          {"masks", t.masks},                  {"triangulate", t.triangulate},
-                          {"total", t.total}};
-        std::cout << j.dump(2) << "\n";
-    } else {
-        std::cout << "fishbone-scanned " << meshPath << " at " << params.camera.width << "x" << params.camera.height
-                  << " (" << rendererUsed << "): " << c.rows << " ribs x " << c.cols << " columns, " << c.covered
-                  << " samples -> patch of " << result.patch.mesh.number_of_vertices() << " vertices, "
-                  << result.patch.mesh.number_of_faces() << " faces in " << t.total << " s, written to " << outPath
-                  << "\n";
-    }
-    return 0;
+    ScanRun run;
+    nlohmann::json& j = run.json;
+    j["grid"] = "fishbone";
+    j["resolution"] = {params.camera.width, params.camera.height};
+    j["fishbone"] = {{"direction", fishbone.direction == PrincipalDirection::Min ? "min" : "max"},
+                     {"h_pixels", fishbone.spacing},
+                     {"key_ribs", fishbone.keyRibs.size()},
+                     {"drawn_backbone", !fishbone.drawnBackbone.empty()}};
+    j["counts"] = {{"rows", c.rows},
+                   {"cols", c.cols},
+                   {"rib_vertices", c.ribVertices},
+                   {"covered", c.covered},
+                   {"front_facing", c.frontFacing},
+                   {"on_hint_face", c.onHintFace},
+                   {"after_lasso", c.afterLasso},
+                   {"after_quality", c.afterQuality},
+                   {"after_morphology", c.afterMorphology}};
+    addPatchCounts(j["counts"], result.patch);
+    j["timings_s"] = {{"curvature", t.curvature},          {"ray_caster_build", t.rayCasterBuild},
+                      {"render_reference", t.renderReference}, {"direction_field", t.directionField},
+                      {"tracing", t.tracing},              {"ray_casting", t.rayCasting},
+                      {"masks", t.masks},                  {"triangulate", t.triangulate},
+                      {"total", t.total}};
+    std::ostringstream text;
+    text << "fishbone-scanned " << meshPath << " at " << params.camera.width << "x" << params.camera.height << " ("
+         << rendererUsed << "): " << c.rows << " ribs x " << c.cols << " columns, " << c.covered
+         << " samples -> patch of " << result.patch.mesh.number_of_vertices() << " vertices, "
+         << result.patch.mesh.number_of_faces() << " faces in " << t.total << " s";
+    run.summary = text.str();
+    run.patch = std::move(result.patch);
+    run.currentBuffers = std::move(result.currentBuffers);
+    return run;
+}
+
+ScanRun regularScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& current, MeshRenderer& currentRenderer,
+                    const ScanParams& params, const std::string& meshPath, const std::string& rendererUsed) {
+    ScanResult result = scanPatch(reference, renderer, current, currentRenderer, params);
+    const ScanCounts& c = result.counts;
+    const ScanTimings& t = result.timings;
+    ScanRun run;
+    nlohmann::json& j = run.json;
+    j["resolution"] = {params.camera.width, params.camera.height};
+    j["camera"] = {{"eye", {params.camera.eye.x(), params.camera.eye.y(), params.camera.eye.z()}},
+                   {"focal", {params.camera.focal.x(), params.camera.focal.y(), params.camera.focal.z()}},
+                   {"up", {params.camera.up.x(), params.camera.up.y(), params.camera.up.z()}},
+                   {"parallel", params.camera.parallel},
+                   {"view_angle_deg", params.camera.viewAngleDeg},
+                   {"parallel_scale", params.camera.parallelScale}};
+    j["counts"] = {{"pixels", c.pixels},
+                   {"covered", c.covered},
+                   {"front_facing", c.frontFacing},
+                   {"after_lasso", c.afterLasso},
+                   {"after_quality", c.afterQuality},
+                   {"after_morphology", c.afterMorphology}};
+    addPatchCounts(j["counts"], result.patch);
+    j["timings_s"] = {{"render_reference", t.renderReference}, {"render_current", t.renderCurrent},
+                      {"sample", t.sample},                    {"lasso", t.lasso},
+                      {"quality_mask", t.qualityMask},         {"morphology", t.morphology},
+                      {"triangulate", t.triangulate},          {"total", t.total}};
+    std::ostringstream text;
+    text << "scanned " << meshPath << " at " << params.camera.width << "x" << params.camera.height << " ("
+         << rendererUsed << "): " << c.covered << " covered pixels -> patch of "
+         << result.patch.mesh.number_of_vertices() << " vertices, " << result.patch.mesh.number_of_faces()
+         << " faces in " << t.total << " s";
+    run.summary = text.str();
+    run.patch = std::move(result.patch);
+    run.currentBuffers = std::move(result.currentBuffers);
+    return run;
+}
+
+// The StitchReport with snake_case keys.
+nlohmann::json stitchJson(const StitchReport& r) {
+    return {{"faces_removed", r.facesRemoved},
+            {"faces_added", r.facesAdded},
+            {"seam_edges", r.seamEdges},
+            {"seam_length", r.seamLength},
+            {"seam_min_angle_deg", r.seamMinAngleDeg},
+            {"seam_frac_min_angle_above_25", r.seamFracMinAngleAbove25},
+            {"seam_faces", r.seamFaces},
+            {"components_stitched", r.componentsStitched},
+            {"components_skipped", r.componentsSkipped},
+            {"pieces_stitched", r.piecesStitched},
+            {"patch_faces_trimmed", r.patchFacesTrimmed},
+            {"collapses", r.collapses},
+            {"flips", r.flips},
+            {"skipped", r.skipped},
+            {"seconds", r.seconds}};
+}
+
+// The next free scan id of a mesh: one more than the largest props::faceScanId (0 when it has none).
+int nextScanId(const Mesh& mesh) {
+    const auto [ids, has] = mesh.property_map<FaceIndex, std::int32_t>(props::faceScanId);
+    std::int32_t next = 0;
+    if (has)
+        for (FaceIndex f : mesh.faces()) next = std::max(next, ids[f] + 1);
+    return next;
+}
+
+// True when the two paths name the same existing file.
+bool sameFile(const std::string& a, const std::string& b) {
+    std::error_code ec;
+    const bool same = std::filesystem::equivalent(a, b, ec);
+    return !ec && same;
 }
 
 } // namespace
@@ -218,14 +297,16 @@ int runScan(const std::vector<std::string>& args) {
     std::string meshPath, outPath, view = "iso", cameraText, resolution = "256", zoom = "1", lassoText, erodeText = "1",
                                    dilateText = "1", rendererKind = "auto", scanIdText = "0", maxEdge = "3",
                                    maxAngle = "80", margin = "0.1";
-    std::string fishboneText;
-    bool haveFishbone = false;
+    std::string fishboneText, intoPath;
+    bool haveFishbone = false, haveInto = false, haveScanId = false;
     bool haveView = false, haveCamera = false, haveLasso = false, parallel = false, json = false, force = false;
     ArgParser p("fss-remesh scan", "Scan MESH from a camera: render it off-screen, turn every covered pixel into a "
                                    "sample on the surface, mask the samples and triangulate the pixel grid into a "
-                                   "regular patch (interior valence 6), written to OUT.");
+                                   "regular patch (interior valence 6), written to OUT. With --into CURRENT the patch "
+                                   "is stitched into CURRENT and the result written to OUT.");
     p.positional("MESH", "The reference mesh to scan (.off .obj .ply .stl).", &meshPath);
-    p.option("-o", "OUT", "Output file of the patch (.ply keeps per-face quality and scan id).", &outPath);
+    p.option("-o", "OUT", "Output file of the patch, or of the stitched mesh with --into (.ply keeps per-face "
+                          "quality and scan id).", &outPath);
     p.option("--output", "OUT", "Same as -o.", &outPath);
     p.option("--view", "V", "Standard view fitted to the mesh: iso, +x, -x, +y, -y, +z, -z (default iso). '+x' looks "
                             "from the +x side.", &view, &haveView);
@@ -256,13 +337,22 @@ int runScan(const std::vector<std::string>& args) {
     p.option("--quality-margin", "M", "A sample replaces a face only when better by this fraction (default 0.1).",
              &margin);
     p.flag("--force-replace", "Keep every sample regardless of the quality of the mesh already there.", &force);
-    p.option("--scan-id", "N", "Scan id stored on the patch faces (default 0).", &scanIdText);
+    p.option("--into", "CURRENT",
+             "Stitch the patch into the mesh CURRENT and write the result to OUT instead of the patch. MESH stays "
+             "the reference the samples come from; CURRENT's faces decide where the scan is better (quality "
+             "mask) and are replaced there. Give MESH itself for the first scan and chain through .ply files, "
+             "which keep each face's quality and scan id.", &intoPath, &haveInto);
+    p.option("--scan-id", "N", "Scan id stored on the patch faces (default 0; with --into one more than the "
+                               "largest in CURRENT).", &scanIdText, &haveScanId);
     p.option("--renderer", "R", "auto (GPU, else CPU), gpu (head-less OpenGL) or cpu (ray casting).",
              &rendererKind);
-    p.flag("--json", "Print a JSON report: counts and the timing of each stage.", &json);
+    p.flag("--json", "Print a JSON report: counts and the timing of each stage (with --into also the stitch "
+                      "report under \"stitch\").", &json);
     p.epilog("examples:\n  fss-remesh scan fandisk.off -o patch.ply --view iso --resolution 512\n"
              "  fss-remesh scan fandisk.off -o patch.ply --view +x --lasso \"0.2,0.2;0.8,0.2;0.5,0.9\" --erode 2\n"
-             "  fss-remesh scan fandisk.off -o patch.ply --renderer cpu --fishbone \"seed=0.4,0.55;dir=min;h=3\"");
+             "  fss-remesh scan fandisk.off -o patch.ply --renderer cpu --fishbone \"seed=0.4,0.55;dir=min;h=3\"\n"
+             "  fss-remesh scan fandisk.off --into fandisk.off -o step1.ply --view iso\n"
+             "  fss-remesh scan fandisk.off --into step1.ply -o step2.ply --view +x --json");
     if (!p.parse(args)) return 0;
 
     if (outPath.empty()) throw UsageError("'fss-remesh scan' needs an output file: -o OUT.");
@@ -298,47 +388,60 @@ int runScan(const std::vector<std::string>& args) {
     std::optional<FishboneParams> fishbone;
     if (haveFishbone) fishbone = parseFishbone(fishboneText, w, h);
 
+    // The current mesh: the reference itself (first scan, or --into MESH) or the mesh of --into.
+    std::optional<Mesh> intoMesh;
+    if (haveInto && !sameFile(intoPath, meshPath)) intoMesh = readMesh(intoPath);
+    const Mesh& current = intoMesh ? *intoMesh : reference;
+    if (haveInto && !haveScanId) params.scan.scanId = nextScanId(current);
+
     std::string rendererUsed;
     std::unique_ptr<MeshRenderer> renderer = makeRenderer(rendererKind, rendererUsed);
     renderer->setMesh(reference);
-    if (fishbone) return runFishboneScan(reference, *renderer, rendererUsed, params, *fishbone, meshPath, outPath, json);
-    const ScanResult result = scanPatch(reference, *renderer, reference, *renderer, params);
+    std::unique_ptr<MeshRenderer> currentRenderer;
+    if (intoMesh) {
+        std::string used; // the kind the reference got (a second GPU context that fails falls back to CPU)
+        currentRenderer = makeRenderer(rendererUsed == "cpu" ? "cpu" : "auto", used);
+        currentRenderer->setMesh(*intoMesh);
+    }
+    MeshRenderer& renderCurrent = currentRenderer ? *currentRenderer : *renderer;
+    ScanRun run = fishbone ? fishboneScan(reference, *renderer, current, renderCurrent, params, *fishbone, meshPath,
+                                          rendererUsed)
+                           : regularScan(reference, *renderer, current, renderCurrent, params, meshPath, rendererUsed);
     if (auto* gpu = dynamic_cast<render::GpuMeshRenderer*>(renderer.get()))
         rendererUsed = "gpu (" + gpu->rasterizer().glRenderer() + ")";
-    writeMesh(result.patch.mesh, outPath, WriteOptions{.binary = false});
 
-    if (json) {
-        const ScanCounts& c = result.counts;
-        const ScanTimings& t = result.timings;
-        nlohmann::json j;
-        j["input"] = meshPath;
-        j["output"] = outPath;
-        j["renderer"] = rendererUsed;
-        j["resolution"] = {w, h};
-        j["camera"] = {{"eye", {params.camera.eye.x(), params.camera.eye.y(), params.camera.eye.z()}},
-                       {"focal", {params.camera.focal.x(), params.camera.focal.y(), params.camera.focal.z()}},
-                       {"up", {params.camera.up.x(), params.camera.up.y(), params.camera.up.z()}},
-                       {"parallel", params.camera.parallel},
-                       {"view_angle_deg", params.camera.viewAngleDeg},
-                       {"parallel_scale", params.camera.parallelScale}};
-        j["counts"] = {{"pixels", c.pixels},
-                       {"covered", c.covered},
-                       {"front_facing", c.frontFacing},
-                       {"after_lasso", c.afterLasso},
-                       {"after_quality", c.afterQuality},
-                       {"after_morphology", c.afterMorphology}};
-        addPatchCounts(j["counts"], result.patch);
-        j["timings_s"] = {{"render_reference", t.renderReference}, {"render_current", t.renderCurrent},
-                          {"sample", t.sample},                    {"lasso", t.lasso},
-                          {"quality_mask", t.qualityMask},         {"morphology", t.morphology},
-                          {"triangulate", t.triangulate},          {"total", t.total}};
-        std::cout << j.dump(2) << "\n";
+    nlohmann::json j;
+    j["input"] = meshPath;
+    j["output"] = outPath;
+    j["renderer"] = rendererUsed;
+    j.update(run.json);
+    std::string summary = run.summary;
+    if (haveInto) {
+        // Stitch the patch into (a copy of) the current mesh; nothing is written when that fails.
+        Mesh result = current;
+        StitchOptions stitchOptions;
+        stitchOptions.collectGarbage = true;
+        const StitchReport report =
+            stitchPatch(result, run.patch.mesh, params.camera, stitchOptions, run.currentBuffers.faceId);
+        writeMesh(result, outPath, WriteOptions{.binary = false});
+        j["into"] = intoPath;
+        j["scan_id"] = params.scan.scanId;
+        j["stitch"] = stitchJson(report);
+        j["result"] = {{"vertices", result.number_of_vertices()}, {"faces", result.number_of_faces()}};
+        j["timings_s"]["stitch"] = report.seconds;
+        std::ostringstream text;
+        text << "; stitched into " << intoPath << " (scan id " << params.scan.scanId << "): " << report.facesRemoved
+             << " faces replaced by " << report.facesAdded << " (" << report.componentsStitched
+             << " components stitched, " << report.componentsSkipped << " skipped, seam min angle "
+             << report.seamMinAngleDeg << " deg) in " << report.seconds << " s -> " << result.number_of_faces()
+             << " faces, written to " << outPath;
+        summary += text.str();
     } else {
-        std::cout << "scanned " << meshPath << " at " << w << "x" << h << " (" << rendererUsed << "): "
-                  << result.counts.covered << " covered pixels -> patch of " << result.patch.mesh.number_of_vertices()
-                  << " vertices, " << result.patch.mesh.number_of_faces() << " faces in " << result.timings.total
-                  << " s, written to " << outPath << "\n";
+        writeMesh(run.patch.mesh, outPath, WriteOptions{.binary = false});
+        summary += ", written to " + outPath;
     }
+    if (json) std::cout << j.dump(2) << "\n";
+    else std::cout << summary << "\n";
     return 0;
 }
 

@@ -14,6 +14,27 @@
 ///   session.undo();              // back to the reference, exactly
 /// \endcode
 ///
+/// **Exact undo / redo.** undo() and redo() restore the current mesh *index for index*: the same number of
+/// vertices, halfedges and faces; every vertex with a bit-identical point (the same 64-bit patterns, so even
+/// -0.0 vs 0.0 is told apart) and the same halfedge; every halfedge with the same next, prev, target vertex
+/// and face; every face with the same halfedge, hence the same vertex indices in the same order; the same
+/// face properties props::faceQuality and props::faceScanId (bit-identical values, and present or absent
+/// as before). Other properties an input file may have brought are resized with the mesh but their values
+/// are not recorded. To make this possible the current mesh never holds garbage: the session runs
+/// collect_garbage() after every stitch (deterministic), and it does so on the reference at construction
+/// (a reference with garbage is renumbered).
+///
+/// **History memory.** A step stores the index-wise difference of the element arrays between the mesh
+/// before and after it: for every vertex, halfedge and face whose record changed (or that exists in one
+/// state only) its record(s) — 32 bytes per vertex record, 16 per halfedge record, 12 per face record,
+/// both the old and the new record plus a 4-byte index for an element present in both states, one record
+/// for an element present in one state only — plus a few hundred bytes for the ScanStep and StitchReport.
+/// A stitch adding F faces and removing R therefore costs roughly 90 × (F + R) bytes whatever the mesh size
+/// (measured: an 18k-face patch costs 1.6 MB in a 10k- and 1.7 MB in a 300k-face sphere, whose element
+/// arrays take 2.1 and 22 MB). Finding the changed records compares the two states once per accept (linear in the mesh,
+/// a few milliseconds per 100k faces); undo() and redo() write the records back in time proportional to
+/// the change.
+///
 /// A Session is not thread-safe: call it from one thread at a time (the widgets run scan() and accept()
 /// on a worker thread while the GUI only reads what it copied).
 #include "fss/fishbone_scan.h"
@@ -97,10 +118,13 @@ public:
     const ScanPreview* preview() const;
     /// Drops the pending preview.
     void reject();
-    /// Stitches the pending preview into the current mesh, records the step in the history (clearing the
-    /// redo steps) and drops the preview.
+    /// Stitches the pending preview into the current mesh (StitchOptions::collectGarbage is forced on, see
+    /// the file comment), records the step in the history (clearing the redo steps, forgetting the oldest
+    /// step beyond maxUndoSteps) and drops the preview. Reports progress through \p progress (stages
+    /// "stitch", "record").
     /// \throw InvalidInputError when there is no preview or nothing could be stitched (the preview stays);
-    ///        CancelledError. Strong guarantee: on failure the current mesh and the history are unchanged.
+    ///        CancelledError. Strong guarantee: on failure the current mesh, the preview, the history and
+    ///        the event log are unchanged (the stitch runs on a copy that replaces the mesh only at the end).
     const StitchReport& accept(const Progress& progress = {});
 
     bool canUndo() const;
@@ -108,18 +132,24 @@ public:
     /// Steps that can be undone / redone now.
     std::size_t undoCount() const;
     std::size_t redoCount() const;
-    /// Restores the current mesh to exactly what it was before the last accepted step (drops any preview).
-    /// \throw InvalidInputError when there is nothing to undo.
+    /// Restores the current mesh to exactly (see the file comment) what it was before the last accepted
+    /// step, in time proportional to that step's change; drops any preview.
+    /// \throw InvalidInputError when there is nothing to undo (nothing changes). Out of memory (the only
+    ///        other failure) is thrown before the mesh is touched.
     void undo();
-    /// Re-applies the last undone step, restoring exactly the mesh it produced (drops any preview).
-    /// \throw InvalidInputError when there is nothing to redo.
+    /// Re-applies the last undone step, restoring exactly the mesh it produced, in time proportional to
+    /// that step's change; drops any preview.
+    /// \throw InvalidInputError when there is nothing to redo (nothing changes). Out of memory (the only
+    ///        other failure) is thrown before the mesh is touched.
     void redo();
     /// The steps currently in the history (oldest first): the first undoCount() are applied, the rest
-    /// can be redone.
+    /// can be redone. Steps forgotten beyond maxUndoSteps are not listed (events() still has them).
     std::vector<ScanStep> steps() const;
     /// The stitch report of history step \p i (as steps()).
+    /// \throw InvalidInputError when \p i >= steps().size().
     const StitchReport& report(std::size_t i) const;
-    /// Bytes the history holds for undo and redo (grows with the size of the changes, not of the mesh).
+    /// Bytes the history holds for undo and redo: the change records of every step (see the file comment)
+    /// plus the steps' parameters and reports. Grows with the size of the changes, not of the mesh.
     std::size_t historyBytes() const;
     /// Everything that happened since construction, in order (for session files).
     const std::vector<SessionEvent>& events() const;

@@ -1,0 +1,710 @@
+// Session files: JSON writer, validating reader and replay (session_file.h).
+#include "fss/session_file.h"
+
+#include "fss/error.h"
+#include "fss/mesh_io.h"
+#include "fss/sha256.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <initializer_list>
+#include <limits>
+#include <sstream>
+#include <system_error>
+#include <unistd.h>
+
+namespace fss {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+constexpr const char* kFormatName = "fss-session";
+
+double seconds(std::chrono::steady_clock::time_point since) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+bool isSha256Hex(const std::string& s) {
+    if (s.size() != 64) return false;
+    for (char c : s)
+        if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'))) return false;
+    return true;
+}
+
+// ---------------------------------------------------------------------------------------------- writing
+
+// Every double goes through here: JSON has no NaN or infinity, and a silent null would not round-trip.
+struct Writer {
+    Json number(double v, const std::string& field) const {
+        if (!std::isfinite(v))
+            throw InvalidInputError("The session cannot be saved: " + field + " is not a finite number.");
+        return Json(v);
+    }
+    Json vec3(const Eigen::Vector3d& v, const std::string& field) const {
+        return Json::array({number(v.x(), field), number(v.y(), field), number(v.z(), field)});
+    }
+    Json vec2(const Eigen::Vector2d& v, const std::string& field) const {
+        return Json::array({number(v.x(), field), number(v.y(), field)});
+    }
+    Json points(const std::vector<Eigen::Vector2d>& pts, const std::string& field) const {
+        Json a = Json::array();
+        for (std::size_t i = 0; i < pts.size(); ++i)
+            a.push_back(vec2(pts[i], field + "[" + std::to_string(i) + "]"));
+        return a;
+    }
+
+    Json camera(const Camera& c, const std::string& f) const {
+        Json j;
+        j["eye"] = vec3(c.eye, f + ".eye");
+        j["focal"] = vec3(c.focal, f + ".focal");
+        j["up"] = vec3(c.up, f + ".up");
+        j["projection"] = c.parallel ? "parallel" : "perspective";
+        j["view_angle_deg"] = number(c.viewAngleDeg, f + ".view_angle_deg");
+        j["parallel_scale"] = number(c.parallelScale, f + ".parallel_scale");
+        j["near"] = number(c.nearPlane, f + ".near");
+        j["far"] = number(c.farPlane, f + ".far");
+        j["width"] = c.width;
+        j["height"] = c.height;
+        return j;
+    }
+
+    Json streamline(const StreamlineOptions& s, const std::string& f) const {
+        if (s.insideRegion)
+            throw InvalidInputError("The session cannot be saved: " + f +
+                                    " has a region mask (a function), which a session file cannot hold.");
+        Json j;
+        j["step"] = number(s.step, f + ".step");
+        j["min_step"] = number(s.minStep, f + ".min_step");
+        if (s.maxLength == std::numeric_limits<double>::infinity())
+            j["max_length"] = nullptr;
+        else
+            j["max_length"] = number(s.maxLength, f + ".max_length");
+        j["min_anisotropy"] = number(s.minAnisotropy, f + ".min_anisotropy");
+        j["low_anisotropy"] = s.lowAnisotropy == LowAnisotropyPolicy::Stop ? "stop" : "continue_straight";
+        j["max_turn_deg"] = number(s.maxTurnDeg, f + ".max_turn_deg");
+        j["max_steps"] = s.maxSteps;
+        return j;
+    }
+
+    Json fishbone(const FishboneParams& p, const std::string& f) const {
+        Json j;
+        j["seed"] = p.seed ? vec2(*p.seed, f + ".seed") : Json(nullptr);
+        j["direction"] = p.direction == PrincipalDirection::Min ? "min" : "max";
+        j["h"] = number(p.spacing, f + ".h");
+        j["key_ribs"] = points(p.keyRibs, f + ".key_ribs");
+        Json drawn = Json::array();
+        for (std::size_t i = 0; i < p.drawnKeyRibs.size(); ++i)
+            drawn.push_back(points(p.drawnKeyRibs[i], f + ".drawn_key_ribs[" + std::to_string(i) + "]"));
+        j["drawn_key_ribs"] = std::move(drawn);
+        j["drawn_backbone"] = points(p.drawnBackbone, f + ".drawn_backbone");
+        Json t;
+        t["spacing"] = number(p.tracing.spacing, f + ".tracing.spacing");
+        t["extend_beyond_key_ribs"] = p.tracing.extendBeyondKeyRibs;
+        t["backbone"] = streamline(p.tracing.backboneTracing, f + ".tracing.backbone");
+        t["ribs"] = streamline(p.tracing.ribTracing, f + ".tracing.ribs");
+        j["tracing"] = std::move(t);
+        j["min_seed_anisotropy"] = number(p.minSeedAnisotropy, f + ".min_seed_anisotropy");
+        j["raycast"] = {{"rings", p.raycast.rings}, {"verify_unoccluded", p.raycast.verifyUnoccluded}};
+        return j;
+    }
+
+    Json stitch(const StitchOptions& s, const std::string& f) const {
+        Json j;
+        j["seam_rings"] = s.seamRings;
+        j["optimise_seam"] = s.optimiseSeam;
+        j["collapse_edge_ratio"] = number(s.collapseEdgeRatio, f + ".collapse_edge_ratio");
+        j["seam_grading"] = number(s.seamGrading, f + ".seam_grading");
+        j["min_angle_floor_deg"] = number(s.minAngleFloorDeg, f + ".min_angle_floor_deg");
+        j["max_view_angle_deg"] = number(s.maxViewAngleDeg, f + ".max_view_angle_deg");
+        j["max_normal_change_deg"] = number(s.maxNormalChangeDeg, f + ".max_normal_change_deg");
+        j["max_gap_ratio"] = number(s.maxGapRatio, f + ".max_gap_ratio");
+        j["max_trim_rounds"] = s.maxTrimRounds;
+        j["min_component_faces"] = s.minComponentFaces;
+        j["collect_garbage"] = s.collectGarbage;
+        return j;
+    }
+
+    Json step(const ScanStep& s, const std::string& f) const {
+        const ScanParams& p = s.params;
+        Json j;
+        j["camera"] = camera(p.camera, f + ".camera");
+        j["lasso"] = p.lasso ? points(p.lasso->points, f + ".lasso") : Json(nullptr);
+        j["erode_radius"] = p.erodeRadius;
+        j["dilate_radius"] = p.dilateRadius;
+        j["scan"] = {
+            {"scan_id", p.scan.scanId},
+            {"quality_angle_limit_deg",
+             number(p.scan.qualityAngleLimitDeg, f + ".scan.quality_angle_limit_deg")},
+            {"max_snap_footprints", number(p.scan.maxSnapFootprints, f + ".scan.max_snap_footprints")}};
+        j["quality_mask"] = {{"margin", number(p.quality.margin, f + ".quality_mask.margin")},
+                             {"force_replace", p.quality.forceReplace},
+                             {"search_rings", p.quality.searchRings}};
+        j["triangulate"] = {{"max_edge_footprints",
+                             number(p.triangulate.maxEdgeFootprints, f + ".triangulate.max_edge_footprints")},
+                            {"max_sampling_angle_deg", number(p.triangulate.maxSamplingAngleDeg,
+                                                              f + ".triangulate.max_sampling_angle_deg")}};
+        j["grid"] = s.fishbone ? "fishbone" : "regular";
+        if (s.fishbone) j["fishbone"] = fishbone(*s.fishbone, f + ".fishbone");
+        j["stitch"] = stitch(s.stitch, f + ".stitch");
+        return j;
+    }
+};
+
+const char* kindName(SessionEvent::Kind kind) {
+    switch (kind) {
+    case SessionEvent::Kind::Accept:
+        return "accept";
+    case SessionEvent::Kind::Undo:
+        return "undo";
+    case SessionEvent::Kind::Redo:
+        return "redo";
+    }
+    return "accept";
+}
+
+Json toJson(const SessionFile& file, const std::string& meshPathText) {
+    const Writer w;
+    if (file.renderer != "cpu" && file.renderer != "gpu")
+        throw InvalidInputError("The session cannot be saved: its renderer '" + file.renderer +
+                                "' is not one of cpu, gpu.");
+    if (!isSha256Hex(file.meshSha256))
+        throw InvalidInputError(
+            "The session cannot be saved: mesh.sha256 is not 64 lowercase hexadecimal digits.");
+    Json j;
+    j["format"] = kFormatName;
+    j["version"] = kSessionFileVersion;
+    if (!file.description.empty()) j["description"] = file.description;
+    j["mesh"] = {{"path", meshPathText}, {"sha256", file.meshSha256}};
+    j["renderer"] = file.renderer;
+    j["curvature"] = {
+        {"jet_degree", file.curvature.jetDegree},
+        {"min_points", file.curvature.minPoints},
+        {"max_rings", file.curvature.maxRings},
+        {"anisotropy_epsilon", w.number(file.curvature.anisotropyEpsilon, "curvature.anisotropy_epsilon")}};
+    Json events = Json::array();
+    for (std::size_t i = 0; i < file.events.size(); ++i) {
+        const SessionEvent& e = file.events[i];
+        Json je;
+        je["kind"] = kindName(e.kind);
+        if (e.kind == SessionEvent::Kind::Accept)
+            je["step"] = w.step(e.step, "events[" + std::to_string(i) + "].step");
+        events.push_back(std::move(je));
+    }
+    j["events"] = std::move(events);
+    return j;
+}
+
+// ---------------------------------------------------------------------------------------------- reading
+
+// A JSON value with its path in the file ("events[3].step.camera"), for messages naming the field.
+class Node {
+public:
+    Node(const Json& value, std::string path, const std::string& file)
+        : v_(value), path_(std::move(path)), file_(file) {}
+
+    const std::string& path() const { return path_; }
+    [[noreturn]] void fail(const std::string& what) const {
+        throw IoError(file_ + ": " + path_ + " " + what + ".");
+    }
+
+    bool isNull() const { return v_.is_null(); }
+
+    /// The member \p key of this object (which must be one).
+    Node at(const std::string& key) const {
+        requireObject();
+        const auto it = v_.find(key);
+        if (it == v_.end()) Node(v_, child(key), file_).fail("is missing");
+        return Node(*it, child(key), file_);
+    }
+    bool has(const std::string& key) const { return v_.is_object() && v_.contains(key); }
+    /// Refuses members other than \p allowed (typos would otherwise be ignored silently).
+    void onlyKeys(std::initializer_list<const char*> allowed) const {
+        requireObject();
+        for (const auto& item : v_.items()) {
+            bool known = false;
+            for (const char* a : allowed)
+                known = known || item.key() == a;
+            if (!known) fail("has an unknown field '" + item.key() + "'");
+        }
+    }
+    Node element(std::size_t i) const { return Node(v_[i], path_ + "[" + std::to_string(i) + "]", file_); }
+    std::size_t arraySize(const std::string& what = "an array") const {
+        if (!v_.is_array()) fail("must be " + what);
+        return v_.size();
+    }
+
+    double number() const {
+        if (!v_.is_number()) fail("must be a number");
+        const double d = v_.get<double>();
+        if (!std::isfinite(d)) fail("must be a finite number");
+        return d;
+    }
+    double positive() const {
+        const double d = number();
+        if (!(d > 0)) fail("must be a positive number");
+        return d;
+    }
+    double nonNegative() const {
+        const double d = number();
+        if (!(d >= 0)) fail("must be a number of at least 0");
+        return d;
+    }
+    double inRange(double lo, double hi, bool loOpen, bool hiOpen) const {
+        const double d = number();
+        const bool ok = (loOpen ? d > lo : d >= lo) && (hiOpen ? d < hi : d <= hi);
+        if (!ok) {
+            std::ostringstream os;
+            os << "must be a number in " << (loOpen ? "(" : "[") << lo << ", " << hi << (hiOpen ? ")" : "]");
+            fail(os.str());
+        }
+        return d;
+    }
+    std::int64_t integer(std::int64_t lo, std::int64_t hi, const std::string& what) const {
+        if (!v_.is_number_integer()) fail("must be " + what);
+        if (v_.is_number_unsigned() &&
+            v_.get<std::uint64_t>() > std::uint64_t(std::numeric_limits<std::int64_t>::max()))
+            fail("must be " + what);
+        const std::int64_t i = v_.get<std::int64_t>();
+        if (i < lo || i > hi) fail("must be " + what);
+        return i;
+    }
+    bool boolean() const {
+        if (!v_.is_boolean()) fail("must be true or false");
+        return v_.get<bool>();
+    }
+    std::string string() const {
+        if (!v_.is_string()) fail("must be a string");
+        return v_.get<std::string>();
+    }
+    /// One of \p choices (as a string).
+    std::string choice(std::initializer_list<const char*> choices) const {
+        std::string list;
+        for (const char* c : choices)
+            list += std::string(list.empty() ? "" : ", ") + "\"" + c + "\"";
+        if (!v_.is_string()) fail("must be one of " + list);
+        const std::string s = v_.get<std::string>();
+        for (const char* c : choices)
+            if (s == c) return s;
+        fail("must be one of " + list + ", not \"" + s + "\"");
+    }
+    Eigen::Vector3d vec3() const {
+        if (!v_.is_array() || v_.size() != 3) fail("must be an array of 3 numbers");
+        return {element(0).number(), element(1).number(), element(2).number()};
+    }
+    Eigen::Vector2d vec2() const {
+        if (!v_.is_array() || v_.size() != 2) fail("must be an array of 2 numbers [x, y]");
+        return {element(0).number(), element(1).number()};
+    }
+    std::vector<Eigen::Vector2d> points() const {
+        const std::size_t n = arraySize("an array of points [x, y]");
+        std::vector<Eigen::Vector2d> pts;
+        pts.reserve(n);
+        for (std::size_t i = 0; i < n; ++i)
+            pts.push_back(element(i).vec2());
+        return pts;
+    }
+
+private:
+    void requireObject() const {
+        if (!v_.is_object()) fail("must be a JSON object");
+    }
+    std::string child(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+    const Json& v_;
+    std::string path_;
+    const std::string& file_;
+};
+
+constexpr std::int64_t kIntMax = std::numeric_limits<int>::max();
+
+Camera readCamera(const Node& n) {
+    n.onlyKeys({"eye", "focal", "up", "projection", "view_angle_deg", "parallel_scale", "near", "far",
+                "width", "height"});
+    Camera c;
+    c.eye = n.at("eye").vec3();
+    c.focal = n.at("focal").vec3();
+    c.up = n.at("up").vec3();
+    c.parallel = n.at("projection").choice({"perspective", "parallel"}) == "parallel";
+    c.viewAngleDeg = n.at("view_angle_deg").inRange(0, 180, true, true);
+    c.parallelScale = n.at("parallel_scale").positive();
+    c.nearPlane = n.at("near").positive();
+    c.farPlane = n.at("far").positive();
+    if (!(c.farPlane > c.nearPlane)) n.at("far").fail("must be larger than near");
+    const std::string side = "a positive integer of at most " + std::to_string(Camera::kMaxResolution);
+    c.width = int(n.at("width").integer(1, Camera::kMaxResolution, side));
+    c.height = int(n.at("height").integer(1, Camera::kMaxResolution, side));
+    if ((c.eye - c.focal).norm() == 0)
+        n.at("focal").fail("must differ from eye (the camera has no viewing direction)");
+    if (c.up.cross(c.focal - c.eye).norm() <= 1e-12 * c.up.norm() * (c.focal - c.eye).norm())
+        n.at("up").fail("must not be zero or parallel to the viewing direction");
+    try {
+        c.validate();
+    } catch (const InvalidInputError& e) {
+        n.fail(std::string("is invalid (") + e.what() + ")");
+    }
+    return c;
+}
+
+StreamlineOptions readStreamline(const Node& n) {
+    n.onlyKeys(
+        {"step", "min_step", "max_length", "min_anisotropy", "low_anisotropy", "max_turn_deg", "max_steps"});
+    StreamlineOptions s;
+    s.step = n.at("step").positive();
+    s.minStep = n.at("min_step").positive();
+    if (s.minStep > s.step) n.at("min_step").fail("must not exceed step");
+    const Node maxLength = n.at("max_length");
+    s.maxLength = maxLength.isNull() ? std::numeric_limits<double>::infinity() : maxLength.positive();
+    s.minAnisotropy = n.at("min_anisotropy").inRange(0, 1, false, false);
+    s.lowAnisotropy = n.at("low_anisotropy").choice({"stop", "continue_straight"}) == "stop"
+                          ? LowAnisotropyPolicy::Stop
+                          : LowAnisotropyPolicy::ContinueStraight;
+    s.maxTurnDeg = n.at("max_turn_deg").positive();
+    s.maxSteps = std::size_t(
+        n.at("max_steps").integer(1, std::numeric_limits<std::int64_t>::max(), "a positive integer"));
+    return s;
+}
+
+FishboneParams readFishbone(const Node& n) {
+    n.onlyKeys({"seed", "direction", "h", "key_ribs", "drawn_key_ribs", "drawn_backbone", "tracing",
+                "min_seed_anisotropy", "raycast"});
+    FishboneParams p;
+    const Node seed = n.at("seed");
+    if (!seed.isNull()) p.seed = seed.vec2();
+    p.direction =
+        n.at("direction").choice({"min", "max"}) == "min" ? PrincipalDirection::Min : PrincipalDirection::Max;
+    p.spacing = n.at("h").positive();
+    p.keyRibs = n.at("key_ribs").points();
+    const Node drawn = n.at("drawn_key_ribs");
+    const std::size_t count = drawn.arraySize("an array of polylines");
+    for (std::size_t i = 0; i < count; ++i) {
+        p.drawnKeyRibs.push_back(drawn.element(i).points());
+        if (p.drawnKeyRibs.back().size() < 2) drawn.element(i).fail("must have at least 2 points");
+    }
+    p.drawnBackbone = n.at("drawn_backbone").points();
+    if (p.drawnBackbone.size() == 1) n.at("drawn_backbone").fail("must be empty or have at least 2 points");
+    if (!p.seed && p.drawnBackbone.empty()) n.at("seed").fail("must be given when drawn_backbone is empty");
+    const Node t = n.at("tracing");
+    t.onlyKeys({"spacing", "extend_beyond_key_ribs", "backbone", "ribs"});
+    p.tracing.spacing = t.at("spacing").positive();
+    p.tracing.extendBeyondKeyRibs = t.at("extend_beyond_key_ribs").boolean();
+    p.tracing.backboneTracing = readStreamline(t.at("backbone"));
+    p.tracing.ribTracing = readStreamline(t.at("ribs"));
+    p.minSeedAnisotropy = n.at("min_seed_anisotropy").inRange(0, 1, false, false);
+    const Node r = n.at("raycast");
+    r.onlyKeys({"rings", "verify_unoccluded"});
+    p.raycast.rings = int(r.at("rings").integer(0, kIntMax, "an integer of at least 0"));
+    p.raycast.verifyUnoccluded = r.at("verify_unoccluded").boolean();
+    return p;
+}
+
+StitchOptions readStitch(const Node& n) {
+    n.onlyKeys({"seam_rings", "optimise_seam", "collapse_edge_ratio", "seam_grading", "min_angle_floor_deg",
+                "max_view_angle_deg", "max_normal_change_deg", "max_gap_ratio", "max_trim_rounds",
+                "min_component_faces", "collect_garbage"});
+    StitchOptions s;
+    s.seamRings = int(n.at("seam_rings").integer(0, kIntMax, "an integer of at least 0"));
+    s.optimiseSeam = n.at("optimise_seam").boolean();
+    s.collapseEdgeRatio = n.at("collapse_edge_ratio").nonNegative();
+    s.seamGrading = n.at("seam_grading").nonNegative();
+    s.minAngleFloorDeg = n.at("min_angle_floor_deg").inRange(0, 60, false, false);
+    s.maxViewAngleDeg = n.at("max_view_angle_deg").inRange(0, 90, true, false);
+    s.maxNormalChangeDeg = n.at("max_normal_change_deg").inRange(0, 180, true, false);
+    s.maxGapRatio = n.at("max_gap_ratio").positive();
+    s.maxTrimRounds = int(n.at("max_trim_rounds").integer(0, kIntMax, "an integer of at least 0"));
+    s.minComponentFaces =
+        std::size_t(n.at("min_component_faces")
+                        .integer(0, std::numeric_limits<std::int64_t>::max(), "an integer of at least 0"));
+    s.collectGarbage = n.at("collect_garbage").boolean();
+    return s;
+}
+
+ScanStep readStep(const Node& n) {
+    n.onlyKeys({"camera", "lasso", "erode_radius", "dilate_radius", "scan", "quality_mask", "triangulate",
+                "grid", "fishbone", "stitch"});
+    ScanStep step;
+    ScanParams& p = step.params;
+    p.camera = readCamera(n.at("camera"));
+    const Node lasso = n.at("lasso");
+    if (!lasso.isNull()) {
+        p.lasso = Lasso{lasso.points()};
+        try {
+            validateLasso(*p.lasso);
+        } catch (const InvalidInputError&) {
+            lasso.fail("must enclose an area (at least 3 points, not all collinear)");
+        }
+    }
+    p.erodeRadius = int(n.at("erode_radius").integer(0, 1024, "an integer in [0, 1024]"));
+    p.dilateRadius = int(n.at("dilate_radius").integer(0, 1024, "an integer in [0, 1024]"));
+    const Node scan = n.at("scan");
+    scan.onlyKeys({"scan_id", "quality_angle_limit_deg", "max_snap_footprints"});
+    p.scan.scanId = std::int32_t(scan.at("scan_id").integer(std::numeric_limits<std::int32_t>::min(),
+                                                            std::numeric_limits<std::int32_t>::max(),
+                                                            "a 32-bit integer"));
+    p.scan.qualityAngleLimitDeg = scan.at("quality_angle_limit_deg").inRange(0, 90, true, true);
+    p.scan.maxSnapFootprints = scan.at("max_snap_footprints").nonNegative();
+    const Node quality = n.at("quality_mask");
+    quality.onlyKeys({"margin", "force_replace", "search_rings"});
+    p.quality.margin = quality.at("margin").inRange(0, 1, false, true);
+    p.quality.forceReplace = quality.at("force_replace").boolean();
+    p.quality.searchRings = int(quality.at("search_rings").integer(0, kIntMax, "an integer of at least 0"));
+    const Node tri = n.at("triangulate");
+    tri.onlyKeys({"max_edge_footprints", "max_sampling_angle_deg"});
+    p.triangulate.maxEdgeFootprints = tri.at("max_edge_footprints").positive();
+    p.triangulate.maxSamplingAngleDeg = tri.at("max_sampling_angle_deg").inRange(0, 90, true, false);
+    const bool fishbone = n.at("grid").choice({"regular", "fishbone"}) == "fishbone";
+    if (fishbone)
+        step.fishbone = readFishbone(n.at("fishbone"));
+    else if (n.has("fishbone"))
+        n.at("fishbone").fail("must not be given when grid is \"regular\"");
+    step.stitch = readStitch(n.at("stitch"));
+    return step;
+}
+
+// "line L, column C" of byte offset \p byte in \p text (1-based).
+std::string lineColumn(const std::string& text, std::size_t byte) {
+    std::size_t line = 1, column = 1;
+    for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
+        if (text[i] == '\n') {
+            ++line;
+            column = 1;
+        } else {
+            ++column;
+        }
+    }
+    return "line " + std::to_string(line) + ", column " + std::to_string(column);
+}
+
+std::filesystem::path absoluteNormal(const std::filesystem::path& p) {
+    return std::filesystem::absolute(p).lexically_normal();
+}
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------- public API
+
+SessionFile sessionFileFromSession(const Session& session, const std::filesystem::path& meshPath,
+                                   const std::string& renderer, const CurvatureOptions& curvature) {
+    if (renderer != "cpu" && renderer != "gpu")
+        throw InvalidInputError("The renderer '" + renderer + "' of a session file is not one of cpu, gpu.");
+    SessionFile file;
+    file.meshPath = meshPath;
+    file.meshSha256 = sha256OfFile(meshPath);
+    file.renderer = renderer;
+    file.curvature = curvature;
+    file.events = session.events();
+    (void)toJson(file,
+                 meshPath.generic_string()); // refuses what cannot be stored, before anything is written
+    return file;
+}
+
+std::string sessionFileToJson(const SessionFile& file) {
+    return toJson(file, file.meshPath.generic_string()).dump(2) + "\n";
+}
+
+void saveSessionFile(const SessionFile& file, const std::filesystem::path& path) {
+    std::filesystem::path written = file.meshPath;
+    if (written.is_relative()) {
+        const std::filesystem::path folder = absoluteNormal(path).parent_path();
+        written = absoluteNormal(file.meshPath).lexically_relative(folder);
+        if (written.empty()) written = absoluteNormal(file.meshPath);
+    }
+    const std::string text = toJson(file, written.generic_string()).dump(2) + "\n";
+    const std::filesystem::path tmp = path.string() + ".tmp" + std::to_string(::getpid());
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        if (!out)
+            throw IoError("The session file " + path.string() + " cannot be written (cannot create " +
+                          tmp.string() + ").");
+        out << text;
+        out.flush();
+        if (!out) {
+            std::error_code ec;
+            std::filesystem::remove(tmp, ec);
+            throw IoError("The session file " + path.string() + " could not be written completely.");
+        }
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) {
+        std::filesystem::remove(tmp, ec);
+        throw IoError("The session file " + path.string() + " cannot be written (" + ec.message() + ").");
+    }
+}
+
+SessionFile sessionFileFromJson(const std::string& text, const std::string& name,
+                                const std::filesystem::path& baseDir, const SessionFileLoadOptions& options) {
+    Json json;
+    try {
+        json = Json::parse(text);
+    } catch (const Json::parse_error& e) {
+        if (text.find_first_not_of(" \t\r\n") == std::string::npos)
+            throw IoError(name + " is empty, not a session file.");
+        throw IoError(name + " is not valid JSON (" +
+                      (e.byte >= text.size() ? "it ends early, at " : "error at ") +
+                      lineColumn(text, e.byte > 0 ? e.byte - 1 : 0) + ").");
+    }
+    const Node root(json, "", name);
+    if (!json.is_object()) throw IoError(name + " is not a session file: its JSON is not an object.");
+    if (!root.has("format"))
+        throw IoError(name + ": format is missing (a session file has \"format\": \"fss-session\").");
+    if (root.at("format").string() != kFormatName)
+        root.at("format").fail("must be \"fss-session\" (this is not an FSS session file)");
+    const std::int64_t version = root.at("version").integer(1, kIntMax, "a positive integer");
+    if (version != kSessionFileVersion)
+        root.at("version").fail("is " + std::to_string(version) + ", but this FSS reads version " +
+                                std::to_string(kSessionFileVersion) + " only");
+    root.onlyKeys({"format", "version", "description", "mesh", "renderer", "curvature", "events"});
+
+    SessionFile file;
+    file.version = int(version);
+    file.source = name;
+    if (root.has("description")) file.description = root.at("description").string();
+    const Node mesh = root.at("mesh");
+    mesh.onlyKeys({"path", "sha256"});
+    const std::string meshText = mesh.at("path").string();
+    if (meshText.empty()) mesh.at("path").fail("must not be empty");
+    std::filesystem::path meshPath(meshText);
+    if (meshPath.is_relative()) meshPath = (baseDir / meshPath).lexically_normal();
+    file.meshPath = meshPath;
+    file.meshSha256 = mesh.at("sha256").string();
+    if (!isSha256Hex(file.meshSha256)) mesh.at("sha256").fail("must be 64 lowercase hexadecimal digits");
+    file.renderer = root.at("renderer").choice({"cpu", "gpu"});
+    const Node curvature = root.at("curvature");
+    curvature.onlyKeys({"jet_degree", "min_points", "max_rings", "anisotropy_epsilon"});
+    file.curvature.jetDegree = int(curvature.at("jet_degree").integer(2, 3, "2 or 3"));
+    file.curvature.minPoints =
+        int(curvature.at("min_points").integer(6, kIntMax, "an integer of at least 6"));
+    file.curvature.maxRings = int(curvature.at("max_rings").integer(1, kIntMax, "an integer of at least 1"));
+    file.curvature.anisotropyEpsilon = curvature.at("anisotropy_epsilon").positive();
+
+    const Node events = root.at("events");
+    const std::size_t count = events.arraySize("an array of events");
+    std::size_t applied = 0, recorded = 0; // the history as the log builds it
+    for (std::size_t i = 0; i < count; ++i) {
+        const Node e = events.element(i);
+        SessionEvent event;
+        const std::string kind = e.at("kind").choice({"accept", "undo", "redo"});
+        if (kind == "accept") {
+            e.onlyKeys({"kind", "step"});
+            event.kind = SessionEvent::Kind::Accept;
+            event.step = readStep(e.at("step"));
+            recorded = ++applied;
+        } else {
+            e.onlyKeys({"kind"});
+            if (kind == "undo") {
+                event.kind = SessionEvent::Kind::Undo;
+                if (applied == 0) e.fail("is an undo with no accepted step left to undo");
+                --applied;
+            } else {
+                event.kind = SessionEvent::Kind::Redo;
+                if (applied == recorded) e.fail("is a redo with no undone step to redo");
+                ++applied;
+            }
+        }
+        file.events.push_back(std::move(event));
+    }
+
+    if (options.verifyMesh) {
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(file.meshPath, ec))
+            mesh.at("path").fail("names the mesh " + file.meshPath.string() + ", which does not exist");
+        if (sha256OfFile(file.meshPath) != file.meshSha256)
+            mesh.at("sha256").fail("does not match the mesh " + file.meshPath.string() +
+                                   " (the file changed since the session was recorded)");
+    }
+    return file;
+}
+
+SessionFile loadSessionFile(const std::filesystem::path& path, const SessionFileLoadOptions& options) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec))
+        throw IoError("The session file " + path.string() + " does not exist.");
+    if (!std::filesystem::is_regular_file(path, ec))
+        throw IoError("The session file " + path.string() + " is not a regular file.");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw IoError("The session file " + path.string() + " cannot be opened for reading.");
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (in.bad()) throw IoError("The session file " + path.string() + " could not be read.");
+    return sessionFileFromJson(text.str(), path.string(), absoluteNormal(path).parent_path(), options);
+}
+
+ReplayResult replaySession(const SessionFile& file, const RendererFactory& renderer,
+                           const Progress& progress) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::string name = file.source.empty() ? std::string("the session") : file.source.string();
+    if (!file.meshSha256.empty() && sha256OfFile(file.meshPath) != file.meshSha256)
+        throw IoError(name + ": the mesh " + file.meshPath.string() +
+                      " does not match mesh.sha256 (the file changed since the session was recorded).");
+    Mesh reference = readMesh(file.meshPath);
+    const double readSeconds = seconds(start);
+
+    SessionOptions options;
+    options.renderer = renderer;
+    options.curvature = file.curvature;
+    std::size_t accepts = 0;
+    for (const SessionEvent& e : file.events)
+        accepts += e.kind == SessionEvent::Kind::Accept;
+    options.maxUndoSteps = std::max<std::size_t>(options.maxUndoSteps, accepts);
+    ReplayResult result{Session(std::move(reference), std::move(options)), {}, readSeconds, 0};
+
+    const std::size_t n = file.events.size();
+    // Inner stages report their own fractions (some restart at 0 per sub-stage): keep the total monotone.
+    double last = 0;
+    auto report = [&progress, &last](double fraction, const std::string& stage) {
+        last = std::max(last, std::min(fraction, 1.0));
+        progress.report(last, stage);
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+        const SessionEvent& e = file.events[i];
+        const std::string label = "events[" + std::to_string(i) + "]";
+        auto inner = [&](double from, double to, const std::string& what) {
+            return Progress([&report, i, n, from, to, what](double f, std::string_view stage) {
+                report((double(i) + from + (to - from) * std::clamp(f, 0.0, 1.0)) / double(n),
+                       what + (stage.empty() ? std::string() : ": " + std::string(stage)));
+                return true;
+            });
+        };
+        ReplayedEvent done;
+        done.kind = e.kind;
+        const auto eventStart = std::chrono::steady_clock::now();
+        try {
+            switch (e.kind) {
+            case SessionEvent::Kind::Accept: {
+                done.fishbone = e.step.fishbone.has_value();
+                const ScanPreview& preview = result.session.scan(e.step, inner(0.0, 0.8, label + " scan"));
+                done.scanSeconds = seconds(eventStart);
+                done.patchFaces = preview.patch.mesh.number_of_faces();
+                const auto stitchStart = std::chrono::steady_clock::now();
+                done.stitch = result.session.accept(inner(0.8, 1.0, label + " stitch"));
+                done.stitchSeconds = seconds(stitchStart);
+                break;
+            }
+            case SessionEvent::Kind::Undo:
+                report(double(i) / double(n), label + " undo");
+                result.session.undo();
+                break;
+            case SessionEvent::Kind::Redo:
+                report(double(i) / double(n), label + " redo");
+                result.session.redo();
+                break;
+            }
+        } catch (const CancelledError&) {
+            throw;
+        } catch (const InvalidInputError& err) {
+            throw InvalidInputError(name + ", " + label + " (" + kindName(e.kind) + "): " + err.what());
+        }
+        done.seconds = seconds(eventStart);
+        result.events.push_back(std::move(done));
+    }
+    report(1.0, "done");
+    result.totalSeconds = seconds(start);
+    return result;
+}
+
+} // namespace fss

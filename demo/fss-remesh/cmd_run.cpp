@@ -1,0 +1,344 @@
+// fss-remesh run SESSION.json -o OUT [--report R.json] [--json] [--snapshot S.png] [--snapshot-size WxH]
+//                [--snapshot-view V] [--renderer session|auto|gpu|cpu] [--no-self-intersections]
+// Replays a session file head-less (session_file.h) and reports what it made.
+#include "args.h"
+#include "commands.h"
+
+#include "fss/camera.h"
+#include "fss/error.h"
+#include "fss/mesh_io.h"
+#include "fss/metrics.h"
+#include "fss/render/gpu_mesh_renderer.h"
+#include "fss/render/snapshot.h"
+#include "fss/session_file.h"
+
+#include <nlohmann/json.hpp>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace fss::cli {
+namespace {
+
+using Json = nlohmann::ordered_json;
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// A one-line progress bar redrawn in place on stderr (only used when stderr is a terminal).
+class ProgressBar {
+public:
+    bool update(double fraction, std::string_view stage) {
+        const int percent = int(fraction * 100.0 + 1e-9);
+        const auto now = Clock::now();
+        if (percent == lastPercent_ && std::string(stage) == lastStage_ &&
+            std::chrono::duration<double>(now - lastDraw_).count() < 0.2)
+            return true;
+        lastPercent_ = percent;
+        lastStage_ = std::string(stage);
+        lastDraw_ = now;
+        constexpr int kWidth = 30;
+        const int filled = std::clamp(int(fraction * kWidth), 0, kWidth);
+        std::string text = "\r[" + std::string(std::size_t(filled), '#') +
+                           std::string(std::size_t(kWidth - filled), ' ') + "] " + std::to_string(percent) +
+                           "% " + lastStage_;
+        if (text.size() > 100) text.resize(100);
+        std::fprintf(stderr, "%s\x1b[K", text.c_str());
+        std::fflush(stderr);
+        drawn_ = true;
+        return true;
+    }
+    void finish() {
+        if (drawn_) std::fprintf(stderr, "\r\x1b[K");
+        std::fflush(stderr);
+        drawn_ = false;
+    }
+    ~ProgressBar() { finish(); }
+
+private:
+    int lastPercent_ = -1;
+    std::string lastStage_;
+    Clock::time_point lastDraw_{};
+    bool drawn_ = false;
+};
+
+Json stitchJson(const StitchReport& r) {
+    return Json{{"faces_removed", r.facesRemoved},
+                {"faces_added", r.facesAdded},
+                {"seam_edges", r.seamEdges},
+                {"seam_length", r.seamLength},
+                {"seam_faces", r.seamFaces},
+                {"seam_min_angle_deg", r.seamMinAngleDeg},
+                {"seam_frac_min_angle_above_25", r.seamFracMinAngleAbove25},
+                {"components_stitched", r.componentsStitched},
+                {"components_skipped", r.componentsSkipped},
+                {"pieces_stitched", r.piecesStitched},
+                {"patch_faces_trimmed", r.patchFacesTrimmed},
+                {"collapses", r.collapses},
+                {"flips", r.flips},
+                {"skipped", r.skipped},
+                {"seconds", r.seconds}};
+}
+
+const char* kindName(SessionEvent::Kind kind) {
+    switch (kind) {
+    case SessionEvent::Kind::Accept:
+        return "accept";
+    case SessionEvent::Kind::Undo:
+        return "undo";
+    case SessionEvent::Kind::Redo:
+        return "redo";
+    }
+    return "?";
+}
+
+// The renderer factory for the replay: "cpu", "gpu" (fails without GL) or "auto" (GPU, else CPU).
+RendererFactory makeFactory(const std::string& kind, std::string& used, const std::string& command) {
+    if (kind == "cpu") {
+        used = "cpu";
+        return [] { return std::make_unique<CpuMeshRenderer>(); };
+    }
+    try {
+        render::GpuMeshRenderer probe; // creates the head-less context: fails here when there is no GL
+    } catch (const Error& e) {
+        if (kind == "gpu") throw;
+        std::cerr << command << ": note: " << e.what() << " Falling back to CPU ray casting.\n";
+        used = "cpu";
+        return [] { return std::make_unique<CpuMeshRenderer>(); };
+    }
+    used = "gpu";
+    return [] { return std::make_unique<render::GpuMeshRenderer>(); };
+}
+
+} // namespace
+
+int runRun(const std::vector<std::string>& args) {
+    const std::string command = "fss-remesh run";
+    std::string sessionPath, outPath, reportPath, snapshotPath,
+        snapshotSize = "1024x768", snapshotView = "iso", snapshotZoom = "1", rendererKind = "session";
+    bool haveReport = false, haveSnapshot = false, json = false, noSelf = false, quiet = false;
+    ArgParser p(command,
+                "Replay the session file SESSION.json head-less: read its input mesh (checking its "
+                "SHA-256), apply every recorded scan, undo and redo in order, and write the resulting mesh "
+                "to OUT. With the renderer the session was recorded with, OUT is identical to the mesh "
+                "the recording session produced.");
+    p.positional("SESSION.json", "Session file (fss-session JSON, written by fss-demo or the C++ API).",
+                 &sessionPath);
+    p.option("-o", "OUT", "Output mesh (.off .obj .ply .stl; .ply keeps per-face quality and scan id).",
+             &outPath);
+    p.option("--output", "OUT", "Same as -o.", &outPath);
+    p.option(
+        "--report", "R.json",
+        "Write a JSON report: every metric of 'fss-remesh info' for OUT (with Hausdorff distances to the "
+        "input) and for the input, and per event the scan and stitch times and the stitch report.",
+        &reportPath, &haveReport);
+    p.flag("--json", "Print the same JSON report on stdout instead of the text summary.", &json);
+    p.option(
+        "--snapshot", "S.png",
+        "Render OUT head-less into a PNG coloured by each triangle's minimum angle (red 0, yellow 30, green "
+        "60 degrees).",
+        &snapshotPath, &haveSnapshot);
+    p.option("--snapshot-size", "WxH", "Size of the snapshot in pixels (default 1024x768).", &snapshotSize);
+    p.option("--snapshot-view", "V", "View of the snapshot: iso, +x, -x, +y, -y, +z, -z (default iso).",
+             &snapshotView);
+    p.option("--snapshot-zoom", "F", "Zoom factor of the snapshot camera (> 0, default 1: the whole mesh).",
+             &snapshotZoom);
+    p.option(
+        "--renderer", "R",
+        "session (default: the renderer the session was recorded with), auto (GPU, else CPU), gpu or cpu. "
+        "Another renderer than the recording's gives a slightly different mesh.",
+        &rendererKind);
+    p.flag("--no-self-intersections", "Skip the self-intersection count in the report (slow on huge meshes).",
+           &noSelf);
+    p.flag("--quiet", "No progress bar (it is shown only when stderr is a terminal anyway).", &quiet);
+    p.epilog("example:\n  fss-remesh run examples/fandisk.session.json -o fandisk_remeshed.ply --report "
+             "report.json "
+             "--snapshot fandisk.png");
+    if (!p.parse(args)) return 0;
+
+    if (outPath.empty()) throw UsageError("'fss-remesh run' needs an output file: -o OUT.");
+    if (!isSupportedMeshFile(outPath))
+        throw UsageError("The output file " + outPath + " has no supported extension (.off .obj .ply .stl).");
+    if (rendererKind != "session" && rendererKind != "auto" && rendererKind != "gpu" && rendererKind != "cpu")
+        throw UsageError("The value '" + rendererKind +
+                         "' of --renderer is not one of session, auto, gpu, cpu.");
+    if (haveReport && reportPath.empty()) throw UsageError("The option --report needs a file name.");
+    if (haveSnapshot) {
+        const std::string ext = std::filesystem::path(snapshotPath).extension().string();
+        if (ext != ".png" && ext != ".PNG")
+            throw UsageError("The snapshot " + snapshotPath + " must be a .png file.");
+    }
+    const auto [snapW, snapH] = parseResolution("--snapshot-size", snapshotSize, Camera::kMaxResolution);
+    const double zoom = parseDouble("--snapshot-zoom", snapshotZoom);
+    if (!(zoom > 0)) throw UsageError("The value of --snapshot-zoom must be positive.");
+    const auto view = parseStandardView(snapshotView);
+    if (!view)
+        throw UsageError("The value '" + snapshotView +
+                         "' of --snapshot-view is not one of iso, +x, -x, +y, -y, +z, -z.");
+
+    const auto start = Clock::now();
+    const SessionFile file = loadSessionFile(sessionPath);
+    const double loadSeconds = since(start);
+
+    const std::string kind = rendererKind == "session" ? file.renderer : rendererKind;
+    std::string used;
+    const RendererFactory factory = makeFactory(kind, used, command);
+    if (used != file.renderer)
+        std::cerr << command << ": note: the session was recorded with the " << file.renderer
+                  << " renderer and is replayed with the " << used << " one; the mesh may differ slightly.\n";
+
+    const bool showProgress = !quiet && ::isatty(STDERR_FILENO) == 1;
+    ProgressBar bar;
+    Progress progress;
+    if (showProgress)
+        progress = Progress([&bar](double f, std::string_view stage) { return bar.update(f, stage); });
+
+    const auto replayStart = Clock::now();
+    ReplayResult replay = replaySession(file, factory, progress);
+    const double replaySeconds = since(replayStart);
+    const Mesh& result = replay.session.current();
+
+    auto t = Clock::now();
+    writeMesh(result, outPath);
+    const double writeSeconds = since(t);
+
+    const bool wantReport = haveReport || json;
+    Json report;
+    double metricsSeconds = 0;
+    std::optional<Metrics> metrics, inputMetrics;
+    t = Clock::now();
+    {
+        MetricsOptions options;
+        options.selfIntersections = !noSelf;
+        options.reference = &replay.session.reference();
+        if (showProgress) bar.update(1.0, "metrics");
+        metrics = computeMetrics(result, options);
+        options.reference = nullptr;
+        inputMetrics = computeMetrics(replay.session.reference(), options);
+    }
+    metricsSeconds = since(t);
+
+    double snapshotSeconds = 0;
+    render::Snapshot shot;
+    if (haveSnapshot) {
+        if (showProgress) bar.update(1.0, "snapshot");
+        t = Clock::now();
+        Camera camera = Camera::standardView(*view, boundingBox(result), snapW, snapH);
+        camera.zoom(zoom);
+        render::SnapshotOptions options;
+        if (rendererKind == "cpu") options.renderer = render::SnapshotOptions::Renderer::Cpu;
+        shot = render::renderSnapshot(result, camera, options);
+        render::writePng(shot.image, snapshotPath);
+        snapshotSeconds = since(t);
+    }
+    bar.finish();
+
+    std::size_t accepts = 0, undos = 0, redos = 0;
+    for (const ReplayedEvent& e : replay.events) {
+        accepts += e.kind == SessionEvent::Kind::Accept;
+        undos += e.kind == SessionEvent::Kind::Undo;
+        redos += e.kind == SessionEvent::Kind::Redo;
+    }
+
+    if (wantReport) {
+        report["session"] = sessionPath;
+        report["input"] = file.meshPath.string();
+        report["input_sha256"] = file.meshSha256;
+        report["output"] = outPath;
+        report["renderer"] = used;
+        report["renderer_recorded"] = file.renderer;
+        report["counts"] = {{"events", replay.events.size()},
+                            {"accepted", accepts},
+                            {"undone", undos},
+                            {"redone", redos},
+                            {"steps_applied", replay.session.undoCount()}};
+        Json events = Json::array();
+        for (std::size_t i = 0; i < replay.events.size(); ++i) {
+            const ReplayedEvent& e = replay.events[i];
+            Json je;
+            je["index"] = i;
+            je["kind"] = kindName(e.kind);
+            if (e.kind == SessionEvent::Kind::Accept) {
+                je["grid"] = e.fishbone ? "fishbone" : "regular";
+                je["patch_faces"] = e.patchFaces;
+                je["scan_s"] = e.scanSeconds;
+                je["stitch_s"] = e.stitchSeconds;
+            }
+            je["seconds"] = e.seconds;
+            if (e.stitch) je["stitch"] = stitchJson(*e.stitch);
+            events.push_back(std::move(je));
+        }
+        report["events"] = std::move(events);
+        report["timings_s"] = {{"load_session", loadSeconds}, {"read_mesh", replay.readSeconds},
+                               {"replay", replaySeconds},     {"write", writeSeconds},
+                               {"metrics", metricsSeconds},   {"snapshot", snapshotSeconds},
+                               {"total", since(start)}};
+        report["metrics"] = Json::parse(metricsToJson(*metrics));
+        report["input_metrics"] = Json::parse(metricsToJson(*inputMetrics));
+        if (haveSnapshot)
+            report["snapshot"] = {
+                {"file", snapshotPath},
+                {"width", snapW},
+                {"height", snapH},
+                {"view", snapshotView},
+                {"renderer", shot.renderer},
+                {"covered_fraction", double(shot.covered) / (double(snapW) * double(snapH))}};
+        if (haveReport) {
+            const std::string tmp = reportPath + ".tmp" + std::to_string(::getpid());
+            {
+                std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+                if (!out) throw IoError("The report " + reportPath + " cannot be written.");
+                out << report.dump(2) << "\n";
+                if (!out.flush())
+                    throw IoError("The report " + reportPath + " could not be written completely.");
+            }
+            std::error_code ec;
+            std::filesystem::rename(tmp, reportPath, ec);
+            if (ec) throw IoError("The report " + reportPath + " cannot be written (" + ec.message() + ").");
+        }
+    }
+
+    if (json) {
+        std::cout << report.dump(2) << "\n";
+    } else {
+        const Metrics& m = *metrics;
+        std::cout << "replayed " << sessionPath << " (" << accepts << " scans, " << undos << " undos, "
+                  << redos << " redos; " << used << " renderer) in " << replaySeconds << " s: " << m.vertices
+                  << " vertices, " << m.faces << " faces, written to " << outPath << "\n";
+        std::cout << metricsToText(m);
+        if (inputMetrics) {
+            const Metrics& in = *inputMetrics;
+            char line[160];
+            std::cout << "  compared with the input        input      output\n";
+            auto row = [&](const char* label, double a, double b, const char* fmt) {
+                std::snprintf(line, sizeof line, fmt, label, a, b);
+                std::cout << line;
+            };
+            row("vertices", double(in.vertices), double(m.vertices), "    %-24s %10.0f  %10.0f\n");
+            row("faces", double(in.faces), double(m.faces), "    %-24s %10.0f  %10.0f\n");
+            row("valence-6 interior (%)", 100 * in.fracValence6Interior, 100 * m.fracValence6Interior,
+                "    %-24s %10.1f  %10.1f\n");
+            row("min angle (deg)", in.minAngleDeg, m.minAngleDeg, "    %-24s %10.2f  %10.2f\n");
+            row("mean min angle (deg)", in.meanMinAngleDeg, m.meanMinAngleDeg, "    %-24s %10.2f  %10.2f\n");
+            row("min angle < 30 deg (%)", 100 * in.fracMinAngleBelow30, 100 * m.fracMinAngleBelow30,
+                "    %-24s %10.2f  %10.2f\n");
+        }
+        if (haveReport) std::cout << "report written to " << reportPath << "\n";
+        if (haveSnapshot)
+            std::cout << "snapshot (" << shot.renderer << ") written to " << snapshotPath << "\n";
+    }
+    return 0;
+}
+
+} // namespace fss::cli

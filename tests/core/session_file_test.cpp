@@ -1,0 +1,612 @@
+// Session files: every field of a ScanStep round-trips bit-exactly, doubles of any bit pattern survive the
+// JSON text, bad files give one sentence naming the file and the field, and a replay reproduces the
+// recording session's current mesh exactly.
+#include "fss/error.h"
+#include "fss/mesh_io.h"
+#include "fss/session_file.h"
+#include "fss/sha256.h"
+#include "fss/shapes.h"
+
+#include "test_data.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+
+namespace {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+using Json = nlohmann::ordered_json;
+
+// Bitwise equality of doubles (distinguishes -0.0 from 0.0).
+::testing::AssertionResult sameBits(double a, double b) {
+    if (std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b))
+        return ::testing::AssertionSuccess();
+    std::ostringstream os;
+    os.precision(17);
+    os << a << " != " << b;
+    return ::testing::AssertionFailure() << os.str();
+}
+
+void expectSame(const Vector2d& a, const Vector2d& b) {
+    EXPECT_TRUE(sameBits(a.x(), b.x()));
+    EXPECT_TRUE(sameBits(a.y(), b.y()));
+}
+void expectSame(const Vector3d& a, const Vector3d& b) {
+    for (int i = 0; i < 3; ++i)
+        EXPECT_TRUE(sameBits(a[i], b[i]));
+}
+void expectSame(const std::vector<Vector2d>& a, const std::vector<Vector2d>& b) {
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i)
+        expectSame(a[i], b[i]);
+}
+
+void expectSame(const fss::StreamlineOptions& a, const fss::StreamlineOptions& b) {
+    EXPECT_TRUE(sameBits(a.step, b.step));
+    EXPECT_TRUE(sameBits(a.minStep, b.minStep));
+    EXPECT_TRUE(sameBits(a.maxLength, b.maxLength));
+    EXPECT_TRUE(sameBits(a.minAnisotropy, b.minAnisotropy));
+    EXPECT_EQ(a.lowAnisotropy, b.lowAnisotropy);
+    EXPECT_TRUE(sameBits(a.maxTurnDeg, b.maxTurnDeg));
+    EXPECT_EQ(a.maxSteps, b.maxSteps);
+    EXPECT_FALSE(b.insideRegion);
+}
+
+// Every field of a ScanStep.
+void expectSame(const fss::ScanStep& a, const fss::ScanStep& b) {
+    const fss::Camera &ca = a.params.camera, &cb = b.params.camera;
+    expectSame(ca.eye, cb.eye);
+    expectSame(ca.focal, cb.focal);
+    expectSame(ca.up, cb.up);
+    EXPECT_EQ(ca.parallel, cb.parallel);
+    EXPECT_TRUE(sameBits(ca.viewAngleDeg, cb.viewAngleDeg));
+    EXPECT_TRUE(sameBits(ca.parallelScale, cb.parallelScale));
+    EXPECT_TRUE(sameBits(ca.nearPlane, cb.nearPlane));
+    EXPECT_TRUE(sameBits(ca.farPlane, cb.farPlane));
+    EXPECT_EQ(ca.width, cb.width);
+    EXPECT_EQ(ca.height, cb.height);
+    ASSERT_EQ(a.params.lasso.has_value(), b.params.lasso.has_value());
+    if (a.params.lasso) expectSame(a.params.lasso->points, b.params.lasso->points);
+    EXPECT_EQ(a.params.erodeRadius, b.params.erodeRadius);
+    EXPECT_EQ(a.params.dilateRadius, b.params.dilateRadius);
+    EXPECT_EQ(a.params.scan.scanId, b.params.scan.scanId);
+    EXPECT_TRUE(sameBits(a.params.scan.qualityAngleLimitDeg, b.params.scan.qualityAngleLimitDeg));
+    EXPECT_TRUE(sameBits(a.params.scan.maxSnapFootprints, b.params.scan.maxSnapFootprints));
+    EXPECT_TRUE(sameBits(a.params.quality.margin, b.params.quality.margin));
+    EXPECT_EQ(a.params.quality.forceReplace, b.params.quality.forceReplace);
+    EXPECT_EQ(a.params.quality.searchRings, b.params.quality.searchRings);
+    EXPECT_TRUE(sameBits(a.params.triangulate.maxEdgeFootprints, b.params.triangulate.maxEdgeFootprints));
+    EXPECT_TRUE(sameBits(a.params.triangulate.maxSamplingAngleDeg, b.params.triangulate.maxSamplingAngleDeg));
+    ASSERT_EQ(a.fishbone.has_value(), b.fishbone.has_value());
+    if (a.fishbone) {
+        const fss::FishboneParams &fa = *a.fishbone, &fb = *b.fishbone;
+        ASSERT_EQ(fa.seed.has_value(), fb.seed.has_value());
+        if (fa.seed) expectSame(*fa.seed, *fb.seed);
+        EXPECT_EQ(fa.direction, fb.direction);
+        EXPECT_TRUE(sameBits(fa.spacing, fb.spacing));
+        expectSame(fa.keyRibs, fb.keyRibs);
+        ASSERT_EQ(fa.drawnKeyRibs.size(), fb.drawnKeyRibs.size());
+        for (std::size_t i = 0; i < fa.drawnKeyRibs.size(); ++i)
+            expectSame(fa.drawnKeyRibs[i], fb.drawnKeyRibs[i]);
+        expectSame(fa.drawnBackbone, fb.drawnBackbone);
+        EXPECT_TRUE(sameBits(fa.tracing.spacing, fb.tracing.spacing));
+        EXPECT_EQ(fa.tracing.extendBeyondKeyRibs, fb.tracing.extendBeyondKeyRibs);
+        expectSame(fa.tracing.backboneTracing, fb.tracing.backboneTracing);
+        expectSame(fa.tracing.ribTracing, fb.tracing.ribTracing);
+        EXPECT_TRUE(sameBits(fa.minSeedAnisotropy, fb.minSeedAnisotropy));
+        EXPECT_EQ(fa.raycast.rings, fb.raycast.rings);
+        EXPECT_EQ(fa.raycast.verifyUnoccluded, fb.raycast.verifyUnoccluded);
+    }
+    const fss::StitchOptions &sa = a.stitch, &sb = b.stitch;
+    EXPECT_EQ(sa.seamRings, sb.seamRings);
+    EXPECT_EQ(sa.optimiseSeam, sb.optimiseSeam);
+    EXPECT_TRUE(sameBits(sa.collapseEdgeRatio, sb.collapseEdgeRatio));
+    EXPECT_TRUE(sameBits(sa.seamGrading, sb.seamGrading));
+    EXPECT_TRUE(sameBits(sa.minAngleFloorDeg, sb.minAngleFloorDeg));
+    EXPECT_TRUE(sameBits(sa.maxViewAngleDeg, sb.maxViewAngleDeg));
+    EXPECT_TRUE(sameBits(sa.maxNormalChangeDeg, sb.maxNormalChangeDeg));
+    EXPECT_TRUE(sameBits(sa.maxGapRatio, sb.maxGapRatio));
+    EXPECT_EQ(sa.maxTrimRounds, sb.maxTrimRounds);
+    EXPECT_EQ(sa.minComponentFaces, sb.minComponentFaces);
+    EXPECT_EQ(sa.collectGarbage, sb.collectGarbage);
+}
+
+std::string slurpText(const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+// A small mesh file in the test scratch folder (its bytes are what the sha256 covers).
+std::filesystem::path writeTestMesh(const std::string& name, const fss::Mesh& mesh) {
+    const auto path = fss::test::tmpPath(name);
+    fss::writeMesh(mesh, path);
+    return path;
+}
+
+// A regular step with every field away from its default (and awkward doubles).
+fss::ScanStep regularStep() {
+    fss::ScanStep s;
+    fss::Camera& c = s.params.camera;
+    c.eye = {0.1 + 0.2, -1.0 / 3.0, 1e-300};
+    c.focal = {-0.0, 4.9406564584124654e-324, 123456789.123456789};
+    c.up = {std::nextafter(1.0, 2.0), 2.0 / 3.0, -7.25};
+    c.parallel = true;
+    c.viewAngleDeg = 12.345678901234567;
+    c.parallelScale = 0.7071067811865476;
+    c.nearPlane = 0.0012345;
+    c.farPlane = 98765.4321;
+    c.width = 321;
+    c.height = 123;
+    s.params.lasso = fss::Lasso{{{10.5, 11.25}, {300.125, 12}, {150, 100.0 / 3.0}, {20, 99.9}}};
+    s.params.erodeRadius = 3;
+    s.params.dilateRadius = 2;
+    s.params.scan.scanId = -7;
+    s.params.scan.qualityAngleLimitDeg = 77.7;
+    s.params.scan.maxSnapFootprints = 1.5;
+    s.params.quality.margin = 0.0625;
+    s.params.quality.forceReplace = true;
+    s.params.quality.searchRings = 4;
+    s.params.triangulate.maxEdgeFootprints = 2.75;
+    s.params.triangulate.maxSamplingAngleDeg = 71.5;
+    s.stitch.seamRings = 3;
+    s.stitch.optimiseSeam = false;
+    s.stitch.collapseEdgeRatio = 0.33;
+    s.stitch.seamGrading = 0.5;
+    s.stitch.minAngleFloorDeg = 2.5;
+    s.stitch.maxViewAngleDeg = 80.5;
+    s.stitch.maxNormalChangeDeg = 15.25;
+    s.stitch.maxGapRatio = 0.2;
+    s.stitch.maxTrimRounds = 9;
+    s.stitch.minComponentFaces = 5;
+    s.stitch.collectGarbage = true;
+    return s;
+}
+
+fss::ScanStep fishboneStep() {
+    fss::ScanStep s;
+    s.params.camera.width = 200;
+    s.params.camera.height = 150;
+    fss::FishboneParams fb;
+    fb.seed = Vector2d(100.25, 75.125);
+    fb.direction = fss::PrincipalDirection::Max;
+    fb.spacing = 3.5;
+    fb.keyRibs = {{90, 70}, {110.5, 80.25}};
+    fb.drawnKeyRibs = {{{1, 2}, {3, 4}, {5.5, 6.5}}, {{7, 8}, {9, 10}}};
+    fb.drawnBackbone = {{20, 30}, {40, 50.5}, {60.75, 55}};
+    fb.tracing.spacing = 2.5;
+    fb.tracing.extendBeyondKeyRibs = false;
+    fb.tracing.backboneTracing.step = 0.3;
+    fb.tracing.backboneTracing.minStep = 0.01;
+    fb.tracing.backboneTracing.maxLength = 77.5;
+    fb.tracing.backboneTracing.minAnisotropy = 0.07;
+    fb.tracing.backboneTracing.lowAnisotropy = fss::LowAnisotropyPolicy::Stop;
+    fb.tracing.backboneTracing.maxTurnDeg = 12.5;
+    fb.tracing.backboneTracing.maxSteps = 123456;
+    fb.tracing.ribTracing.step = 0.2;
+    fb.tracing.ribTracing.maxLength = std::numeric_limits<double>::infinity();
+    fb.tracing.ribTracing.lowAnisotropy = fss::LowAnisotropyPolicy::ContinueStraight;
+    fb.minSeedAnisotropy = 0.15;
+    fb.raycast.rings = 3;
+    fb.raycast.verifyUnoccluded = true;
+    s.fishbone = fb;
+    return s;
+}
+
+fss::SessionFile sampleFile(const std::filesystem::path& meshPath) {
+    fss::SessionFile f;
+    f.description = "every field";
+    f.meshPath = meshPath;
+    f.meshSha256 = fss::sha256OfFile(meshPath);
+    f.renderer = "gpu";
+    f.curvature.jetDegree = 3;
+    f.curvature.minPoints = 30;
+    f.curvature.maxRings = 4;
+    f.curvature.anisotropyEpsilon = 2.5e-3;
+    f.events.push_back({fss::SessionEvent::Kind::Accept, regularStep()});
+    f.events.push_back({fss::SessionEvent::Kind::Accept, fishboneStep()});
+    f.events.push_back({fss::SessionEvent::Kind::Undo, {}});
+    f.events.push_back({fss::SessionEvent::Kind::Redo, {}});
+    f.events.push_back({fss::SessionEvent::Kind::Undo, {}});
+    return f;
+}
+
+TEST(SessionFile, EveryFieldRoundTripsExactly) {
+    const auto mesh = writeTestMesh("session_file_roundtrip.off", fss::shapes::icosahedron());
+    const fss::SessionFile original = sampleFile(mesh);
+    const auto path = fss::test::tmpPath("session_file_roundtrip.session.json");
+    fss::saveSessionFile(original, path);
+    const fss::SessionFile loaded = fss::loadSessionFile(path);
+    EXPECT_EQ(loaded.version, fss::kSessionFileVersion);
+    EXPECT_EQ(loaded.description, original.description);
+    EXPECT_EQ(std::filesystem::absolute(loaded.meshPath).lexically_normal(),
+              std::filesystem::absolute(mesh).lexically_normal());
+    EXPECT_EQ(loaded.meshSha256, original.meshSha256);
+    EXPECT_EQ(loaded.renderer, "gpu");
+    EXPECT_EQ(loaded.curvature.jetDegree, 3);
+    EXPECT_EQ(loaded.curvature.minPoints, 30);
+    EXPECT_EQ(loaded.curvature.maxRings, 4);
+    EXPECT_TRUE(sameBits(loaded.curvature.anisotropyEpsilon, 2.5e-3));
+    EXPECT_EQ(loaded.source, path);
+    ASSERT_EQ(loaded.events.size(), original.events.size());
+    for (std::size_t i = 0; i < original.events.size(); ++i) {
+        SCOPED_TRACE("event " + std::to_string(i));
+        EXPECT_EQ(loaded.events[i].kind, original.events[i].kind);
+        if (original.events[i].kind == fss::SessionEvent::Kind::Accept)
+            expectSame(original.events[i].step, loaded.events[i].step);
+    }
+    // The sign of -0.0 and the subnormal survive.
+    EXPECT_TRUE(std::signbit(loaded.events[0].step.params.camera.focal.x()));
+    // Saving the loaded file again gives the same text.
+    const auto again = fss::test::tmpPath("session_file_roundtrip2.session.json");
+    fss::saveSessionFile(loaded, again);
+    EXPECT_EQ(fss::test::tmpPath("x").parent_path(), again.parent_path());
+    std::ifstream a(path), b(again);
+    std::stringstream ta, tb;
+    ta << a.rdbuf();
+    tb << b.rdbuf();
+    EXPECT_EQ(ta.str(), tb.str());
+}
+
+// nlohmann::json writes the shortest text that reads back to the same double: checked on random bit
+// patterns over the whole finite range and on random doubles of the magnitudes cameras have.
+TEST(SessionFile, DoublesRoundTripBitExactly) {
+    const auto mesh = writeTestMesh("session_file_doubles.off", fss::shapes::icosahedron());
+    std::mt19937_64 rng(2024);
+    std::uniform_real_distribution<double> moderate(-1e4, 1e4);
+    fss::SessionFile file;
+    file.meshPath = mesh;
+    file.meshSha256 = fss::sha256OfFile(mesh);
+    std::vector<double> values;
+    for (int i = 0; i < 3000; ++i) {
+        double v;
+        do
+            v = std::bit_cast<double>(rng());
+        while (!std::isfinite(v));
+        values.push_back(v);
+        values.push_back(moderate(rng));
+    }
+    fss::ScanStep step;
+    step.params.lasso = fss::Lasso{};
+    for (std::size_t i = 0; i + 1 < values.size(); i += 2)
+        step.params.lasso->points.emplace_back(values[i], values[i + 1]);
+    // The lasso must enclose an area to load: these corners make sure it does whatever the random points are.
+    step.params.lasso->points.emplace_back(0, 0);
+    step.params.lasso->points.emplace_back(1, 0);
+    step.params.lasso->points.emplace_back(0, 1);
+    file.events.push_back({fss::SessionEvent::Kind::Accept, step});
+    const fss::SessionFile loaded =
+        fss::sessionFileFromJson(fss::sessionFileToJson(file), "doubles.json", ".", {.verifyMesh = false});
+    const auto& pts = loaded.events.at(0).step.params.lasso->points;
+    ASSERT_EQ(pts.size(), step.params.lasso->points.size());
+    std::size_t mismatches = 0;
+    for (std::size_t i = 0; i < pts.size(); ++i)
+        mismatches += !sameBits(pts[i].x(), step.params.lasso->points[i].x()) ||
+                      !sameBits(pts[i].y(), step.params.lasso->points[i].y());
+    EXPECT_EQ(mismatches, 0u);
+}
+
+TEST(SessionFile, RelativeMeshPathIsRelativeToTheSessionFile) {
+    const auto dir = fss::test::tmpPath("session_file_paths");
+    std::filesystem::create_directories(dir / "meshes");
+    std::filesystem::create_directories(dir / "sessions");
+    const auto mesh = writeTestMesh("session_file_paths/meshes/ico.off", fss::shapes::icosahedron());
+    fss::SessionFile file;
+    file.meshPath = std::filesystem::relative(mesh); // relative to the working directory
+    file.meshSha256 = fss::sha256OfFile(mesh);
+    const auto session = dir / "sessions" / "s.json";
+    fss::saveSessionFile(file, session);
+    const Json j = Json::parse(slurpText(session));
+    EXPECT_EQ(j["mesh"]["path"], "../meshes/ico.off");
+    const fss::SessionFile loaded = fss::loadSessionFile(session);
+    EXPECT_TRUE(std::filesystem::equivalent(loaded.meshPath, mesh));
+    // An absolute path stays absolute.
+    file.meshPath = std::filesystem::absolute(mesh);
+    fss::saveSessionFile(file, session);
+    EXPECT_EQ(Json::parse(slurpText(session))["mesh"]["path"], file.meshPath.generic_string());
+}
+
+// ---- Bad files: one sentence naming the file and the field ----------------------------------------------
+
+class BadSessionFile : public ::testing::Test {
+protected:
+    void SetUp() override {
+        mesh_ = writeTestMesh("session_file_bad.off", fss::shapes::icosahedron());
+        fss::SessionFile f = sampleFile(mesh_);
+        good_ = Json::parse(fss::sessionFileToJson(f));
+    }
+    // The message of loading \p text from a file "bad.session.json" next to the mesh (IoError), or
+    // "(no error)".
+    std::string load(const std::string& text) {
+        const auto path = fss::test::tmpPath("bad.session.json");
+        {
+            std::ofstream out(path, std::ios::binary | std::ios::trunc);
+            out << text;
+        }
+        try {
+            fss::loadSessionFile(path);
+        } catch (const fss::IoError& e) {
+            const std::string m = e.what();
+            EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+            EXPECT_EQ(m.back(), '.') << m;
+            EXPECT_EQ(m.rfind(path.string(), 0), 0u) << "names the file first: " << m;
+            return m.substr(path.string().size());
+        }
+        return "(no error)";
+    }
+    std::string load(const Json& j) { return load(j.dump(2)); }
+    std::string load(const char* text) { return load(std::string(text)); }
+    Json good_;
+    std::filesystem::path mesh_;
+};
+
+TEST_F(BadSessionFile, GoodFileLoads) {
+    good_["mesh"]["path"] =
+        mesh_.filename().string(); // relative to the session file, which is in the same folder
+    EXPECT_EQ(load(good_), "(no error)");
+}
+
+TEST_F(BadSessionFile, WrongFormatOrVersion) {
+    Json j = good_;
+    j["version"] = 2;
+    EXPECT_EQ(load(j), ": version is 2, but this FSS reads version 1 only.");
+    j["version"] = "1";
+    EXPECT_EQ(load(j), ": version must be a positive integer.");
+    j = good_;
+    j["format"] = "something-else";
+    EXPECT_EQ(load(j), ": format must be \"fss-session\" (this is not an FSS session file).");
+    j.erase("format");
+    EXPECT_EQ(load(j), ": format is missing (a session file has \"format\": \"fss-session\").");
+    EXPECT_EQ(load("[1, 2]"), " is not a session file: its JSON is not an object.");
+    EXPECT_EQ(load(""), " is empty, not a session file.");
+}
+
+TEST_F(BadSessionFile, MissingFields) {
+    Json j = good_;
+    j["events"][0]["step"]["camera"].erase("width");
+    EXPECT_EQ(load(j), ": events[0].step.camera.width is missing.");
+    j = good_;
+    j["events"][1]["step"]["fishbone"]["tracing"]["ribs"].erase("max_turn_deg");
+    EXPECT_EQ(load(j), ": events[1].step.fishbone.tracing.ribs.max_turn_deg is missing.");
+    j = good_;
+    j["events"][0]["step"].erase("stitch");
+    EXPECT_EQ(load(j), ": events[0].step.stitch is missing.");
+    j = good_;
+    j.erase("mesh");
+    EXPECT_EQ(load(j), ": mesh is missing.");
+    j = good_;
+    j["events"][1]["step"]["grid"] = "fishbone";
+    j["events"][1]["step"].erase("fishbone");
+    EXPECT_EQ(load(j), ": events[1].step.fishbone is missing.");
+}
+
+TEST_F(BadSessionFile, WrongTypesAndValues) {
+    const std::pair<std::function<void(Json&)>, std::string> cases[] = {
+        {[](Json& j) { j["events"][0]["step"]["camera"]["width"] = "321"; },
+         ": events[0].step.camera.width must be a positive integer of at most 8192."},
+        {[](Json& j) { j["events"][0]["step"]["camera"]["width"] = 0; },
+         ": events[0].step.camera.width must be a positive integer of at most 8192."},
+        {[](Json& j) { j["events"][0]["step"]["camera"]["height"] = 12.5; },
+         ": events[0].step.camera.height must be a positive integer of at most 8192."},
+        {[](Json& j) {
+             j["events"][0]["step"]["camera"]["eye"] = Json::array({1, 2});
+         },
+         ": events[0].step.camera.eye must be an array of 3 numbers."},
+        {[](Json& j) { j["events"][0]["step"]["camera"]["up"][1] = "x"; },
+         ": events[0].step.camera.up[1] must be a number."},
+        {[](Json& j) { j["events"][0]["step"]["camera"]["projection"] = "fisheye"; },
+         ": events[0].step.camera.projection must be one of \"perspective\", \"parallel\", not \"fisheye\"."},
+        {[](Json& j) { j["events"][0]["step"]["camera"]["far"] = 0.001; },
+         ": events[0].step.camera.far must be larger than near."},
+        {[](Json& j) { j["events"][0]["step"]["camera"]["focal"] = j["events"][0]["step"]["camera"]["eye"]; },
+         ": events[0].step.camera.focal must differ from eye (the camera has no viewing direction)."},
+        {[](Json& j) {
+             j["events"][0]["step"]["lasso"] = Json::array({Json::array({0, 0}), Json::array({1, 1})});
+         },
+         ": events[0].step.lasso must enclose an area (at least 3 points, not all collinear)."},
+        {[](Json& j) { j["events"][0]["step"]["erode_radius"] = -1; },
+         ": events[0].step.erode_radius must be an integer in [0, 1024]."},
+        {[](Json& j) { j["events"][0]["step"]["quality_mask"]["force_replace"] = 1; },
+         ": events[0].step.quality_mask.force_replace must be true or false."},
+        {[](Json& j) { j["events"][0]["step"]["quality_mask"]["margin"] = 1.5; },
+         ": events[0].step.quality_mask.margin must be a number in [0, 1)."},
+        {[](Json& j) { j["events"][0]["step"]["grid"] = "hexagonal"; },
+         ": events[0].step.grid must be one of \"regular\", \"fishbone\", not \"hexagonal\"."},
+        {[](Json& j) { j["events"][0]["step"]["fishbone"] = j["events"][1]["step"]["fishbone"]; },
+         ": events[0].step.fishbone must not be given when grid is \"regular\"."},
+        {[](Json& j) { j["events"][1]["step"]["fishbone"]["h"] = -4; },
+         ": events[1].step.fishbone.h must be a positive number."},
+        {[](Json& j) { j["events"][1]["step"]["fishbone"]["direction"] = "sideways"; },
+         ": events[1].step.fishbone.direction must be one of \"min\", \"max\", not \"sideways\"."},
+        {[](Json& j) {
+             j["events"][1]["step"]["fishbone"]["key_ribs"][1] = Json::array({1, 2, 3});
+         },
+         ": events[1].step.fishbone.key_ribs[1] must be an array of 2 numbers [x, y]."},
+        {[](Json& j) {
+             j["events"][1]["step"]["fishbone"]["seed"] = nullptr;
+             j["events"][1]["step"]["fishbone"]["drawn_backbone"] = Json::array();
+         },
+         ": events[1].step.fishbone.seed must be given when drawn_backbone is empty."},
+        {[](Json& j) { j["events"][1]["step"]["fishbone"]["tracing"]["backbone"]["low_anisotropy"] = true; },
+         ": events[1].step.fishbone.tracing.backbone.low_anisotropy must be one of \"stop\", "
+         "\"continue_straight\"."},
+        {[](Json& j) { j["events"][1]["step"]["stitch"]["seam_rings"] = 1.5; },
+         ": events[1].step.stitch.seam_rings must be an integer of at least 0."},
+        {[](Json& j) { j["events"][0]["step"]["camera"]["eyes"] = 1; },
+         ": events[0].step.camera has an unknown field 'eyes'."},
+        {[](Json& j) { j["events"][2]["kind"] = "rotate"; },
+         ": events[2].kind must be one of \"accept\", \"undo\", \"redo\", not \"rotate\"."},
+        {[](Json& j) {
+             j["events"] = Json::array({Json{{"kind", "undo"}}});
+         },
+         ": events[0] is an undo with no accepted step left to undo."},
+        {[](Json& j) {
+             j["events"][3]["kind"] = "redo";
+             j["events"][4]["kind"] = "redo";
+         },
+         ": events[4] is a redo with no undone step to redo."},
+        {[](Json& j) { j["events"] = Json::object(); }, ": events must be an array of events."},
+        {[](Json& j) { j["renderer"] = "vulkan"; },
+         ": renderer must be one of \"cpu\", \"gpu\", not \"vulkan\"."},
+        {[](Json& j) { j["curvature"]["jet_degree"] = 4; }, ": curvature.jet_degree must be 2 or 3."},
+        {[](Json& j) { j["mesh"]["sha256"] = "abc"; },
+         ": mesh.sha256 must be 64 lowercase hexadecimal digits."},
+    };
+    for (const auto& [edit, expected] : cases) {
+        Json j = good_;
+        edit(j);
+        EXPECT_EQ(load(j), expected);
+    }
+}
+
+TEST_F(BadSessionFile, UnknownMeshAndChangedMesh) {
+    Json j = good_;
+    j["mesh"]["path"] = "no_such_mesh.off";
+    const auto missing = (fss::test::tmpPath("no_such_mesh.off")).lexically_normal();
+    EXPECT_EQ(load(j), ": mesh.path names the mesh " + missing.string() + ", which does not exist.");
+    j = good_;
+    j["mesh"]["sha256"] = std::string(64, '0');
+    EXPECT_EQ(load(j), ": mesh.sha256 does not match the mesh " + j["mesh"]["path"].get<std::string>() +
+                           " (the file changed since the session was recorded).");
+}
+
+TEST_F(BadSessionFile, TruncatedJson) {
+    const std::string text = good_.dump(2);
+    const std::string message = load(text.substr(0, text.size() / 2));
+    EXPECT_EQ(message.rfind(" is not valid JSON (it ends early, at line ", 0), 0u) << message;
+    EXPECT_EQ(
+        load("{\"format\": \"fss-session\",, }").rfind(" is not valid JSON (error at line 1, column ", 0),
+        0u);
+    // A missing file is an IoError too, naming it.
+    EXPECT_THROW(fss::loadSessionFile(fss::test::tmpPath("no_such.session.json")), fss::IoError);
+}
+
+TEST(SessionFile, SavingRefusesWhatCannotBeStored) {
+    const auto mesh = writeTestMesh("session_file_refuse.off", fss::shapes::icosahedron());
+    fss::SessionFile f = sampleFile(mesh);
+    f.events[0].step.params.camera.eye.x() = std::numeric_limits<double>::quiet_NaN();
+    try {
+        fss::sessionFileToJson(f);
+        FAIL() << "no error";
+    } catch (const fss::InvalidInputError& e) {
+        EXPECT_STREQ(e.what(),
+                     "The session cannot be saved: events[0].step.camera.eye is not a finite number.");
+    }
+    f = sampleFile(mesh);
+    f.events[1].step.fishbone->tracing.ribTracing.insideRegion = [](const Vector2d&) { return true; };
+    EXPECT_THROW(fss::sessionFileToJson(f), fss::InvalidInputError);
+    f = sampleFile(mesh);
+    f.renderer = "opengl";
+    EXPECT_THROW(fss::sessionFileToJson(f), fss::InvalidInputError);
+    EXPECT_FALSE(std::filesystem::exists(fss::test::tmpPath("refused.session.json")));
+    EXPECT_THROW(fss::saveSessionFile(f, fss::test::tmpPath("refused.session.json")), fss::InvalidInputError);
+    EXPECT_FALSE(std::filesystem::exists(fss::test::tmpPath("refused.session.json")));
+}
+
+// ---- Replay ---------------------------------------------------------------------------------------------
+
+// The mesh written as text in index order (points bit-exact via hexfloat): equal strings = equal meshes.
+std::string fingerprint(const fss::Mesh& mesh) {
+    std::ostringstream out;
+    out << std::hexfloat;
+    for (auto v : mesh.vertices())
+        out << mesh.point(v) << '\n';
+    for (auto f : mesh.faces()) {
+        for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
+            out << std::size_t(v) << ' ';
+        out << '\n';
+    }
+    return out.str();
+}
+
+fss::ScanStep viewStep(const fss::Mesh& mesh, fss::StandardView view, int resolution, double zoom = 1.0) {
+    fss::ScanStep step;
+    step.params.camera = fss::Camera::standardView(view, fss::boundingBox(mesh), resolution, resolution);
+    step.params.camera.zoom(zoom);
+    step.params.scan.scanId = int(view);
+    return step;
+}
+
+// Records a session through the API (scans, a rejected preview, an undo, a redo, a fishbone scan), saves it,
+// loads it and replays it: the current meshes are identical, and so is every stitch report's face count.
+TEST(SessionFile, ReplayReproducesTheRecordedMesh) {
+    const auto meshFile =
+        writeTestMesh("session_file_replay.off", fss::shapes::cylinder(48, 12, 1.0, 2.0, true));
+    fss::Session recorded(fss::readMesh(meshFile));
+    const fss::Mesh& ref = recorded.reference();
+    recorded.scan(viewStep(ref, fss::StandardView::PosX, 96));
+    recorded.accept();
+    recorded.scan(viewStep(ref, fss::StandardView::NegY, 96));
+    recorded.reject(); // not in the log
+    recorded.scan(viewStep(ref, fss::StandardView::PosY, 96, 1.5));
+    recorded.accept();
+    recorded.undo();
+    recorded.redo();
+    fss::ScanStep fish = viewStep(ref, fss::StandardView::NegX, 96);
+    fish.fishbone = fss::FishboneParams{};
+    fish.fishbone->seed = Vector2d(48.3, 48.7);
+    fish.fishbone->spacing = 3;
+    recorded.scan(fish);
+    recorded.accept();
+    recorded.scan(viewStep(ref, fss::StandardView::PosZ, 64));
+    recorded.accept();
+    recorded.undo();
+    ASSERT_EQ(recorded.events().size(), 7u);
+
+    const auto path = fss::test::tmpPath("replay.session.json");
+    fss::saveSessionFile(fss::sessionFileFromSession(recorded, meshFile), path);
+    const fss::SessionFile loaded = fss::loadSessionFile(path);
+    std::vector<std::pair<double, std::string>> reports;
+    fss::ReplayResult replay =
+        fss::replaySession(loaded, {}, fss::Progress([&](double f, std::string_view stage) {
+                               reports.emplace_back(f, std::string(stage));
+                               return true;
+                           }));
+    EXPECT_NE(fingerprint(recorded.current()), fingerprint(recorded.reference())); // the scans changed it
+    EXPECT_EQ(fingerprint(replay.session.current()), fingerprint(recorded.current()));
+    EXPECT_EQ(replay.session.undoCount(), recorded.undoCount());
+    EXPECT_EQ(replay.session.redoCount(), recorded.redoCount());
+    ASSERT_EQ(replay.events.size(), 7u);
+    EXPECT_TRUE(replay.events[4].fishbone);
+    EXPECT_GT(replay.events[4].patchFaces, 50u);
+    std::size_t accepted = 0;
+    for (const fss::ReplayedEvent& e : replay.events) {
+        EXPECT_EQ(e.stitch.has_value(), e.kind == fss::SessionEvent::Kind::Accept);
+        if (e.stitch) {
+            EXPECT_GT(e.stitch->facesAdded, 0u);
+            EXPECT_GT(e.scanSeconds, 0.0);
+            ++accepted;
+        }
+    }
+    EXPECT_EQ(accepted, 4u);
+    // Progress is monotone from 0 to 1.
+    ASSERT_FALSE(reports.empty());
+    for (std::size_t i = 1; i < reports.size(); ++i)
+        EXPECT_GE(reports[i].first, reports[i - 1].first - 1e-12);
+    EXPECT_EQ(reports.back().first, 1.0);
+
+    // A scan that fails on replay names the event.
+    fss::SessionFile broken = loaded;
+    broken.events[0].step.params.camera.eye = Vector3d(100, 100, 100);
+    broken.events[0].step.params.camera.focal = Vector3d(200, 200, 200); // looks away from the mesh
+    try {
+        fss::replaySession(broken);
+        FAIL() << "no error";
+    } catch (const fss::InvalidInputError& e) {
+        EXPECT_EQ(std::string(e.what()).rfind(path.string() + ", events[0] (accept): ", 0), 0u) << e.what();
+    }
+}
+
+} // namespace

@@ -1,0 +1,794 @@
+// Stitching property test (issue #4): on CGAL sample meshes, hundreds of random scans, each scanned from the
+// reference, masked against the current mesh and stitched into it (chained). After EVERY stitch the
+// invariants of DESIGN.md §5 are checked independently of the stitcher's own checks and of StitchReport:
+//  - valid halfedge structure, triangles only, no isolated or non-manifold vertices, no two edges joining
+//    the same two vertices (edge-manifold), consistent orientation (a closed mesh keeps a positive volume);
+//  - a closed mesh stays closed; the number of boundary loops is unchanged;
+//  - no self-intersections: CGAL::Polygon_mesh_processing::does_self_intersect on every face that changed
+//    and every face whose bounding box meets one of them (the mesh was free of intersections before, so a
+//    new intersecting pair contains a changed face); the whole mesh is checked by does_self_intersect
+//    every kFullCheckEvery scans and at the end;
+//  - no degenerate faces (exact collinearity test);
+//  - faces outside the seam neighbourhood unchanged: every face index live before and after keeps its
+//    vertices and their points unless it is "changed"; every changed or removed face of the mesh before the
+//    stitch lies within StitchOptions::seamRings vertex rings of a face that touches the patch's footprint
+//    (its projection covers a pixel of the patch's sample mask dilated by one pixel, or one of its vertices
+//    projects into such a pixel);
+//  - Hausdorff distance to the reference within one pixel footprint, both directions, sampled:
+//    current → reference at the three corners, the three edge midpoints and the centroid of every face
+//    the stitch added; reference → current at the corners and centroid of every reference face within
+//    two footprints of the changed region's bounding box. The bound at a point on (or nearest to) a
+//    current-mesh face made by scan s is scan s's pixel footprint there (Camera::pixelFootprint); a face
+//    still carrying the input's scan id −1 lies on the input surface, bound 1e-9 of the bounding box
+//    diagonal. The whole mesh is measured both ways at the end.
+// A scan that produces no patch (the view misses the visible surface, every sample is worse than the mesh)
+// does not count; a patch that cannot be stitched at all (InvalidInputError) is allowed, counted, must leave
+// the mesh bit for bit unchanged, and most patches must stitch. Seeds are fixed and printed on failure.
+#include "fss/camera_projector.h"
+#include "fss/error.h"
+#include "fss/scan_pipeline.h"
+#include "fss/stitch.h"
+#include "fss/triangulate.h"
+
+#include "test_data.h"
+
+#include <CGAL/AABB_face_graph_triangle_primitive.h>
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/Polygon_mesh_processing/measure.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Surface_mesh/IO/OFF.h>
+#include <CGAL/box_intersection_d.h>
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <random>
+#include <set>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace PMP = CGAL::Polygon_mesh_processing;
+using fss::Camera;
+using fss::FaceIndex;
+using fss::HalfedgeIndex;
+using fss::Mesh;
+using fss::Point3;
+using fss::VertexIndex;
+using Vec3 = Eigen::Vector3d;
+
+namespace {
+
+constexpr int kFullCheckEvery = 25;
+
+Vec3 vec(const Point3& p) {
+    return {p.x(), p.y(), p.z()};
+}
+
+// A z-buffer rasterizer standing in for the GPU renderer (fss::render::Rasterizer): per pixel centre the
+// nearest face covering it (closed edge functions in double), depth interpolated affinely on the screen
+// (window depth is affine there) and stored as float like the GPU's. O(faces + covered pixels) per render,
+// much cheaper than CpuMeshRenderer's ray casting, which keeps this test within its CPU budget. The scan
+// snaps every sample onto the plane of the face under it, so the depth precision does not matter.
+class ZBufferRenderer final : public fss::MeshRenderer {
+public:
+    void setMesh(const Mesh& mesh) override { mesh_ = &mesh; }
+    fss::FrameBuffers render(const Camera& camera) override {
+        Camera cam = camera;
+        cam.fitClippingRange(fss::boundingBox(*mesh_));
+        cam.validate();
+        const fss::CameraProjector proj(cam);
+        const int W = cam.width, H = cam.height;
+        fss::FrameBuffers fb;
+        fb.camera = cam;
+        std::vector<double> depth(std::size_t(W) * std::size_t(H), 2.0);
+        fb.faceId.assign(depth.size(), fss::FrameBuffers::kNoFace);
+        for (FaceIndex f : mesh_->faces()) {
+            Vec3 s[3];
+            int k = 0;
+            bool ok = true;
+            for (auto v : CGAL::vertices_around_face(mesh_->halfedge(f), *mesh_)) {
+                const Vec3 p = vec(mesh_->point(v));
+                if (proj.viewDepth(p) <= cam.nearPlane) ok = false;
+                s[k++] = proj.project(p);
+            }
+            if (!ok) continue;
+            const double area =
+                (s[1].x() - s[0].x()) * (s[2].y() - s[0].y()) - (s[1].y() - s[0].y()) * (s[2].x() - s[0].x());
+            if (!(area != 0)) continue;
+            const int x0 = std::max(0, int(std::floor(std::min({s[0].x(), s[1].x(), s[2].x()}) - 0.5)));
+            const int x1 = std::min(W - 1, int(std::ceil(std::max({s[0].x(), s[1].x(), s[2].x()}))));
+            const int y0 = std::max(0, int(std::floor(std::min({s[0].y(), s[1].y(), s[2].y()}) - 0.5)));
+            const int y1 = std::min(H - 1, int(std::ceil(std::max({s[0].y(), s[1].y(), s[2].y()}))));
+            for (int y = y0; y <= y1; ++y)
+                for (int x = x0; x <= x1; ++x) {
+                    const double px = x + 0.5, py = y + 0.5;
+                    double b[3];
+                    for (int i = 0; i < 3; ++i) {
+                        const Vec3 &p = s[(i + 1) % 3], &q = s[(i + 2) % 3];
+                        b[i] = ((q.x() - p.x()) * (py - p.y()) - (q.y() - p.y()) * (px - p.x())) / area;
+                    }
+                    if (b[0] < 0 || b[1] < 0 || b[2] < 0) continue;
+                    const double z = b[0] * s[0].z() + b[1] * s[1].z() + b[2] * s[2].z();
+                    if (!(z >= 0 && z <= 1)) continue;
+                    const std::size_t i = std::size_t(y) * std::size_t(W) + std::size_t(x);
+                    if (z < depth[i]) {
+                        depth[i] = z;
+                        fb.faceId[i] = std::uint32_t(f);
+                    }
+                }
+        }
+        fb.depth.resize(depth.size());
+        for (std::size_t i = 0; i < depth.size(); ++i)
+            fb.depth[i] = depth[i] <= 1.0 ? float(depth[i]) : 1.0f;
+        return fb;
+    }
+
+private:
+    const Mesh* mesh_ = nullptr;
+};
+
+using Primitive = CGAL::AABB_face_graph_triangle_primitive<Mesh>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<fss::Kernel, Primitive>>;
+
+// ---- the scan setup: random views, resolutions, lassos, morphology
+struct ScanSetup {
+    Camera camera;
+    std::optional<fss::Lasso> lasso;
+    int erode = 0, dilate = 0;
+    bool forceReplace = false;
+    std::string text;
+};
+
+Vec3 randomDirection(std::mt19937& rng) {
+    std::normal_distribution<double> N(0, 1);
+    Vec3 d;
+    do
+        d = Vec3(N(rng), N(rng), N(rng));
+    while (d.norm() < 1e-3);
+    return d.normalized();
+}
+
+ScanSetup randomSetup(std::mt19937& rng, const Eigen::AlignedBox3d& box, int maxRes) {
+    std::uniform_real_distribution<double> U(0, 1);
+    ScanSetup s;
+    // Resolution log-uniform in [32, maxRes].
+    const int res = int(std::lround(std::exp(std::log(32.0) + U(rng) * (std::log(double(maxRes)) - std::log(32.0)))));
+    const int W = std::clamp(int(res * (0.8 + 0.4 * U(rng))), 32, maxRes), H = res;
+    Camera& c = s.camera;
+    c.width = W;
+    c.height = H;
+    c.viewAngleDeg = 20 + 20 * U(rng);
+    c.parallel = U(rng) < 0.15;
+    const Vec3 centre = box.center(), half = 0.5 * box.sizes();
+    const double radius = half.norm();
+    const double zoom = std::exp(U(rng) * std::log(2.5)); // 1: whole object; 2.5: a part of it
+    const Vec3 focal = centre + (1.0 - 1.0 / zoom) * half.cwiseProduct(Vec3(2 * U(rng) - 1, 2 * U(rng) - 1, 2 * U(rng) - 1));
+    const Vec3 dir = randomDirection(rng);
+    const double fit = radius / std::sin(0.5 * c.viewAngleDeg * std::numbers::pi / 180.0);
+    c.focal = focal;
+    c.eye = focal + dir * std::max(fit / zoom, 1.8 * radius); // outside the bounding sphere
+    c.parallelScale = radius / zoom;
+    // The pixel footprint at the focal point is at least diag / 100 (a high resolution widens the view
+    // instead): the chained mesh then converges to about the density of a 100² scan of the whole object and
+    // stays small enough for hundreds of scans with full checks after each.
+    {
+        const double minFootprint = 2 * radius / 100 * (1 + U(rng));
+        const double fp = c.pixelFootprint(focal);
+        if (fp < minFootprint) {
+            c.eye = focal + (c.eye - focal) * (minFootprint / fp);
+            c.parallelScale *= minFootprint / fp;
+        }
+    }
+    do
+        c.up = randomDirection(rng);
+    while (c.up.cross(dir).norm() < 0.2);
+    c.fitClippingRange(box);
+    // Lasso: none, a star-shaped polygon, or random points (often self-intersecting), or a pentagram.
+    const double kind = U(rng);
+    std::ostringstream t;
+    t << "res " << W << "x" << H << (c.parallel ? " parallel" : " perspective") << " zoom " << zoom;
+    // Lassos of high-resolution scans select a detail (at most about as many samples as a 160² scan of the
+    // whole view) to keep the patches of comparable size.
+    const double detail = std::min(1.0, 160.0 / res);
+    if (kind < 0.15 && res <= 160) {
+        t << " no lasso";
+    } else {
+        fss::Lasso l;
+        // Around a point of the object's image (its bounding sphere's projection).
+        const Vec3 cp = c.project(centre);
+        const double objectPixels = std::min(0.5 * std::min(W, H), radius / c.pixelFootprint(centre));
+        const Eigen::Vector2d m(std::clamp(cp.x() + objectPixels * (1.2 * U(rng) - 0.6), 0.0, double(W)),
+                                std::clamp(cp.y() + objectPixels * (1.2 * U(rng) - 0.6), 0.0, double(H)));
+        const double r = std::max(3.0, std::min(std::min(W, H) * (0.15 + 0.45 * U(rng)) * detail,
+                                                objectPixels * (0.3 + 0.7 * U(rng))));
+        if (kind < 0.6) {
+            const int n = 3 + int(U(rng) * 10);
+            std::vector<double> angles(std::size_t(n), 0);
+            for (auto& a : angles)
+                a = 2 * std::numbers::pi * U(rng);
+            std::sort(angles.begin(), angles.end());
+            for (double a : angles) {
+                const double rr = r * (0.3 + 0.7 * U(rng));
+                l.points.push_back(m + rr * Eigen::Vector2d(std::cos(a), std::sin(a)));
+            }
+            t << " star lasso " << n;
+        } else if (kind < 0.9) {
+            const int n = 4 + int(U(rng) * 6);
+            for (int i = 0; i < n; ++i)
+                l.points.push_back(m + r * Eigen::Vector2d(2 * U(rng) - 1, 2 * U(rng) - 1));
+            t << " random lasso " << n;
+        } else {
+            const double a0 = 2 * std::numbers::pi * U(rng);
+            for (int i = 0; i < 5; ++i) {
+                const double a = a0 + 4 * std::numbers::pi * i / 5.0;
+                l.points.push_back(m + r * Eigen::Vector2d(std::cos(a), std::sin(a)));
+            }
+            t << " pentagram lasso";
+        }
+        s.lasso = std::move(l);
+    }
+    // Half of the scans force the replacement (QualityMaskOptions::forceReplace): with the footprint
+    // floor above, the quality mask alone would soon reject almost every scan.
+    s.forceReplace = U(rng) < 0.5;
+    t << (s.forceReplace ? " force-replace" : "");
+    s.erode = int(U(rng) * 4);
+    s.dilate = int(U(rng) * 4);
+    t << " erode " << s.erode << " dilate " << s.dilate;
+    s.text = t.str();
+    return s;
+}
+
+// ---- mesh invariants
+std::size_t boundaryLoops(const Mesh& m) {
+    std::unordered_set<std::uint32_t> seen;
+    std::size_t loops = 0;
+    for (auto h : m.halfedges()) {
+        if (!m.is_border(h) || seen.count(std::uint32_t(h))) continue;
+        ++loops;
+        auto g = h;
+        do {
+            seen.insert(std::uint32_t(g));
+            g = m.next(g);
+        } while (g != h);
+    }
+    return loops;
+}
+
+// Isolated vertices, vertices whose faces form more than one fan.
+std::size_t nonManifoldVertices(const Mesh& m) {
+    std::unordered_map<std::uint32_t, int> incoming;
+    for (auto h : m.halfedges())
+        ++incoming[std::uint32_t(m.target(h))];
+    std::size_t bad = 0;
+    for (auto v : m.vertices()) {
+        if (m.halfedge(v) == Mesh::null_halfedge()) {
+            ++bad;
+            continue;
+        }
+        int n = 0, borders = 0;
+        for (auto h : CGAL::halfedges_around_target(m.halfedge(v), m)) {
+            ++n;
+            borders += m.is_border(h);
+        }
+        if (n != incoming[std::uint32_t(v)] || borders > 1) ++bad;
+    }
+    return bad;
+}
+
+// Two edges joining the same pair of vertices (the surface would be non-manifold along that edge).
+std::size_t duplicateEdges(const Mesh& m) {
+    std::unordered_set<std::uint64_t> seen;
+    std::size_t n = 0;
+    for (auto e : m.edges()) {
+        std::uint32_t a = std::uint32_t(m.vertex(e, 0)), b = std::uint32_t(m.vertex(e, 1));
+        if (a > b) std::swap(a, b);
+        if (!seen.insert((std::uint64_t(a) << 32) | b).second) ++n;
+    }
+    return n;
+}
+
+std::size_t degenerateFaces(const Mesh& m) {
+    std::size_t n = 0;
+    for (auto f : m.faces()) {
+        auto h = m.halfedge(f);
+        if (CGAL::collinear(m.point(m.source(h)), m.point(m.target(h)), m.point(m.target(m.next(h))))) ++n;
+    }
+    return n;
+}
+
+std::array<VertexIndex, 3> corners(const Mesh& m, FaceIndex f) {
+    const HalfedgeIndex h = m.halfedge(f);
+    return {m.source(h), m.target(h), m.target(m.next(h))};
+}
+
+// Face f of a live in both meshes with the same vertices (same cyclic order) at the same points?
+bool sameFace(const Mesh& a, const Mesh& b, FaceIndex f) {
+    if (std::size_t(f) >= b.num_faces() || b.is_removed(f)) return false;
+    auto ca = corners(a, f), cb = corners(b, f);
+    for (int r = 0; r < 3; ++r) {
+        bool same = true;
+        for (int k = 0; k < 3 && same; ++k) {
+            const VertexIndex va = ca[std::size_t(k)], vb = cb[std::size_t((k + r) % 3)];
+            same = va == vb && a.point(va) == b.point(vb);
+        }
+        if (same) return true;
+    }
+    return false;
+}
+
+void expectBitIdentical(const Mesh& a, const Mesh& b) {
+    ASSERT_EQ(a.num_vertices(), b.num_vertices());
+    ASSERT_EQ(a.num_halfedges(), b.num_halfedges());
+    ASSERT_EQ(a.num_faces(), b.num_faces());
+    ASSERT_EQ(a.number_of_removed_faces(), b.number_of_removed_faces());
+    for (std::size_t i = 0; i < a.num_vertices(); ++i) {
+        const VertexIndex v(static_cast<std::uint32_t>(i));
+        ASSERT_EQ(a.is_removed(v), b.is_removed(v));
+        ASSERT_EQ(a.point(v), b.point(v));
+        ASSERT_EQ(a.halfedge(v), b.halfedge(v));
+    }
+    for (std::size_t i = 0; i < a.num_halfedges(); ++i) {
+        const HalfedgeIndex h(static_cast<std::uint32_t>(i));
+        ASSERT_EQ(a.next(h), b.next(h));
+        ASSERT_EQ(a.target(h), b.target(h));
+        ASSERT_EQ(a.face(h), b.face(h));
+    }
+}
+
+using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, FaceIndex>;
+Box faceBox(const Mesh& m, FaceIndex f) {
+    CGAL::Bbox_3 b;
+    for (auto v : CGAL::vertices_around_face(m.halfedge(f), m))
+        b += m.point(v).bbox();
+    return Box(b, f);
+}
+
+// Faces of m whose bounding boxes meet the bounding box of one of `changed` (changed ones included).
+std::vector<FaceIndex> facesNear(const Mesh& m, const std::vector<FaceIndex>& changed) {
+    std::vector<Box> a, b;
+    for (FaceIndex f : changed)
+        a.push_back(faceBox(m, f));
+    for (FaceIndex f : m.faces())
+        b.push_back(faceBox(m, f));
+    std::set<FaceIndex> out(changed.begin(), changed.end());
+    CGAL::box_intersection_d(a.begin(), a.end(), b.begin(), b.end(),
+                             [&](const Box&, const Box& y) { out.insert(y.info()); });
+    return {out.begin(), out.end()};
+}
+
+// ---- footprint of the patch in the scan's image
+struct Footprint {
+    int W = 0, H = 0;
+    std::vector<char> mask; // pixels of patch samples, dilated by one pixel
+    bool at(int x, int y) const { return x >= 0 && y >= 0 && x < W && y < H && mask[std::size_t(y * W + x)]; }
+};
+
+Footprint footprintOf(const fss::Patch& patch, const Camera& cam) {
+    Footprint fp;
+    fp.W = cam.width;
+    fp.H = cam.height;
+    std::vector<char> raw(std::size_t(fp.W) * std::size_t(fp.H), 0);
+    auto gi = patch.mesh.property_map<VertexIndex, fss::GridIndex>(fss::props::vertexGridIndex);
+    if (!gi.second) throw std::runtime_error("patch without grid indices");
+    for (auto v : patch.mesh.vertices()) {
+        const fss::GridIndex g = gi.first[v];
+        raw[std::size_t(g.row * fp.W + g.col)] = 1;
+    }
+    fp.mask.assign(raw.size(), 0);
+    for (int y = 0; y < fp.H; ++y)
+        for (int x = 0; x < fp.W; ++x) {
+            if (!raw[std::size_t(y * fp.W + x)]) continue;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int X = x + dx, Y = y + dy;
+                    if (X >= 0 && Y >= 0 && X < fp.W && Y < fp.H) fp.mask[std::size_t(Y * fp.W + X)] = 1;
+                }
+        }
+    return fp;
+}
+
+// Does face f of m touch the footprint in the view (a vertex in a footprint pixel, or a footprint pixel
+// centre inside its projection)?
+bool touchesFootprint(const Mesh& m, FaceIndex f, const Camera& cam, const Footprint& fp) {
+    Vec3 s[3];
+    int k = 0;
+    for (auto v : CGAL::vertices_around_face(m.halfedge(f), m)) {
+        const Vec3 p = vec(m.point(v));
+        if (cam.viewDepth(p) <= 0) return false;
+        s[k] = cam.project(p);
+        if (fp.at(int(std::floor(s[k].x())), int(std::floor(s[k].y())))) return true;
+        ++k;
+    }
+    const double area = (s[1].x() - s[0].x()) * (s[2].y() - s[0].y()) - (s[1].y() - s[0].y()) * (s[2].x() - s[0].x());
+    if (area == 0) return false;
+    const int x0 = std::max(0, int(std::floor(std::min({s[0].x(), s[1].x(), s[2].x()}))));
+    const int x1 = std::min(fp.W - 1, int(std::ceil(std::max({s[0].x(), s[1].x(), s[2].x()}))));
+    const int y0 = std::max(0, int(std::floor(std::min({s[0].y(), s[1].y(), s[2].y()}))));
+    const int y1 = std::min(fp.H - 1, int(std::ceil(std::max({s[0].y(), s[1].y(), s[2].y()}))));
+    for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+            if (!fp.at(x, y)) continue;
+            const double px = x + 0.5, py = y + 0.5;
+            bool in = true;
+            for (int i = 0; i < 3 && in; ++i) {
+                const Vec3 &p = s[(i + 1) % 3], &q = s[(i + 2) % 3];
+                in = ((q.x() - p.x()) * (py - p.y()) - (q.y() - p.y()) * (px - p.x())) / area >= 0;
+            }
+            if (in) return true;
+        }
+    return false;
+}
+
+// ---- one mesh
+struct Case {
+    const char* file;
+    std::uint32_t seed;
+    int patches; // scans that produce a patch
+    int maxRes;
+};
+
+struct Figures {
+    int attempts = 0, noPatch = 0, stitched = 0, refused = 0;
+    double worstToRef = 0, worstFromRef = 0; // Hausdorff / footprint
+    std::size_t facesStart = 0, facesEnd = 0;
+    double stitchSeconds = 0, scanSeconds = 0, checkSeconds = 0;
+    std::map<std::string, int> reasons; // why patches were refused
+};
+
+class StitchProperty : public ::testing::TestWithParam<Case> {};
+
+TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
+    const Case& cs = GetParam();
+    Mesh ref;
+    {
+        std::ifstream in(fss::test::meshPath(cs.file));
+        ASSERT_TRUE(in && CGAL::IO::read_OFF(in, ref)) << cs.file;
+    }
+    ASSERT_TRUE(CGAL::is_triangle_mesh(ref));
+    const bool closed = CGAL::is_closed(ref);
+    const std::size_t loops = boundaryLoops(ref);
+    const Eigen::AlignedBox3d box = fss::boundingBox(ref);
+    const double diag = box.diagonal().norm();
+    const double inputTol = 1e-9 * diag;
+    ASSERT_FALSE(PMP::does_self_intersect(ref));
+    Tree refTree(faces(ref).first, faces(ref).second, ref);
+    refTree.accelerate_distance_queries();
+    // Reference sample points (corners and centroids), for reference → current.
+    std::vector<Vec3> refPoints;
+    for (auto v : ref.vertices())
+        refPoints.push_back(vec(ref.point(v)));
+    for (auto f : ref.faces()) {
+        Vec3 c(0, 0, 0);
+        for (auto v : CGAL::vertices_around_face(ref.halfedge(f), ref))
+            c += vec(ref.point(v)) / 3.0;
+        refPoints.push_back(c);
+    }
+
+    ZBufferRenderer refRenderer, curRenderer;
+    refRenderer.setMesh(ref);
+    Mesh current = ref;
+    std::map<std::int32_t, Camera> scanCameras;
+    Figures fig;
+    fig.facesStart = ref.number_of_faces();
+    std::mt19937 rng(cs.seed);
+    const fss::StitchOptions options;
+    using Clock = std::chrono::steady_clock;
+    auto seconds = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+
+    // Bound of the distance at a point p on / nearest to face f of the current mesh: the pixel footprint
+    // at p of the scan that sampled the face's surface (its scan id) and of the scan whose stitch last
+    // re-made the face (its seam vertices come from that scan), whichever is larger; inputTol for faces
+    // of the input that no stitch has touched.
+    // A vertex that a stitch placed on the old surface (a seam crossing on an old edge, a refinement
+    // vertex) inherits the bound of the old face it lies on: vertexBound; samples and input vertices lie
+    // on the reference (inputTol).
+    std::vector<std::int32_t> madeBy(ref.num_faces(), -1);
+    std::unordered_map<std::uint32_t, double> vertexBound;
+    auto boundAt = [&](const Mesh& m, FaceIndex f, const Vec3& p) {
+        auto sid = m.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId);
+        const std::int32_t s = sid.second ? sid.first[f] : -1;
+        const std::int32_t k = std::size_t(f) < madeBy.size() ? madeBy[std::size_t(f)] : -1;
+        double b = inputTol;
+        if (s >= 0) b = std::max(b, scanCameras.at(s).pixelFootprint(p));
+        if (k >= 0) b = std::max(b, scanCameras.at(k).pixelFootprint(p));
+        for (auto v : CGAL::vertices_around_face(m.halfedge(f), m)) {
+            auto it = vertexBound.find(std::uint32_t(v));
+            if (it != vertexBound.end()) b = std::max(b, it->second);
+        }
+        return b;
+    };
+    // Explains a face that is too far from the reference.
+    auto describe = [&](const Mesh& m, FaceIndex f) {
+        auto sid = m.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId);
+        std::ostringstream os;
+        os << " [face " << std::uint32_t(f) << " scan id " << (sid.second ? sid.first[f] : -1) << " made by scan "
+           << (std::size_t(f) < madeBy.size() ? madeBy[std::size_t(f)] : -1) << "; corners:";
+        const auto c = corners(m, f);
+        for (int i = 0; i < 3; ++i) {
+            const Vec3 p = vec(m.point(c[std::size_t(i)])), q = vec(m.point(c[std::size_t((i + 1) % 3)]));
+            os << " (d " << std::sqrt(refTree.squared_distance(m.point(c[std::size_t(i)]))) << ", edge "
+               << (q - p).norm() << ", bound " << boundAt(m, f, p) << ")";
+        }
+        os << "]";
+        return os.str();
+    };
+    auto toReference = [&](const Mesh& m, FaceIndex f, double& worst, std::string& where) {
+        const auto c = corners(m, f);
+        const Vec3 P[3] = {vec(m.point(c[0])), vec(m.point(c[1])), vec(m.point(c[2]))};
+        const Vec3 pts[7] = {P[0], P[1], P[2], 0.5 * (P[0] + P[1]), 0.5 * (P[1] + P[2]), 0.5 * (P[2] + P[0]),
+                             (P[0] + P[1] + P[2]) / 3.0};
+        for (const Vec3& p : pts) {
+            const double d = std::sqrt(refTree.squared_distance(Point3(p.x(), p.y(), p.z())));
+            const double r = d / boundAt(m, f, p);
+            if (r > worst) {
+                worst = r;
+                std::ostringstream os;
+                os << "point (" << p.transpose() << ") distance " << d << describe(m, f);
+                where = os.str();
+            }
+        }
+    };
+    auto fromReference = [&](const Mesh& m, Tree& tree, const Vec3& p, double& worst, std::string& where) {
+        const auto [q, f] = tree.closest_point_and_primitive(Point3(p.x(), p.y(), p.z()));
+        const double d = (vec(q) - p).norm();
+        double bound = boundAt(m, f, vec(q));
+        if (d > bound) {
+            // The nearest face may be one that no scan changed beside a patch that cut a corner of the
+            // reference: the bound at p is the largest among the faces within 2d of p.
+            std::vector<Primitive::Id> near;
+            const double r = 2 * d;
+            tree.all_intersected_primitives(fss::Kernel::Iso_cuboid_3(p.x() - r, p.y() - r, p.z() - r, p.x() + r,
+                                                                      p.y() + r, p.z() + r),
+                                            std::back_inserter(near));
+            const Point3 P(p.x(), p.y(), p.z());
+            for (FaceIndex g : near) {
+                const auto c = corners(m, g);
+                const fss::Kernel::Triangle_3 t(m.point(c[0]), m.point(c[1]), m.point(c[2]));
+                if (CGAL::squared_distance(P, t) <= r * r) bound = std::max(bound, boundAt(m, g, vec(m.point(c[0]))));
+            }
+        }
+        const double r = d / bound;
+        if (r > worst) {
+            worst = r;
+            std::ostringstream os;
+            os << "reference point (" << p.transpose() << ") distance " << d << " to" << describe(m, f);
+            where = os.str();
+        }
+    };
+
+    int scanId = 0;
+    while (fig.stitched + fig.refused < cs.patches && fig.attempts < 3 * cs.patches) {
+        ++fig.attempts;
+        const ScanSetup setup = randomSetup(rng, box, cs.maxRes);
+        const std::string trace = std::string(cs.file) + " seed " + std::to_string(cs.seed) + " attempt " +
+                                  std::to_string(fig.attempts) + " scan id " + std::to_string(scanId + 1) + ": " +
+                                  setup.text;
+        SCOPED_TRACE(trace);
+        fss::ScanParams params;
+        params.camera = setup.camera;
+        params.lasso = setup.lasso;
+        params.erodeRadius = setup.erode;
+        params.dilateRadius = setup.dilate;
+        params.scan.scanId = scanId + 1;
+        params.quality.forceReplace = setup.forceReplace;
+        auto t = Clock::now();
+        curRenderer.setMesh(current);
+        fss::ScanResult scan;
+        try {
+            scan = fss::scanPatch(ref, refRenderer, current, curRenderer, params);
+        } catch (const fss::InvalidInputError&) {
+            ++fig.noPatch;
+            fig.scanSeconds += seconds(t);
+            continue;
+        }
+        fig.scanSeconds += seconds(t);
+        ++scanId;
+        const Camera cam = scan.grid.camera;
+        scanCameras[scanId] = cam;
+
+        const Mesh before = current;
+        t = Clock::now();
+        fss::StitchReport report;
+        try {
+            report = fss::stitchPatch(current, scan.patch.mesh, cam, options, scan.currentBuffers.faceId);
+            ++fig.stitched;
+        } catch (const fss::InvalidInputError& e) {
+            fig.stitchSeconds += seconds(t);
+            ++fig.refused;
+            std::string why = e.what();
+            why = why.substr(0, why.find(':'));
+            if (why.find("No part") == 0) {
+                why = e.what();
+                why = why.substr(why.find(':') + 2);
+            }
+            ++fig.reasons[why];
+            expectBitIdentical(current, before);
+            if (HasFailure()) return;
+            continue;
+        }
+        fig.stitchSeconds += seconds(t);
+        t = Clock::now();
+
+        // Structure.
+        ASSERT_TRUE(current.is_valid(false));
+        ASSERT_TRUE(CGAL::is_triangle_mesh(current));
+        EXPECT_EQ(nonManifoldVertices(current), 0u);
+        EXPECT_EQ(duplicateEdges(current), 0u);
+        EXPECT_EQ(CGAL::is_closed(current), closed);
+        EXPECT_EQ(boundaryLoops(current), loops);
+        EXPECT_EQ(degenerateFaces(current), 0u);
+        if (closed) {
+            EXPECT_GT(PMP::volume(current), 0.0);
+        }
+
+        // Changed faces: new indices, or indices whose vertices / points differ; removed ones.
+        std::vector<FaceIndex> changedAfter;
+        for (auto f : current.faces())
+            if (std::size_t(f) >= before.num_faces() || before.is_removed(f) || !sameFace(current, before, f))
+                changedAfter.push_back(f);
+        std::vector<FaceIndex> changedBefore;
+        for (auto f : before.faces())
+            if (!sameFace(before, current, f)) changedBefore.push_back(f);
+        EXPECT_FALSE(changedAfter.empty());
+        // Bounds of the new vertices (before madeBy changes: the old faces' bounds are wanted).
+        {
+            Tree old(changedBefore.begin(), changedBefore.end(), before);
+            std::unordered_map<std::uint32_t, double> bounds;
+            for (FaceIndex f : changedAfter)
+                for (auto v : CGAL::vertices_around_face(current.halfedge(f), current)) {
+                    const bool fresh = std::size_t(v) >= before.num_vertices() || before.is_removed(v) ||
+                                       before.point(v) != current.point(v);
+                    if (!fresh || bounds.count(std::uint32_t(v))) continue;
+                    const Point3& p = current.point(v);
+                    double b = inputTol;
+                    if (refTree.squared_distance(p) > inputTol * inputTol && !changedBefore.empty()) {
+                        std::vector<Primitive::Id> on;
+                        const double r = inputTol;
+                        old.all_intersected_primitives(fss::Kernel::Iso_cuboid_3(p.x() - r, p.y() - r, p.z() - r,
+                                                                                 p.x() + r, p.y() + r, p.z() + r),
+                                                       std::back_inserter(on));
+                        if (on.empty()) on.push_back(old.closest_point_and_primitive(p).second);
+                        for (FaceIndex g : on)
+                            b = std::max(b, boundAt(before, g, vec(p)));
+                    }
+                    bounds[std::uint32_t(v)] = b;
+                }
+            for (const auto& [v, b] : bounds)
+                vertexBound[v] = b;
+        }
+        madeBy.resize(current.num_faces(), -1);
+        for (FaceIndex f : changedAfter)
+            madeBy[std::size_t(f)] = scanId;
+
+        // Seam neighbourhood: every changed face of `before` within seamRings vertex rings of a face that
+        // touches the patch's footprint.
+        {
+            const Footprint fp = footprintOf(scan.patch, cam);
+            std::unordered_map<std::uint32_t, bool> touches;
+            auto touching = [&](FaceIndex f) {
+                auto [it, fresh] = touches.try_emplace(std::uint32_t(f), false);
+                if (fresh) it->second = touchesFootprint(before, f, cam, fp);
+                return it->second;
+            };
+            std::size_t outside = 0;
+            std::string example;
+            for (FaceIndex f : changedBefore) {
+                std::set<FaceIndex> ring{f}, seen{f};
+                bool ok = touching(f);
+                for (int r = 0; r < options.seamRings && !ok; ++r) {
+                    std::set<FaceIndex> next;
+                    for (FaceIndex g : ring)
+                        for (auto v : CGAL::vertices_around_face(before.halfedge(g), before))
+                            for (auto h : CGAL::faces_around_target(before.halfedge(v), before))
+                                if (h != Mesh::null_face() && seen.insert(h).second) next.insert(h);
+                    for (FaceIndex g : next)
+                        ok = ok || touching(g);
+                    ring.swap(next);
+                }
+                if (!ok) {
+                    ++outside;
+                    if (example.empty()) example = "face " + std::to_string(std::uint32_t(f));
+                }
+            }
+            EXPECT_EQ(outside, 0u) << "changed faces outside the seam neighbourhood, e.g. " << example << " of "
+                                   << changedBefore.size();
+        }
+
+        // Self-intersections.
+        if (scanId % kFullCheckEvery == 0) {
+            EXPECT_FALSE(PMP::does_self_intersect(current));
+        } else {
+            EXPECT_FALSE(PMP::does_self_intersect(facesNear(current, changedAfter), current));
+        }
+
+        // Hausdorff, both directions, in footprints.
+        {
+            double worst = 0;
+            std::string where;
+            for (FaceIndex f : changedAfter)
+                toReference(current, f, worst, where);
+            EXPECT_LE(worst, 1.0) << "current -> reference: " << where;
+            fig.worstToRef = std::max(fig.worstToRef, worst);
+
+            CGAL::Bbox_3 b;
+            double fpMax = 0;
+            for (FaceIndex f : changedAfter)
+                for (auto v : CGAL::vertices_around_face(current.halfedge(f), current)) {
+                    b += current.point(v).bbox();
+                    fpMax = std::max(fpMax, cam.pixelFootprint(vec(current.point(v))));
+                }
+            Tree tree(faces(current).first, faces(current).second, current);
+            tree.accelerate_distance_queries();
+            worst = 0;
+            where.clear();
+            const double grow = 2 * fpMax;
+            for (const Vec3& p : refPoints)
+                if (p.x() >= b.xmin() - grow && p.x() <= b.xmax() + grow && p.y() >= b.ymin() - grow &&
+                    p.y() <= b.ymax() + grow && p.z() >= b.zmin() - grow && p.z() <= b.zmax() + grow)
+                    fromReference(current, tree, p, worst, where);
+            EXPECT_LE(worst, 1.0) << "reference -> current: " << where;
+            fig.worstFromRef = std::max(fig.worstFromRef, worst);
+        }
+        fig.checkSeconds += seconds(t);
+        if (HasFailure()) {
+            std::printf("FAILED at %s\n%zu faces removed, %zu added, %zu seam faces\n", trace.c_str(),
+                        report.facesRemoved, report.facesAdded, report.seamFaces);
+            return;
+        }
+    }
+
+    // The whole mesh at the end.
+    EXPECT_FALSE(PMP::does_self_intersect(current));
+    {
+        double worst = 0;
+        std::string where;
+        for (auto f : current.faces())
+            toReference(current, f, worst, where);
+        EXPECT_LE(worst, 1.0) << "current -> reference: " << where;
+        Tree tree(faces(current).first, faces(current).second, current);
+        tree.accelerate_distance_queries();
+        double worst2 = 0;
+        for (const Vec3& p : refPoints)
+            fromReference(current, tree, p, worst2, where);
+        EXPECT_LE(worst2, 1.0) << "reference -> current: " << where;
+        fig.worstToRef = std::max(fig.worstToRef, worst);
+        fig.worstFromRef = std::max(fig.worstFromRef, worst2);
+    }
+    fig.facesEnd = current.number_of_faces();
+    std::printf("%s (seed %u): %d scan attempts, %d without a patch, %d patches stitched, %d refused; faces %zu -> "
+                "%zu; worst Hausdorff / footprint: current->reference %.3f, reference->current %.3f; "
+                "time scan %.1f s, stitch %.1f s, checks %.1f s\n",
+                cs.file, cs.seed, fig.attempts, fig.noPatch, fig.stitched, fig.refused, fig.facesStart,
+                fig.facesEnd, fig.worstToRef, fig.worstFromRef, fig.scanSeconds, fig.stitchSeconds,
+                fig.checkSeconds);
+    for (const auto& [why, n] : fig.reasons)
+        std::printf("  refused %d x: %s\n", n, why.c_str());
+    EXPECT_GE(fig.stitched + fig.refused, cs.patches) << "too few scans produced a patch";
+    // Most patches stitch (a majority); the refused ones are listed above with their reasons.
+    EXPECT_GT(fig.stitched, fig.refused) << "too many patches could not be stitched";
+}
+
+const int kPatches = [] {
+    const char* env = std::getenv("FSS_STITCH_PROPERTY_SCANS");
+    return env ? std::max(1, std::atoi(env)) : 200;
+}();
+
+INSTANTIATE_TEST_SUITE_P(Meshes, StitchProperty,
+                         ::testing::Values(Case{"couplingdown.off", 1101u, kPatches, 512},
+                                           Case{"elephant.off", 2202u, kPatches, 512},
+                                           Case{"fandisk.off", 3303u, kPatches, 512},
+                                           Case{"mech-holes-shark.off", 4404u, kPatches, 512}),
+                         [](const ::testing::TestParamInfo<Case>& info) {
+                             std::string n = info.param.file;
+                             n = n.substr(0, n.find('.'));
+                             std::replace(n.begin(), n.end(), '-', '_');
+                             return n;
+                         });
+
+} // namespace

@@ -1,0 +1,155 @@
+// Seam quality (issue #4): fandisk after one 256² iso scan (Camera::standardView Iso, no lasso, the
+// command line's default masks) stitched into the input mesh. Computed from the mesh alone, independently
+// of StitchReport:
+//  - seam vertices: vertices with at least one face made by the scan (props::faceScanId == the scan's id)
+//    and at least one face of the input (scan id −1) around them — where the patch meets the old mesh;
+//  - seam triangles: faces with at least one seam vertex;
+//  - no angle below 10° among seam triangles, at least 90 % of them with smallest angle ≥ 25°, every seam
+//    vertex of valence 4 to 8.
+#include "fss/camera.h"
+#include "fss/scan_pipeline.h"
+#include "fss/stitch.h"
+
+#include "test_data.h"
+
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Surface_mesh/IO/OFF.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <set>
+#include <cstdio>
+#include <fstream>
+#include <numbers>
+
+using fss::FaceIndex;
+using fss::Mesh;
+using fss::VertexIndex;
+
+namespace {
+
+double minAngleDeg(const Mesh& m, FaceIndex f) {
+    std::array<Eigen::Vector3d, 3> p;
+    int k = 0;
+    for (auto v : CGAL::vertices_around_face(m.halfedge(f), m)) {
+        const auto& q = m.point(v);
+        p[std::size_t(k++)] = {q.x(), q.y(), q.z()};
+    }
+    double best = 180;
+    for (int i = 0; i < 3; ++i) {
+        const Eigen::Vector3d u = p[std::size_t((i + 1) % 3)] - p[std::size_t(i)],
+                              w = p[std::size_t((i + 2) % 3)] - p[std::size_t(i)];
+        best = std::min(best, std::atan2(u.cross(w).norm(), u.dot(w)) * 180.0 / std::numbers::pi);
+    }
+    return best;
+}
+
+} // namespace
+
+// DISABLED: the stitcher does not meet these targets yet. Measured at commit time (run with
+// --gtest_also_run_disabled_tests, FSS_SEAM_DEBUG=1 lists the poor faces): smallest seam angle 1.99°
+// (target ≥ 10°), 89.6 % of seam triangles ≥ 25° (target ≥ 90 %), 21 seam vertices of valence 9–10
+// (target 4–8). Nearly all faces below 10° are pieces of old mesh faces outside the patch (a seam crossing
+// and two old vertices, the old vertex far away: fans of the coarser old mesh), the high valences are old
+// mesh vertices snapped onto the patch boundary. Enable it when the seam optimisation reaches the targets.
+TEST(StitchSeam, DISABLED_FandiskIsoScanSeamQuality) {
+    Mesh ref;
+    std::ifstream in(fss::test::meshPath("fandisk.off"));
+    ASSERT_TRUE(in && CGAL::IO::read_OFF(in, ref));
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(ref);
+    fss::ScanParams params;
+    params.camera = fss::Camera::standardView(fss::StandardView::Iso, fss::boundingBox(ref), 256, 256);
+    params.scan.scanId = 1;
+    const fss::ScanResult scan = fss::scanPatch(ref, renderer, ref, renderer, params);
+    Mesh current = ref;
+    const fss::StitchReport report =
+        fss::stitchPatch(current, scan.patch.mesh, scan.grid.camera, {}, scan.currentBuffers.faceId);
+    ASSERT_GE(report.componentsStitched, 1);
+
+    auto sid = current.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId);
+    ASSERT_TRUE(sid.second);
+    std::vector<VertexIndex> seam;
+    std::set<FaceIndex> seamFaces;
+    std::size_t scanFaces = 0;
+    for (auto f : current.faces())
+        scanFaces += sid.first[f] == 1;
+    for (auto v : current.vertices()) {
+        bool scanned = false, input = false;
+        for (auto f : CGAL::faces_around_target(current.halfedge(v), current)) {
+            if (f == Mesh::null_face()) continue;
+            scanned = scanned || sid.first[f] == 1;
+            input = input || sid.first[f] == -1;
+        }
+        if (!(scanned && input)) continue;
+        seam.push_back(v);
+        for (auto f : CGAL::faces_around_target(current.halfedge(v), current))
+            if (f != Mesh::null_face()) seamFaces.insert(f);
+    }
+    ASSERT_GT(scanFaces, 10000u);
+    ASSERT_GT(seam.size(), 100u);
+
+    double worst = 180;
+    std::size_t above25 = 0;
+    for (FaceIndex f : seamFaces) {
+        const double a = minAngleDeg(current, f);
+        worst = std::min(worst, a);
+        above25 += a >= 25.0;
+    }
+    if (std::getenv("FSS_SEAM_DEBUG")) {
+        // Where the poor seam triangles are: patch or old mesh, and how obliquely the scan saw them.
+        const Eigen::Vector3d eye = scan.grid.camera.eye;
+        std::map<std::string, int> kinds;
+        for (FaceIndex f : seamFaces) {
+            const double a = minAngleDeg(current, f);
+            if (a >= 25) continue;
+            std::array<Eigen::Vector3d, 3> p;
+            int k = 0;
+            for (auto v : CGAL::vertices_around_face(current.halfedge(f), current)) {
+                const auto& q = current.point(v);
+                p[std::size_t(k++)] = {q.x(), q.y(), q.z()};
+            }
+            const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
+            const Eigen::Vector3d c = (p[0] + p[1] + p[2]) / 3.0;
+            const double view = std::acos(std::clamp(n.dot((eye - c).normalized()), -1.0, 1.0)) * 180 / std::numbers::pi;
+            const std::string key = std::string(sid.first[f] == 1 ? "patch" : "old") + (a < 10 ? " <10" : " 10-25") +
+                                    (view > 70 ? " grazing>70" : view > 50 ? " view50-70" : " view<50");
+            ++kinds[key];
+            if (a < 10) {
+                std::printf("  bad face %u min %.2f view %.1f label %d:", std::uint32_t(f), a, view, sid.first[f]);
+                for (auto v : CGAL::vertices_around_face(current.halfedge(f), current)) {
+                    const bool old = std::size_t(v) < ref.num_vertices() && ref.point(v) == current.point(v);
+                    const bool onSeam = std::find(seam.begin(), seam.end(), v) != seam.end();
+                    std::printf(" [%s%s deg %zu]", old ? "old" : "new", onSeam ? " seam" : "", std::size_t(current.degree(v)));
+                }
+                std::printf(" edges");
+                for (int i = 0; i < 3; ++i) std::printf(" %.4f", (p[std::size_t(i)] - p[std::size_t((i + 1) % 3)]).norm());
+                std::printf("\n");
+            }
+        }
+        for (const auto& [k, n] : kinds)
+            std::printf("  %s: %d\n", k.c_str(), n);
+    }
+    std::size_t badValence = 0;
+    std::map<std::size_t, std::size_t> histogram;
+    for (VertexIndex v : seam) {
+        const std::size_t d = current.degree(v);
+        ++histogram[d];
+        badValence += d < 4 || d > 8;
+    }
+    const double frac = double(above25) / double(seamFaces.size());
+    std::printf("fandisk iso 256^2: %zu patch faces, %zu seam vertices, %zu seam triangles, smallest angle %.2f deg, "
+                "%.1f %% with smallest angle >= 25 deg, %zu seam vertices of valence outside 4..8; valences:",
+                scanFaces, seam.size(), seamFaces.size(), worst, 100.0 * frac, badValence);
+    for (const auto& [d, n] : histogram)
+        std::printf(" %zu:%zu", d, n);
+    std::printf("\n");
+    EXPECT_GE(worst, 10.0);
+    EXPECT_GE(frac, 0.9);
+    EXPECT_EQ(badValence, 0u);
+    EXPECT_FALSE(CGAL::Polygon_mesh_processing::does_self_intersect(current));
+    EXPECT_TRUE(CGAL::is_closed(current));
+}
