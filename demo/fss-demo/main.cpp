@@ -2,30 +2,37 @@
 //
 //   fss-demo [--view V] [--colormap C] [MESH]
 //   fss-demo --screenshot FILE.png [--view iso|+x|-x|+y|-y|+z|-z] [--colormap none|angle|valence]
-//            [--size WxH] [MESH]
+//            [--size WxH] [--scan VIEW]... [--resolution N] [MESH]
 //
 // Without MESH the bundled default mesh (CGAL's fandisk) is opened. --screenshot renders the window to
 // FILE and exits: 0 on success, 1 with one sentence on stderr when it failed, 2 for a wrong command line.
+// Each --scan VIEW first takes a regular scan of the whole view from that standard view (at --resolution,
+// default 256) and accepts it, as a user would with Take scan and Accept.
 #include "main_window.h"
 
 #include <fss/camera.h>
 #include <fss/error.h>
 #include <fss/mesh_io.h>
+#include <fss/widgets/remesh_widget.h>
+#include <fss/widgets/scan_panel.h>
 #include <fss/widgets/vtk_view.h>
 
 #include <QApplication>
+#include <QElapsedTimer>
+#include <QThread>
 
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace {
 
 const char* const kUsage =
     "usage: fss-demo [--screenshot FILE.png] [--view iso|+x|-x|+y|-y|+z|-z] [--colormap none|angle|valence]\n"
-    "                [--size WxH] [MESH]\n";
+    "                [--size WxH] [--scan VIEW]... [--resolution N] [MESH]\n";
 
 struct Options {
     std::string mesh = FSS_DEFAULT_MESH;
@@ -33,6 +40,8 @@ struct Options {
     fss::StandardView view = fss::StandardView::Iso;
     fss::widgets::ColorMap colorMap = fss::widgets::ColorMap::None;
     int width = 1024, height = 768;
+    std::vector<fss::StandardView> scans;
+    int resolution = 256;
 };
 
 // Writes errors to stderr instead of opening a box (the --screenshot mode must never block).
@@ -72,6 +81,24 @@ std::optional<Options> parse(int argc, char** argv, bool& help) {
                 return std::nullopt;
             }
             o.view = *view;
+        } else if (a == "--scan") {
+            const auto v = value("--scan");
+            if (!v) return std::nullopt;
+            const auto view = fss::parseStandardView(*v);
+            if (!view) {
+                std::cerr << "Unknown scan view '" << *v << "': use iso, +x, -x, +y, -y, +z or -z.\n";
+                return std::nullopt;
+            }
+            o.scans.push_back(*view);
+        } else if (a == "--resolution") {
+            const auto v = value("--resolution");
+            if (!v) return std::nullopt;
+            char rest = 0;
+            if (std::sscanf(v->c_str(), "%d%c", &o.resolution, &rest) != 1 || o.resolution < 16 ||
+                o.resolution > 4096) {
+                std::cerr << "Bad resolution '" << *v << "': use a number of pixels between 16 and 4096.\n";
+                return std::nullopt;
+            }
         } else if (a == "--colormap") {
             const auto v = value("--colormap");
             if (!v) return std::nullopt;
@@ -86,7 +113,8 @@ std::optional<Options> parse(int argc, char** argv, bool& help) {
             if (!v) return std::nullopt;
             int w = 0, h = 0;
             char rest = 0;
-            if (std::sscanf(v->c_str(), "%dx%d%c", &w, &h, &rest) != 2 || w < 64 || h < 64 || w > 8192 || h > 8192) {
+            if (std::sscanf(v->c_str(), "%dx%d%c", &w, &h, &rest) != 2 || w < 64 || h < 64 || w > 8192 ||
+                h > 8192) {
                 std::cerr << "Bad size '" << *v << "': use WIDTHxHEIGHT, each between 64 and 8192.\n";
                 return std::nullopt;
             }
@@ -131,6 +159,7 @@ int main(int argc, char** argv) {
 
     fss::widgets::VtkView::setDefaultSurfaceFormat(); // before the QApplication exists
     QApplication app(argc, argv);
+    QApplication::setOrganizationName(QStringLiteral("FSS"));
     QApplication::setApplicationName(QStringLiteral("fss-demo"));
     QApplication::setApplicationVersion(QStringLiteral(FSS_VERSION));
 
@@ -142,7 +171,34 @@ int main(int argc, char** argv) {
     window.setColorMap(options->colorMap);
 
     if (options->screenshot) {
-        window.setMesh(std::move(*mesh), QString::fromStdString(std::filesystem::path(options->mesh).filename().string()));
+        window.setMesh(std::move(*mesh),
+                       QString::fromStdString(std::filesystem::path(options->mesh).filename().string()));
+        if (!options->scans.empty()) {
+            window.show(); // the scans use the view's camera at its final size
+            QApplication::processEvents();
+            fss::widgets::RemeshWidget* remesh = window.remeshWidget();
+            remesh->scanPanel()->setResolution(options->resolution);
+            QString failure;
+            QObject::connect(remesh, &fss::widgets::RemeshWidget::errorOccurred,
+                             [&failure](const QString& message) { failure = message; });
+            for (const fss::StandardView v : options->scans) {
+                window.view()->setStandardView(v);
+                QApplication::processEvents();
+                if (remesh->scan()) {
+                    remesh->accept();
+                    while (remesh->isBusy()) {
+                        QApplication::processEvents(QEventLoop::AllEvents, 50);
+                        QThread::msleep(5);
+                    }
+                }
+                if (!failure.isEmpty()) {
+                    std::cerr << "The scan from " << fss::standardViewName(v)
+                              << " failed: " << failure.toStdString() << "\n";
+                    return 1;
+                }
+            }
+            window.view()->setStandardView(options->view);
+        }
         const QString error = window.saveScreenshot(QString::fromStdString(*options->screenshot));
         if (!error.isEmpty()) {
             std::cerr << error.toStdString() << "\n";

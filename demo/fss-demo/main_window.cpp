@@ -13,6 +13,7 @@
 #include <QLabel>
 #include <QMenuBar>
 #include <QMessageBox>
+#include <QSettings>
 #include <QStatusBar>
 #include <QThread>
 #include <QWindow>
@@ -28,10 +29,18 @@ void MessageBoxPresenter::showError(QWidget* parent, const QString& title, const
 MainWindow::MainWindow(std::unique_ptr<MessagePresenter> presenter, QWidget* parent)
     : QMainWindow(parent), presenter_(std::move(presenter)) {
     if (!presenter_) presenter_ = std::make_unique<MessageBoxPresenter>();
-    view_ = new widgets::VtkView(this);
-    setCentralWidget(view_);
+    remesh_ = new widgets::RemeshWidget(this);
+    setCentralWidget(remesh_);
     statistics_ = new QLabel(this);
     statusBar()->addPermanentWidget(statistics_, 1);
+    connect(remesh_, &widgets::RemeshWidget::meshChanged, this, [this] {
+        updateStatistics();
+        emit meshChanged();
+    });
+    // Errors of the remeshing work (a scan that sees nothing, a stitch that fails) go to the status bar;
+    // file errors are shown by openMesh / saveMesh through the presenter.
+    connect(remesh_, &widgets::RemeshWidget::errorOccurred, this,
+            [this](const QString& message) { statusBar()->showMessage(message, 10000); });
     createMenus();
     setWindowTitle(QStringLiteral("FSS demo"));
     resize(1024, 768);
@@ -44,16 +53,26 @@ void MainWindow::createMenus() {
     QMenu* file = menuBar()->addMenu(tr("&File"));
     file->addAction(tr("&Open…"), QKeySequence::Open, this, &MainWindow::openDialog);
     file->addAction(tr("&Save As…"), QKeySequence::SaveAs, this, &MainWindow::saveDialog);
+    recentMenu_ = file->addMenu(tr("Open &Recent"));
+    updateRecentMenu();
     file->addSeparator();
     file->addAction(tr("&Quit"), QKeySequence::Quit, this, &QWidget::close);
 
+    QMenu* edit = menuBar()->addMenu(tr("&Edit"));
+    edit->addAction(remesh_->undoAction());
+    edit->addAction(remesh_->redoAction());
+    edit->addSeparator();
+    edit->addAction(remesh_->scanAction());
+    edit->addAction(remesh_->acceptAction());
+    edit->addAction(remesh_->rejectAction());
+
     QMenu* viewMenu = menuBar()->addMenu(tr("&View"));
     const std::pair<StandardView, const char*> views[] = {
-        {StandardView::Iso, "&Iso"},    {StandardView::PosX, "From +&X"}, {StandardView::NegX, "From −X"},
-        {StandardView::PosY, "From +&Y"}, {StandardView::NegY, "From −Y"}, {StandardView::PosZ, "From +&Z"},
+        {StandardView::Iso, "&Iso"},      {StandardView::PosX, "From +&X"}, {StandardView::NegX, "From −X"},
+        {StandardView::PosY, "From +&Y"}, {StandardView::NegY, "From −Y"},  {StandardView::PosZ, "From +&Z"},
         {StandardView::NegZ, "From −Z"}};
     for (const auto& [v, label] : views)
-        viewMenu->addAction(tr(label), this, [this, v = v] { view_->setStandardView(v); });
+        viewMenu->addAction(tr(label), this, [this, v = v] { view()->setStandardView(v); });
 
     QMenu* colors = menuBar()->addMenu(tr("&Colour"));
     auto* group = new QActionGroup(this);
@@ -61,17 +80,26 @@ void MainWindow::createMenus() {
                                                               {widgets::ColorMap::MinAngle, "&Minimum angle"},
                                                               {widgets::ColorMap::Valence, "&Valence"}};
     for (const auto& [m, label] : maps) {
-        QAction* action = colors->addAction(tr(label), this, [this, m = m] { view_->setColorMap(m); });
+        QAction* action = colors->addAction(tr(label), this, [this, m = m] { view()->setColorMap(m); });
         action->setCheckable(true);
-        action->setChecked(m == view_->colorMap());
+        action->setChecked(m == view()->colorMap());
         group->addAction(action);
         colorActions_.emplace_back(m, action);
     }
 }
 
+widgets::VtkView* MainWindow::view() const {
+    return remesh_->view();
+}
+
+const Mesh& MainWindow::mesh() const {
+    return remesh_->mesh();
+}
+
 void MainWindow::setColorMap(widgets::ColorMap map) {
-    view_->setColorMap(map);
-    for (auto& [m, action] : colorActions_) action->setChecked(m == map);
+    view()->setColorMap(map);
+    for (auto& [m, action] : colorActions_)
+        action->setChecked(m == map);
 }
 
 bool MainWindow::openMesh(const QString& path) {
@@ -82,33 +110,71 @@ bool MainWindow::openMesh(const QString& path) {
         reportError(tr("Open mesh"), QString::fromStdString(e.what()));
         return false;
     }
+    const QString previousPath = meshPath_, previousName = meshName_;
     meshPath_ = path;
-    setMesh(std::move(mesh), QFileInfo(path).fileName());
+    meshName_ = QFileInfo(path).fileName();
+    if (!remesh_->setMesh(mesh)) {
+        meshPath_ = previousPath;
+        meshName_ = previousName;
+        reportError(tr("Open mesh"),
+                    tr("%1 cannot be remeshed: %2").arg(QFileInfo(path).fileName(), remesh_->statusText()));
+        return false;
+    }
+    addRecentFile(path);
     return true;
 }
 
 bool MainWindow::saveMesh(const QString& path) {
     try {
-        writeMesh(mesh_, path.toStdString());
+        writeMesh(mesh(), path.toStdString());
     } catch (const std::exception& e) {
         reportError(tr("Save mesh"), QString::fromStdString(e.what()));
         return false;
     }
     meshPath_ = path;
     meshName_ = QFileInfo(path).fileName();
+    addRecentFile(path);
     updateStatistics();
     return true;
 }
 
 void MainWindow::setMesh(Mesh mesh, const QString& name) {
-    mesh_ = std::move(mesh);
+    const QString previous = meshName_;
     meshName_ = name;
-    view_->setMesh(mesh_);
-    updateStatistics();
-    emit meshChanged();
+    if (!remesh_->setMesh(mesh)) meshName_ = previous; // the widget reported why; the previous mesh stays
 }
 
-QString MainWindow::statisticsText() const { return statistics_->text(); }
+QStringList MainWindow::recentFiles() const {
+    return QSettings().value(QStringLiteral("recentFiles")).toStringList();
+}
+
+void MainWindow::addRecentFile(const QString& path) {
+    const QString absolute = QFileInfo(path).absoluteFilePath();
+    QStringList files = recentFiles();
+    files.removeAll(absolute);
+    files.prepend(absolute);
+    while (files.size() > kMaxRecentFiles)
+        files.removeLast();
+    QSettings().setValue(QStringLiteral("recentFiles"), files);
+    updateRecentMenu();
+}
+
+void MainWindow::updateRecentMenu() {
+    recentMenu_->clear();
+    const QStringList files = recentFiles();
+    for (int i = 0; i < files.size(); ++i) {
+        const QString path = files[i];
+        recentMenu_
+            ->addAction(QStringLiteral("&%1 %2").arg(i + 1).arg(QFileInfo(path).fileName()), this,
+                        [this, path] { openMesh(path); })
+            ->setToolTip(path);
+    }
+    recentMenu_->setEnabled(!files.isEmpty());
+}
+
+QString MainWindow::statisticsText() const {
+    return statistics_->text();
+}
 
 void MainWindow::reportError(const QString& title, const QString& message) {
     statusBar()->showMessage(message, 10000);
@@ -117,32 +183,36 @@ void MainWindow::reportError(const QString& title, const QString& message) {
 }
 
 void MainWindow::updateStatistics() {
-    setWindowTitle(meshName_.isEmpty() ? QStringLiteral("FSS demo") : meshName_ + QStringLiteral(" — FSS demo"));
-    if (mesh_.is_empty()) {
+    setWindowTitle(meshName_.isEmpty() ? QStringLiteral("FSS demo")
+                                       : meshName_ + QStringLiteral(" — FSS demo"));
+    if (mesh().is_empty()) {
         statistics_->setText(tr("No mesh"));
         return;
     }
     MetricsOptions options;
     options.selfIntersections = false;
-    const Metrics m = computeMetrics(mesh_, options);
-    statistics_->setText(tr("%1: %2 vertices, %3 faces, valence 6: %4 % of %5 interior vertices, min angle %6°")
-                             .arg(meshName_)
-                             .arg(m.vertices)
-                             .arg(m.faces)
-                             .arg(100.0 * m.fracValence6Interior, 0, 'f', 1)
-                             .arg(m.interiorVertices)
-                             .arg(m.minAngleDeg, 0, 'f', 1));
+    const Metrics m = computeMetrics(mesh(), options);
+    statistics_->setText(
+        tr("%1: %2 vertices, %3 faces, valence 6: %4 % of %5 interior vertices, min angle %6°")
+            .arg(meshName_)
+            .arg(m.vertices)
+            .arg(m.faces)
+            .arg(100.0 * m.fracValence6Interior, 0, 'f', 1)
+            .arg(m.interiorVertices)
+            .arg(m.minAngleDeg, 0, 'f', 1));
 }
 
 void MainWindow::openDialog() {
     const QString path = QFileDialog::getOpenFileName(this, tr("Open mesh"), QFileInfo(meshPath_).path(),
-                                                      tr("Meshes (*.off *.obj *.ply *.stl);;All files (*)"));
+                                                      tr("Meshes (*.off *.obj *.ply *.stl);;OFF (*.off);;OBJ "
+                                                         "(*.obj);;PLY (*.ply);;STL (*.stl);;All files (*)"));
     if (!path.isEmpty()) openMesh(path);
 }
 
 void MainWindow::saveDialog() {
-    const QString path = QFileDialog::getSaveFileName(this, tr("Save mesh"), meshPath_,
-                                                      tr("Meshes (*.off *.obj *.ply *.stl)"));
+    const QString path = QFileDialog::getSaveFileName(
+        this, tr("Save mesh"), meshPath_,
+        tr("PLY, keeps scan ids and quality (*.ply);;OFF (*.off);;OBJ (*.obj);;STL (*.stl)"));
     if (!path.isEmpty()) saveMesh(path);
 }
 

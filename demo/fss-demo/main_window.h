@@ -1,14 +1,17 @@
 #pragma once
 /// \file main_window.h
-/// The main window of fss-demo: a VtkView with File / View / Colour menus and mesh statistics in the
-/// status bar. Errors go through a MessagePresenter so that tests can open bad files without a modal box.
+/// The main window of fss-demo: a RemeshWidget (view, tools, panels, history) with File (open, save,
+/// recent files), Edit (undo, redo), View and Colour menus and mesh statistics in the status bar. Errors
+/// go through a MessagePresenter so that tests can open bad files without a modal box.
 
 #include <fss/camera.h>
 #include <fss/mesh.h>
+#include <fss/widgets/remesh_widget.h>
 #include <fss/widgets/vtk_view.h>
 
 #include <QMainWindow>
 #include <QString>
+#include <QStringList>
 
 #include <memory>
 #include <utility>
@@ -16,6 +19,7 @@
 
 class QAction;
 class QLabel;
+class QMenu;
 
 namespace fss::demo {
 
@@ -34,7 +38,7 @@ public:
     void showError(QWidget* parent, const QString& title, const QString& message) override;
 };
 
-/// The demo's main window. Owns the current mesh; the view shows it.
+/// The demo's main window around a RemeshWidget, which owns the mesh and its remeshing session.
 class MainWindow : public QMainWindow {
     Q_OBJECT
 public:
@@ -42,23 +46,31 @@ public:
     explicit MainWindow(std::unique_ptr<MessagePresenter> presenter = nullptr, QWidget* parent = nullptr);
     ~MainWindow() override;
 
+    /// Most recently opened or saved files kept in the recent-files menu.
+    static constexpr int kMaxRecentFiles = 8;
+
     /// Reads \p path with fss::readMesh and shows it. On failure the previous mesh stays, the error (one
-    /// sentence) is shown through the presenter and errorOccurred() is emitted. \return success
+    /// sentence) is shown through the presenter and errorOccurred() is emitted. On success the file
+    /// heads the recent files. \return success
     bool openMesh(const QString& path);
     /// Writes the current mesh to \p path (format by extension). On failure reports like openMesh.
     bool saveMesh(const QString& path);
     /// Shows \p mesh under the display name \p name (used in the title and status bar).
     void setMesh(Mesh mesh, const QString& name);
 
-    /// The current mesh (empty before the first successful open).
-    const Mesh& mesh() const { return mesh_; }
+    /// The current mesh (empty before the first successful open): the input with the accepted scans.
+    const Mesh& mesh() const;
     /// The file the current mesh came from (empty when none).
     QString meshPath() const { return meshPath_; }
     /// Colours the view by \p map and checks the matching Colour menu entry.
     void setColorMap(widgets::ColorMap map);
 
     /// The 3D view.
-    widgets::VtkView* view() const { return view_; }
+    widgets::VtkView* view() const;
+    /// The remeshing widget (tools, panels, history).
+    widgets::RemeshWidget* remeshWidget() const { return remesh_; }
+    /// The recent files, most recent first (QSettings "recentFiles", at most kMaxRecentFiles).
+    QStringList recentFiles() const;
     /// The statistics shown in the status bar.
     QString statisticsText() const;
 
@@ -78,12 +90,14 @@ private:
     void updateStatistics();
     void openDialog();
     void saveDialog();
+    void addRecentFile(const QString& path);
+    void updateRecentMenu();
 
     std::unique_ptr<MessagePresenter> presenter_;
-    widgets::VtkView* view_ = nullptr;
+    widgets::RemeshWidget* remesh_ = nullptr;
     QLabel* statistics_ = nullptr;
+    QMenu* recentMenu_ = nullptr;
     std::vector<std::pair<widgets::ColorMap, QAction*>> colorActions_;
-    Mesh mesh_;
     QString meshPath_;
     QString meshName_;
 };

@@ -5,10 +5,17 @@
 #include "test_data.h"
 
 #include <fss/mesh_io.h>
+#include <fss/shapes.h>
+#include <fss/widgets/remesh_widget.h>
+#include <fss/widgets/scan_panel.h>
 #include <fss/widgets/vtk_view.h>
 
+#include <QAction>
 #include <QApplication>
+#include <QElapsedTimer>
 #include <QFile>
+#include <QFileInfo>
+#include <QSettings>
 #include <QImage>
 #include <QProcess>
 #include <QSignalSpy>
@@ -95,6 +102,20 @@ private slots:
         QVERIFY(!QFile::exists(out));
     }
 
+    void screenshotAfterAScan() {
+        const QString out = tmp("demo_scanned.png");
+        QFile::remove(out);
+        const RunResult r = runDemo({"--screenshot", out, "--size", "800x600", "--scan", "+z", "--resolution", "96",
+                                     "--colormap", "angle",
+                                     QString::fromStdString(fss::test::meshPath("fandisk.off").string())});
+        QVERIFY2(r.exitCode == 0, qPrintable(r.err));
+        QImage image;
+        QVERIFY(image.load(out));
+        QVERIFY(fss::test::pixelFraction(image, fss::test::qualityGreen) > 0.02);
+        QCOMPARE(runDemo({"--screenshot", out, "--scan", "sideways"}).exitCode, 2);
+        QCOMPARE(runDemo({"--screenshot", out, "--resolution", "3"}).exitCode, 2);
+    }
+
     void wrongCommandLineIsRefused() {
         const RunResult r = runDemo({"--screenshot", tmp("x.png"), "--view", "sideways"});
         QCOMPARE(r.exitCode, 2);
@@ -140,6 +161,66 @@ private slots:
         QCOMPARE(messages.size(), 1);
     }
 
+    void recentFilesKeepTheLastEight() {
+        QSettings().remove(QStringLiteral("recentFiles"));
+        QStringList messages;
+        fss::demo::MainWindow window(std::make_unique<RecordingPresenter>(&messages));
+        QVERIFY(window.recentFiles().isEmpty());
+        const fss::Mesh tetra = fss::readMesh(fss::test::meshPath("tetrahedron.off"));
+        QStringList written;
+        for (int i = 0; i < 10; ++i) {
+            const QString path = tmp(qPrintable(QString("demo_recent_%1.off").arg(i)));
+            fss::writeMesh(tetra, path.toStdString());
+            QVERIFY(window.openMesh(path));
+            written.prepend(QFileInfo(path).absoluteFilePath());
+        }
+        QVERIFY(!window.openMesh(badMeshFile())); // failures are not recorded
+        QCOMPARE(window.recentFiles().size(), fss::demo::MainWindow::kMaxRecentFiles);
+        QCOMPARE(window.recentFiles(), written.mid(0, fss::demo::MainWindow::kMaxRecentFiles));
+        QVERIFY(window.openMesh(written.at(5))); // reopening moves a file to the front, without duplicates
+        QCOMPARE(window.recentFiles().front(), written.at(5));
+        QCOMPARE(window.recentFiles().count(written.at(5)), 1);
+        QCOMPARE(window.recentFiles().size(), fss::demo::MainWindow::kMaxRecentFiles);
+        QSettings().remove(QStringLiteral("recentFiles"));
+    }
+
+    void editUndoRedoAfterAScan() {
+        QStringList messages;
+        fss::demo::MainWindow window(std::make_unique<RecordingPresenter>(&messages));
+        window.resize(1000, 700);
+        window.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&window));
+        window.setMesh(fss::shapes::icosphere(3), QStringLiteral("sphere"));
+        fss::widgets::RemeshWidget* remesh = window.remeshWidget();
+        QAction* undo = remesh->undoAction();
+        QAction* redo = remesh->redoAction();
+        QCOMPARE(undo->shortcut(), QKeySequence(QKeySequence::Undo));
+        QCOMPARE(redo->shortcut(), QKeySequence(QKeySequence::Redo));
+        QVERIFY(!undo->isEnabled());
+        const fss::Mesh before = window.mesh();
+        QVERIFY(window.statisticsText().contains(QString("%1 faces").arg(before.number_of_faces())));
+        remesh->scanPanel()->setResolution(128);
+        QVERIFY(remesh->scan());
+        QSignalSpy changed(&window, &fss::demo::MainWindow::meshChanged);
+        remesh->accept();
+        QElapsedTimer t;
+        t.start();
+        while (remesh->isBusy() && t.elapsed() < 60000) QTest::qWait(10);
+        QCOMPARE(changed.count(), 1);
+        const std::size_t faces = window.mesh().number_of_faces();
+        QVERIFY(faces != before.number_of_faces());
+        QVERIFY(window.statisticsText().contains(QString("%1 faces").arg(faces)));
+        QVERIFY(undo->isEnabled());
+        undo->trigger();
+        QCOMPARE(window.mesh().number_of_faces(), before.number_of_faces());
+        QVERIFY(window.statisticsText().contains(QString("%1 faces").arg(before.number_of_faces())));
+        QVERIFY(redo->isEnabled());
+        redo->trigger();
+        QCOMPARE(window.mesh().number_of_faces(), faces);
+        QCOMPARE(changed.count(), 3);
+        QVERIFY(messages.isEmpty());
+    }
+
     void windowScreenshotShowsTheMesh() {
         QStringList messages;
         fss::demo::MainWindow window(std::make_unique<RecordingPresenter>(&messages));
@@ -156,6 +237,7 @@ private slots:
 int main(int argc, char** argv) {
     fss::widgets::VtkView::setDefaultSurfaceFormat();
     QApplication app(argc, argv);
+    QApplication::setOrganizationName(QStringLiteral("FSS-tests")); // keeps the user's recent files alone
     DemoTest test;
     return QTest::qExec(&test, argc, argv);
 }

@@ -1,0 +1,625 @@
+// RemeshWidget under a real X server (Xvfb), driven by synthetic mouse events: navigation, a lasso + scan
+// + accept (every invariant of DESIGN.md §5 checked with CGAL), exact undo / redo, a fishbone grid from a
+// seed and two clicked key-ribs, the QualityPanel's histograms against independent counts, and the GUI
+// event loop running while a 100k-face stitch runs on the worker thread.
+#include "test_data.h"
+
+#include <fss/camera.h>
+#include <fss/mask.h>
+#include <fss/mesh_io.h>
+#include <fss/shapes.h>
+#include <fss/widgets/fishbone_tool.h>
+#include <fss/widgets/lasso_tool.h>
+#include <fss/widgets/quality_panel.h>
+#include <fss/widgets/remesh_widget.h>
+#include <fss/widgets/scan_panel.h>
+#include <fss/widgets/scan_tool.h>
+#include <fss/widgets/screen_mapping.h>
+#include <fss/widgets/tool.h>
+#include <fss/widgets/vtk_view.h>
+
+#include <CGAL/Polygon_mesh_processing/connected_components.h>
+#include <CGAL/Polygon_mesh_processing/orientation.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Polygon_mesh_processing/shape_predicates.h>
+#include <CGAL/boost/graph/helpers.h>
+
+#include <QApplication>
+#include <QElapsedTimer>
+#include <QLineF>
+#include <QMouseEvent>
+#include <QPushButton>
+#include <QSignalSpy>
+#include <QTest>
+#include <QTimer>
+#include <QUndoStack>
+#include <QUndoView>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <set>
+
+namespace PMP = CGAL::Polygon_mesh_processing;
+using fss::widgets::FishboneTool;
+using fss::widgets::RemeshWidget;
+
+namespace {
+
+void sendMouse(QWidget* w, QEvent::Type type, QPointF pos, Qt::MouseButton button, Qt::MouseButtons buttons,
+               Qt::KeyboardModifiers modifiers = Qt::NoModifier) {
+    QMouseEvent event(type, pos, w->mapToGlobal(pos), button, buttons, modifiers);
+    QApplication::sendEvent(w, &event);
+}
+
+void click(QWidget* w, QPointF pos, Qt::KeyboardModifiers modifiers = Qt::NoModifier) {
+    sendMouse(w, QEvent::MouseButtonPress, pos, Qt::LeftButton, Qt::LeftButton, modifiers);
+    sendMouse(w, QEvent::MouseButtonRelease, pos, Qt::LeftButton, Qt::NoButton, modifiers);
+}
+
+// A lasso drawn with the mouse: a circle of \p radius DIP around \p centre in \p steps moves.
+QPolygonF drawLasso(QWidget* view, QPointF centre, double radius, int steps = 48) {
+    QPolygonF drawn;
+    const QPointF start = centre + QPointF(radius, 0);
+    sendMouse(view, QEvent::MouseButtonPress, start, Qt::LeftButton, Qt::LeftButton);
+    drawn << start;
+    for (int i = 1; i <= steps; ++i) {
+        const double a = 2 * std::numbers::pi * i / steps;
+        const QPointF p = centre + QPointF(radius * std::cos(a), radius * std::sin(a));
+        sendMouse(view, QEvent::MouseMove, p, Qt::NoButton, Qt::LeftButton);
+        drawn << p;
+    }
+    sendMouse(view, QEvent::MouseButtonRelease, drawn.back(), Qt::LeftButton, Qt::NoButton);
+    return drawn;
+}
+
+std::unique_ptr<RemeshWidget> shownWidget(const fss::Mesh& mesh, QSize size = {1000, 700}) {
+    auto w = std::make_unique<RemeshWidget>();
+    w->resize(size);
+    w->show();
+    if (!QTest::qWaitForWindowExposed(w.get())) return nullptr;
+    if (!w->setMesh(mesh)) return nullptr;
+    QTest::qWait(20);
+    return w;
+}
+
+bool waitIdle(RemeshWidget& w, int timeoutMs = 120000) {
+    QElapsedTimer t;
+    t.start();
+    while (w.isBusy() && t.elapsed() < timeoutMs)
+        QTest::qWait(5);
+    return !w.isBusy();
+}
+
+Eigen::Vector3d vec(const fss::Point3& p) {
+    return {p.x(), p.y(), p.z()};
+}
+
+using Triangle = std::array<std::array<double, 3>, 3>;
+
+// The face's corner positions, rotated so that the smallest corner comes first (orientation kept).
+Triangle triangle(const fss::Mesh& m, fss::FaceIndex f) {
+    Triangle t;
+    int i = 0;
+    for (fss::VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m)) {
+        const fss::Point3& p = m.point(v);
+        t[std::size_t(i++)] = {p.x(), p.y(), p.z()};
+    }
+    const auto first = std::min_element(t.begin(), t.end()) - t.begin();
+    std::rotate(t.begin(), t.begin() + first, t.end());
+    return t;
+}
+
+double longestEdge(const fss::Mesh& m) {
+    double l = 0;
+    for (fss::EdgeIndex e : m.edges())
+        l = std::max(l,
+                     (vec(m.point(m.source(m.halfedge(e)))) - vec(m.point(m.target(m.halfedge(e))))).norm());
+    return l;
+}
+
+std::size_t borderEdges(const fss::Mesh& m) {
+    std::size_t n = 0;
+    for (fss::EdgeIndex e : m.edges())
+        n += m.is_border(e) ? 1 : 0;
+    return n;
+}
+
+// DESIGN.md §5 on \p after, the result of stitching \p patch into \p before.
+// Returns the number of faces far from the patch that were checked to be untouched.
+std::size_t checkInvariants(const fss::Mesh& before, const fss::Mesh& after, const fss::Mesh& patch) {
+    [&] {
+        QVERIFY(CGAL::is_valid_polygon_mesh(after));
+        QVERIFY(CGAL::is_triangle_mesh(after));
+        QCOMPARE(borderEdges(after), borderEdges(before)); // no new holes; closed stays closed
+        if (CGAL::is_closed(before)) {
+            QVERIFY(CGAL::is_closed(after));
+            QCOMPARE(PMP::is_outward_oriented(after),
+                     PMP::is_outward_oriented(before)); // consistent orientation
+        }
+        for (fss::VertexIndex v : after.vertices())
+            QVERIFY2(!after.is_isolated(v), "isolated vertex");
+        for (fss::FaceIndex f : after.faces())
+            QVERIFY2(!PMP::is_degenerate_triangle_face(f, after), "degenerate face");
+        QVERIFY2(!PMP::does_self_intersect(after), "self-intersection");
+        fss::Mesh a = after, b = before;
+        QCOMPARE(PMP::connected_components(a, a.add_property_map<fss::FaceIndex, std::size_t>("f:cc").first),
+                 PMP::connected_components(b, b.add_property_map<fss::FaceIndex, std::size_t>("f:cc").first));
+    }();
+    // Faces away from the patch (farther than 4 of the mesh's longest edges from its bounding box) are
+    // untouched: the same corners in the same order.
+    Eigen::AlignedBox3d box;
+    for (fss::VertexIndex v : patch.vertices())
+        box.extend(vec(patch.point(v)));
+    const double margin = 4 * std::max(longestEdge(before), longestEdge(patch));
+    box.min().array() -= margin;
+    box.max().array() += margin;
+    std::set<Triangle> afterFaces;
+    for (fss::FaceIndex f : after.faces())
+        afterFaces.insert(triangle(after, f));
+    std::size_t far = 0, missing = 0;
+    for (fss::FaceIndex f : before.faces()) {
+        bool inside = false;
+        for (fss::VertexIndex v : CGAL::vertices_around_face(before.halfedge(f), before))
+            inside = inside || box.contains(vec(before.point(v)));
+        if (inside) continue;
+        ++far;
+        missing += afterFaces.count(triangle(before, f)) ? 0 : 1;
+    }
+    if (missing != 0) qWarning("%zu of %zu far faces changed", missing, far);
+    return missing == 0 ? far : 0;
+}
+
+bool identical(const fss::Mesh& a, const fss::Mesh& b) {
+    if (a.number_of_vertices() != b.number_of_vertices() || a.number_of_faces() != b.number_of_faces() ||
+        a.number_of_removed_faces() != b.number_of_removed_faces())
+        return false;
+    auto va = a.vertices().begin();
+    for (fss::VertexIndex vb : b.vertices()) {
+        if (*va != vb || a.point(*va) != b.point(vb)) return false;
+        ++va;
+    }
+    auto fa = a.faces().begin();
+    for (fss::FaceIndex fb : b.faces()) {
+        if (*fa != fb) return false;
+        auto ca = CGAL::vertices_around_face(a.halfedge(*fa), a).begin();
+        for (fss::VertexIndex v : CGAL::vertices_around_face(b.halfedge(fb), b))
+            if (*ca++ != v) return false;
+        ++fa;
+    }
+    return true;
+}
+
+// Independent counts for the QualityPanel: valence by counting the halfedges pointing at each vertex,
+// smallest angle by the law of cosines; faces whose smallest angle lies within 1e-6° of a bin boundary
+// are counted in `ambiguous` (the panel's atan2 may put them in the neighbouring bin).
+struct Counts {
+    std::map<int, std::size_t> valence;
+    std::vector<std::size_t> angle = std::vector<std::size_t>(12, 0);
+    std::size_t ambiguous = 0;
+};
+
+Counts independentCounts(const fss::Mesh& m) {
+    Counts c;
+    std::map<fss::VertexIndex, int> in;
+    std::set<fss::VertexIndex> onBorder;
+    for (fss::HalfedgeIndex h : m.halfedges()) {
+        ++in[m.target(h)];
+        if (m.is_border(h)) {
+            onBorder.insert(m.target(h));
+            onBorder.insert(m.source(h));
+        }
+    }
+    for (const auto& [v, count] : in)
+        if (!onBorder.count(v)) ++c.valence[count];
+    for (fss::FaceIndex f : m.faces()) {
+        std::vector<Eigen::Vector3d> p;
+        for (fss::VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m))
+            p.push_back(vec(m.point(v)));
+        const double a = (p[1] - p[2]).norm(), b = (p[0] - p[2]).norm(), cc = (p[0] - p[1]).norm();
+        auto corner = [](double opposite, double s1, double s2) {
+            return std::acos(
+                       std::clamp((s1 * s1 + s2 * s2 - opposite * opposite) / (2 * s1 * s2), -1.0, 1.0)) *
+                   180 / std::numbers::pi;
+        };
+        const double smallest = std::min({corner(a, b, cc), corner(b, a, cc), corner(cc, a, b)});
+        const double bin = smallest / 5.0;
+        if (std::abs(bin - std::round(bin)) < 1e-6 / 5.0 && smallest > 1e-6 && smallest < 60 - 1e-6)
+            ++c.ambiguous;
+        ++c.angle[std::size_t(std::clamp(int(bin), 0, 11))];
+    }
+    return c;
+}
+
+void compareQuality(const fss::widgets::QualityPanel& panel, const fss::Mesh& mesh) {
+    const Counts c = independentCounts(mesh);
+    QVERIFY(panel.valenceHistogram() == c.valence);
+    QCOMPARE(panel.faceCount(), mesh.number_of_faces());
+    std::size_t differ = 0;
+    for (int i = 0; i < 12; ++i)
+        differ += std::size_t(
+            std::abs(long(panel.minAngleHistogram()[std::size_t(i)]) - long(c.angle[std::size_t(i)])));
+    QVERIFY2(differ <= 2 * c.ambiguous,
+             qPrintable(QString("%1 differences, %2 ambiguous").arg(differ).arg(c.ambiguous)));
+}
+
+} // namespace
+
+class RemeshWidgetTest : public QObject {
+    Q_OBJECT
+private slots:
+    void dragRotatesAndLassoConsumesTheLeftButton() {
+        auto w = shownWidget(fss::readMesh(fss::test::meshPath("fandisk.off")));
+        QVERIFY(w);
+        QWidget* view = w->view();
+        const QPointF c(view->width() / 2.0, view->height() / 2.0);
+        const fss::Camera before = w->view()->camera();
+        sendMouse(view, QEvent::MouseButtonPress, c, Qt::LeftButton, Qt::LeftButton);
+        for (int i = 1; i <= 10; ++i)
+            sendMouse(view, QEvent::MouseMove, c + QPointF(8 * i, 3 * i), Qt::NoButton, Qt::LeftButton);
+        sendMouse(view, QEvent::MouseButtonRelease, c + QPointF(80, 30), Qt::LeftButton, Qt::NoButton);
+        const fss::Camera rotated = w->view()->camera();
+        QVERIFY2((rotated.eye - before.eye).norm() > 0.1 * (before.eye - before.focal).norm(), "no rotation");
+
+        w->setActiveTool(w->lassoTool());
+        QVERIFY(w->statusText().contains("Drag"));
+        drawLasso(view, c, 100);
+        const fss::Camera after = w->view()->camera();
+        QVERIFY2((after.eye - rotated.eye).norm() < 1e-12, "the lasso's drag moved the camera");
+        QVERIFY(w->lassoTool()->hasLasso());
+        QVERIFY(w->statusText().contains("Lasso set"));
+        QTest::keyClick(view, Qt::Key_Escape);
+        QVERIFY(!w->lassoTool()->hasLasso());
+    }
+
+    void lassoScanAcceptKeepsInvariantsAndUndoIsExact() {
+        const fss::Mesh input = fss::shapes::icosphere(4); // closed, 5120 faces
+        auto w = shownWidget(input);
+        QVERIFY(w);
+        w->view()->setStandardView(fss::StandardView::PosZ);
+        w->scanPanel()->setResolution(200);
+        w->setActiveTool(w->lassoTool());
+        QWidget* view = w->view();
+        const QPointF centre(view->width() / 2.0, view->height() / 2.0);
+        const double radius = view->height() / 6.0;
+        const QPolygonF drawn = drawLasso(view, centre, radius);
+        QVERIFY(w->lassoTool()->hasLasso());
+
+        // Lasso positions are converted from view DIP to scan-image pixels.
+        const fss::ScanStep step = w->scanTool()->step();
+        QVERIFY(step.params.lasso.has_value());
+        const QSize image(step.params.camera.width, step.params.camera.height);
+        QCOMPARE(std::max(image.width(), image.height()), 200);
+        QCOMPARE(step.params.lasso->points.size(), std::size_t(w->lassoTool()->polygon().size()));
+        const double sx = double(image.width()) / view->width(), sy = double(image.height()) / view->height();
+        for (std::size_t i = 0; i < step.params.lasso->points.size(); ++i) {
+            const QPointF p = w->lassoTool()->polygon()[qsizetype(i)];
+            QVERIFY(std::abs(step.params.lasso->points[i].x() - p.x() * sx) < 1e-9);
+            QVERIFY(std::abs(step.params.lasso->points[i].y() - p.y() * sy) < 1e-9);
+        }
+
+        QSignalSpy accepted(w.get(), &RemeshWidget::scanAccepted);
+        QSignalSpy changed(w.get(), &RemeshWidget::meshChanged);
+        QVERIFY(w->scan());
+        QVERIFY(w->hasPreview());
+        const fss::Mesh patch = w->session()->preview()->patch.mesh;
+        QVERIFY(patch.number_of_faces() > 200);
+        // Every patch vertex lies inside the lasso (in scan pixels, from the step's camera).
+        const fss::Camera scanCamera = w->session()->preview()->step.params.camera;
+        for (fss::VertexIndex v : patch.vertices()) {
+            const Eigen::Vector3d s = scanCamera.project(vec(patch.point(v)));
+            QVERIFY(fss::insideLasso(*step.params.lasso, s.head<2>()));
+        }
+        // ... and they fill it: the patch's screen area is most of the lasso's (a circle of radius r·sx).
+        const double lassoArea = std::numbers::pi * radius * sx * radius * sy;
+        double patchArea = 0;
+        for (fss::FaceIndex f : patch.faces()) {
+            std::vector<Eigen::Vector2d> q;
+            for (fss::VertexIndex v : CGAL::vertices_around_face(patch.halfedge(f), patch))
+                q.push_back(scanCamera.project(vec(patch.point(v))).head<2>());
+            patchArea +=
+                std::abs((q[1] - q[0]).x() * (q[2] - q[0]).y() - (q[1] - q[0]).y() * (q[2] - q[0]).x()) / 2;
+        }
+        QVERIFY2(patchArea > 0.7 * lassoArea && patchArea < lassoArea,
+                 qPrintable(QString("patch %1 px², lasso %2 px²").arg(patchArea).arg(lassoArea)));
+
+        const fss::Mesh before = w->mesh();
+        const std::size_t panelUpdates = w->qualityPanel()->updateCount();
+        w->accept();
+        QVERIFY(w->isBusy());
+        QVERIFY(!w->lassoTool()->isEnabled()); // tools are disabled while the stitch runs
+        QVERIFY(waitIdle(*w));
+        QCOMPARE(accepted.count(), 1);
+        QCOMPARE(changed.count(), 1);
+        QVERIFY(!w->hasPreview());
+        const fss::Mesh after = w->mesh();
+        QVERIFY(!identical(before, after));
+        QVERIFY(after.number_of_faces() != before.number_of_faces());
+        const auto report = accepted.at(0).at(0).value<fss::StitchReport>();
+        QVERIFY(report.facesAdded > 0 && report.facesRemoved > 0);
+        const std::size_t far = checkInvariants(before, after, patch);
+        QVERIFY2(far > 1000, qPrintable(QString("only %1 far faces were checked").arg(far)));
+        QCOMPARE(w->qualityPanel()->updateCount(), panelUpdates + 1);
+        compareQuality(*w->qualityPanel(), after);
+        QCOMPARE(w->undoStack()->count(), 1);
+        QCOMPARE(w->historyView()->model()->rowCount(), 2); // "Input mesh" and the scan
+        qInfo("lasso scan: %zu patch faces; stitch removed %zu, added %zu faces; %zu far faces untouched",
+              std::size_t(patch.number_of_faces()), report.facesRemoved, report.facesAdded, far);
+
+        // Undo restores the exact previous mesh; redo the exact result.
+        w->undoStack()->undo();
+        QVERIFY(identical(w->mesh(), before));
+        compareQuality(*w->qualityPanel(), before);
+        QCOMPARE(changed.count(), 2);
+        w->undoStack()->redo();
+        QVERIFY(identical(w->mesh(), after));
+        compareQuality(*w->qualityPanel(), after);
+        QCOMPARE(w->session()->undoCount(), std::size_t(1));
+        QCOMPARE(w->qualityPanel()->updateCount(), panelUpdates + 3);
+    }
+
+    void fishboneSeedAndTwoKeyRibsGiveAGridPreview() {
+        // A cylinder seen from the side: the minimal curvature runs along its axis (vertical on screen), the
+        // maximal one around it (horizontal).
+        auto w = shownWidget(fss::shapes::cylinder(96, 48, 1.0, 2.0, true));
+        QVERIFY(w);
+        w->view()->setStandardView(fss::StandardView::PosX);
+        w->scanPanel()->setResolution(256);
+        w->scanPanel()->setFishboneSpacing(3.0);
+        w->setActiveTool(w->fishboneTool());
+        FishboneTool* tool = w->fishboneTool();
+        QVERIFY(w->statusText().contains("seed"));
+        tool->setRibMode(FishboneTool::RibMode::KeyRibs);
+        QWidget* view = w->view();
+        const QPointF centre(view->width() / 2.0, view->height() / 2.0);
+        click(view, centre); // the seed: the first fishbone scan estimates the curvature on the worker
+        QVERIFY(waitIdle(*w));
+        QTRY_VERIFY_WITH_TIMEOUT(tool->backbone().size() > 10, 30000);
+        QVERIFY2(!tool->hasGridPreview(), "key-rib mode shows only the backbone before two key-ribs");
+        QVERIFY(!w->hasPreview());
+        QVERIFY(w->statusText().contains("key-rib 1"));
+        // Around the seed the backbone runs along the axis: vertical on the screen. (Beyond the side it
+        // follows the rims, the caps' creases, whose minimal curvature direction runs along them.)
+        const QPolygonF backbone = tool->backbone();
+        qsizetype i0 = 0;
+        for (qsizetype i = 0; i < backbone.size(); ++i)
+            if (QLineF(backbone[i], centre).length() < QLineF(backbone[i0], centre).length()) i0 = i;
+        QVERIFY(QLineF(backbone[i0], centre).length() < 3.0);
+        QVERIFY(i0 >= 15 && i0 + 15 < backbone.size());
+        QPolygonF side;
+        for (qsizetype i = i0 - 15; i <= i0 + 15; ++i)
+            side << backbone[i];
+        const QRectF bb = side.boundingRect();
+        QVERIFY2(bb.height() > 100 && bb.width() < 2,
+                 qPrintable(QString("backbone near the seed %1 x %2").arg(bb.width()).arg(bb.height())));
+
+        const QPointF k1 = backbone[i0 - 12], k2 = backbone[i0 + 12];
+        click(view, k1 + QPointF(3, 0)); // a little off the backbone: snapped onto it
+        QVERIFY(w->statusText().contains("key-rib 2"));
+        click(view, k2 + QPointF(-3, 0));
+        QCOMPARE(tool->keyRibs().size(), std::size_t(2));
+        QVERIFY(tool->hasGridPreview());
+        QVERIFY(w->hasPreview());
+        QVERIFY(tool->ribCount() > 10);
+        const fss::ScanPreview& preview = *w->session()->preview();
+        QVERIFY(preview.fishbone.has_value());
+        QVERIFY(preview.step.fishbone.has_value());
+        QCOMPARE(preview.step.fishbone->keyRibs.size(), std::size_t(2));
+        QVERIFY(preview.fishbone->rows > 10 && preview.fishbone->cols > 10);
+        QVERIFY(preview.patch.mesh.number_of_faces() > 100);
+        // The key-ribs were converted to scan pixels: each lies on a backbone sample of the grid.
+        const fss::widgets::ScreenMapping mapping{
+            QSizeF(view->size()), QSize(preview.step.params.camera.width, preview.step.params.camera.height)};
+        for (std::size_t k = 0; k < 2; ++k) {
+            const Eigen::Vector2d expected = mapping.toImage(tool->keyRibs()[k]);
+            QVERIFY((preview.step.fishbone->keyRibs[k] - expected).norm() < 1e-9);
+            double nearest = 1e9;
+            for (int r = 0; r < preview.fishbone->rows; ++r)
+                if (preview.fishbone->isPresent(r, preview.fishbone->backboneColumn))
+                    nearest = std::min(
+                        nearest,
+                        (preview.fishbone->at(r, preview.fishbone->backboneColumn) - expected).norm());
+            QVERIFY2(nearest < 0.5, qPrintable(QString::number(nearest)));
+        }
+        // Ribs run around the cylinder: horizontal on the screen (the rib through the seed's row).
+        int mid = 0;
+        const Eigen::Vector2d seedImage = mapping.toImage(centre);
+        for (int r = 0; r < preview.fishbone->rows; ++r)
+            if (preview.fishbone->isPresent(r, preview.fishbone->backboneColumn) &&
+                (preview.fishbone->at(r, preview.fishbone->backboneColumn) - seedImage).norm() <
+                    (preview.fishbone->at(mid, preview.fishbone->backboneColumn) - seedImage).norm())
+                mid = r;
+        Eigen::Vector2d first(0, 0), last(0, 0);
+        bool haveFirst = false;
+        for (int c = 0; c < preview.fishbone->cols; ++c)
+            if (preview.fishbone->isPresent(mid, c)) {
+                if (!haveFirst) first = preview.fishbone->at(mid, c);
+                haveFirst = true;
+                last = preview.fishbone->at(mid, c);
+            }
+        QVERIFY(std::abs((last - first).x()) > 5 * std::abs((last - first).y()));
+        qInfo("fishbone: %d x %d grid, %zu rib vertices shown as %zu ribs, patch %zu faces",
+              preview.fishbone->rows, preview.fishbone->cols, preview.fishbone->presentCount(),
+              tool->ribCount(), std::size_t(preview.patch.mesh.number_of_faces()));
+
+        // Dragging a key-rib along the backbone rescans.
+        const QPointF from = tool->keyRibs()[0];
+        const QPointF to = backbone[i0 - 9];
+        sendMouse(view, QEvent::MouseButtonPress, from, Qt::LeftButton, Qt::LeftButton);
+        sendMouse(view, QEvent::MouseMove, to, Qt::NoButton, Qt::LeftButton);
+        sendMouse(view, QEvent::MouseButtonRelease, to, Qt::LeftButton, Qt::NoButton);
+        QVERIFY(std::hypot(tool->keyRibs()[0].x() - to.x(), tool->keyRibs()[0].y() - to.y()) < 1e-9);
+        QVERIFY(tool->hasGridPreview());
+        if (qEnvironmentVariableIsSet("FSS_TEST_SCREENSHOTS"))
+            w->grab().save(QStringLiteral("/tmp/fishbone_widget.png"));
+
+        // Accept: the fishbone patch is stitched in.
+        const fss::Mesh before = w->mesh();
+        const fss::Mesh patch = w->session()->preview()->patch.mesh;
+        QTest::keyClick(view, Qt::Key_Return);
+        QVERIFY(waitIdle(*w));
+        QCOMPARE(w->undoStack()->count(), 1);
+        QVERIFY(!identical(before, w->mesh()));
+        checkInvariants(before, w->mesh(), patch);
+        compareQuality(*w->qualityPanel(), w->mesh());
+    }
+
+    void aDrawnBackboneGivesAGridAlongIt() {
+        auto w = shownWidget(fss::shapes::cylinder(96, 48, 1.0, 2.0, true));
+        QVERIFY(w);
+        w->view()->setStandardView(fss::StandardView::PosX);
+        w->scanPanel()->setResolution(256);
+        w->scanPanel()->setFishboneSpacing(3.0);
+        w->setActiveTool(w->fishboneTool());
+        FishboneTool* tool = w->fishboneTool();
+        tool->setInputMode(FishboneTool::InputMode::DrawBackbone);
+        QVERIFY(w->statusText().contains("draw the backbone"));
+        QWidget* view = w->view();
+        // A slanted stroke across the side of the cylinder.
+        const QPointF a(view->width() / 2.0 - 40, view->height() / 2.0 - 80);
+        const QPointF b(view->width() / 2.0 + 40, view->height() / 2.0 + 80);
+        sendMouse(view, QEvent::MouseButtonPress, a, Qt::LeftButton, Qt::LeftButton);
+        for (int i = 1; i <= 20; ++i)
+            sendMouse(view, QEvent::MouseMove, a + (b - a) * (i / 20.0), Qt::NoButton, Qt::LeftButton);
+        sendMouse(view, QEvent::MouseButtonRelease, b, Qt::LeftButton, Qt::NoButton);
+        QVERIFY(tool->drawnBackbone().size() >= 10);
+        QVERIFY(!tool->seed());
+        QVERIFY(waitIdle(*w));
+        QTRY_VERIFY_WITH_TIMEOUT(tool->hasGridPreview(), 30000);
+        const fss::ScanPreview& preview = *w->session()->preview();
+        QVERIFY(preview.step.fishbone && !preview.step.fishbone->drawnBackbone.empty());
+        QVERIFY(preview.patch.mesh.number_of_faces() > 100);
+        // The grid's backbone follows the stroke: every backbone sample lies on the segment a–b (DIP).
+        for (const QPointF& p : tool->backbone()) {
+            const QPointF d = b - a;
+            const double t = std::clamp(QPointF::dotProduct(p - a, d) / QPointF::dotProduct(d, d), 0.0, 1.0);
+            QVERIFY2(QLineF(p, a + t * d).length() < 1.5,
+                     qPrintable(QString("(%1, %2)").arg(p.x()).arg(p.y())));
+        }
+        QVERIFY(tool->backbone().size() > 20);
+    }
+
+    void aLassoOverTheBackgroundFailsWithOneSentence() {
+        auto w = shownWidget(fss::shapes::icosphere(3));
+        QVERIFY(w);
+        w->view()->setStandardView(fss::StandardView::PosZ);
+        w->setActiveTool(w->lassoTool());
+        drawLasso(w->view(), QPointF(30, 30), 15); // in the corner: background only
+        QSignalSpy errors(w.get(), &RemeshWidget::errorOccurred);
+        QVERIFY(!w->scan());
+        QCOMPARE(errors.count(), 1);
+        const QString message = errors.at(0).at(0).toString();
+        QVERIFY2(message.endsWith('.') && !message.contains('\n'), qPrintable(message));
+        QVERIFY(!w->hasPreview());
+        QCOMPARE(w->statusText(), message);
+        w->accept(); // nothing to accept: a sentence, no work started
+        QCOMPARE(errors.count(), 2);
+        QVERIFY(!w->isBusy());
+        QCOMPARE(w->undoStack()->count(), 0);
+    }
+
+    void cancelStopsTheCurvatureEstimate() {
+        auto w =
+            shownWidget(fss::shapes::torus(320, 160, 1.0, 0.4)); // 100k faces: the estimate takes a while
+        QVERIFY(w);
+        w->view()->setStandardView(fss::StandardView::PosZ);
+        w->setActiveTool(w->fishboneTool());
+        QWidget* view = w->view();
+        click(view, QPointF(view->width() / 2.0 + view->height() / 3.0, view->height() / 2.0));
+        QVERIFY(w->isBusy());
+        QVERIFY(!w->fishboneTool()->isEnabled());
+        QVERIFY(w->statusText().contains("curvature"));
+        QPushButton* cancel = nullptr;
+        for (QPushButton* b : w->findChildren<QPushButton*>())
+            if (b->text() == "Cancel") cancel = b;
+        QVERIFY(cancel && cancel->isVisible());
+        QTest::mouseClick(cancel, Qt::LeftButton);
+        QVERIFY(waitIdle(*w));
+        QVERIFY(!w->session()->preview());
+        QVERIFY(!const_cast<fss::Session*>(w->session())
+                     ->fishboneCache()
+                     .hasCurvature(w->session()->reference()));
+        QVERIFY(!w->fishboneTool()->hasInput());
+        QVERIFY2(w->statusText().contains("cancelled"), qPrintable(w->statusText()));
+        QVERIFY(w->fishboneTool()->isEnabled());
+    }
+
+    void destroyingTheWidgetWhileItStitchesWaits() {
+        auto w = shownWidget(fss::shapes::icosphere(4));
+        QVERIFY(w);
+        QVERIFY(w->scan());
+        w->accept();
+        QVERIFY(w->isBusy());
+        w.reset(); // must wait for the worker (which uses the session) instead of crashing
+        QVERIFY(!w);
+    }
+
+    void guiKeepsProcessingEventsWhileA100kFaceStitchRuns() {
+        const fss::Mesh torus = fss::shapes::torus(320, 160, 1.0, 0.4); // 102400 faces
+        QCOMPARE(torus.number_of_faces(), std::size_t(102400));
+        QElapsedTimer setTimer;
+        setTimer.start();
+        auto w = shownWidget(torus);
+        QVERIFY(w);
+        const qint64 setMs = setTimer.elapsed();
+        w->view()->setStandardView(fss::StandardView::PosZ);
+        w->scanPanel()->setResolution(400);
+        QElapsedTimer scanTimer;
+        scanTimer.start();
+        QVERIFY(w->scan());
+        const qint64 scanMs = scanTimer.elapsed();
+        const std::size_t patchFaces = w->session()->preview()->patch.mesh.number_of_faces();
+
+        // A 2 ms timer on the GUI thread measures the event loop while the stitch runs on the worker.
+        int ticks = 0;
+        qint64 maxGap = 0, last = 0, maxGapAt = 0;
+        std::vector<qint64> gaps;
+        QElapsedTimer clock;
+        QTimer timer;
+        timer.setInterval(2);
+        connect(&timer, &QTimer::timeout, [&] {
+            if (!w->isBusy()) return;
+            const qint64 now = clock.elapsed();
+            if (now - last > maxGap) {
+                maxGap = now - last;
+                maxGapAt = now;
+            }
+            gaps.push_back(now - last);
+            last = now;
+            ++ticks;
+        });
+        QSignalSpy accepted(w.get(), &RemeshWidget::scanAccepted);
+        const fss::Mesh before = w->mesh();
+        clock.start();
+        timer.start();
+        w->accept();
+        QVERIFY(w->isBusy());
+        QVERIFY(waitIdle(*w));
+        const qint64 workMs = clock.elapsed();
+        timer.stop();
+        QCOMPARE(accepted.count(), 1);
+        QVERIFY(w->mesh().number_of_faces() != before.number_of_faces());
+        QVERIFY2(
+            ticks >= 3,
+            qPrintable(QString("only %1 timer events during %2 ms of stitching").arg(ticks).arg(workMs)));
+        std::sort(gaps.begin(), gaps.end());
+        qInfo(
+            "100k torus: setMesh %lld ms, scan %lld ms (%zu patch faces), stitch %lld ms on the worker; GUI "
+            "timer (2 ms) events during it: %d, gap median %lld ms, 90th percentile %lld ms, longest %lld ms "
+            "(ending %lld ms after the start)",
+            setMs, scanMs, patchFaces, workMs, ticks, gaps[gaps.size() / 2], gaps[gaps.size() * 9 / 10],
+            maxGap, maxGapAt);
+    }
+};
+
+int main(int argc, char** argv) {
+    fss::widgets::VtkView::setDefaultSurfaceFormat();
+    QApplication app(argc, argv);
+    RemeshWidgetTest test;
+    return QTest::qExec(&test, argc, argv);
+}
+
+#include "remesh_widget_test.moc"

@@ -1,0 +1,155 @@
+#pragma once
+/// \file remesh_widget.h
+/// RemeshWidget: the composite drop-in widget of FSS for a CAD / FEM preprocessor — a VtkView with the
+/// tools (navigate, lasso, scan, fishbone), the ScanPanel, the QualityPanel and the history (a QUndoView
+/// of undoStack()), a status line, and a progress bar with a Cancel button.
+///
+/// It owns a fss::Session (session.h): the mesh given to setMesh() / openMesh() is the session's
+/// reference; every accepted scan changes the current mesh (mesh()), and every accept is one QUndoCommand
+/// on undoStack() (undo / redo call Session::undo / redo). Scans are rendered on the GUI thread (they
+/// need the view's GL context, or the CPU renderer); the long work — stitching (Session::accept) and the
+/// curvature estimate of a first fishbone scan — runs on a worker thread with progress and Cancel, and the
+/// tools are disabled meanwhile. The Session is touched by one thread at a time: while isBusy() the
+/// widget does not call it from the GUI thread (undo / redo wait for the worker to finish).
+
+#include "fss/mesh.h"
+#include "fss/session.h"
+#include "fss/stitch.h"
+
+#include <QString>
+#include <QWidget>
+
+#include <memory>
+
+class QAction;
+class QLabel;
+class QProgressBar;
+class QPushButton;
+class QUndoStack;
+class QUndoView;
+
+namespace fss::widgets {
+
+class FishboneTool;
+class LassoTool;
+class NavigateTool;
+class QualityPanel;
+class ScanPanel;
+class ScanTool;
+class Tool;
+class VtkView;
+
+/// The composite remeshing widget (see the file comment). Several may live in one process.
+class RemeshWidget : public QWidget {
+    Q_OBJECT
+public:
+    explicit RemeshWidget(QWidget* parent = nullptr);
+    /// Cancels and waits for running work.
+    ~RemeshWidget() override;
+    RemeshWidget(const RemeshWidget&) = delete;
+    RemeshWidget& operator=(const RemeshWidget&) = delete;
+
+    /// Starts a new session on a copy of \p mesh (the reference): the history is cleared, the view shows
+    /// the mesh from the initial view. Waits for running work first. An empty, non-triangle or invalid
+    /// mesh is refused: errorOccurred() with one sentence, the previous mesh stays.
+    /// \return whether the mesh was taken.
+    bool setMesh(const Mesh& mesh);
+    /// Reads \p path (fss::readMesh: OFF, OBJ, PLY, STL) and calls setMesh(). On failure the previous
+    /// mesh stays and errorOccurred() carries the reader's sentence. \return success
+    bool openMesh(const QString& path);
+    /// The current mesh (the reference with the accepted scans stitched in); empty before the first mesh.
+    /// A copy owned by the GUI thread, safe to read at any time: while isBusy() it is the mesh before the
+    /// running accept.
+    const Mesh& mesh() const;
+    /// The reference mesh of the session (empty before the first mesh).
+    const Mesh& referenceMesh() const;
+    /// Writes mesh() to \p path (fss::writeMesh; format by extension). On failure errorOccurred().
+    /// \return success
+    bool saveMesh(const QString& path);
+
+    /// The undo stack: one command per accepted scan. Prefer undoAction() / redoAction(), which are
+    /// disabled while work runs; calling undo()/redo() on the stack meanwhile waits for the work to end.
+    QUndoStack* undoStack() const;
+    /// Undo / redo actions of undoStack() (with the standard shortcuts), disabled while isBusy().
+    QAction* undoAction() const;
+    QAction* redoAction() const;
+    /// The Scan, Accept and Reject actions of the tool bar.
+    QAction* scanAction() const;
+    QAction* acceptAction() const;
+    QAction* rejectAction() const;
+
+    /// The parts (owned by the widget).
+    VtkView* view() const;
+    ScanPanel* scanPanel() const;
+    QualityPanel* qualityPanel() const;
+    QUndoView* historyView() const;
+    NavigateTool* navigateTool() const;
+    LassoTool* lassoTool() const;
+    ScanTool* scanTool() const;
+    FishboneTool* fishboneTool() const;
+
+    /// The tool receiving the mouse (one of the four above); Navigate initially.
+    Tool* activeTool() const;
+    /// Activates \p tool (one of the widget's tools) and deactivates the previous one.
+    void setActiveTool(Tool* tool);
+
+    /// The session (null before the first mesh). Do not call it while isBusy().
+    const Session* session() const;
+    /// Whether a scan preview is pending (Accept / Reject apply to it).
+    bool hasPreview() const;
+    /// Whether work runs on the worker thread (stitching, curvature).
+    bool isBusy() const;
+    /// The sentence in the status line: what the active tool expects next, or what is running.
+    QString statusText() const;
+    /// Whether the view shows the reference mesh as a ghost (when the view supports it).
+    bool ghostVisible() const { return ghost_; }
+
+public slots:
+    /// A regular scan (ScanTool::step: the view's camera at the panel's resolution, the lasso if any) on
+    /// the GUI thread; the result becomes the preview. On failure errorOccurred() with the reason (the
+    /// previous preview stays). \return success
+    bool scan();
+    /// Stitches the preview in on the worker thread (progress, Cancel); when it has finished, pushes the
+    /// undo command and emits scanAccepted() and meshChanged(). Does nothing while busy or without a
+    /// preview (errorOccurred() says so). Failures leave the mesh unchanged and emit errorOccurred().
+    void accept();
+    /// Drops the preview.
+    void reject();
+    /// Asks running work to stop (honoured at the next progress report; a stitch that has started runs
+    /// to its end, since Session::accept has no intermediate report).
+    void cancel();
+    /// Shows or hides the reference as a translucent ghost.
+    void setGhostVisible(bool visible);
+
+signals:
+    /// mesh() changed: a new mesh, an accepted scan, undo or redo.
+    void meshChanged();
+    /// A scan was stitched in; \p report says what the stitch did.
+    void scanAccepted(const fss::StitchReport& report);
+    /// Something failed; \p message is one sentence for the user.
+    void errorOccurred(const QString& message);
+    /// statusText() changed.
+    void statusChanged(const QString& text);
+    /// isBusy() changed.
+    void busyChanged(bool busy);
+    /// A preview appeared or went away.
+    void previewChanged();
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> d_;
+    bool ghost_ = false;
+
+    friend class AcceptCommand;
+    void undoStep();
+    void redoStep();
+    void afterMeshChange();
+    void showPreview();
+    void runFishbone();
+    void reportError(const QString& message);
+    void setBusy(bool busy, const QString& what = {});
+    void updateStatus();
+    void waitForWork();
+};
+
+} // namespace fss::widgets

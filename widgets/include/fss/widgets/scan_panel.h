@@ -1,0 +1,96 @@
+#pragma once
+/// \file scan_panel.h
+/// ScanPanel: the settings of the next scan — resolution (with the edge length it gives in world units),
+/// erosion / dilation radii, the triangulation and quality thresholds, force-replace, and the fishbone
+/// grid's spacing — and the scan camera they make from the view's camera.
+
+#include "fss/camera.h"
+#include "fss/scan_pipeline.h"
+
+#include <Eigen/Core>
+
+#include <QWidget>
+
+#include <optional>
+
+class QCheckBox;
+class QDoubleSpinBox;
+class QLabel;
+class QSpinBox;
+
+namespace fss::widgets {
+
+/// The scan settings panel (see the file comment). Every value has a getter and a setter so that
+/// applications and tests can drive it without the mouse; settingsChanged() follows every change.
+class ScanPanel : public QWidget {
+    Q_OBJECT
+public:
+    explicit ScanPanel(QWidget* parent = nullptr);
+    ~ScanPanel() override;
+
+    /// Scan resolution: the number of pixels (samples) along the longer side of the scan image; the
+    /// shorter side follows the view's aspect. Clamped to [16, 4096]; default 256.
+    int resolution() const;
+    void setResolution(int pixels);
+    /// Morphological erosion radius in grid samples, [0, 8]; default 1.
+    int erodeRadius() const;
+    void setErodeRadius(int radius);
+    /// Dilation radius after the erosion, [0, 8]; default 1 (never re-admits rejected samples).
+    int dilateRadius() const;
+    void setDilateRadius(int radius);
+    /// Triangles with an edge longer than this many pixel footprints span a depth step and are dropped
+    /// (TriangulateOptions::maxEdgeFootprints), [1, 20]; default 3.
+    double maxEdgeFootprints() const;
+    void setMaxEdgeFootprints(double footprints);
+    /// Grazing limit in degrees (TriangulateOptions::maxSamplingAngleDeg), [10, 90]; default 80.
+    double maxSamplingAngleDeg() const;
+    void setMaxSamplingAngleDeg(double degrees);
+    /// Quality margin (QualityMaskOptions::margin), [0, 0.9]; default 0.1.
+    double qualityMargin() const;
+    void setQualityMargin(double margin);
+    /// Keep every sample regardless of the current mesh's quality (QualityMaskOptions::forceReplace).
+    bool forceReplace() const;
+    void setForceReplace(bool force);
+    /// Fishbone grid spacing h in scan-image pixels (FishboneParams::spacing), [0.5, 32]; default 2.
+    double fishboneSpacing() const;
+    void setFishboneSpacing(double pixels);
+
+    /// The scan image size for a view image of \p viewSize (any unit): the longer side is resolution(),
+    /// the other keeps the aspect (at least 1).
+    QSize scanSize(QSizeF viewSize) const;
+    /// The view's camera (as VtkView::camera()) with the scan image size of scanSize().
+    Camera scanCamera(const Camera& viewCamera) const;
+    /// The scan parameters for \p viewCamera: scanCamera(), the radii, thresholds and force-replace; no
+    /// lasso (the caller adds it) and scan id −1.
+    ScanParams scanParams(const Camera& viewCamera) const;
+
+    /// Updates the edge-length line for \p viewCamera, measured at world point \p at (e.g. the centre of
+    /// the mesh): one regular-grid edge is the scan camera's pixel footprint there. std::nullopt clears it.
+    void updateEdgeLength(const std::optional<Camera>& viewCamera, const Eigen::Vector3d& at = {0, 0, 0});
+    /// The edge length currently shown (world units; 0 when none).
+    double edgeLength() const { return edgeLength_; }
+    /// The text of the edge-length line.
+    QString edgeLengthText() const;
+
+signals:
+    /// Some setting changed (by the user or a setter).
+    void settingsChanged();
+
+private:
+    void refreshEdgeLength();
+
+    QSpinBox* resolution_ = nullptr;
+    QSpinBox* erode_ = nullptr;
+    QSpinBox* dilate_ = nullptr;
+    QDoubleSpinBox* maxEdge_ = nullptr;
+    QDoubleSpinBox* maxAngle_ = nullptr;
+    QDoubleSpinBox* margin_ = nullptr;
+    QCheckBox* force_ = nullptr;
+    QDoubleSpinBox* spacing_ = nullptr;
+    QLabel* edgeLabel_ = nullptr;
+    std::optional<Camera> viewCamera_;
+    Eigen::Vector3d at_{0, 0, 0};
+    double edgeLength_ = 0;
+};
+
+} // namespace fss::widgets
