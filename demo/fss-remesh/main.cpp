@@ -18,6 +18,7 @@ Feature-sensitive remeshing by virtual range scanning (Vorsatz et al., VMV 2000)
 commands:
   info MESH      Print quality metrics of a mesh (optionally against a reference).
   scan MESH      Scan MESH from a camera into a regular patch (and stitch it with --into).
+  auto MESH      Remesh the whole surface of MESH automatically (views, resolution, coverage).
 
 Run 'fss-remesh <command> --help' for the options of a command.
 Exit status: 0 on success, 1 when the work failed, 2 when the command line is wrong.
@@ -45,6 +46,7 @@ int main(int argc, char** argv) {
         if (command == "info") return fss::cli::runInfo(args);
 #ifdef FSS_HAVE_RENDER
         if (command == "scan") return fss::cli::runScan(args);
+        if (command == "auto") return fss::cli::runAuto(args);
 #endif
         std::cerr << "fss-remesh: unknown command '" << command << "'; run 'fss-remesh --help'.\n";
         return 2;
