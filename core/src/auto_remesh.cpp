@@ -224,7 +224,7 @@ struct RegularScan {
 
 RegularScan regularScan(const Mesh& reference, MeshRenderer& referenceRenderer, Mesh& current,
                         MeshRenderer& currentRenderer, const Camera& camera, std::int32_t scanId, int fillRadius,
-                        const AutoOptions& options) {
+                        double maxSamplingAngleDeg, const AutoOptions& options) {
     const FrameBuffers ref = referenceRenderer.render(camera);
     if (ref.coveredCount() == 0) throw InvalidInputError("The view sees no part of the mesh.");
     RegularScan out;
@@ -238,6 +238,11 @@ RegularScan regularScan(const Mesh& reference, MeshRenderer& referenceRenderer, 
         admissibleBefore.resize(grid.samples.size());
         for (std::size_t i = 0; i < grid.samples.size(); ++i) admissibleBefore[i] = grid.samples[i].admissible;
     }
+    // Keep each view to the part of the surface it sees well: its patch boundary then runs where the current
+    // mesh is a clean height field in the view (no silhouettes or occlusion contours), which the stitcher needs.
+    const double maxAngle = maxSamplingAngleDeg * std::numbers::pi / 180.0;
+    for (Sample& s : grid.samples)
+        if (s.admissible && s.samplingAngle > maxAngle) s.admissible = s.valid = false;
     QualityMaskOptions q;
     q.margin = options.qualityMargin;
     applyQualityMask(grid, current, out.currentBuffers, q);
@@ -287,6 +292,9 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
         throw InvalidInputError("The target edge length must be a positive number.");
     if (!(options.servedAngleDeg > 0 && options.servedAngleDeg <= 80))
         throw InvalidInputError("The served angle of the view plan must be in (0, 80] degrees.");
+    if (!(options.maxSamplingAngleDeg > options.servedAngleDeg && options.maxSamplingAngleDeg <= 85) ||
+        !(options.followUpMaxSamplingAngleDeg > 0 && options.followUpMaxSamplingAngleDeg <= 85))
+        throw InvalidInputError("The largest sampling angles must be in (served angle, 85] degrees.");
     if (options.maxViews < 1) throw InvalidInputError("The view budget must be at least one view.");
     if (!(options.footprintRatio > 0.1 && options.footprintRatio <= 4))
         throw InvalidInputError("The footprint ratio must be in (0.1, 4].");
@@ -388,7 +396,11 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
                 FishboneParams fb;
                 fb.drawnBackbone = line;
                 fb.direction = PrincipalDirection::Min;
-                fb.spacing = h;
+                // A whole number of spacings along the line, so that both of its ends (corners) are sampled.
+                double screenLength = 0;
+                for (std::size_t i = 1; i < line.size(); ++i) screenLength += (line[i] - line[i - 1]).norm();
+                fb.spacing = screenLength / std::max(1.0, std::round(screenLength / h));
+                fb.spacing = std::clamp(fb.spacing, 0.75 * h, 1.5 * h);
                 step.camera = params.camera;
                 auto ts = Clock::now();
                 FishboneScanResult scan = scanFishbonePatch(reference, *referenceRenderer, current, *currentRenderer,
@@ -463,7 +475,7 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
             step.camera = frameParallel(views[i], corners, footprint, 2 * L);
             auto ts = Clock::now();
             RegularScan scan = regularScan(reference, *referenceRenderer, current, *currentRenderer, step.camera,
-                                           step.scanId, -1, options);
+                                           step.scanId, -1, options.maxSamplingAngleDeg, options);
             result.scanSeconds += secondsSince(ts);
             step.camera = scan.camera;
             step.patchFaces = scan.patch.mesh.number_of_faces();
@@ -568,7 +580,8 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
             try {
                 auto ts = Clock::now();
                 RegularScan scan = regularScan(reference, *referenceRenderer, current, *currentRenderer, best,
-                                               step.scanId, 2 + options.morphologyRadius, options);
+                                               step.scanId, 2 + options.morphologyRadius,
+                                               options.followUpMaxSamplingAngleDeg, options);
                 result.scanSeconds += secondsSince(ts);
                 step.patchFaces = scan.patch.mesh.number_of_faces();
                 stitchInto(step, scan.patch.mesh, scan.camera, scan.currentBuffers.faceId);

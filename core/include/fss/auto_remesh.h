@@ -53,6 +53,12 @@ struct AutoOptions {
     /// A face counts as served by a view when the angle between its normal and the view direction is
     /// at most this (degrees); the greedy view plan stops when every face is served. In (0, 80].
     double servedAngleDeg = 40.0;
+    /// Samples of an initial view seen at a larger angle between view ray and surface normal (degrees) are
+    /// left to other views: the patch of a view ends where it sees the surface well, away from its
+    /// silhouettes and occlusion contours, where the stitch is clean. In (servedAngleDeg, 85].
+    double maxSamplingAngleDeg = 60.0;
+    /// The same limit for the follow-up views.
+    double followUpMaxSamplingAngleDeg = 70.0;
     /// Faces whose served area share is below this fraction of the total area do not justify a view of
     /// their own in the initial plan (the follow-up views handle them).
     double minViewAreaFraction = 0.002;
@@ -73,10 +79,17 @@ struct AutoOptions {
     double fishboneBandWidth = 2.5;
     /// Erosion / dilation radius of the scans' morphology.
     int morphologyRadius = 1;
-    /// Options of every stitch.
-    StitchOptions stitch{};
+    /// Options of every stitch. Faces with a smallest angle under 10° are refused (trimmed and retried).
+    StitchOptions stitch = defaultStitch();
     /// Quality-mask margin (mask.h QualityMaskOptions::margin) of the regular scans.
     double qualityMargin = 0.1;
+
+    /// StitchOptions with minAngleFloorDeg = 10.
+    static StitchOptions defaultStitch() {
+        StitchOptions s;
+        s.minAngleFloorDeg = 10.0;
+        return s;
+    }
 };
 
 /// What happened to one scan of autoRemesh.
