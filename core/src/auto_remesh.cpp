@@ -7,6 +7,8 @@
 #include "fss/scan_pipeline.h"
 #include "fss/triangulate.h"
 
+#include <CGAL/boost/graph/Euler_operations.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -182,6 +184,55 @@ std::vector<FeatureChain> featureChains(const Mesh& mesh, double featureAngleDeg
     return chains;
 }
 
+double minCornerAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+    auto angle = [](const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& r) {
+        const Eigen::Vector3d u = q - p, v = r - p;
+        return std::atan2(u.cross(v).norm(), u.dot(v));
+    };
+    return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
+}
+
+/// Flips edges between two nearly coplanar faces (normals within \p maxDihedralDeg) where the flip raises
+/// the smaller of the two faces' smallest angles, for faces with a smallest angle under \p belowDeg: the
+/// slivers that seams leave. A flip is done only when the new edge does not exist yet, both end vertices keep
+/// valence ≥ 3, and both new faces keep the orientation of the old ones (normals within maxDihedralDeg):
+/// connectivity stays manifold and the surface moves nowhere (the quad is flat to within the dihedral limit).
+std::size_t flipSlivers(Mesh& mesh, double belowDeg, double maxDihedralDeg, int rounds) {
+    const double below = belowDeg * std::numbers::pi / 180.0;
+    const double cosDihedral = std::cos(maxDihedralDeg * std::numbers::pi / 180.0);
+    std::size_t flips = 0;
+    for (int round = 0; round < rounds; ++round) {
+        std::size_t flipsThisRound = 0;
+        for (EdgeIndex e : mesh.edges()) {
+            if (mesh.is_border(e)) continue;
+            const HalfedgeIndex h = mesh.halfedge(e), o = mesh.opposite(h);
+            const VertexIndex va = mesh.source(h), vb = mesh.target(h);
+            const VertexIndex vc = mesh.target(mesh.next(h)), vd = mesh.target(mesh.next(o));
+            if (vc == vd) continue;
+            const Eigen::Vector3d a = toEigen(mesh.point(va)), b = toEigen(mesh.point(vb));
+            const Eigen::Vector3d c = toEigen(mesh.point(vc)), d = toEigen(mesh.point(vd));
+            const double before = std::min(minCornerAngle(a, b, c), minCornerAngle(b, a, d));
+            if (before >= below) continue;
+            const Eigen::Vector3d n1 = (b - a).cross(c - a), n2 = (a - b).cross(d - b);
+            if (n1.norm() == 0 || n2.norm() == 0 || n1.normalized().dot(n2.normalized()) < cosDihedral) continue;
+            // After the flip: faces (c, a, d) and (d, b, c).
+            const Eigen::Vector3d m1 = (a - c).cross(d - c), m2 = (b - d).cross(c - d);
+            if (m1.norm() == 0 || m2.norm() == 0) continue;
+            const Eigen::Vector3d n = (n1.normalized() + n2.normalized()).normalized();
+            if (m1.normalized().dot(n) < cosDihedral || m2.normalized().dot(n) < cosDihedral) continue;
+            const double after = std::min(minCornerAngle(c, a, d), minCornerAngle(d, b, c));
+            if (after <= before + 1e-6) continue;
+            if (mesh.degree(va) <= 3 || mesh.degree(vb) <= 3) continue;
+            if (CGAL::halfedge(vc, vd, mesh).second) continue;
+            CGAL::Euler::flip_edge(h, mesh);
+            ++flipsThisRound;
+        }
+        flips += flipsThisRound;
+        if (flipsThisRound == 0) break;
+    }
+    return flips;
+}
+
 /// Resamples a screen polyline so that consecutive points are at least \p minGap pixels apart.
 Polyline2 thinPolyline(const Polyline2& in, double minGap) {
     Polyline2 out;
@@ -295,6 +346,8 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
     if (!(options.maxSamplingAngleDeg > options.servedAngleDeg && options.maxSamplingAngleDeg <= 85) ||
         !(options.followUpMaxSamplingAngleDeg > 0 && options.followUpMaxSamplingAngleDeg <= 85))
         throw InvalidInputError("The largest sampling angles must be in (served angle, 85] degrees.");
+    if (options.initialFillRadius < -1 || options.initialFillRadius > 16)
+        throw InvalidInputError("The fill radius of the initial views must be in [-1, 16] pixels.");
     if (options.maxViews < 1) throw InvalidInputError("The view budget must be at least one view.");
     if (!(options.footprintRatio > 0.1 && options.footprintRatio <= 4))
         throw InvalidInputError("The footprint ratio must be in (0.1, 4].");
@@ -342,6 +395,7 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
             step.stitched = true;
             step.facesAdded = r.facesAdded;
             step.facesRemoved = r.facesRemoved;
+            step.patchFacesTrimmed = r.patchFacesTrimmed;
             if (!r.skipped.empty()) step.note = r.skipped.front();
             currentRenderer->setMesh(current);
         } catch (const CancelledError&) {
@@ -464,6 +518,7 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
     }
     result.planSeconds += secondsSince(tPlan);
 
+    const int initialFill = options.initialFillRadius;
     for (std::size_t i = 0; i < views.size() && budgetLeft(); ++i) {
         progress.report(0.3 + 0.4 * double(i) / double(views.size()),
                         "scan " + std::to_string(i + 1) + "/" + std::to_string(views.size()));
@@ -475,7 +530,7 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
             step.camera = frameParallel(views[i], corners, footprint, 2 * L);
             auto ts = Clock::now();
             RegularScan scan = regularScan(reference, *referenceRenderer, current, *currentRenderer, step.camera,
-                                           step.scanId, -1, options.maxSamplingAngleDeg, options);
+                                           step.scanId, initialFill, options.maxSamplingAngleDeg, options);
             result.scanSeconds += secondsSince(ts);
             step.camera = scan.camera;
             step.patchFaces = scan.patch.mesh.number_of_faces();
@@ -596,6 +651,11 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
         if (scansThisRound == 0 || measureCoverage(current).fraction() <= coverageBefore + 1e-6) break;
     }
 
+    if (options.flipSliversBelowDeg > 0) {
+        auto t = Clock::now();
+        result.sliverFlips = flipSlivers(current, options.flipSliversBelowDeg, 20.0, 8);
+        result.stitchSeconds += secondsSince(t);
+    }
     progress.report(1.0, "done");
     current.collect_garbage();
     const Coverage c = measureCoverage(current);

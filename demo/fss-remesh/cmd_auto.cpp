@@ -128,6 +128,7 @@ int runAuto(const std::vector<std::string>& args) {
         j["input_faces_left"] = result.inputFacesLeft;
         j["input_area_left"] = result.inputAreaLeft;
         j["feature_chains"] = result.featureChains;
+        j["sliver_flips"] = result.sliverFlips;
         j["scans_stitched"] = result.scansStitched;
         j["scans_skipped"] = result.scansSkipped;
         nlohmann::json steps = nlohmann::json::array();
@@ -141,6 +142,7 @@ int runAuto(const std::vector<std::string>& args) {
                              {"patch_faces", s.patchFaces},
                              {"faces_added", s.facesAdded},
                              {"faces_removed", s.facesRemoved},
+                             {"patch_faces_trimmed", s.patchFacesTrimmed},
                              {"coverage_after", s.coverageAfter},
                              {"seconds", s.seconds},
                              {"note", s.note}});

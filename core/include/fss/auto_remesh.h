@@ -59,6 +59,10 @@ struct AutoOptions {
     double maxSamplingAngleDeg = 60.0;
     /// The same limit for the follow-up views.
     double followUpMaxSamplingAngleDeg = 70.0;
+    /// The initial views also take samples over already scanned faces within this many pixels of a face
+    /// left from the input (−1: none), so that no thin strip of input faces survives between two patches
+    /// (e.g. between a feature-line band and a frontal patch).
+    int initialFillRadius = 1;
     /// Faces whose served area share is below this fraction of the total area do not justify a view of
     /// their own in the initial plan (the follow-up views handle them).
     double minViewAreaFraction = 0.002;
@@ -79,6 +83,10 @@ struct AutoOptions {
     double fishboneBandWidth = 2.5;
     /// Erosion / dilation radius of the scans' morphology.
     int morphologyRadius = 1;
+    /// After the last scan, edges between two nearly coplanar faces (within 10°) are flipped where that
+    /// raises the smallest angle of faces whose smallest angle is below this (degrees; 0 = no flips): seams
+    /// leave such slivers when the stitch's angle floor is low.
+    double flipSliversBelowDeg = 20.0;
     /// Options of every stitch. Faces with a smallest angle under 10° are refused (trimmed and retried).
     StitchOptions stitch = defaultStitch();
     /// Quality-mask margin (mask.h QualityMaskOptions::margin) of the regular scans.
@@ -102,6 +110,7 @@ struct AutoStep {
     std::size_t patchFaces = 0;   ///< faces of the scan's patch
     std::size_t facesAdded = 0;   ///< faces the stitch added
     std::size_t facesRemoved = 0; ///< faces the stitch removed
+    std::size_t patchFacesTrimmed = 0; ///< patch faces the stitch left out (StitchReport::patchFacesTrimmed)
     double coverageAfter = 0;     ///< coverage after this step
     double seconds = 0;           ///< scan + stitch wall time
     std::string note;             ///< why it was skipped or trimmed (empty when fully stitched)
@@ -120,6 +129,7 @@ struct AutoResult {
     int scansStitched = 0;          ///< steps with stitched == true
     int scansSkipped = 0;           ///< steps with stitched == false
     std::size_t featureChains = 0;  ///< feature chains found (fishbone only)
+    std::size_t sliverFlips = 0;    ///< edges flipped after the last scan (AutoOptions::flipSliversBelowDeg)
     double seconds = 0;             ///< total wall time
     double planSeconds = 0;         ///< of which: view planning and coverage bookkeeping
     double scanSeconds = 0;         ///< of which: rendering, masks, triangulation
