@@ -58,15 +58,16 @@ std::vector<std::string> meshOrder;
 const fss::Mesh& input(const std::string& name) {
     static std::map<std::string, fss::Mesh> cache;
     auto it = cache.find(name);
-    if (it == cache.end()) it = cache.emplace(name, fss::readMesh(std::string(FSS_BENCH_MESH_DIR) + "/" + name + ".off")).first;
+    if (it == cache.end())
+        it = cache.emplace(name, fss::readMesh(std::string(FSS_BENCH_MESH_DIR) + "/" + name + ".off")).first;
     return it->second;
 }
 
 double area(const fss::Mesh& m) {
     double a = 0;
-    for (fss::FaceIndex f : m.faces()) a += std::sqrt(CGAL::squared_area(m.point(m.source(m.halfedge(f))),
-                                                                       m.point(m.target(m.halfedge(f))),
-                                                                       m.point(m.target(m.next(m.halfedge(f))))));
+    for (fss::FaceIndex f : m.faces())
+        a += std::sqrt(CGAL::squared_area(m.point(m.source(m.halfedge(f))), m.point(m.target(m.halfedge(f))),
+                                          m.point(m.target(m.next(m.halfedge(f))))));
     return a;
 }
 
@@ -132,8 +133,8 @@ void BM_CgalIsotropic(benchmark::State& state, std::string name) {
         const auto t = Clock::now();
         auto constrained = m.add_property_map<fss::EdgeIndex, bool>("e:is_feature", false).first;
         PMP::detect_sharp_edges(m, featureAngle, constrained);
-        PMP::isotropic_remeshing(faces(m), L, m,
-                                 PMP::parameters::number_of_iterations(3).edge_is_constrained_map(constrained));
+        PMP::isotropic_remeshing(
+            faces(m), L, m, PMP::parameters::number_of_iterations(3).edge_is_constrained_map(constrained));
         m.collect_garbage();
         r.cgal.seconds = std::chrono::duration<double>(Clock::now() - t).count();
         state.PauseTiming();
@@ -153,22 +154,24 @@ std::string opt(const std::optional<double>& v) {
 }
 
 void printTable() {
-    std::printf("\nauto (FSS) vs CGAL isotropic_remeshing (3 iterations, sharp edges constrained), same target edge "
-                "length; renderer: %s, fishbone: %s\n",
-                gpuAvailable() ? "gpu" : "cpu", autoOptions().fishbone ? "auto" : "off");
-    std::printf("%-14s %-5s %8s %8s %8s %8s %8s %9s %9s %6s %5s %4s %4s\n", "mesh", "who", "L", "verts", "time_s",
-                "val6", "minang", "H_to_rel", "H_from_rel", "cover", "t/t", "clsd", "SI");
+    std::printf(
+        "\nauto (FSS) vs CGAL isotropic_remeshing (3 iterations, sharp edges constrained), same target edge "
+        "length; renderer: %s, fishbone: %s\n",
+        gpuAvailable() ? "gpu" : "cpu", autoOptions().fishbone ? "auto" : "off");
+    std::printf("%-14s %-5s %8s %8s %8s %8s %8s %9s %9s %6s %5s %4s %4s\n", "mesh", "who", "L", "verts",
+                "time_s", "val6", "minang", "H_to_rel", "H_from_rel", "cover", "t/t", "clsd", "SI");
     for (const std::string& name : meshOrder) {
         const MeshResults& r = results()[name];
         if (!r.haveFss || !r.haveCgal) continue;
         for (int who = 0; who < 2; ++who) {
             const Row& row = who == 0 ? r.fss : r.cgal;
             const fss::Metrics& m = row.metrics;
-            std::printf("%-14s %-5s %8.5f %8zu %8.2f %8.4f %8.2f %9s %9s %6.4f %5.2f %4s %4zu\n", name.c_str(),
-                        who == 0 ? "fss" : "cgal", r.edgeLength, m.vertices, row.seconds, m.fracValence6Interior,
-                        m.minAngleDeg, opt(m.hausdorffToRefRel).c_str(), opt(m.hausdorffFromRefRel).c_str(),
-                        who == 0 ? row.coverage : 1.0, who == 0 ? r.fss.seconds / r.cgal.seconds : 1.0,
-                        m.closed ? "yes" : "no", m.selfIntersections.value_or(0));
+            std::printf("%-14s %-5s %8.5f %8zu %8.2f %8.4f %8.2f %9s %9s %6.4f %5.2f %4s %4zu\n",
+                        name.c_str(), who == 0 ? "fss" : "cgal", r.edgeLength, m.vertices, row.seconds,
+                        m.fracValence6Interior, m.minAngleDeg, opt(m.hausdorffToRefRel).c_str(),
+                        opt(m.hausdorffFromRefRel).c_str(), who == 0 ? row.coverage : 1.0,
+                        who == 0 ? r.fss.seconds / r.cgal.seconds : 1.0, m.closed ? "yes" : "no",
+                        m.selfIntersections.value_or(0));
         }
     }
     std::fflush(stdout);

@@ -20,9 +20,13 @@ namespace fss {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double secondsSince(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
-Eigen::Vector3d toEigen(const Point3& p) { return {p.x(), p.y(), p.z()}; }
+Eigen::Vector3d toEigen(const Point3& p) {
+    return {p.x(), p.y(), p.z()};
+}
 
 struct FaceGeometry {
     Eigen::Vector3d normal{0, 0, 0}; ///< unit (zero for a degenerate face)
@@ -60,8 +64,8 @@ std::vector<Eigen::Vector3d> candidateDirections(int n) {
 /// A parallel camera looking along −\p from (the eye on the \p from side) that frames \p points (plus
 /// \p margin world units on each side) with square pixels of side \p footprint. The image is enlarged by
 /// raising the footprint when it would exceed Camera::kMaxResolution.
-Camera frameParallel(const Eigen::Vector3d& from, const std::vector<Eigen::Vector3d>& points, double footprint,
-                     double margin) {
+Camera frameParallel(const Eigen::Vector3d& from, const std::vector<Eigen::Vector3d>& points,
+                     double footprint, double margin) {
     const Eigen::Vector3d w = -from.normalized(); // view direction
     const Eigen::Vector3d up0 = std::abs(w.z()) > 0.9 ? Eigen::Vector3d(0, 1, 0) : Eigen::Vector3d(0, 0, 1);
     const Eigen::Vector3d right = w.cross(up0).normalized();
@@ -108,8 +112,10 @@ Coverage measureCoverage(Mesh& mesh) {
     for (FaceIndex f : mesh.faces()) {
         const double a = faceGeometry(mesh, f).area;
         c.total += a;
-        if (ids[f] >= 0) c.scanned += a;
-        else ++c.inputFaces;
+        if (ids[f] >= 0)
+            c.scanned += a;
+        else
+            ++c.inputFaces;
     }
     return c;
 }
@@ -140,8 +146,8 @@ std::vector<FeatureChain> featureChains(const Mesh& mesh, double featureAngleDeg
         }
     }
     auto bisectorOf = [&](HalfedgeIndex h) {
-        const Eigen::Vector3d b = faceGeometry(mesh, mesh.face(h)).normal +
-                                  faceGeometry(mesh, mesh.face(mesh.opposite(h))).normal;
+        const Eigen::Vector3d b =
+            faceGeometry(mesh, mesh.face(h)).normal + faceGeometry(mesh, mesh.face(mesh.opposite(h))).normal;
         return b.norm() > 1e-12 ? Eigen::Vector3d(b.normalized()) : Eigen::Vector3d(0, 0, 0);
     };
     std::vector<char> used(sharp.size(), 0);
@@ -214,7 +220,8 @@ std::size_t flipSlivers(Mesh& mesh, double belowDeg, double maxDihedralDeg, int 
             const double before = std::min(minCornerAngle(a, b, c), minCornerAngle(b, a, d));
             if (before >= below) continue;
             const Eigen::Vector3d n1 = (b - a).cross(c - a), n2 = (a - b).cross(d - b);
-            if (n1.norm() == 0 || n2.norm() == 0 || n1.normalized().dot(n2.normalized()) < cosDihedral) continue;
+            if (n1.norm() == 0 || n2.norm() == 0 || n1.normalized().dot(n2.normalized()) < cosDihedral)
+                continue;
             // After the flip: faces (c, a, d) and (d, b, c).
             const Eigen::Vector3d m1 = (a - c).cross(d - c), m2 = (b - d).cross(c - d);
             if (m1.norm() == 0 || m2.norm() == 0) continue;
@@ -274,8 +281,8 @@ struct RegularScan {
 };
 
 RegularScan regularScan(const Mesh& reference, MeshRenderer& referenceRenderer, Mesh& current,
-                        MeshRenderer& currentRenderer, const Camera& camera, std::int32_t scanId, int fillRadius,
-                        double maxSamplingAngleDeg, const AutoOptions& options) {
+                        MeshRenderer& currentRenderer, const Camera& camera, std::int32_t scanId,
+                        int fillRadius, double maxSamplingAngleDeg, const AutoOptions& options) {
     const FrameBuffers ref = referenceRenderer.render(camera);
     if (ref.coveredCount() == 0) throw InvalidInputError("The view sees no part of the mesh.");
     RegularScan out;
@@ -287,10 +294,12 @@ RegularScan regularScan(const Mesh& reference, MeshRenderer& referenceRenderer, 
     std::vector<char> admissibleBefore;
     if (fillRadius >= 0) {
         admissibleBefore.resize(grid.samples.size());
-        for (std::size_t i = 0; i < grid.samples.size(); ++i) admissibleBefore[i] = grid.samples[i].admissible;
+        for (std::size_t i = 0; i < grid.samples.size(); ++i)
+            admissibleBefore[i] = grid.samples[i].admissible;
     }
     // Keep each view to the part of the surface it sees well: its patch boundary then runs where the current
-    // mesh is a clean height field in the view (no silhouettes or occlusion contours), which the stitcher needs.
+    // mesh is a clean height field in the view (no silhouettes or occlusion contours), which the stitcher
+    // needs.
     const double maxAngle = maxSamplingAngleDeg * std::numbers::pi / 180.0;
     for (Sample& s : grid.samples)
         if (s.admissible && s.samplingAngle > maxAngle) s.admissible = s.valid = false;
@@ -338,7 +347,8 @@ double edgeLengthForVertexCount(double area, std::size_t vertices) {
 AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const Progress& progress) {
     const auto start = Clock::now();
     if (reference.number_of_faces() == 0) throw InvalidInputError("The mesh to remesh has no faces.");
-    if (!CGAL::is_triangle_mesh(reference)) throw InvalidInputError("The mesh to remesh is not a triangle mesh.");
+    if (!CGAL::is_triangle_mesh(reference))
+        throw InvalidInputError("The mesh to remesh is not a triangle mesh.");
     if (!(options.edgeLength >= 0) || !std::isfinite(options.edgeLength))
         throw InvalidInputError("The target edge length must be a positive number.");
     if (!(options.servedAngleDeg > 0 && options.servedAngleDeg <= 80))
@@ -363,7 +373,8 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
     }
     if (!(result.area > 0)) throw InvalidInputError("The mesh to remesh has no area.");
     const Eigen::AlignedBox3d box = boundingBox(reference);
-    for (int i = 0; i < 8; ++i) corners.push_back(box.corner(Eigen::AlignedBox3d::CornerType(i)));
+    for (int i = 0; i < 8; ++i)
+        corners.push_back(box.corner(Eigen::AlignedBox3d::CornerType(i)));
     result.edgeLength = options.edgeLength > 0
                             ? options.edgeLength
                             : edgeLengthForVertexCount(result.area, options.targetVertices > 0
@@ -452,13 +463,14 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
                 fb.direction = PrincipalDirection::Min;
                 // A whole number of spacings along the line, so that both of its ends (corners) are sampled.
                 double screenLength = 0;
-                for (std::size_t i = 1; i < line.size(); ++i) screenLength += (line[i] - line[i - 1]).norm();
+                for (std::size_t i = 1; i < line.size(); ++i)
+                    screenLength += (line[i] - line[i - 1]).norm();
                 fb.spacing = screenLength / std::max(1.0, std::round(screenLength / h));
                 fb.spacing = std::clamp(fb.spacing, 0.75 * h, 1.5 * h);
                 step.camera = params.camera;
                 auto ts = Clock::now();
-                FishboneScanResult scan = scanFishbonePatch(reference, *referenceRenderer, current, *currentRenderer,
-                                                            params, fb, cache);
+                FishboneScanResult scan = scanFishbonePatch(reference, *referenceRenderer, current,
+                                                            *currentRenderer, params, fb, cache);
                 result.scanSeconds += secondsSince(ts);
                 step.patchFaces = scan.patch.mesh.number_of_faces();
                 stitchInto(step, scan.patch.mesh, scan.grid.camera, scan.currentBuffers.faceId);
@@ -490,7 +502,8 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
     }
     std::vector<Eigen::Vector3d> binNormal(candidates.size());
     for (std::size_t i = 0; i < candidates.size(); ++i)
-        binNormal[i] = binNormalSum[i].norm() > 0 ? Eigen::Vector3d(binNormalSum[i].normalized()) : candidates[i];
+        binNormal[i] =
+            binNormalSum[i].norm() > 0 ? Eigen::Vector3d(binNormalSum[i].normalized()) : candidates[i];
     std::vector<char> served(candidates.size(), 0);
     auto servedArea = [&](const Eigen::Vector3d& d) {
         double a = 0;
@@ -510,7 +523,8 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
         // Centre the view on what it serves (a single plane gets an exactly frontal view).
         Eigen::Vector3d mean(0, 0, 0);
         for (std::size_t b = 0; b < candidates.size(); ++b)
-            if (!served[b] && binArea[b] > 0 && binNormal[b].dot(bestDir) >= servedCos) mean += binNormalSum[b];
+            if (!served[b] && binArea[b] > 0 && binNormal[b].dot(bestDir) >= servedCos)
+                mean += binNormalSum[b];
         if (mean.norm() > 0 && servedArea(mean.normalized()) >= 0.95 * bestArea) bestDir = mean.normalized();
         for (std::size_t b = 0; b < candidates.size(); ++b)
             if (binArea[b] > 0 && binNormal[b].dot(bestDir) >= servedCos) served[b] = 1;
@@ -529,8 +543,9 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
         try {
             step.camera = frameParallel(views[i], corners, footprint, 2 * L);
             auto ts = Clock::now();
-            RegularScan scan = regularScan(reference, *referenceRenderer, current, *currentRenderer, step.camera,
-                                           step.scanId, initialFill, options.maxSamplingAngleDeg, options);
+            RegularScan scan =
+                regularScan(reference, *referenceRenderer, current, *currentRenderer, step.camera,
+                            step.scanId, initialFill, options.maxSamplingAngleDeg, options);
             result.scanSeconds += secondsSince(ts);
             step.camera = scan.camera;
             step.patchFaces = scan.patch.mesh.number_of_faces();
@@ -571,12 +586,14 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
                 r.normalSum += fg.area * fg.normal;
                 for (HalfedgeIndex h : CGAL::halfedges_around_face(current.halfedge(g), current)) {
                     const FaceIndex o = current.face(current.opposite(h));
-                    if (o != Mesh::null_face() && ids[o] < 0 && !seen[o.idx()]) seen[o.idx()] = 1, stack.push_back(o);
+                    if (o != Mesh::null_face() && ids[o] < 0 && !seen[o.idx()])
+                        seen[o.idx()] = 1, stack.push_back(o);
                 }
             }
             regions.push_back(std::move(r));
         }
-        std::sort(regions.begin(), regions.end(), [](const Region& a, const Region& b) { return a.area > b.area; });
+        std::sort(regions.begin(), regions.end(),
+                  [](const Region& a, const Region& b) { return a.area > b.area; });
         result.planSeconds += secondsSince(t);
         int scansThisRound = 0;
         const double coverageBefore = measureCoverage(current).fraction();
@@ -596,11 +613,13 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
             }
             if (members.empty()) continue;
             t = Clock::now();
-            Eigen::Vector3d n = region.normalSum.norm() > 0.3 * region.area ? Eigen::Vector3d(region.normalSum.normalized())
-                                                                             : faceGeometry(current, region.faces[0]).normal;
+            Eigen::Vector3d n = region.normalSum.norm() > 0.3 * region.area
+                                    ? Eigen::Vector3d(region.normalSum.normalized())
+                                    : faceGeometry(current, region.faces[0]).normal;
             if (n.norm() == 0) continue;
             // Candidate directions around the region's mean normal; the one that sees most of it wins.
-            const Eigen::Vector3d a = std::abs(n.x()) < 0.9 ? Eigen::Vector3d(1, 0, 0) : Eigen::Vector3d(0, 1, 0);
+            const Eigen::Vector3d a =
+                std::abs(n.x()) < 0.9 ? Eigen::Vector3d(1, 0, 0) : Eigen::Vector3d(0, 1, 0);
             const Eigen::Vector3d u = n.cross(a).normalized(), v = n.cross(u);
             std::vector<Eigen::Vector3d> dirs{n};
             for (double tilt : {25.0, 50.0})
@@ -634,9 +653,9 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
             step.camera = best;
             try {
                 auto ts = Clock::now();
-                RegularScan scan = regularScan(reference, *referenceRenderer, current, *currentRenderer, best,
-                                               step.scanId, 2 + options.morphologyRadius,
-                                               options.followUpMaxSamplingAngleDeg, options);
+                RegularScan scan =
+                    regularScan(reference, *referenceRenderer, current, *currentRenderer, best, step.scanId,
+                                2 + options.morphologyRadius, options.followUpMaxSamplingAngleDeg, options);
                 result.scanSeconds += secondsSince(ts);
                 step.patchFaces = scan.patch.mesh.number_of_faces();
                 stitchInto(step, scan.patch.mesh, scan.camera, scan.currentBuffers.faceId);

@@ -60,8 +60,9 @@ const AutoRun& fandiskRun() {
         EXPECT_TRUE(ids.second) << "the PLY output keeps the scan id of every face";
         for (fss::FaceIndex f : r.mesh.faces()) {
             const auto h = r.mesh.halfedge(f);
-            const double a = std::sqrt(CGAL::squared_area(r.mesh.point(r.mesh.source(h)), r.mesh.point(r.mesh.target(h)),
-                                                          r.mesh.point(r.mesh.target(r.mesh.next(h)))));
+            const double a =
+                std::sqrt(CGAL::squared_area(r.mesh.point(r.mesh.source(h)), r.mesh.point(r.mesh.target(h)),
+                                             r.mesh.point(r.mesh.target(r.mesh.next(h)))));
             r.totalArea += a;
             if (ids.second && ids.first[f] >= 0) r.scannedArea += a;
         }
@@ -79,7 +80,8 @@ TEST(CliAuto, FandiskIsCoveredClosedManifoldAndFreeOfSelfIntersections) {
     EXPECT_EQ(r.report.at("renderer").get<std::string>(), "gpu");
     EXPECT_EQ(r.report.at("input_vertices").get<int>(), 6475);
     // The edge length of 6475 vertices on fandisk's area 2.20602: sqrt(A / (N·√3/2)).
-    EXPECT_NEAR(r.report.at("edge_length").get<double>(), std::sqrt(2.20602 / (6475 * std::sqrt(3.0) / 2)), 1e-5);
+    EXPECT_NEAR(r.report.at("edge_length").get<double>(), std::sqrt(2.20602 / (6475 * std::sqrt(3.0) / 2)),
+                1e-5);
     // Coverage: reported and recomputed from the faces' scan ids agree, and reach the 95 %.
     const double coverage = r.report.at("coverage").get<double>();
     EXPECT_NEAR(r.scannedArea / r.totalArea, coverage, 1e-6);

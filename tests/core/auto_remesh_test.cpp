@@ -20,8 +20,8 @@ double scannedAreaFraction(const fss::Mesh& m) {
     double scanned = 0, total = 0;
     for (fss::FaceIndex f : m.faces()) {
         const auto h = m.halfedge(f);
-        const double a =
-            std::sqrt(CGAL::squared_area(m.point(m.source(h)), m.point(m.target(h)), m.point(m.target(m.next(h)))));
+        const double a = std::sqrt(
+            CGAL::squared_area(m.point(m.source(h)), m.point(m.target(h)), m.point(m.target(m.next(h)))));
         total += a;
         if (ids.first[f] >= 0) scanned += a;
     }

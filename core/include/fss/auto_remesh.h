@@ -104,23 +104,23 @@ struct AutoOptions {
 struct AutoStep {
     enum class Kind { Initial, FollowUp, Fishbone };
     Kind kind = Kind::Initial;
-    Camera camera;                ///< the scan camera (width × height = resolution)
-    std::int32_t scanId = -1;     ///< id on the faces it made (props::faceScanId)
-    bool stitched = false;        ///< false: skipped, see `note`
-    std::size_t patchFaces = 0;   ///< faces of the scan's patch
-    std::size_t facesAdded = 0;   ///< faces the stitch added
-    std::size_t facesRemoved = 0; ///< faces the stitch removed
+    Camera camera;                     ///< the scan camera (width × height = resolution)
+    std::int32_t scanId = -1;          ///< id on the faces it made (props::faceScanId)
+    bool stitched = false;             ///< false: skipped, see `note`
+    std::size_t patchFaces = 0;        ///< faces of the scan's patch
+    std::size_t facesAdded = 0;        ///< faces the stitch added
+    std::size_t facesRemoved = 0;      ///< faces the stitch removed
     std::size_t patchFacesTrimmed = 0; ///< patch faces the stitch left out (StitchReport::patchFacesTrimmed)
-    double coverageAfter = 0;     ///< coverage after this step
-    double seconds = 0;           ///< scan + stitch wall time
-    std::string note;             ///< why it was skipped or trimmed (empty when fully stitched)
+    double coverageAfter = 0;          ///< coverage after this step
+    double seconds = 0;                ///< scan + stitch wall time
+    std::string note;                  ///< why it was skipped or trimmed (empty when fully stitched)
 };
 
 /// The result of autoRemesh.
 struct AutoResult {
-    Mesh mesh;                   ///< the remeshed surface (garbage collected)
-    double edgeLength = 0;       ///< the target edge length used (world units)
-    double area = 0;             ///< area of the reference
+    Mesh mesh;             ///< the remeshed surface (garbage collected)
+    double edgeLength = 0; ///< the target edge length used (world units)
+    double area = 0;       ///< area of the reference
     /// Fraction of the area of `mesh` made by scans (faces with props::faceScanId ≥ 0).
     double coverage = 0;
     std::size_t inputFacesLeft = 0; ///< faces of `mesh` left from the input
