@@ -10,6 +10,7 @@ int runInfo(const std::vector<std::string>& args);
 #ifdef FSS_HAVE_RENDER
 int runScan(const std::vector<std::string>& args);
 int runRun(const std::vector<std::string>& args);
+int runAuto(const std::vector<std::string>& args);
 #endif
 
 } // namespace fss::cli

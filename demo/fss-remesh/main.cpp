@@ -19,6 +19,7 @@ commands:
   info MESH      Print quality metrics of a mesh (optionally against a reference).
   scan MESH      Scan MESH from a camera into a regular patch (and stitch it with --into).
   run SESSION    Replay a session file head-less; report metrics, timings and a snapshot.
+  auto MESH      Remesh the whole surface of MESH automatically (views, resolution, coverage).
 
 Run 'fss-remesh <command> --help' for the options of a command.
 Exit status: 0 on success, 1 when the work failed, 2 when the command line is wrong.
@@ -47,6 +48,7 @@ int main(int argc, char** argv) {
 #ifdef FSS_HAVE_RENDER
         if (command == "scan") return fss::cli::runScan(args);
         if (command == "run") return fss::cli::runRun(args);
+        if (command == "auto") return fss::cli::runAuto(args);
 #endif
         std::cerr << "fss-remesh: unknown command '" << command << "'; run 'fss-remesh --help'.\n";
         return 2;

@@ -1,0 +1,204 @@
+// `fss-remesh auto` (fss::autoRemesh) against CGAL::Polygon_mesh_processing::isotropic_remeshing on four
+// closed CGAL sample meshes, at the same target edge length (the one that gives the input's vertex count,
+// auto_remesh.h edgeLengthForVertexCount). CGAL: sharp edges detected with detect_sharp_edges at the same
+// feature angle as FSS and passed as edge_is_constrained_map, 3 iterations. Each remesher runs once per
+// mesh (Iterations(1)); the quality of both results is measured with fss::computeMetrics against the input
+// (fraction of valence-6 interior vertices, minimum angle, Hausdorff distance both ways relative to the
+// bbox diagonal) and printed side by side after the benchmarks, with the time ratio FSS / CGAL.
+//
+//   ./build/bin/bench_auto                       # the four default meshes, GPU renderer when available
+//   FSS_AUTO_BENCH_MESHES=fandisk,eight ./build/bin/bench_auto
+//   FSS_AUTO_BENCH_FISHBONE=1 ./build/bin/bench_auto   # with --fishbone auto
+//
+// CGAL's isotropic remeshing is a heavy translation unit: it lives here only, never in core.
+#include "fss/auto_remesh.h"
+#include "fss/error.h"
+#include "fss/mesh_io.h"
+#include "fss/metrics.h"
+#include "fss/render/gpu_mesh_renderer.h"
+
+#include <CGAL/Polygon_mesh_processing/detect_features.h>
+#include <CGAL/Polygon_mesh_processing/remesh.h>
+
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace PMP = CGAL::Polygon_mesh_processing;
+using Clock = std::chrono::steady_clock;
+
+struct Row {
+    double seconds = 0;
+    fss::Metrics metrics;
+    double coverage = -1; // FSS only
+    int scans = 0;
+};
+
+struct MeshResults {
+    double edgeLength = 0;
+    std::size_t inputVertices = 0;
+    Row fss, cgal;
+    bool haveFss = false, haveCgal = false;
+};
+
+std::map<std::string, MeshResults>& results() {
+    static std::map<std::string, MeshResults> r;
+    return r;
+}
+std::vector<std::string> meshOrder;
+
+const fss::Mesh& input(const std::string& name) {
+    static std::map<std::string, fss::Mesh> cache;
+    auto it = cache.find(name);
+    if (it == cache.end())
+        it = cache.emplace(name, fss::readMesh(std::string(FSS_BENCH_MESH_DIR) + "/" + name + ".off")).first;
+    return it->second;
+}
+
+double area(const fss::Mesh& m) {
+    double a = 0;
+    for (fss::FaceIndex f : m.faces())
+        a += std::sqrt(CGAL::squared_area(m.point(m.source(m.halfedge(f))), m.point(m.target(m.halfedge(f))),
+                                          m.point(m.target(m.next(m.halfedge(f))))));
+    return a;
+}
+
+fss::Metrics measure(const fss::Mesh& mesh, const fss::Mesh& reference) {
+    fss::MetricsOptions mo;
+    mo.reference = &reference;
+    return fss::computeMetrics(mesh, mo);
+}
+
+bool gpuAvailable() {
+    static const bool ok = [] {
+        try {
+            fss::render::GpuMeshRenderer probe;
+            return true;
+        } catch (const fss::Error&) {
+            return false;
+        }
+    }();
+    return ok;
+}
+
+fss::AutoOptions autoOptions() {
+    fss::AutoOptions o;
+    if (gpuAvailable()) o.renderer = [] { return std::make_unique<fss::render::GpuMeshRenderer>(); };
+    const char* fb = std::getenv("FSS_AUTO_BENCH_FISHBONE");
+    o.fishbone = fb && std::string(fb) == "1";
+    return o;
+}
+
+void BM_FssAuto(benchmark::State& state, std::string name) {
+    const fss::Mesh& ref = input(name);
+    MeshResults& r = results()[name];
+    r.inputVertices = ref.number_of_vertices();
+    r.edgeLength = fss::edgeLengthForVertexCount(area(ref), ref.number_of_vertices());
+    fss::AutoOptions o = autoOptions();
+    o.edgeLength = r.edgeLength;
+    for (auto _ : state) {
+        const auto t = Clock::now();
+        fss::AutoResult res = fss::autoRemesh(ref, o);
+        r.fss.seconds = std::chrono::duration<double>(Clock::now() - t).count();
+        state.PauseTiming();
+        r.fss.metrics = measure(res.mesh, ref);
+        r.fss.coverage = res.coverage;
+        r.fss.scans = res.scansStitched;
+        r.haveFss = true;
+        state.ResumeTiming();
+    }
+    state.counters["vertices"] = double(r.fss.metrics.vertices);
+    state.counters["coverage"] = r.fss.coverage;
+    state.counters["valence6"] = r.fss.metrics.fracValence6Interior;
+    state.counters["min_angle"] = r.fss.metrics.minAngleDeg;
+}
+
+void BM_CgalIsotropic(benchmark::State& state, std::string name) {
+    const fss::Mesh& ref = input(name);
+    MeshResults& r = results()[name];
+    const double L = fss::edgeLengthForVertexCount(area(ref), ref.number_of_vertices());
+    const double featureAngle = fss::AutoOptions{}.featureAngleDeg;
+    for (auto _ : state) {
+        state.PauseTiming();
+        fss::Mesh m = ref;
+        state.ResumeTiming();
+        const auto t = Clock::now();
+        auto constrained = m.add_property_map<fss::EdgeIndex, bool>("e:is_feature", false).first;
+        PMP::detect_sharp_edges(m, featureAngle, constrained);
+        PMP::isotropic_remeshing(
+            faces(m), L, m, PMP::parameters::number_of_iterations(3).edge_is_constrained_map(constrained));
+        m.collect_garbage();
+        r.cgal.seconds = std::chrono::duration<double>(Clock::now() - t).count();
+        state.PauseTiming();
+        r.cgal.metrics = measure(m, ref);
+        r.haveCgal = true;
+        state.ResumeTiming();
+    }
+    state.counters["vertices"] = double(r.cgal.metrics.vertices);
+    state.counters["valence6"] = r.cgal.metrics.fracValence6Interior;
+    state.counters["min_angle"] = r.cgal.metrics.minAngleDeg;
+}
+
+std::string opt(const std::optional<double>& v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.5f", v ? *v : -1.0);
+    return buf;
+}
+
+void printTable() {
+    std::printf(
+        "\nauto (FSS) vs CGAL isotropic_remeshing (3 iterations, sharp edges constrained), same target edge "
+        "length; renderer: %s, fishbone: %s\n",
+        gpuAvailable() ? "gpu" : "cpu", autoOptions().fishbone ? "auto" : "off");
+    std::printf("%-14s %-5s %8s %8s %8s %8s %8s %9s %9s %6s %5s %4s %4s\n", "mesh", "who", "L", "verts",
+                "time_s", "val6", "minang", "H_to_rel", "H_from_rel", "cover", "t/t", "clsd", "SI");
+    for (const std::string& name : meshOrder) {
+        const MeshResults& r = results()[name];
+        if (!r.haveFss || !r.haveCgal) continue;
+        for (int who = 0; who < 2; ++who) {
+            const Row& row = who == 0 ? r.fss : r.cgal;
+            const fss::Metrics& m = row.metrics;
+            std::printf("%-14s %-5s %8.5f %8zu %8.2f %8.4f %8.2f %9s %9s %6.4f %5.2f %4s %4zu\n",
+                        name.c_str(), who == 0 ? "fss" : "cgal", r.edgeLength, m.vertices, row.seconds,
+                        m.fracValence6Interior, m.minAngleDeg, opt(m.hausdorffToRefRel).c_str(),
+                        opt(m.hausdorffFromRefRel).c_str(), who == 0 ? row.coverage : 1.0,
+                        who == 0 ? r.fss.seconds / r.cgal.seconds : 1.0, m.closed ? "yes" : "no",
+                        m.selfIntersections.value_or(0));
+        }
+    }
+    std::fflush(stdout);
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    std::string list = "fandisk,elephant,couplingdown,bunny00";
+    if (const char* env = std::getenv("FSS_AUTO_BENCH_MESHES")) list = env;
+    std::stringstream ss(list);
+    for (std::string name; std::getline(ss, name, ',');)
+        if (!name.empty()) meshOrder.push_back(name);
+    for (const std::string& name : meshOrder) {
+        benchmark::RegisterBenchmark(("BM_FssAuto/" + name).c_str(), BM_FssAuto, name)
+            ->Iterations(1)
+            ->Unit(benchmark::kSecond)
+            ->UseRealTime();
+        benchmark::RegisterBenchmark(("BM_CgalIsotropic/" + name).c_str(), BM_CgalIsotropic, name)
+            ->Iterations(1)
+            ->Unit(benchmark::kSecond)
+            ->UseRealTime();
+    }
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    printTable();
+    return 0;
+}

@@ -1,0 +1,154 @@
+#pragma once
+/// \file auto_remesh.h
+/// Automatic full-surface remeshing by virtual range scanning (`fss-remesh auto`): the scans a person
+/// would take in the GUI, chosen without one.
+///
+///  1. **Resolution from the edge length.** Every regular scan uses a parallel camera whose pixel footprint
+///     is the target edge length L, so a frontal region gets edges of length L. L is given, or derived from
+///     a target vertex count N through the area A of the reference: a regular triangulation has about 2N
+///     triangles of area (√3/4)·L², so A ≈ N·(√3/2)·L².
+///  2. **Views from the Gauss map.** The initial views are chosen greedily over a dense set of directions
+///     on the sphere: each next view is the direction that sees, nearly frontally, the largest area of the
+///     reference not yet served by an earlier view (normals only, occlusion ignored). CAD faces get exactly
+///     frontal views; curved regions get more views, about one per cone of normals.
+///  3. **The quality mask keeps the best view of each region.** Scans are chained: each scan's quality
+///     mask runs against the current mesh (scan_pipeline.h), so a later view replaces an earlier one only
+///     where it samples clearly better, and each patch is stitched in at once (stitch.h).
+///  4. **Coverage-driven follow-up views.** Faces still left from the input (props::faceScanId < 0) are
+///     grouped into connected regions; for each, several directions around its mean normal are rendered and
+///     the one that sees most of the region (occlusion included) is scanned, framed on the region, and
+///     allowed to replace the faces next to it so that no thin strip of input faces survives. Repeated
+///     until the coverage goal, the view budget, or no progress.
+///  5. **Feature lines (optional, `fishbone`).** Sharp edges (dihedral angle above a threshold) are chained
+///     into polylines between corners; each long enough chain is scanned first with a fishbone grid whose
+///     hand-drawn backbone is the chain projected into a view that sees both sides of the edge, inside a
+///     band-shaped lasso around it, so that samples lie on the feature line itself.
+///
+/// Every stitch has the strong guarantee: a scan or stitch that fails is skipped (and reported), the mesh
+/// is never left invalid.
+
+#include "fss/camera.h"
+#include "fss/mesh.h"
+#include "fss/progress.h"
+#include "fss/session.h"
+#include "fss/stitch.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace fss {
+
+/// Options of autoRemesh. Defaults are the command line's.
+struct AutoOptions {
+    /// Target edge length in world units; 0 = derive it from targetVertices.
+    double edgeLength = 0;
+    /// Target vertex count when edgeLength is 0; 0 = the reference's vertex count.
+    std::size_t targetVertices = 0;
+    /// Scan chained sharp feature lines with fishbone grids first (see the file comment, step 5).
+    bool fishbone = false;
+    /// Renderer of the reference and the current mesh; empty = CpuMeshRenderer.
+    RendererFactory renderer;
+    /// A face counts as served by a view when the angle between its normal and the view direction is
+    /// at most this (degrees); the greedy view plan stops when every face is served. In (0, 80].
+    double servedAngleDeg = 40.0;
+    /// Samples of an initial view seen at a larger angle between view ray and surface normal (degrees) are
+    /// left to other views: the patch of a view ends where it sees the surface well, away from its
+    /// silhouettes and occlusion contours, where the stitch is clean. In (servedAngleDeg, 85].
+    double maxSamplingAngleDeg = 60.0;
+    /// The same limit for the follow-up views.
+    double followUpMaxSamplingAngleDeg = 70.0;
+    /// The initial views also take samples over already scanned faces within this many pixels of a face
+    /// left from the input (−1: none), so that no thin strip of input faces survives between two patches
+    /// (e.g. between a feature-line band and a frontal patch).
+    int initialFillRadius = 1;
+    /// Faces whose served area share is below this fraction of the total area do not justify a view of
+    /// their own in the initial plan (the follow-up views handle them).
+    double minViewAreaFraction = 0.002;
+    /// Stop adding follow-up views once this fraction of the area is remeshed.
+    double coverageGoal = 0.999;
+    /// Largest number of scans in total (initial + follow-up + fishbone).
+    int maxViews = 80;
+    /// Rounds of follow-up views.
+    int followUpRounds = 4;
+    /// Pixel footprint of the regular scans as a fraction of the edge length (a tilted surface is
+    /// sampled more coarsely in one direction: < 1 compensates on average).
+    double footprintRatio = 0.92;
+    /// Dihedral angle (degrees between the two face normals) above which an edge is a sharp feature.
+    double featureAngleDeg = 35.0;
+    /// Feature chains shorter than this many edge lengths are not fishbone-scanned.
+    double minFeatureLength = 6.0;
+    /// Half width of the fishbone band (lasso) around a feature line, in edge lengths.
+    double fishboneBandWidth = 2.5;
+    /// Erosion / dilation radius of the scans' morphology.
+    int morphologyRadius = 1;
+    /// After the last scan, edges between two nearly coplanar faces (within 10°) are flipped where that
+    /// raises the smallest angle of faces whose smallest angle is below this (degrees; 0 = no flips): seams
+    /// leave such slivers when the stitch's angle floor is low.
+    double flipSliversBelowDeg = 20.0;
+    /// Options of every stitch. Faces with a smallest angle under 10° are refused (trimmed and retried).
+    StitchOptions stitch = defaultStitch();
+    /// Quality-mask margin (mask.h QualityMaskOptions::margin) of the regular scans.
+    double qualityMargin = 0.1;
+
+    /// StitchOptions with minAngleFloorDeg = 10.
+    static StitchOptions defaultStitch() {
+        StitchOptions s;
+        s.minAngleFloorDeg = 10.0;
+        return s;
+    }
+};
+
+/// What happened to one scan of autoRemesh.
+struct AutoStep {
+    enum class Kind { Initial, FollowUp, Fishbone };
+    Kind kind = Kind::Initial;
+    Camera camera;                     ///< the scan camera (width × height = resolution)
+    std::int32_t scanId = -1;          ///< id on the faces it made (props::faceScanId)
+    bool stitched = false;             ///< false: skipped, see `note`
+    std::size_t patchFaces = 0;        ///< faces of the scan's patch
+    std::size_t facesAdded = 0;        ///< faces the stitch added
+    std::size_t facesRemoved = 0;      ///< faces the stitch removed
+    std::size_t patchFacesTrimmed = 0; ///< patch faces the stitch left out (StitchReport::patchFacesTrimmed)
+    double coverageAfter = 0;          ///< coverage after this step
+    double seconds = 0;                ///< scan + stitch wall time
+    std::string note;                  ///< why it was skipped or trimmed (empty when fully stitched)
+};
+
+/// The result of autoRemesh.
+struct AutoResult {
+    Mesh mesh;             ///< the remeshed surface (garbage collected)
+    double edgeLength = 0; ///< the target edge length used (world units)
+    double area = 0;       ///< area of the reference
+    /// Fraction of the area of `mesh` made by scans (faces with props::faceScanId ≥ 0).
+    double coverage = 0;
+    std::size_t inputFacesLeft = 0; ///< faces of `mesh` left from the input
+    double inputAreaLeft = 0;       ///< their area
+    std::vector<AutoStep> steps;    ///< every scan attempted, in order
+    int scansStitched = 0;          ///< steps with stitched == true
+    int scansSkipped = 0;           ///< steps with stitched == false
+    std::size_t featureChains = 0;  ///< feature chains found (fishbone only)
+    std::size_t sliverFlips = 0;    ///< edges flipped after the last scan (AutoOptions::flipSliversBelowDeg)
+    double seconds = 0;             ///< total wall time
+    double planSeconds = 0;         ///< of which: view planning and coverage bookkeeping
+    double scanSeconds = 0;         ///< of which: rendering, masks, triangulation
+    double stitchSeconds = 0;       ///< of which: stitching
+};
+
+/// The edge length a regular triangulation with \p vertices vertices of a surface of area \p area has:
+/// sqrt(area / (vertices · √3/2)). \throw InvalidInputError when area ≤ 0 or vertices = 0.
+double edgeLengthForVertexCount(double area, std::size_t vertices);
+
+/// Remeshes the whole visible surface of \p reference (see the file comment).
+/// \param reference  a valid, consistently oriented, edge-manifold triangle mesh (closed or not).
+/// \param options    see AutoOptions.
+/// \param progress   fractions in [0, 1] with stages "plan", "scan i/n", "follow-up", "fishbone"; may cancel.
+/// \return the remeshed mesh and a report; the mesh is valid after every step (strong guarantee of each
+///         stitch), closed when the reference is.
+/// \throw InvalidInputError when the reference is empty, not a triangle mesh, has no area, or an option is
+///        out of range (one sentence naming it); CancelledError through \p progress; fss::Error from the
+///        renderer factory.
+AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options = {}, const Progress& progress = {});
+
+} // namespace fss

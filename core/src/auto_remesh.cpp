@@ -1,0 +1,689 @@
+#include "fss/auto_remesh.h"
+
+#include "fss/error.h"
+#include "fss/fishbone_scan.h"
+#include "fss/mask.h"
+#include "fss/scan.h"
+#include "fss/scan_pipeline.h"
+#include "fss/triangulate.h"
+
+#include <CGAL/boost/graph/Euler_operations.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <unordered_set>
+
+namespace fss {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+Eigen::Vector3d toEigen(const Point3& p) {
+    return {p.x(), p.y(), p.z()};
+}
+
+struct FaceGeometry {
+    Eigen::Vector3d normal{0, 0, 0}; ///< unit (zero for a degenerate face)
+    Eigen::Vector3d centroid{0, 0, 0};
+    double area = 0;
+};
+
+FaceGeometry faceGeometry(const Mesh& mesh, FaceIndex f) {
+    const HalfedgeIndex h = mesh.halfedge(f);
+    const Eigen::Vector3d a = toEigen(mesh.point(mesh.source(h)));
+    const Eigen::Vector3d b = toEigen(mesh.point(mesh.target(h)));
+    const Eigen::Vector3d c = toEigen(mesh.point(mesh.target(mesh.next(h))));
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    FaceGeometry g;
+    const double len = n.norm();
+    g.area = 0.5 * len;
+    if (len > 0) g.normal = n / len;
+    g.centroid = (a + b + c) / 3.0;
+    return g;
+}
+
+/// Evenly spread unit directions (Fibonacci sphere), after the six axis directions.
+std::vector<Eigen::Vector3d> candidateDirections(int n) {
+    std::vector<Eigen::Vector3d> dirs = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
+    for (int i = 0; i < n; ++i) {
+        const double z = 1.0 - 2.0 * (i + 0.5) / n;
+        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+        const double phi = golden * i;
+        dirs.emplace_back(r * std::cos(phi), r * std::sin(phi), z);
+    }
+    return dirs;
+}
+
+/// A parallel camera looking along −\p from (the eye on the \p from side) that frames \p points (plus
+/// \p margin world units on each side) with square pixels of side \p footprint. The image is enlarged by
+/// raising the footprint when it would exceed Camera::kMaxResolution.
+Camera frameParallel(const Eigen::Vector3d& from, const std::vector<Eigen::Vector3d>& points,
+                     double footprint, double margin) {
+    const Eigen::Vector3d w = -from.normalized(); // view direction
+    const Eigen::Vector3d up0 = std::abs(w.z()) > 0.9 ? Eigen::Vector3d(0, 1, 0) : Eigen::Vector3d(0, 0, 1);
+    const Eigen::Vector3d right = w.cross(up0).normalized();
+    const Eigen::Vector3d up = right.cross(w).normalized();
+    double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300, z0 = 1e300, z1 = -1e300;
+    for (const Eigen::Vector3d& p : points) {
+        const double x = p.dot(right), y = p.dot(up), z = p.dot(w);
+        x0 = std::min(x0, x), x1 = std::max(x1, x);
+        y0 = std::min(y0, y), y1 = std::max(y1, y);
+        z0 = std::min(z0, z), z1 = std::max(z1, z);
+    }
+    x0 -= margin, x1 += margin, y0 -= margin, y1 += margin;
+    const double ext = std::max({x1 - x0, y1 - y0, footprint});
+    const double f = std::max(footprint, ext / (Camera::kMaxResolution - 4));
+    Camera cam;
+    cam.parallel = true;
+    cam.width = std::clamp(int(std::ceil((x1 - x0) / f)) + 2, 16, Camera::kMaxResolution);
+    cam.height = std::clamp(int(std::ceil((y1 - y0) / f)) + 2, 16, Camera::kMaxResolution);
+    cam.parallelScale = 0.5 * cam.height * f;
+    const Eigen::Vector3d centre = right * (0.5 * (x0 + x1)) + up * (0.5 * (y0 + y1)) + w * (0.5 * (z0 + z1));
+    const double depth = std::max(z1 - z0, ext) + margin;
+    cam.focal = centre;
+    cam.eye = centre - w * depth;
+    cam.up = up;
+    cam.nearPlane = 0.01 * depth;
+    cam.farPlane = 10 * depth;
+    return cam;
+}
+
+/// The scan id map of \p mesh, created with −1 when absent.
+Mesh::Property_map<FaceIndex, std::int32_t> scanIds(Mesh& mesh) {
+    return mesh.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1).first;
+}
+
+struct Coverage {
+    double scanned = 0, total = 0;
+    std::size_t inputFaces = 0;
+    double fraction() const { return total > 0 ? scanned / total : 0; }
+};
+
+Coverage measureCoverage(Mesh& mesh) {
+    auto ids = scanIds(mesh);
+    Coverage c;
+    for (FaceIndex f : mesh.faces()) {
+        const double a = faceGeometry(mesh, f).area;
+        c.total += a;
+        if (ids[f] >= 0)
+            c.scanned += a;
+        else
+            ++c.inputFaces;
+    }
+    return c;
+}
+
+/// Sharp feature chains of \p mesh: polylines of edges whose dihedral angle exceeds the threshold, between
+/// vertices where the chain ends, branches or turns sharply, each with the mean bisector of its two
+/// sides' normals.
+struct FeatureChain {
+    std::vector<Eigen::Vector3d> points;
+    Eigen::Vector3d bisector{0, 0, 0};
+    double length = 0;
+};
+
+std::vector<FeatureChain> featureChains(const Mesh& mesh, double featureAngleDeg, double maxBisectorTurnDeg) {
+    const double cosFeature = std::cos(featureAngleDeg * std::numbers::pi / 180.0);
+    const double cosTurn = std::cos(maxBisectorTurnDeg * std::numbers::pi / 180.0);
+    std::vector<char> sharp(mesh.number_of_edges() + mesh.number_of_removed_edges(), 0);
+    std::vector<int> degree(mesh.number_of_vertices() + mesh.number_of_removed_vertices(), 0);
+    for (EdgeIndex e : mesh.edges()) {
+        if (mesh.is_border(e)) continue;
+        const HalfedgeIndex h = mesh.halfedge(e);
+        const Eigen::Vector3d n1 = faceGeometry(mesh, mesh.face(h)).normal;
+        const Eigen::Vector3d n2 = faceGeometry(mesh, mesh.face(mesh.opposite(h))).normal;
+        if (n1.dot(n2) < cosFeature) {
+            sharp[e.idx()] = 1;
+            ++degree[mesh.source(h).idx()];
+            ++degree[mesh.target(h).idx()];
+        }
+    }
+    auto bisectorOf = [&](HalfedgeIndex h) {
+        const Eigen::Vector3d b =
+            faceGeometry(mesh, mesh.face(h)).normal + faceGeometry(mesh, mesh.face(mesh.opposite(h))).normal;
+        return b.norm() > 1e-12 ? Eigen::Vector3d(b.normalized()) : Eigen::Vector3d(0, 0, 0);
+    };
+    std::vector<char> used(sharp.size(), 0);
+    std::vector<FeatureChain> chains;
+    auto walk = [&](HalfedgeIndex start) {
+        FeatureChain chain;
+        chain.points.push_back(toEigen(mesh.point(mesh.source(start))));
+        Eigen::Vector3d sum(0, 0, 0);
+        HalfedgeIndex h = start;
+        while (true) {
+            used[mesh.edge(h).idx()] = 1;
+            const Eigen::Vector3d p = toEigen(mesh.point(mesh.target(h)));
+            const double len = (p - chain.points.back()).norm();
+            sum += bisectorOf(h) * len;
+            chain.length += len;
+            chain.points.push_back(p);
+            const VertexIndex v = mesh.target(h);
+            if (degree[v.idx()] != 2) break;
+            HalfedgeIndex next;
+            for (HalfedgeIndex o : CGAL::halfedges_around_source(v, mesh))
+                if (sharp[mesh.edge(o).idx()] && !used[mesh.edge(o).idx()]) next = o;
+            if (next == Mesh::null_halfedge()) break;
+            const Eigen::Vector3d b = bisectorOf(next);
+            if (sum.norm() > 0 && b.dot(sum.normalized()) < cosTurn) break; // the next piece faces elsewhere
+            h = next;
+        }
+        if (sum.norm() > 0) chain.bisector = sum.normalized();
+        chains.push_back(std::move(chain));
+    };
+    // Chains from their ends first (vertices of degree ≠ 2), then the closed loops.
+    for (int pass = 0; pass < 2; ++pass)
+        for (HalfedgeIndex h : mesh.halfedges()) {
+            const EdgeIndex e = mesh.edge(h);
+            if (!sharp[e.idx()] || used[e.idx()]) continue;
+            if (pass == 0 && degree[mesh.source(h).idx()] == 2) continue;
+            walk(h);
+        }
+    // A chain that stopped at a turn of the bisector continues as a new chain from where it stopped: the
+    // walk above leaves the remaining edges unused, and the second pass starts them from a degree-2 vertex.
+    return chains;
+}
+
+double minCornerAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+    auto angle = [](const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& r) {
+        const Eigen::Vector3d u = q - p, v = r - p;
+        return std::atan2(u.cross(v).norm(), u.dot(v));
+    };
+    return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
+}
+
+/// Flips edges between two nearly coplanar faces (normals within \p maxDihedralDeg) where the flip raises
+/// the smaller of the two faces' smallest angles, for faces with a smallest angle under \p belowDeg: the
+/// slivers that seams leave. A flip is done only when the new edge does not exist yet, both end vertices keep
+/// valence ≥ 3, and both new faces keep the orientation of the old ones (normals within maxDihedralDeg):
+/// connectivity stays manifold and the surface moves nowhere (the quad is flat to within the dihedral limit).
+std::size_t flipSlivers(Mesh& mesh, double belowDeg, double maxDihedralDeg, int rounds) {
+    const double below = belowDeg * std::numbers::pi / 180.0;
+    const double cosDihedral = std::cos(maxDihedralDeg * std::numbers::pi / 180.0);
+    std::size_t flips = 0;
+    for (int round = 0; round < rounds; ++round) {
+        std::size_t flipsThisRound = 0;
+        for (EdgeIndex e : mesh.edges()) {
+            if (mesh.is_border(e)) continue;
+            const HalfedgeIndex h = mesh.halfedge(e), o = mesh.opposite(h);
+            const VertexIndex va = mesh.source(h), vb = mesh.target(h);
+            const VertexIndex vc = mesh.target(mesh.next(h)), vd = mesh.target(mesh.next(o));
+            if (vc == vd) continue;
+            const Eigen::Vector3d a = toEigen(mesh.point(va)), b = toEigen(mesh.point(vb));
+            const Eigen::Vector3d c = toEigen(mesh.point(vc)), d = toEigen(mesh.point(vd));
+            const double before = std::min(minCornerAngle(a, b, c), minCornerAngle(b, a, d));
+            if (before >= below) continue;
+            const Eigen::Vector3d n1 = (b - a).cross(c - a), n2 = (a - b).cross(d - b);
+            if (n1.norm() == 0 || n2.norm() == 0 || n1.normalized().dot(n2.normalized()) < cosDihedral)
+                continue;
+            // After the flip: faces (c, a, d) and (d, b, c).
+            const Eigen::Vector3d m1 = (a - c).cross(d - c), m2 = (b - d).cross(c - d);
+            if (m1.norm() == 0 || m2.norm() == 0) continue;
+            const Eigen::Vector3d n = (n1.normalized() + n2.normalized()).normalized();
+            if (m1.normalized().dot(n) < cosDihedral || m2.normalized().dot(n) < cosDihedral) continue;
+            const double after = std::min(minCornerAngle(c, a, d), minCornerAngle(d, b, c));
+            if (after <= before + 1e-6) continue;
+            if (mesh.degree(va) <= 3 || mesh.degree(vb) <= 3) continue;
+            if (CGAL::halfedge(vc, vd, mesh).second) continue;
+            CGAL::Euler::flip_edge(h, mesh);
+            ++flipsThisRound;
+        }
+        flips += flipsThisRound;
+        if (flipsThisRound == 0) break;
+    }
+    return flips;
+}
+
+/// Resamples a screen polyline so that consecutive points are at least \p minGap pixels apart.
+Polyline2 thinPolyline(const Polyline2& in, double minGap) {
+    Polyline2 out;
+    for (const Eigen::Vector2d& p : in)
+        if (out.empty() || (p - out.back()).norm() >= minGap) out.push_back(p);
+    if (out.size() >= 2 && (in.back() - out.back()).norm() > 1e-9) out.back() = in.back();
+    return out;
+}
+
+/// A band-shaped lasso of half width \p halfWidth pixels around the screen polyline \p line.
+Lasso bandLasso(const Polyline2& line, double halfWidth) {
+    Lasso lasso;
+    const std::size_t n = line.size();
+    std::vector<Eigen::Vector2d> left, right;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Eigen::Vector2d a = line[i == 0 ? 0 : i - 1], b = line[i + 1 == n ? n - 1 : i + 1];
+        Eigen::Vector2d t = b - a;
+        if (t.norm() < 1e-12) t = Eigen::Vector2d(1, 0);
+        t.normalize();
+        const Eigen::Vector2d nrm(-t.y(), t.x());
+        // Extend the ends along the line by a little so the band covers the end samples.
+        Eigen::Vector2d p = line[i];
+        if (i == 0) p -= t * (0.5 * halfWidth);
+        if (i + 1 == n) p += t * (0.5 * halfWidth);
+        left.push_back(p + nrm * halfWidth);
+        right.push_back(p - nrm * halfWidth);
+    }
+    lasso.points = left;
+    lasso.points.insert(lasso.points.end(), right.rbegin(), right.rend());
+    return lasso;
+}
+
+/// The regular scan of autoRemesh: scanPatch's stages, with the quality mask overridden (samples
+/// re-admitted) where the current mesh shows an input face within \p fillRadius pixels.
+struct RegularScan {
+    Patch patch;
+    FrameBuffers currentBuffers;
+    Camera camera;
+};
+
+RegularScan regularScan(const Mesh& reference, MeshRenderer& referenceRenderer, Mesh& current,
+                        MeshRenderer& currentRenderer, const Camera& camera, std::int32_t scanId,
+                        int fillRadius, double maxSamplingAngleDeg, const AutoOptions& options) {
+    const FrameBuffers ref = referenceRenderer.render(camera);
+    if (ref.coveredCount() == 0) throw InvalidInputError("The view sees no part of the mesh.");
+    RegularScan out;
+    out.currentBuffers = currentRenderer.render(ref.camera);
+    out.camera = ref.camera;
+    ScanOptions so;
+    so.scanId = scanId;
+    SampleGrid grid = sampleRegularGrid(ref, reference, so);
+    std::vector<char> admissibleBefore;
+    if (fillRadius >= 0) {
+        admissibleBefore.resize(grid.samples.size());
+        for (std::size_t i = 0; i < grid.samples.size(); ++i)
+            admissibleBefore[i] = grid.samples[i].admissible;
+    }
+    // Keep each view to the part of the surface it sees well: its patch boundary then runs where the current
+    // mesh is a clean height field in the view (no silhouettes or occlusion contours), which the stitcher
+    // needs.
+    const double maxAngle = maxSamplingAngleDeg * std::numbers::pi / 180.0;
+    for (Sample& s : grid.samples)
+        if (s.admissible && s.samplingAngle > maxAngle) s.admissible = s.valid = false;
+    QualityMaskOptions q;
+    q.margin = options.qualityMargin;
+    applyQualityMask(grid, current, out.currentBuffers, q);
+    if (fillRadius >= 0) {
+        // Pixels that show an input face of the current mesh, dilated by fillRadius.
+        auto ids = scanIds(current);
+        const int W = grid.cols, H = grid.rows;
+        std::vector<char> input(std::size_t(W) * std::size_t(H), 0);
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                const std::uint32_t f = out.currentBuffers.faceAt(x, y);
+                if (f != FrameBuffers::kNoFace && ids[FaceIndex(f)] < 0) input[grid.index(y, x)] = 1;
+            }
+        std::vector<char> near(input.size(), 0);
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                if (!input[grid.index(y, x)]) continue;
+                for (int dy = -fillRadius; dy <= fillRadius; ++dy)
+                    for (int dx = -fillRadius; dx <= fillRadius; ++dx)
+                        if (grid.inside(y + dy, x + dx)) near[grid.index(y + dy, x + dx)] = 1;
+            }
+        for (std::size_t i = 0; i < grid.samples.size(); ++i)
+            if (admissibleBefore[i] && near[i]) grid.samples[i].admissible = grid.samples[i].valid = true;
+    }
+    erode(grid, options.morphologyRadius);
+    dilate(grid, options.morphologyRadius);
+    removeUntriangulatableSamples(grid);
+    out.patch = triangulateGrid(grid, TriangulateOptions{});
+    if (out.patch.mesh.number_of_faces() == 0)
+        throw InvalidInputError("No sample of the view is better than the mesh already there.");
+    return out;
+}
+
+} // namespace
+
+double edgeLengthForVertexCount(double area, std::size_t vertices) {
+    if (!(area > 0) || !std::isfinite(area)) throw InvalidInputError("The surface area must be positive.");
+    if (vertices == 0) throw InvalidInputError("The target vertex count must be positive.");
+    return std::sqrt(area / (double(vertices) * std::sqrt(3.0) / 2.0));
+}
+
+AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const Progress& progress) {
+    const auto start = Clock::now();
+    if (reference.number_of_faces() == 0) throw InvalidInputError("The mesh to remesh has no faces.");
+    if (!CGAL::is_triangle_mesh(reference))
+        throw InvalidInputError("The mesh to remesh is not a triangle mesh.");
+    if (!(options.edgeLength >= 0) || !std::isfinite(options.edgeLength))
+        throw InvalidInputError("The target edge length must be a positive number.");
+    if (!(options.servedAngleDeg > 0 && options.servedAngleDeg <= 80))
+        throw InvalidInputError("The served angle of the view plan must be in (0, 80] degrees.");
+    if (!(options.maxSamplingAngleDeg > options.servedAngleDeg && options.maxSamplingAngleDeg <= 85) ||
+        !(options.followUpMaxSamplingAngleDeg > 0 && options.followUpMaxSamplingAngleDeg <= 85))
+        throw InvalidInputError("The largest sampling angles must be in (served angle, 85] degrees.");
+    if (options.initialFillRadius < -1 || options.initialFillRadius > 16)
+        throw InvalidInputError("The fill radius of the initial views must be in [-1, 16] pixels.");
+    if (options.maxViews < 1) throw InvalidInputError("The view budget must be at least one view.");
+    if (!(options.footprintRatio > 0.1 && options.footprintRatio <= 4))
+        throw InvalidInputError("The footprint ratio must be in (0.1, 4].");
+
+    AutoResult result;
+    // Reference geometry: per-face normals and areas, bounding box.
+    std::vector<FaceGeometry> faces;
+    std::vector<Eigen::Vector3d> corners;
+    faces.reserve(reference.number_of_faces());
+    for (FaceIndex f : reference.faces()) {
+        faces.push_back(faceGeometry(reference, f));
+        result.area += faces.back().area;
+    }
+    if (!(result.area > 0)) throw InvalidInputError("The mesh to remesh has no area.");
+    const Eigen::AlignedBox3d box = boundingBox(reference);
+    for (int i = 0; i < 8; ++i)
+        corners.push_back(box.corner(Eigen::AlignedBox3d::CornerType(i)));
+    result.edgeLength = options.edgeLength > 0
+                            ? options.edgeLength
+                            : edgeLengthForVertexCount(result.area, options.targetVertices > 0
+                                                                        ? options.targetVertices
+                                                                        : reference.number_of_vertices());
+    const double L = result.edgeLength;
+    const double footprint = L * options.footprintRatio;
+
+    auto makeRenderer = [&]() -> std::unique_ptr<MeshRenderer> {
+        if (options.renderer) return options.renderer();
+        return std::make_unique<CpuMeshRenderer>();
+    };
+    std::unique_ptr<MeshRenderer> referenceRenderer = makeRenderer();
+    std::unique_ptr<MeshRenderer> currentRenderer = makeRenderer();
+    referenceRenderer->setMesh(reference);
+    Mesh current = reference;
+    scanIds(current);
+    currentRenderer->setMesh(current);
+
+    std::int32_t nextScanId = 0;
+    const double servedCos = std::cos(options.servedAngleDeg * std::numbers::pi / 180.0);
+
+    // Runs one stitch of a patch; on failure the mesh is unchanged and the step says why.
+    auto stitchInto = [&](AutoStep& step, const Mesh& patch, const Camera& camera,
+                          const std::vector<std::uint32_t>& faceIds) {
+        auto t = Clock::now();
+        try {
+            const StitchReport r = stitchPatch(current, patch, camera, options.stitch, faceIds);
+            step.stitched = true;
+            step.facesAdded = r.facesAdded;
+            step.facesRemoved = r.facesRemoved;
+            step.patchFacesTrimmed = r.patchFacesTrimmed;
+            if (!r.skipped.empty()) step.note = r.skipped.front();
+            currentRenderer->setMesh(current);
+        } catch (const CancelledError&) {
+            throw;
+        } catch (const Error& e) {
+            step.note = e.what();
+        }
+        result.stitchSeconds += secondsSince(t);
+    };
+    auto finishStep = [&](AutoStep& step, Clock::time_point t0) {
+        step.seconds = secondsSince(t0);
+        step.coverageAfter = measureCoverage(current).fraction();
+        (step.stitched ? result.scansStitched : result.scansSkipped)++;
+        result.steps.push_back(std::move(step));
+    };
+    auto budgetLeft = [&]() { return int(result.steps.size()) < options.maxViews; };
+
+    // 1. Feature lines with fishbone grids.
+    if (options.fishbone) {
+        progress.report(0.0, "fishbone");
+        auto t = Clock::now();
+        const std::vector<FeatureChain> chains = featureChains(reference, options.featureAngleDeg, 40.0);
+        result.featureChains = chains.size();
+        result.planSeconds += secondsSince(t);
+        FishboneCache cache;
+        const double h = 4.0; // rib and backbone spacing in pixels
+        std::size_t done = 0;
+        for (const FeatureChain& chain : chains) {
+            ++done;
+            if (!budgetLeft()) break;
+            if (chain.length < options.minFeatureLength * L || chain.bisector.norm() == 0) continue;
+            progress.report(0.3 * double(done) / double(chains.size()), "fishbone");
+            const auto t0 = Clock::now();
+            AutoStep step;
+            step.kind = AutoStep::Kind::Fishbone;
+            step.scanId = nextScanId++;
+            try {
+                ScanParams params;
+                params.camera = frameParallel(chain.bisector, chain.points, footprint / h,
+                                              (options.fishboneBandWidth + 3) * L);
+                params.erodeRadius = params.dilateRadius = options.morphologyRadius;
+                params.scan.scanId = step.scanId;
+                params.quality.margin = options.qualityMargin;
+                Polyline2 line;
+                for (const Eigen::Vector3d& p : chain.points) {
+                    const Eigen::Vector3d s = params.camera.project(p);
+                    line.emplace_back(s.x(), s.y());
+                }
+                line = thinPolyline(line, 1.0);
+                if (line.size() < 2) continue;
+                params.lasso = bandLasso(line, options.fishboneBandWidth * h);
+                FishboneParams fb;
+                fb.drawnBackbone = line;
+                fb.direction = PrincipalDirection::Min;
+                // A whole number of spacings along the line, so that both of its ends (corners) are sampled.
+                double screenLength = 0;
+                for (std::size_t i = 1; i < line.size(); ++i)
+                    screenLength += (line[i] - line[i - 1]).norm();
+                fb.spacing = screenLength / std::max(1.0, std::round(screenLength / h));
+                fb.spacing = std::clamp(fb.spacing, 0.75 * h, 1.5 * h);
+                step.camera = params.camera;
+                auto ts = Clock::now();
+                FishboneScanResult scan = scanFishbonePatch(reference, *referenceRenderer, current,
+                                                            *currentRenderer, params, fb, cache);
+                result.scanSeconds += secondsSince(ts);
+                step.patchFaces = scan.patch.mesh.number_of_faces();
+                stitchInto(step, scan.patch.mesh, scan.grid.camera, scan.currentBuffers.faceId);
+            } catch (const CancelledError&) {
+                throw;
+            } catch (const Error& e) {
+                step.note = e.what();
+            }
+            finishStep(step, t0);
+        }
+    }
+
+    // 2. The initial views: greedy cover of the Gauss map, normals binned on a fine set of directions.
+    progress.report(0.3, "plan");
+    auto tPlan = Clock::now();
+    const std::vector<Eigen::Vector3d> candidates = candidateDirections(600);
+    std::vector<double> binArea(candidates.size(), 0);
+    std::vector<Eigen::Vector3d> binNormalSum(candidates.size(), Eigen::Vector3d::Zero());
+    for (const FaceGeometry& g : faces) {
+        if (g.area <= 0) continue;
+        std::size_t best = 0;
+        double bestDot = -2;
+        for (std::size_t i = 0; i < candidates.size(); ++i) {
+            const double d = candidates[i].dot(g.normal);
+            if (d > bestDot) bestDot = d, best = i;
+        }
+        binArea[best] += g.area;
+        binNormalSum[best] += g.area * g.normal;
+    }
+    std::vector<Eigen::Vector3d> binNormal(candidates.size());
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+        binNormal[i] =
+            binNormalSum[i].norm() > 0 ? Eigen::Vector3d(binNormalSum[i].normalized()) : candidates[i];
+    std::vector<char> served(candidates.size(), 0);
+    auto servedArea = [&](const Eigen::Vector3d& d) {
+        double a = 0;
+        for (std::size_t b = 0; b < candidates.size(); ++b)
+            if (!served[b] && binArea[b] > 0 && binNormal[b].dot(d) >= servedCos) a += binArea[b];
+        return a;
+    };
+    std::vector<Eigen::Vector3d> views;
+    while (int(views.size()) < options.maxViews) {
+        double bestArea = 0;
+        Eigen::Vector3d bestDir;
+        for (const Eigen::Vector3d& d : candidates) {
+            const double a = servedArea(d);
+            if (a > bestArea * 1.0001) bestArea = a, bestDir = d;
+        }
+        if (bestArea < options.minViewAreaFraction * result.area) break;
+        // Centre the view on what it serves (a single plane gets an exactly frontal view).
+        Eigen::Vector3d mean(0, 0, 0);
+        for (std::size_t b = 0; b < candidates.size(); ++b)
+            if (!served[b] && binArea[b] > 0 && binNormal[b].dot(bestDir) >= servedCos)
+                mean += binNormalSum[b];
+        if (mean.norm() > 0 && servedArea(mean.normalized()) >= 0.95 * bestArea) bestDir = mean.normalized();
+        for (std::size_t b = 0; b < candidates.size(); ++b)
+            if (binArea[b] > 0 && binNormal[b].dot(bestDir) >= servedCos) served[b] = 1;
+        views.push_back(bestDir);
+    }
+    result.planSeconds += secondsSince(tPlan);
+
+    const int initialFill = options.initialFillRadius;
+    for (std::size_t i = 0; i < views.size() && budgetLeft(); ++i) {
+        progress.report(0.3 + 0.4 * double(i) / double(views.size()),
+                        "scan " + std::to_string(i + 1) + "/" + std::to_string(views.size()));
+        const auto t0 = Clock::now();
+        AutoStep step;
+        step.kind = AutoStep::Kind::Initial;
+        step.scanId = nextScanId++;
+        try {
+            step.camera = frameParallel(views[i], corners, footprint, 2 * L);
+            auto ts = Clock::now();
+            RegularScan scan =
+                regularScan(reference, *referenceRenderer, current, *currentRenderer, step.camera,
+                            step.scanId, initialFill, options.maxSamplingAngleDeg, options);
+            result.scanSeconds += secondsSince(ts);
+            step.camera = scan.camera;
+            step.patchFaces = scan.patch.mesh.number_of_faces();
+            stitchInto(step, scan.patch.mesh, scan.camera, scan.currentBuffers.faceId);
+        } catch (const CancelledError&) {
+            throw;
+        } catch (const Error& e) {
+            step.note = e.what();
+        }
+        finishStep(step, t0);
+    }
+
+    // 3. Follow-up views aimed at the regions still left from the input.
+    for (int round = 0; round < options.followUpRounds && budgetLeft(); ++round) {
+        if (measureCoverage(current).fraction() >= options.coverageGoal) break;
+        progress.report(0.7 + 0.3 * double(round) / double(options.followUpRounds), "follow-up");
+        auto t = Clock::now();
+        auto ids = scanIds(current);
+        // Connected regions of input faces (through edges).
+        struct Region {
+            std::vector<FaceIndex> faces;
+            double area = 0;
+            Eigen::Vector3d normalSum{0, 0, 0};
+        };
+        std::vector<Region> regions;
+        std::vector<char> seen(current.number_of_faces() + current.number_of_removed_faces(), 0);
+        for (FaceIndex f : current.faces()) {
+            if (ids[f] >= 0 || seen[f.idx()]) continue;
+            Region r;
+            std::vector<FaceIndex> stack{f};
+            seen[f.idx()] = 1;
+            while (!stack.empty()) {
+                const FaceIndex g = stack.back();
+                stack.pop_back();
+                r.faces.push_back(g);
+                const FaceGeometry fg = faceGeometry(current, g);
+                r.area += fg.area;
+                r.normalSum += fg.area * fg.normal;
+                for (HalfedgeIndex h : CGAL::halfedges_around_face(current.halfedge(g), current)) {
+                    const FaceIndex o = current.face(current.opposite(h));
+                    if (o != Mesh::null_face() && ids[o] < 0 && !seen[o.idx()])
+                        seen[o.idx()] = 1, stack.push_back(o);
+                }
+            }
+            regions.push_back(std::move(r));
+        }
+        std::sort(regions.begin(), regions.end(),
+                  [](const Region& a, const Region& b) { return a.area > b.area; });
+        result.planSeconds += secondsSince(t);
+        int scansThisRound = 0;
+        const double coverageBefore = measureCoverage(current).fraction();
+        for (const Region& region : regions) {
+            if (!budgetLeft() || scansThisRound >= 12) break;
+            if (region.area < 0.5 * L * L) break;
+            // The region may have been covered by an earlier follow-up of this round.
+            auto idsNow = scanIds(current);
+            std::unordered_set<std::uint32_t> members;
+            std::vector<Eigen::Vector3d> pts;
+            for (FaceIndex f : region.faces) {
+                if (!current.is_removed(f) && idsNow[f] < 0) {
+                    members.insert(std::uint32_t(f.idx()));
+                    for (VertexIndex v : CGAL::vertices_around_face(current.halfedge(f), current))
+                        pts.push_back(toEigen(current.point(v)));
+                }
+            }
+            if (members.empty()) continue;
+            t = Clock::now();
+            Eigen::Vector3d n = region.normalSum.norm() > 0.3 * region.area
+                                    ? Eigen::Vector3d(region.normalSum.normalized())
+                                    : faceGeometry(current, region.faces[0]).normal;
+            if (n.norm() == 0) continue;
+            // Candidate directions around the region's mean normal; the one that sees most of it wins.
+            const Eigen::Vector3d a =
+                std::abs(n.x()) < 0.9 ? Eigen::Vector3d(1, 0, 0) : Eigen::Vector3d(0, 1, 0);
+            const Eigen::Vector3d u = n.cross(a).normalized(), v = n.cross(u);
+            std::vector<Eigen::Vector3d> dirs{n};
+            for (double tilt : {25.0, 50.0})
+                for (int k = 0; k < 6; ++k) {
+                    const double phi = k * std::numbers::pi / 3.0 + (tilt > 30 ? std::numbers::pi / 6 : 0);
+                    const double th = tilt * std::numbers::pi / 180.0;
+                    dirs.push_back(std::cos(th) * n + std::sin(th) * (std::cos(phi) * u + std::sin(phi) * v));
+                }
+            Camera best;
+            double bestSeen = 0;
+            for (const Eigen::Vector3d& d : dirs) {
+                Camera cam = frameParallel(d, pts, footprint, 4 * L);
+                try {
+                    const FrameBuffers fb = currentRenderer->render(cam);
+                    double seenPx = 0;
+                    for (std::uint32_t id : fb.faceId)
+                        if (id != FrameBuffers::kNoFace && members.count(id)) seenPx += 1;
+                    seenPx *= 1.0 - 0.3 * (1.0 - d.dot(n)); // prefer frontal views on a tie
+                    if (seenPx > bestSeen) bestSeen = seenPx, best = fb.camera;
+                } catch (const CancelledError&) {
+                    throw;
+                } catch (const Error&) {
+                }
+            }
+            result.planSeconds += secondsSince(t);
+            if (bestSeen < 1) continue;
+            const auto t0 = Clock::now();
+            AutoStep step;
+            step.kind = AutoStep::Kind::FollowUp;
+            step.scanId = nextScanId++;
+            step.camera = best;
+            try {
+                auto ts = Clock::now();
+                RegularScan scan =
+                    regularScan(reference, *referenceRenderer, current, *currentRenderer, best, step.scanId,
+                                2 + options.morphologyRadius, options.followUpMaxSamplingAngleDeg, options);
+                result.scanSeconds += secondsSince(ts);
+                step.patchFaces = scan.patch.mesh.number_of_faces();
+                stitchInto(step, scan.patch.mesh, scan.camera, scan.currentBuffers.faceId);
+            } catch (const CancelledError&) {
+                throw;
+            } catch (const Error& e) {
+                step.note = e.what();
+            }
+            finishStep(step, t0);
+            ++scansThisRound;
+        }
+        if (scansThisRound == 0 || measureCoverage(current).fraction() <= coverageBefore + 1e-6) break;
+    }
+
+    if (options.flipSliversBelowDeg > 0) {
+        auto t = Clock::now();
+        result.sliverFlips = flipSlivers(current, options.flipSliversBelowDeg, 20.0, 8);
+        result.stitchSeconds += secondsSince(t);
+    }
+    progress.report(1.0, "done");
+    current.collect_garbage();
+    const Coverage c = measureCoverage(current);
+    result.coverage = c.fraction();
+    result.inputFacesLeft = c.inputFaces;
+    result.inputAreaLeft = c.total - c.scanned;
+    result.mesh = std::move(current);
+    result.seconds = secondsSince(start);
+    return result;
+}
+
+} // namespace fss

@@ -1,0 +1,150 @@
+// fss-remesh auto: automatic full-surface remeshing from the command line (head-less GPU renderer), checked
+// against issue #7's criteria on CGAL's fandisk at about its own vertex count, and one clear sentence for
+// each kind of bad command line.
+//
+// The criteria of issue #7 that FSS does not meet yet are kept, unchanged, in the DISABLED_ test below (run
+// it with --gtest_also_run_disabled_tests); the numbers measured are in its comment.
+#include "run_process.h"
+#include "test_data.h"
+
+#include "fss/mesh_io.h"
+#include "fss/metrics.h"
+
+#include <nlohmann/json.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+
+using fss::test::expectCleanFailure;
+using fss::test::meshPath;
+using fss::test::tmpPath;
+
+namespace {
+
+fss::test::ProcessResult remesh(const std::vector<std::string>& args) {
+    return fss::test::runProcess(fss::test::remeshExe(), args, tmpPath("cli_auto"));
+}
+
+const std::string kFandisk = meshPath("fandisk.off").string();
+
+// CGAL::Polygon_mesh_processing::isotropic_remeshing of fandisk at the same target edge length (the one of
+// fandisk's vertex count, 0.019834), 3 iterations, sharp edges (35°) constrained, measured with
+// fss::computeMetrics by bench/auto_bench.cpp (`FSS_AUTO_BENCH_MESHES=fandisk ./build/bin/bench_auto`):
+// Hausdorff distance to / from the input relative to the bbox diagonal.
+constexpr double kCgalFandiskHausdorffToRel = 0.00135;
+constexpr double kCgalFandiskHausdorffFromRel = 0.00135;
+
+struct AutoRun {
+    nlohmann::json report;
+    fss::Mesh mesh;
+    fss::Metrics metrics;
+    double scannedArea = 0, totalArea = 0;
+};
+
+// Runs `auto` once on fandisk (shared by the tests below) and measures the result independently.
+const AutoRun& fandiskRun() {
+    static const AutoRun run = [] {
+        AutoRun r;
+        const auto out = tmpPath("cli_auto/fandisk_auto.ply");
+        const auto p = remesh({"auto", kFandisk, "-o", out.string(), "--json", "--no-metrics"});
+        EXPECT_EQ(p.exitCode, 0) << p.err;
+        if (p.exitCode != 0) return r;
+        r.report = nlohmann::json::parse(p.out);
+        r.mesh = fss::readMesh(out);
+        const fss::Mesh input = fss::readMesh(kFandisk);
+        fss::MetricsOptions mo;
+        mo.reference = &input;
+        r.metrics = fss::computeMetrics(r.mesh, mo);
+        const auto ids = r.mesh.property_map<fss::FaceIndex, std::int32_t>(fss::props::faceScanId);
+        EXPECT_TRUE(ids.second) << "the PLY output keeps the scan id of every face";
+        for (fss::FaceIndex f : r.mesh.faces()) {
+            const auto h = r.mesh.halfedge(f);
+            const double a =
+                std::sqrt(CGAL::squared_area(r.mesh.point(r.mesh.source(h)), r.mesh.point(r.mesh.target(h)),
+                                             r.mesh.point(r.mesh.target(r.mesh.next(h)))));
+            r.totalArea += a;
+            if (ids.second && ids.first[f] >= 0) r.scannedArea += a;
+        }
+        return r;
+    }();
+    return run;
+}
+
+} // namespace
+
+TEST(CliAuto, FandiskIsCoveredClosedManifoldAndFreeOfSelfIntersections) {
+    ASSERT_EQ(std::getenv("DISPLAY"), nullptr) << "this test must run without an X server";
+    const AutoRun& r = fandiskRun();
+    ASSERT_FALSE(r.report.is_null());
+    EXPECT_EQ(r.report.at("renderer").get<std::string>(), "gpu");
+    EXPECT_EQ(r.report.at("input_vertices").get<int>(), 6475);
+    // The edge length of 6475 vertices on fandisk's area 2.20602: sqrt(A / (N·√3/2)).
+    EXPECT_NEAR(r.report.at("edge_length").get<double>(), std::sqrt(2.20602 / (6475 * std::sqrt(3.0) / 2)),
+                1e-5);
+    // Coverage: reported and recomputed from the faces' scan ids agree, and reach the issue's 95 %.
+    const double coverage = r.report.at("coverage").get<double>();
+    EXPECT_NEAR(r.scannedArea / r.totalArea, coverage, 1e-6);
+    EXPECT_GE(coverage, 0.95);
+    EXPECT_GT(r.report.at("scans_stitched").get<int>(), 5);
+    // Valid: closed, manifold, no degenerate faces, no self-intersections (CGAL PMP).
+    const fss::Metrics& m = r.metrics;
+    EXPECT_TRUE(m.closed);
+    EXPECT_EQ(m.boundaryEdges, 0u);
+    EXPECT_EQ(m.nonManifoldVertices, 0u);
+    EXPECT_EQ(m.components, 1u);
+    EXPECT_EQ(m.degenerateFaces, 0u);
+    EXPECT_EQ(m.selfIntersections, std::optional<std::size_t>(0));
+    // About the input's vertex count.
+    EXPECT_NEAR(double(m.vertices), 6475.0, 0.15 * 6475.0);
+    // Issue #7: minimum angle ≥ 10°.
+    EXPECT_GE(m.minAngleDeg, 10.0);
+}
+
+// Issue #7's regularity and distance criteria on fandisk. NOT MET YET, measured on this branch
+// (`fss-remesh auto fandisk.off -o out.ply --json`, GPU renderer; bench_auto gives the same figures):
+// fraction of valence-6 interior vertices 0.646 (criterion ≥ 0.90; CGAL's isotropic remeshing: 0.773),
+// Hausdorff distance to / from the input 0.00740 / 0.00795 of the bbox diagonal (criterion: ≤ CGAL's
+// 0.00135 / 0.00135). The seams between scans are irregular, and the pixel grids cut the sharp edges that
+// CGAL keeps as constraints (--fishbone auto keeps them on a cube, see core_auto_remesh_test, but not yet
+// on fandisk).
+TEST(CliAuto, DISABLED_FandiskMeetsIssue7RegularityAndDistanceCriteria) {
+    const AutoRun& r = fandiskRun();
+    ASSERT_FALSE(r.report.is_null());
+    const fss::Metrics& m = r.metrics;
+    EXPECT_GE(m.fracValence6Interior, 0.90);
+    ASSERT_TRUE(m.hausdorffToRefRel && m.hausdorffFromRefRel);
+    EXPECT_LE(*m.hausdorffToRefRel, kCgalFandiskHausdorffToRel);
+    EXPECT_LE(*m.hausdorffFromRefRel, kCgalFandiskHausdorffFromRel);
+}
+
+TEST(CliAuto, BadCommandLinesGiveOneSentence) {
+    const auto out = tmpPath("cli_auto/bad.off").string();
+    auto r = remesh({"auto", kFandisk});
+    expectCleanFailure(r, "-o OUT");
+    EXPECT_EQ(r.exitCode, 2);
+    r = remesh({"auto", kFandisk, "-o", out, "--edge-length", "0.02", "--target-vertices", "1000"});
+    expectCleanFailure(r, "not both");
+    EXPECT_EQ(r.exitCode, 2);
+    r = remesh({"auto", kFandisk, "-o", out, "--edge-length", "-1"});
+    expectCleanFailure(r, "--edge-length");
+    EXPECT_EQ(r.exitCode, 2);
+    r = remesh({"auto", kFandisk, "-o", out, "--fishbone", "sometimes"});
+    expectCleanFailure(r, "--fishbone");
+    EXPECT_EQ(r.exitCode, 2);
+    r = remesh({"auto", kFandisk, "-o", out, "--renderer", "quantum"});
+    expectCleanFailure(r, "--renderer");
+    EXPECT_EQ(r.exitCode, 2);
+    r = remesh({"auto", kFandisk, "-o", tmpPath("cli_auto/bad.xyz").string()});
+    expectCleanFailure(r, "extension");
+    r = remesh({"auto", meshPath("no-such-mesh.off").string(), "-o", out});
+    expectCleanFailure(r, "no-such-mesh.off");
+    EXPECT_EQ(r.exitCode, 1);
+}
+
+TEST(CliAuto, HelpListsTheOptions) {
+    const auto r = remesh({"auto", "--help"});
+    EXPECT_EQ(r.exitCode, 0);
+    for (const char* option : {"--edge-length", "--target-vertices", "--fishbone", "--json", "--renderer"})
+        EXPECT_NE(r.out.find(option), std::string::npos) << option;
+}
