@@ -1571,7 +1571,8 @@ private:
             const std::int32_t sid = curHasScanId_ ? curScanId_[region_[r]] : -1;
             const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
             const Vec3 n = normalOf(A, B, C).normalized();
-            const double floor = std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C));
+            const double floor = std::min(std::max(O_.minAngleFloorDeg, O_.outsideMinAngleFloorDeg) * kDeg,
+                                          0.999 * minAngle(A, B, C));
             for (CdtFace f : pieces[r])
                 if (f->info().inside == 0)
                     newFaces_.push_back(
@@ -2279,8 +2280,8 @@ private:
                 // Pieces of two mesh faces that are nearly coplanar (a smoothly curved part of the mesh): the
                 // flip moves the surface by the gap between the two diagonals, allowed up to a small
                 // fraction of the patch's edge length (far below a pixel footprint).
-                nearPlanar = !allowed && turn <= maxTurn &&
-                             segmentGap(X, Y, Z1, Z2) <= kNearPlanarFlipGap * h3_;
+                nearPlanar =
+                    !allowed && turn <= maxTurn && segmentGap(X, Y, Z1, Z2) <= kNearPlanarFlipGap * h3_;
                 if (!allowed && !nearPlanar) continue;
             }
             const double oldMin = std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2));
@@ -2299,7 +2300,8 @@ private:
                     const FaceIndex f = S.face(g);
                     const HalfedgeIndex k = S.halfedge(f);
                     loc.planeNormal[f] =
-                        normalOf(pt(S, S.source(k)), pt(S, S.target(k)), pt(S, S.target(S.next(k)))).normalized();
+                        normalOf(pt(S, S.source(k)), pt(S, S.target(k)), pt(S, S.target(S.next(k))))
+                            .normalized();
                 }
             for (HalfedgeIndex g : {S.next(h), S.prev(h), S.next(o), S.prev(o)}) {
                 const EdgeIndex ge = S.edge(g);
@@ -2770,11 +2772,12 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
     if (!(options.collapseEdgeRatio >= 0 && options.collapseEdgeRatio < 0.5) || options.seamRings < 0 ||
         !(options.maxViewAngleDeg > 0 && options.maxViewAngleDeg < 90) ||
         !(options.maxNormalChangeDeg >= 0) || !(options.maxGapRatio > 0) || options.maxTrimRounds < 0 ||
-        !(options.seamGrading >= 0) || !(options.minAngleFloorDeg >= 0 && options.minAngleFloorDeg < 30))
+        !(options.seamGrading >= 0) || !(options.minAngleFloorDeg >= 0 && options.minAngleFloorDeg < 30) ||
+        !(options.outsideMinAngleFloorDeg >= 0 && options.outsideMinAngleFloorDeg < 30))
         throw InvalidInputError(
             "The stitch options are out of range (collapseEdgeRatio in [0, 0.5), seamRings >= 0, "
             "maxViewAngleDeg in (0, 90), maxNormalChangeDeg >= 0, maxGapRatio > 0, maxTrimRounds >= 0, "
-            "seamGrading >= 0, minAngleFloorDeg in [0, 30)).");
+            "seamGrading >= 0, minAngleFloorDeg and outsideMinAngleFloorDeg in [0, 30)).");
 
     const View view(scanCamera);
     StitchReport report;

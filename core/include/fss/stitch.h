@@ -43,6 +43,12 @@ struct StitchOptions {
     /// A face made by the stitch whose smallest angle is below this (degrees) is not accepted (unless the
     /// triangle it comes from already had a smaller one): the patch is trimmed there and retried.
     double minAngleFloorDeg = 1.0;
+    /// A floor (degrees) for the pieces of mesh faces outside the patch only (slivers between the patch
+    /// boundary and an old edge the seam cannot change, e.g. at a crease): below it the patch is trimmed
+    /// there and retried. The larger of this and minAngleFloorDeg applies to those pieces. Off (0) by
+    /// default: 10 brings the fandisk seam test's angles within bounds (smallest 10.2 deg) but makes
+    /// coarse meshes (icosphere level 3) refuse whole patches.
+    double outsideMinAngleFloorDeg = 0.0;
     /// Current-mesh faces seen at a larger angle between normal and view ray (degrees) are not stitched to;
     /// the patch is trimmed away from them.
     double maxViewAngleDeg = 85.0;
