@@ -1,5 +1,8 @@
 #include "fss_designer_plugin.h"
 
+#include <fss/widgets/quality_panel.h>
+#include <fss/widgets/remesh_widget.h>
+#include <fss/widgets/scan_panel.h>
 #include <fss/widgets/vtk_view.h>
 
 namespace fss::designer {
@@ -21,7 +24,7 @@ QString CustomWidget::domXml() const {
 }
 
 WidgetCollection::WidgetCollection(QObject* parent) : QObject(parent) {
-    // One line per widget. (RemeshWidget and the panels join here.)
+    // One line per widget.
     addWidget<widgets::VtkView>({"fss::widgets::VtkView",
                                  "fss/widgets/vtk_view.h",
                                  "vtkView",
@@ -30,6 +33,29 @@ WidgetCollection::WidgetCollection(QObject* parent) : QObject(parent) {
                                  "reference, a preview patch and 2D overlays; trackball navigation.",
                                  {400, 300},
                                  {}});
+    addWidget<widgets::RemeshWidget>({"fss::widgets::RemeshWidget",
+                                      "fss/widgets/remesh_widget.h",
+                                      "remeshWidget",
+                                      "Drop-in remeshing widget: view, tools, scan and quality panels, history",
+                                      "Virtual range scanning of a mesh with lasso, scan and fishbone tools, "
+                                      "undo/redo and live quality histograms.",
+                                      {800, 600},
+                                      {}});
+    addWidget<widgets::ScanPanel>({"fss::widgets::ScanPanel",
+                                   "fss/widgets/scan_panel.h",
+                                   "scanPanel",
+                                   "Scan settings: resolution, erosion / dilation, thresholds, force-replace",
+                                   "The settings of the next scan, with the resulting edge length.",
+                                   {240, 320},
+                                   {}});
+    addWidget<widgets::QualityPanel>({"fss::widgets::QualityPanel",
+                                      "fss/widgets/quality_panel.h",
+                                      "qualityPanel",
+                                      "Valence and minimum-angle histograms of a mesh",
+                                      "Histograms of vertex valence and smallest face angle, updated after "
+                                      "every accept, undo and redo.",
+                                      {240, 320},
+                                      {}});
 }
 
 QList<QDesignerCustomWidgetInterface*> WidgetCollection::customWidgets() const {

@@ -154,7 +154,7 @@ OverlayState* ensureState(VtkView* view) {
 }
 
 // Projects the fallback preview border with the view's current camera into the Preview layer.
-void projectPreview(VtkView* view, OverlayState& s) {
+[[maybe_unused]] void projectPreview(VtkView* view, OverlayState& s) {
     std::vector<Stroke> strokes;
     if (!s.previewBorder.empty() && view->hasMesh()) {
         const Camera camera = view->camera();
