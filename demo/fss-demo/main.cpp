@@ -1,7 +1,7 @@
 // fss-demo: the FSS demo application (a main window around VtkView).
 //
 //   fss-demo [--view V] [--colormap C] [MESH]
-//   fss-demo --screenshot FILE.png [--view iso|+x|-x|+y|-y|+z|-z] [--colormap none|angle|valence]
+//   fss-demo --screenshot FILE.png [--view iso|+x|-x|+y|-y|+z|-z] [--colormap none|angle|valence|scan-id]
 //            [--size WxH] [--scan VIEW]... [--resolution N] [MESH]
 //
 // Without MESH the bundled default mesh (CGAL's fandisk) is opened. --screenshot renders the window to
@@ -31,7 +31,7 @@
 namespace {
 
 const char* const kUsage =
-    "usage: fss-demo [--screenshot FILE.png] [--view iso|+x|-x|+y|-y|+z|-z] [--colormap none|angle|valence]\n"
+    "usage: fss-demo [--screenshot FILE.png] [--view iso|+x|-x|+y|-y|+z|-z] [--colormap none|angle|valence|scan-id]\n"
     "                [--size WxH] [--scan VIEW]... [--resolution N] [MESH]\n";
 
 struct Options {
