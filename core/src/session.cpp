@@ -133,7 +133,13 @@ const StitchReport& Session::accept(const Progress& progress) {
     const ScanPreview& p = *d.preview;
     StitchOptions options = p.step.stitch;
     options.collectGarbage = true;
-    StitchReport report = stitchPatch(next, p.patch.mesh, p.step.params.camera, options, p.currentBuffers.faceId);
+    // The stitch reports its own progress (and is cancellable) between components: mapped into [0, 0.9).
+    const Progress stitchProgress([&progress](double fraction, std::string_view stage) {
+        progress.report(0.85 * fraction, stage);
+        return true;
+    });
+    StitchReport report =
+        stitchPatch(next, p.patch.mesh, p.step.params.camera, options, p.currentBuffers.faceId, stitchProgress);
     if (next.has_garbage()) next.collect_garbage();
     progress.report(0.9, "record");
     HistoryItem item{p.step, std::move(report), detail::MeshDelta::between(d.current, next)};

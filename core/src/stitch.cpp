@@ -2760,7 +2760,8 @@ std::vector<std::vector<int>> components(const PatchData& P, const std::vector<i
 } // namespace
 
 StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCamera,
-                         const StitchOptions& options, std::span<const std::uint32_t> faceIds) {
+                         const StitchOptions& options, std::span<const std::uint32_t> faceIds,
+                         const Progress& progress) {
     const auto start = std::chrono::steady_clock::now();
     scanCamera.validate();
     if (patch.number_of_faces() == 0) throw InvalidInputError("The patch has no faces.");
@@ -2812,7 +2813,11 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
 
     bool propsReady = false;
     std::size_t seamFacesAbove25 = 0;
+    const double totalFaces = double(std::max<std::size_t>(P.tri.size(), 1));
+    std::size_t facesDone = dropped; // faces stitched, trimmed or dropped so far
     while (!work.empty()) {
+        // Cancellation point: between components and trim rounds, never inside an application.
+        progress.report(std::min(1.0, double(facesDone) / totalFaces), "stitch");
         Work w = std::move(work.front());
         work.pop_front();
         if (w.faces.size() < options.minComponentFaces) {
@@ -2868,6 +2873,7 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
             });
         if (!applied) throw Error("Internal error: a rehearsed stitch could not be applied to the mesh.");
         stitched.insert(w.name);
+        facesDone += w.faces.size();
         ++report.piecesStitched;
         report.facesRemoved += plan.removed.size();
         report.facesAdded += plan.faces.size();

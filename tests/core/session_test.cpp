@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <bit>
 #include <chrono>
 #include <cstdio>
@@ -368,7 +370,27 @@ TEST(Session, FailedAcceptChangesNothing) {
         EXPECT_TRUE(asked);
         expectUnchanged();
     }
-    const fss::StitchReport report = session.accept();
+    // Cancelled from inside the stitch (its first report between components: the accept's second report).
+    {
+        int calls = 0;
+        std::string secondStage;
+        const fss::Progress cancel([&](double, std::string_view stage) {
+            if (++calls == 2) secondStage = std::string(stage);
+            return calls < 2;
+        });
+        EXPECT_THROW(session.accept(cancel), fss::CancelledError);
+        EXPECT_EQ(calls, 2);
+        EXPECT_EQ(secondStage, "stitch");
+        expectUnchanged();
+    }
+    // The stitch's reports reach the caller, in order, before "record".
+    std::vector<double> fractions;
+    const fss::StitchReport report = session.accept(fss::Progress([&](double f, std::string_view stage) {
+        if (stage == "stitch" && (fractions.empty() || f < 0.9)) fractions.push_back(f);
+        return true;
+    }));
+    EXPECT_GE(fractions.size(), 2u); // the accept's own 0 and at least one from inside the stitch
+    EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
     EXPECT_GT(report.facesAdded, 0u);
     EXPECT_EQ(session.undoCount(), 2u);
     EXPECT_NE(fingerprint(session.current()), before);

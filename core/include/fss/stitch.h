@@ -16,6 +16,7 @@
 
 #include "fss/camera.h"
 #include "fss/mesh.h"
+#include "fss/progress.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -128,7 +129,12 @@ struct StitchReport {
 ///        component could be stitched (the sentence gives the first reason). Strong guarantee: all checks of
 ///        a component run before \p current is touched, so an exception leaves \p current unchanged bit for
 ///        bit (short of running out of memory while a checked component is being applied).
+/// \throw CancelledError when \p progress asks to stop. It is asked before each component (and each trim
+///        round), never while one is being applied: \p current is then a valid mesh that holds the
+///        components glued in before — every invariant holds, but it is not the mesh of before the call.
+///        Callers that need all or nothing stitch a copy (Session::accept does).
 StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCamera,
-                         const StitchOptions& options = {}, std::span<const std::uint32_t> faceIds = {});
+                         const StitchOptions& options = {}, std::span<const std::uint32_t> faceIds = {},
+                         const Progress& progress = {});
 
 } // namespace fss
