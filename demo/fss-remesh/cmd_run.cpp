@@ -3,6 +3,7 @@
 // Replays a session file head-less (session_file.h) and reports what it made.
 #include "args.h"
 #include "commands.h"
+#include "stitch_json.h"
 
 #include "fss/camera.h"
 #include "fss/error.h"
@@ -72,24 +73,6 @@ private:
     Clock::time_point lastDraw_{};
     bool drawn_ = false;
 };
-
-Json stitchJson(const StitchReport& r) {
-    return Json{{"faces_removed", r.facesRemoved},
-                {"faces_added", r.facesAdded},
-                {"seam_edges", r.seamEdges},
-                {"seam_length", r.seamLength},
-                {"seam_faces", r.seamFaces},
-                {"seam_min_angle_deg", r.seamMinAngleDeg},
-                {"seam_frac_min_angle_above_25", r.seamFracMinAngleAbove25},
-                {"components_stitched", r.componentsStitched},
-                {"components_skipped", r.componentsSkipped},
-                {"pieces_stitched", r.piecesStitched},
-                {"patch_faces_trimmed", r.patchFacesTrimmed},
-                {"collapses", r.collapses},
-                {"flips", r.flips},
-                {"skipped", r.skipped},
-                {"seconds", r.seconds}};
-}
 
 const char* kindName(SessionEvent::Kind kind) {
     switch (kind) {
@@ -276,7 +259,7 @@ int runRun(const std::vector<std::string>& args) {
                 je["stitch_s"] = e.stitchSeconds;
             }
             je["seconds"] = e.seconds;
-            if (e.stitch) je["stitch"] = stitchJson(*e.stitch);
+            if (e.stitch) je["stitch"] = stitchReportJson<Json>(*e.stitch);
             events.push_back(std::move(je));
         }
         report["events"] = std::move(events);

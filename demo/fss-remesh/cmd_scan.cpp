@@ -3,6 +3,7 @@
 //                  [--fishbone "seed=X,Y[;dir=min|max][;h=PIXELS][;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...]"]
 #include "args.h"
 #include "commands.h"
+#include "stitch_json.h"
 
 #include "fss/camera.h"
 #include "fss/error.h"
@@ -256,25 +257,6 @@ ScanRun regularScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& c
     return run;
 }
 
-// The StitchReport with snake_case keys.
-nlohmann::json stitchJson(const StitchReport& r) {
-    return {{"faces_removed", r.facesRemoved},
-            {"faces_added", r.facesAdded},
-            {"seam_edges", r.seamEdges},
-            {"seam_length", r.seamLength},
-            {"seam_min_angle_deg", r.seamMinAngleDeg},
-            {"seam_frac_min_angle_above_25", r.seamFracMinAngleAbove25},
-            {"seam_faces", r.seamFaces},
-            {"components_stitched", r.componentsStitched},
-            {"components_skipped", r.componentsSkipped},
-            {"pieces_stitched", r.piecesStitched},
-            {"patch_faces_trimmed", r.patchFacesTrimmed},
-            {"collapses", r.collapses},
-            {"flips", r.flips},
-            {"skipped", r.skipped},
-            {"seconds", r.seconds}};
-}
-
 // The next free scan id of a mesh: one more than the largest props::faceScanId (0 when it has none).
 int nextScanId(const Mesh& mesh) {
     const auto [ids, has] = mesh.property_map<FaceIndex, std::int32_t>(props::faceScanId);
@@ -426,7 +408,7 @@ int runScan(const std::vector<std::string>& args) {
         writeMesh(result, outPath, WriteOptions{.binary = false});
         j["into"] = intoPath;
         j["scan_id"] = params.scan.scanId;
-        j["stitch"] = stitchJson(report);
+        j["stitch"] = stitchReportJson<nlohmann::json>(report);
         j["result"] = {{"vertices", result.number_of_vertices()}, {"faces", result.number_of_faces()}};
         j["timings_s"]["stitch"] = report.seconds;
         std::ostringstream text;
