@@ -155,18 +155,6 @@ struct Writer {
     }
 };
 
-const char* kindName(SessionEvent::Kind kind) {
-    switch (kind) {
-    case SessionEvent::Kind::Accept:
-        return "accept";
-    case SessionEvent::Kind::Undo:
-        return "undo";
-    case SessionEvent::Kind::Redo:
-        return "redo";
-    }
-    return "accept";
-}
-
 Json toJson(const SessionFile& file, const std::string& meshPathText) {
     const Writer w;
     if (file.renderer != "cpu" && file.renderer != "gpu")
@@ -190,7 +178,7 @@ Json toJson(const SessionFile& file, const std::string& meshPathText) {
     for (std::size_t i = 0; i < file.events.size(); ++i) {
         const SessionEvent& e = file.events[i];
         Json je;
-        je["kind"] = kindName(e.kind);
+        je["kind"] = sessionEventKindName(e.kind);
         if (e.kind == SessionEvent::Kind::Accept)
             je["step"] = w.step(e.step, "events[" + std::to_string(i) + "].step");
         events.push_back(std::move(je));
@@ -697,7 +685,7 @@ ReplayResult replaySession(const SessionFile& file, const RendererFactory& rende
         } catch (const CancelledError&) {
             throw;
         } catch (const InvalidInputError& err) {
-            throw InvalidInputError(name + ", " + label + " (" + kindName(e.kind) + "): " + err.what());
+            throw InvalidInputError(name + ", " + label + " (" + sessionEventKindName(e.kind) + "): " + err.what());
         }
         done.seconds = seconds(eventStart);
         result.events.push_back(std::move(done));
@@ -705,6 +693,18 @@ ReplayResult replaySession(const SessionFile& file, const RendererFactory& rende
     report(1.0, "done");
     result.totalSeconds = seconds(start);
     return result;
+}
+
+const char* sessionEventKindName(SessionEvent::Kind kind) {
+    switch (kind) {
+    case SessionEvent::Kind::Accept:
+        return "accept";
+    case SessionEvent::Kind::Undo:
+        return "undo";
+    case SessionEvent::Kind::Redo:
+        return "redo";
+    }
+    return "accept";
 }
 
 } // namespace fss

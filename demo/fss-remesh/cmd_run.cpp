@@ -74,18 +74,6 @@ private:
     bool drawn_ = false;
 };
 
-const char* kindName(SessionEvent::Kind kind) {
-    switch (kind) {
-    case SessionEvent::Kind::Accept:
-        return "accept";
-    case SessionEvent::Kind::Undo:
-        return "undo";
-    case SessionEvent::Kind::Redo:
-        return "redo";
-    }
-    return "?";
-}
-
 // The renderer factory for the replay: "cpu", "gpu" (fails without GL) or "auto" (GPU, else CPU).
 RendererFactory makeFactory(const std::string& kind, std::string& used, const std::string& command) {
     if (kind == "cpu") {
@@ -251,7 +239,7 @@ int runRun(const std::vector<std::string>& args) {
             const ReplayedEvent& e = replay.events[i];
             Json je;
             je["index"] = i;
-            je["kind"] = kindName(e.kind);
+            je["kind"] = sessionEventKindName(e.kind);
             if (e.kind == SessionEvent::Kind::Accept) {
                 je["grid"] = e.fishbone ? "fishbone" : "regular";
                 je["patch_faces"] = e.patchFaces;

@@ -118,6 +118,9 @@ SessionFile sessionFileFromJson(const std::string& text, const std::string& name
 /// cannot be read.
 SessionFile loadSessionFile(const std::filesystem::path& path, const SessionFileLoadOptions& options = {});
 
+/// The name of an event kind in session files and reports: "accept", "undo" or "redo".
+const char* sessionEventKindName(SessionEvent::Kind kind);
+
 /// What replaying one event took.
 struct ReplayedEvent {
     SessionEvent::Kind kind = SessionEvent::Kind::Accept;
