@@ -323,14 +323,16 @@ TEST(SessionFile, RelativeMeshPathIsRelativeToTheSessionFile) {
 class BadSessionFile : public ::testing::Test {
 protected:
     void SetUp() override {
-        mesh_ = writeTestMesh("session_file_bad.off", fss::shapes::icosahedron());
+        // Per-test file names: ctest runs the tests of this fixture as parallel processes.
+        name_ = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+        mesh_ = writeTestMesh("session_file_bad_" + name_ + ".off", fss::shapes::icosahedron());
         fss::SessionFile f = sampleFile(mesh_);
         good_ = Json::parse(fss::sessionFileToJson(f));
     }
-    // The message of loading \p text from a file "bad.session.json" next to the mesh (IoError), or
+    // The message of loading \p text from a file "bad_<test>.session.json" next to the mesh (IoError), or
     // "(no error)".
     std::string load(const std::string& text) {
-        const auto path = fss::test::tmpPath("bad.session.json");
+        const auto path = fss::test::tmpPath("bad_" + name_ + ".session.json");
         {
             std::ofstream out(path, std::ios::binary | std::ios::trunc);
             out << text;
@@ -349,6 +351,7 @@ protected:
     std::string load(const Json& j) { return load(j.dump(2)); }
     std::string load(const char* text) { return load(std::string(text)); }
     Json good_;
+    std::string name_;
     std::filesystem::path mesh_;
 };
 
