@@ -2,9 +2,10 @@
 //
 //   fss-demo [--view V] [--colormap C] [MESH]
 //   fss-demo --screenshot FILE.png [--view iso|+x|-x|+y|-y|+z|-z] [--colormap none|angle|valence|scan-id]
-//            [--size WxH] [--scan VIEW]... [--resolution N] [MESH]
+//            [--size WxH] [--scan VIEW]... [--resolution N] [MESH | --session FILE.json]
 //
-// Without MESH the bundled default mesh (CGAL's fandisk) is opened. --screenshot renders the window to
+// Without MESH the bundled default mesh (CGAL's fandisk) is opened. --session loads and replays a session
+// file (as File > Open Session) instead of opening a mesh; --scan steps then follow its last step. --screenshot renders the window to
 // FILE and exits: 0 on success, 1 with one sentence on stderr when it failed, 2 for a wrong command line.
 // Each --scan VIEW first takes a regular scan of the whole view from that standard view (at --resolution,
 // default 256) and accepts it, as a user would with Take scan and Accept.
@@ -32,7 +33,7 @@ namespace {
 
 const char* const kUsage =
     "usage: fss-demo [--screenshot FILE.png] [--view iso|+x|-x|+y|-y|+z|-z] [--colormap none|angle|valence|scan-id]\n"
-    "                [--size WxH] [--scan VIEW]... [--resolution N] [MESH]\n";
+    "                [--size WxH] [--scan VIEW]... [--resolution N] [MESH | --session FILE.json]\n";
 
 struct Options {
     std::string mesh = FSS_DEFAULT_MESH;
@@ -42,6 +43,7 @@ struct Options {
     int width = 1024, height = 768;
     std::vector<fss::StandardView> scans;
     int resolution = 256;
+    std::optional<std::string> session; // a session file to replay instead of opening the mesh
 };
 
 // Writes errors to stderr instead of opening a box (the --screenshot mode must never block).
@@ -72,6 +74,10 @@ std::optional<Options> parse(int argc, char** argv, bool& help) {
             const auto v = value("--screenshot");
             if (!v) return std::nullopt;
             o.screenshot = *v;
+        } else if (a == "--session") {
+            const auto v = value("--session");
+            if (!v) return std::nullopt;
+            o.session = *v;
         } else if (a == "--view") {
             const auto v = value("--view");
             if (!v) return std::nullopt;
@@ -131,6 +137,10 @@ std::optional<Options> parse(int argc, char** argv, bool& help) {
             haveMesh = true;
         }
     }
+    if (haveMesh && o.session) {
+        std::cerr << "Give either a mesh or --session, not both.\n" << kUsage;
+        return std::nullopt;
+    }
     return o;
 }
 
@@ -148,7 +158,7 @@ int main(int argc, char** argv) {
     // In --screenshot mode the mesh is read before any window exists, so that a bad file ends the program
     // with its one sentence and nothing else.
     std::optional<fss::Mesh> mesh;
-    if (options->screenshot) {
+    if (options->screenshot && !options->session) {
         try {
             mesh = fss::readMesh(options->mesh);
         } catch (const std::exception& e) {
@@ -171,8 +181,22 @@ int main(int argc, char** argv) {
     window.setColorMap(options->colorMap);
 
     if (options->screenshot) {
-        window.setMesh(std::move(*mesh),
-                       QString::fromStdString(std::filesystem::path(options->mesh).filename().string()));
+        if (options->session) {
+            QString failure;
+            QObject::connect(&window, &fss::demo::MainWindow::errorOccurred,
+                             [&failure](const QString& message) { failure = message; });
+            window.show(); // the replay's scans render in the view's GL context
+            QApplication::processEvents();
+            if (window.openSession(QString::fromStdString(*options->session)))
+                while (window.remeshWidget()->isLoadingSession()) {
+                    QApplication::processEvents(QEventLoop::AllEvents, 50);
+                    QThread::msleep(5);
+                }
+            if (!failure.isEmpty() || window.mesh().is_empty()) return 1; // the presenter printed why
+        } else {
+            window.setMesh(std::move(*mesh),
+                           QString::fromStdString(std::filesystem::path(options->mesh).filename().string()));
+        }
         if (!options->scans.empty()) {
             window.show(); // the scans use the view's camera at its final size
             QApplication::processEvents();
@@ -207,6 +231,9 @@ int main(int argc, char** argv) {
         return 0;
     }
     window.show();
-    window.openMesh(QString::fromStdString(options->mesh));
+    if (options->session)
+        window.openSession(QString::fromStdString(*options->session));
+    else
+        window.openMesh(QString::fromStdString(options->mesh));
     return app.exec();
 }

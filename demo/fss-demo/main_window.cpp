@@ -16,6 +16,7 @@
 #include <QSettings>
 #include <QStatusBar>
 #include <QThread>
+#include <QTimer>
 #include <QWindow>
 
 #include <utility>
@@ -39,8 +40,29 @@ MainWindow::MainWindow(std::unique_ptr<MessagePresenter> presenter, QWidget* par
     });
     // Errors of the remeshing work (a scan that sees nothing, a stitch that fails) go to the status bar;
     // file errors are shown by openMesh / saveMesh through the presenter.
-    connect(remesh_, &widgets::RemeshWidget::errorOccurred, this,
-            [this](const QString& message) { statusBar()->showMessage(message, 10000); });
+    connect(remesh_, &widgets::RemeshWidget::errorOccurred, this, [this](const QString& message) {
+        if (sessionPending_) { // a session replay failed: as serious as a bad file
+            sessionPending_ = false;
+            reportError(tr("Open session"), message);
+            return;
+        }
+        statusBar()->showMessage(message, 10000);
+    });
+    connect(remesh_, &widgets::RemeshWidget::sessionLoaded, this, [this](const QString& path) {
+        sessionPending_ = false;
+        meshPath_ = remesh_->meshPath();
+        meshName_ = QFileInfo(path).fileName();
+        addRecentFile(path);
+        updateStatistics();
+        emit sessionLoaded(path);
+    });
+    // A cancelled replay ends without a signal of its own: forget it once its errors had their turn.
+    connect(remesh_, &widgets::RemeshWidget::busyChanged, this, [this](bool busy) {
+        if (!busy)
+            QTimer::singleShot(0, this, [this] {
+                if (!remesh_->isLoadingSession()) sessionPending_ = false;
+            });
+    });
     createMenus();
     setWindowTitle(QStringLiteral("FSS demo"));
     resize(1024, 768);
@@ -53,6 +75,11 @@ void MainWindow::createMenus() {
     QMenu* file = menuBar()->addMenu(tr("&File"));
     file->addAction(tr("&Open…"), QKeySequence::Open, this, &MainWindow::openDialog);
     file->addAction(tr("&Save As…"), QKeySequence::SaveAs, this, &MainWindow::saveDialog);
+    file->addSeparator();
+    file->addAction(tr("Open Sess&ion…"), QKeySequence(tr("Ctrl+Shift+O")), this, &MainWindow::openSessionDialog);
+    file->addAction(tr("Save S&ession As…"), QKeySequence(tr("Ctrl+Shift+E")), this,
+                    &MainWindow::saveSessionDialog);
+    file->addSeparator();
     recentMenu_ = file->addMenu(tr("Open &Recent"));
     updateRecentMenu();
     file->addSeparator();
@@ -113,7 +140,7 @@ bool MainWindow::openMesh(const QString& path) {
     const QString previousPath = meshPath_, previousName = meshName_;
     meshPath_ = path;
     meshName_ = QFileInfo(path).fileName();
-    if (!remesh_->setMesh(mesh)) {
+    if (!remesh_->setMesh(mesh, path)) {
         meshPath_ = previousPath;
         meshName_ = previousName;
         reportError(tr("Open mesh"),
@@ -166,7 +193,12 @@ void MainWindow::updateRecentMenu() {
         const QString path = files[i];
         recentMenu_
             ->addAction(QStringLiteral("&%1 %2").arg(i + 1).arg(QFileInfo(path).fileName()), this,
-                        [this, path] { openMesh(path); })
+                        [this, path] {
+                            if (path.endsWith(QLatin1String(".json"), Qt::CaseInsensitive))
+                                openSession(path);
+                            else
+                                openMesh(path);
+                        })
             ->setToolTip(path);
     }
     recentMenu_->setEnabled(!files.isEmpty());
@@ -214,6 +246,50 @@ void MainWindow::saveDialog() {
         this, tr("Save mesh"), meshPath_,
         tr("PLY, keeps scan ids and quality (*.ply);;OFF (*.off);;OBJ (*.obj);;STL (*.stl)"));
     if (!path.isEmpty()) saveMesh(path);
+}
+
+bool MainWindow::openSession(const QString& path) {
+    QString error;
+    const auto capture = connect(remesh_, &widgets::RemeshWidget::errorOccurred, this,
+                                 [&error](const QString& message) { error = message; });
+    const bool started = remesh_->loadSession(path);
+    disconnect(capture);
+    if (!started) {
+        reportError(tr("Open session"), error);
+        return false;
+    }
+    sessionPending_ = true;
+    return true;
+}
+
+bool MainWindow::saveSession(const QString& path) {
+    QString error;
+    const auto capture = connect(remesh_, &widgets::RemeshWidget::errorOccurred, this,
+                                 [&error](const QString& message) { error = message; });
+    const bool saved = remesh_->saveSession(path);
+    disconnect(capture);
+    if (!saved) {
+        reportError(tr("Save session"), error);
+        return false;
+    }
+    addRecentFile(path);
+    statusBar()->showMessage(tr("Session saved to %1.").arg(QFileInfo(path).fileName()), 5000);
+    return true;
+}
+
+void MainWindow::openSessionDialog() {
+    const QString path = QFileDialog::getOpenFileName(this, tr("Open session"), QFileInfo(meshPath_).path(),
+                                                      tr("FSS sessions (*.json);;All files (*)"));
+    if (!path.isEmpty()) openSession(path);
+}
+
+void MainWindow::saveSessionDialog() {
+    const QString path = QFileDialog::getSaveFileName(this, tr("Save session"),
+                                                      QFileInfo(meshPath_).path() + QStringLiteral("/") +
+                                                          QFileInfo(meshPath_).completeBaseName() +
+                                                          QStringLiteral(".session.json"),
+                                                      tr("FSS sessions (*.json)"));
+    if (!path.isEmpty()) saveSession(path);
 }
 
 QString MainWindow::saveScreenshot(const QString& path) {

@@ -55,6 +55,14 @@ public:
     bool openMesh(const QString& path);
     /// Writes the current mesh to \p path (format by extension). On failure reports like openMesh.
     bool saveMesh(const QString& path);
+    /// Loads the session file \p path (RemeshWidget::loadSession): validates it and replays it with progress
+    /// and Cancel; the result and its history replace the current session when the replay has finished
+    /// (sessionLoaded()). A bad file or a failed replay is reported like openMesh's errors, and the previous
+    /// mesh stays. On success the file heads the recent files. \return whether the replay started
+    bool openSession(const QString& path);
+    /// Saves the session (input mesh path and SHA-256, every accepted scan, undo and redo) to \p path
+    /// (RemeshWidget::saveSession). On failure reports like openMesh. \return success
+    bool saveSession(const QString& path);
     /// Shows \p mesh under the display name \p name (used in the title and status bar).
     void setMesh(Mesh mesh, const QString& name);
 
@@ -83,6 +91,8 @@ signals:
     void errorOccurred(const QString& message);
     /// A new mesh is shown.
     void meshChanged();
+    /// openSession() has replayed \p path.
+    void sessionLoaded(const QString& path);
 
 private:
     void createMenus();
@@ -90,6 +100,8 @@ private:
     void updateStatistics();
     void openDialog();
     void saveDialog();
+    void openSessionDialog();
+    void saveSessionDialog();
     void addRecentFile(const QString& path);
     void updateRecentMenu();
 
@@ -100,6 +112,7 @@ private:
     std::vector<std::pair<widgets::ColorMap, QAction*>> colorActions_;
     QString meshPath_;
     QString meshName_;
+    bool sessionPending_ = false; // openSession started a replay whose errors go to the presenter
 };
 
 } // namespace fss::demo

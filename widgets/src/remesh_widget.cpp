@@ -2,6 +2,7 @@
 
 #include "fss/error.h"
 #include "fss/mesh_io.h"
+#include "fss/session_file.h"
 #include "fss/widgets/fishbone_tool.h"
 #include "fss/widgets/lasso_tool.h"
 #include "fss/widgets/quality_panel.h"
@@ -14,8 +15,8 @@
 #include <QAction>
 #include <QActionGroup>
 #include <QCoreApplication>
-#include <QElapsedTimer>
 #include <QEventLoop>
+#include <QFileInfo>
 #include <QGroupBox>
 #include <QHBoxLayout>
 #include <QLabel>
@@ -30,7 +31,9 @@
 #include <QUndoView>
 #include <QVBoxLayout>
 
+#include <algorithm>
 #include <atomic>
+#include <filesystem>
 #include <functional>
 #include <mutex>
 #include <string>
@@ -47,7 +50,25 @@ struct Job {
     std::string stage;
     std::string error; // set by the worker on failure
     bool cancelled = false;
+    // The bar shows base + span · (the work's own fraction): a session replay runs one work per event.
+    double base = 0, span = 1;
 };
+
+// Session options for a session of the widget: the view's GPU renderer (sharing its GL context; the CPU
+// renderer when the view has none, which sets *cpuFallback) or, with cpuRenderer, the CPU renderer.
+SessionOptions widgetSessionOptions(VtkView* view, bool cpuRenderer,
+                                    const std::shared_ptr<std::atomic<bool>>& cpuFallback,
+                                    const CurvatureOptions& curvature) {
+    SessionOptions options;
+    options.curvature = curvature;
+    options.renderer = [view, cpuRenderer, cpuFallback]() -> std::unique_ptr<MeshRenderer> {
+        if (!cpuRenderer)
+            if (auto renderer = bridge::createRenderer(view)) return renderer;
+        if (!cpuRenderer) *cpuFallback = true;
+        return std::make_unique<CpuMeshRenderer>();
+    };
+    return options;
+}
 
 QString sentence(const std::exception& e) {
     return QString::fromStdString(e.what());
@@ -60,6 +81,10 @@ QString sentence(const std::exception& e) {
 class AcceptCommand final : public QUndoCommand {
 public:
     AcceptCommand(RemeshWidget* widget, const QString& text) : QUndoCommand(text), widget_(widget) {}
+    static QString textOf(const ScanStep& step) {
+        return step.fishbone ? RemeshWidget::tr("Fishbone scan %1").arg(step.params.scan.scanId)
+                             : RemeshWidget::tr("Scan %1").arg(step.params.scan.scanId);
+    }
     void undo() override { widget_->undoStep(); }
     void redo() override {
         if (first_) {
@@ -74,8 +99,27 @@ private:
     bool first_ = true;
 };
 
+/// A session file being replayed by loadSession: the new session is built here and replaces the widget's
+/// only when every event has been applied.
+struct RemeshWidget::Replay {
+    SessionFile file;
+    QString path;      // the session file, as given
+    QString meshPath;  // its mesh
+    bool cpuRenderer = false;
+    std::unique_ptr<Session> session;
+    std::size_t next = 0; // the next event to apply
+};
+
 struct RemeshWidget::Impl {
     std::unique_ptr<Session> session;
+    QString meshPath;       // the reference's file, if any
+    bool cpuRenderer = false; // the session was made with the CPU renderer
+    // Set by the session's renderer factory when the view could not give a GPU renderer.
+    std::shared_ptr<std::atomic<bool>> cpuFallback = std::make_shared<std::atomic<bool>>(false);
+    CurvatureOptions curvature;        // the session's curvature options (saved in session files)
+    std::unique_ptr<Replay> replay;
+    std::shared_ptr<std::atomic<bool>> cpuFallbackPending; // the replayed session's cpuFallback
+    bool syncingStack = false; // pushing / undoing commands that only mirror the session's history
     Mesh empty;
     // The GUI thread's copy of the session's current mesh: the worker may be replacing the session's
     // own while the GUI reads this one.
@@ -105,7 +149,6 @@ struct RemeshWidget::Impl {
     std::shared_ptr<Job> job;
     QThread* thread = nullptr;
     QString busyWhat;
-    QElapsedTimer busyClock;
     bool updatingView = false;
     bool fishbonePending = false;
     std::int32_t nextScanId = 0;
@@ -245,10 +288,6 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     d.progressTimer->setInterval(250);
     connect(d.progressTimer, &QTimer::timeout, this, [this] {
         if (!d_->job) return;
-        if (d_->progress->maximum() == 0x7fffffff) {
-            d_->progress->setValue(int(d_->busyClock.elapsed() / 1000)); // elapsed seconds
-            return;
-        }
         d_->progress->setValue(int(1000 * d_->job->fraction.load()));
     });
 
@@ -301,28 +340,47 @@ RemeshWidget::~RemeshWidget() {
                        static_cast<Tool*>(d_->scanTool), static_cast<Tool*>(d_->fishbone)})
         tool->deactivate();
     d_->undoStack->clear();
+    d_->replay.reset();
     d_->session.reset(); // its renderers may use the view's GL context: before the view goes
 }
 
-bool RemeshWidget::setMesh(const Mesh& mesh) {
+bool RemeshWidget::setMesh(const Mesh& mesh, const QString& meshPath) {
     waitForWork();
+    if (d_->replay) {
+        reportError(tr("A session is being loaded: cancel it before setting a mesh."));
+        return false;
+    }
+    auto fallback = std::make_shared<std::atomic<bool>>(false);
     std::unique_ptr<Session> session;
     try {
-        SessionOptions options;
-        VtkView* view = d_->view;
-        options.renderer = [view]() -> std::unique_ptr<MeshRenderer> {
-            if (auto renderer = bridge::createRenderer(view)) return renderer;
-            return std::make_unique<CpuMeshRenderer>();
-        };
-        session = std::make_unique<Session>(mesh, std::move(options));
+        session = std::make_unique<Session>(mesh, widgetSessionOptions(d_->view, false, fallback, {}));
     } catch (const std::exception& e) {
         reportError(sentence(e));
         return false;
     }
+    d_->cpuFallback = fallback;
+    installSession(std::move(session), meshPath, false, {});
+    return true;
+}
+
+void RemeshWidget::installSession(std::unique_ptr<Session> session, const QString& meshPath, bool cpuRenderer,
+                                  const CurvatureOptions& curvature) {
     d_->undoStack->clear();
     d_->session = std::move(session);
+    d_->meshPath = meshPath;
+    d_->cpuRenderer = cpuRenderer;
+    d_->curvature = curvature;
     d_->mesh = d_->session->current();
-    d_->nextScanId = 0;
+    // Mirror the session's history on the undo stack: applied steps, then the redo-able ones undone.
+    const std::vector<ScanStep> steps = d_->session->steps();
+    d_->syncingStack = true;
+    for (const ScanStep& step : steps) d_->undoStack->push(new AcceptCommand(this, AcceptCommand::textOf(step)));
+    for (std::size_t i = 0; i < d_->session->redoCount(); ++i) d_->undoStack->undo();
+    d_->syncingStack = false;
+    std::int32_t nextId = 0;
+    for (const SessionEvent& e : d_->session->events())
+        if (e.kind == SessionEvent::Kind::Accept) nextId = std::max(nextId, e.step.params.scan.scanId + 1);
+    d_->nextScanId = nextId;
     d_->lasso->clear();
     d_->fishbone->clear();
     bridge::setPreview(d_->view, nullptr);
@@ -333,10 +391,11 @@ bool RemeshWidget::setMesh(const Mesh& mesh) {
     d_->qualityPanel->setMesh(d_->mesh);
     d_->scanPanel->updateEdgeLength(d_->view->camera(), boundingBox(d_->session->reference()).center());
     d_->scanTool->setPreviewPending(false);
+    d_->undoAction->setEnabled(!isBusy() && d_->undoStack->canUndo());
+    d_->redoAction->setEnabled(!isBusy() && d_->undoStack->canRedo());
     updateStatus();
     emit previewChanged();
     emit meshChanged();
-    return true;
 }
 
 bool RemeshWidget::openMesh(const QString& path) {
@@ -347,7 +406,145 @@ bool RemeshWidget::openMesh(const QString& path) {
         reportError(sentence(e));
         return false;
     }
-    return setMesh(mesh);
+    return setMesh(mesh, path);
+}
+
+QString RemeshWidget::meshPath() const {
+    return d_->meshPath;
+}
+
+bool RemeshWidget::saveSession(const QString& path) {
+    waitForWork();
+    try {
+        if (!d_->session) throw InvalidInputError("There is no session to save: open a mesh first.");
+        if (path.isEmpty()) throw InvalidInputError("The session file name is empty.");
+        const std::filesystem::path file = path.toStdString();
+        std::filesystem::path meshFile = d_->meshPath.toStdString();
+        if (meshFile.empty()) {
+            // The reference came from memory: write it next to the session file, exactly.
+            meshFile = file.parent_path() / (file.stem().string() + ".input.off");
+            WriteOptions exact;
+            exact.precision = 17;
+            writeMesh(d_->session->reference(), meshFile, exact);
+        }
+        const bool cpu = d_->cpuRenderer || d_->cpuFallback->load();
+        saveSessionFile(sessionFileFromSession(*d_->session, meshFile, cpu ? "cpu" : "gpu", d_->curvature), file);
+        if (d_->meshPath.isEmpty()) d_->meshPath = QString::fromStdString(meshFile.string());
+    } catch (const std::exception& e) {
+        reportError(sentence(e));
+        return false;
+    }
+    return true;
+}
+
+bool RemeshWidget::isLoadingSession() const {
+    return d_->replay != nullptr;
+}
+
+bool RemeshWidget::loadSession(const QString& path) {
+    if (isBusy()) {
+        reportError(tr("Work is running: wait for it or cancel it before loading a session."));
+        return false;
+    }
+    auto r = std::make_unique<Replay>();
+    r->path = path;
+    auto fallback = std::make_shared<std::atomic<bool>>(false);
+    try {
+        r->file = loadSessionFile(path.toStdString());
+        r->meshPath = QString::fromStdString(r->file.meshPath.string());
+        r->cpuRenderer = r->file.renderer == "cpu";
+        Mesh mesh = readMesh(r->file.meshPath);
+        r->session = std::make_unique<Session>(
+            std::move(mesh), widgetSessionOptions(d_->view, r->cpuRenderer, fallback, r->file.curvature));
+    } catch (const std::exception& e) {
+        reportError(sentence(e));
+        return false;
+    }
+    d_->replay = std::move(r);
+    d_->cpuFallbackPending = fallback;
+    setBusy(true, tr("Replaying %1").arg(QFileInfo(path).fileName()));
+    replayNext();
+    return true;
+}
+
+void RemeshWidget::failReplay(const QString& message) {
+    d_->replay.reset();
+    d_->cpuFallbackPending.reset();
+    setBusy(false);
+    if (message.isEmpty())
+        d_->status->setText(tr("Loading the session was cancelled; the previous mesh is kept."));
+    else
+        reportError(message);
+}
+
+void RemeshWidget::replayNext() {
+    Replay& r = *d_->replay;
+    const std::vector<SessionEvent>& events = r.file.events;
+    const auto where = [&r](std::size_t i, const QString& why) {
+        return tr("%1, events[%2]: %3").arg(QFileInfo(r.path).fileName()).arg(i).arg(why);
+    };
+    while (r.next < events.size()) {
+        if (d_->job->cancel.load()) return failReplay({});
+        const std::size_t i = r.next;
+        const SessionEvent& e = events[i];
+        Session* s = r.session.get();
+        d_->job->base = double(i) / double(events.size());
+        d_->job->span = 1.0 / double(events.size());
+        d_->job->fraction = d_->job->base;
+        try {
+            if (e.kind == SessionEvent::Kind::Undo) {
+                s->undo();
+                ++r.next;
+                continue;
+            }
+            if (e.kind == SessionEvent::Kind::Redo) {
+                s->redo();
+                ++r.next;
+                continue;
+            }
+            if (e.step.fishbone && (!s->fishboneCache().hasCurvature(s->reference()) ||
+                                    !s->fishboneCache().hasRayCaster(s->reference()))) {
+                // The curvature of the reference, once, on the worker thread; then this event again.
+                startWork(
+                    [s](const Progress& progress) {
+                        s->fishboneCache().curvature(s->reference(), {}, progress);
+                        s->fishboneCache().rayCaster(s->reference());
+                    },
+                    [this, where, i] {
+                        if (!d_->job->error.empty())
+                            return failReplay(where(i, QString::fromStdString(d_->job->error)));
+                        if (d_->job->cancelled) return failReplay({});
+                        replayNext();
+                    });
+                return;
+            }
+            s->scan(e.step); // needs the view's GL context: GUI thread
+        } catch (const std::exception& ex) {
+            return failReplay(where(i, sentence(ex)));
+        }
+        startWork([s](const Progress& progress) { s->accept(progress); },
+                  [this, where, i] {
+                      if (!d_->job->error.empty())
+                          return failReplay(where(i, QString::fromStdString(d_->job->error)));
+                      if (d_->job->cancelled) return failReplay({});
+                      ++d_->replay->next;
+                      replayNext();
+                  });
+        return;
+    }
+    finishReplay();
+}
+
+void RemeshWidget::finishReplay() {
+    std::unique_ptr<Replay> r = std::move(d_->replay);
+    const bool fellBack = !r->cpuRenderer && d_->cpuFallbackPending->load();
+    d_->cpuFallback = std::move(d_->cpuFallbackPending);
+    setBusy(false);
+    installSession(std::move(r->session), r->meshPath, r->cpuRenderer, r->file.curvature);
+    if (fellBack)
+        d_->status->setText(tr("The session was recorded with the GPU renderer, which this view cannot "
+                               "give; it was replayed with the CPU renderer and may differ slightly."));
+    emit sessionLoaded(r->path);
 }
 
 const Mesh& RemeshWidget::mesh() const {
@@ -420,7 +617,7 @@ bool RemeshWidget::hasPreview() const {
     return d_->session && !isBusy() && d_->session->preview();
 }
 bool RemeshWidget::isBusy() const {
-    return d_->thread != nullptr;
+    return d_->thread != nullptr || d_->replay != nullptr;
 }
 QString RemeshWidget::statusText() const {
     return d_->status->text();
@@ -492,28 +689,8 @@ void RemeshWidget::runFishbone() {
         // Started through the job runner below; on success the fishbone scan is run.
         d_->fishbonePending = true;
         setBusy(true, tr("Estimating the curvature of the input mesh"));
-        auto job = d_->job;
-        d_->thread = QThread::create([job, work] {
-            const Progress progress([job](double f, std::string_view stage) {
-                job->fraction = f;
-                {
-                    const std::lock_guard lock(job->mutex);
-                    job->stage = std::string(stage);
-                }
-                return f >= 1.0 || !job->cancel.load();
-            });
-            try {
-                work(progress);
-            } catch (const CancelledError&) {
-                job->cancelled = true;
-            } catch (const std::exception& e) {
-                job->error = e.what();
-            }
-        });
-        QThread* thread = d_->thread;
-        connect(thread, &QThread::finished, this, [this, job, thread] {
-            thread->deleteLater();
-            d_->thread = nullptr;
+        startWork(work, [this] {
+            const std::shared_ptr<Job> job = d_->job;
             setBusy(false);
             if (!job->error.empty()) {
                 d_->fishbonePending = false;
@@ -527,7 +704,6 @@ void RemeshWidget::runFishbone() {
                 runFishbone();
             }
         });
-        thread->start();
         return;
     }
     try {
@@ -555,24 +731,46 @@ void RemeshWidget::accept() {
         return;
     }
     Session* s = d_->session.get();
-    const bool fishbone = s->preview()->step.fishbone.has_value();
-    const QString text = fishbone ? tr("Fishbone scan %1").arg(s->preview()->step.params.scan.scanId)
-                                  : tr("Scan %1").arg(s->preview()->step.params.scan.scanId);
+    const QString text = AcceptCommand::textOf(s->preview()->step);
     auto report = std::make_shared<StitchReport>();
     setBusy(true, tr("Stitching the scan into the mesh"));
+    startWork([s, report](const Progress& progress) { *report = s->accept(progress); },
+              [this, report, text] {
+                  const std::shared_ptr<Job> job = d_->job;
+                  setBusy(false);
+                  if (!job->error.empty()) {
+                      reportError(QString::fromStdString(job->error));
+                      return;
+                  }
+                  if (job->cancelled) {
+                      d_->status->setText(tr("Stitching was cancelled; the preview is kept."));
+                      return;
+                  }
+                  d_->undoStack->push(new AcceptCommand(this, text));
+                  if (d_->fishbone->hasInput()) {
+                      const QSignalBlocker blocker(d_->fishbone); // the accepted grid is done: no rescan
+                      d_->fishbone->clear();
+                  }
+                  d_->lasso->clear();
+                  afterMeshChange();
+                  emit scanAccepted(*report);
+              });
+}
+
+void RemeshWidget::startWork(std::function<void(const Progress&)> work, std::function<void()> done) {
     auto job = d_->job;
-    // Session::accept reports only its start and end: the bar shows the elapsed time instead of a busy
-    // animation (which would repaint the whole GL-composed window many times a second on a software GL).
-    d_->progress->setFormat(tr("stitching… %v s"));
-    d_->progress->setRange(0, 0x7fffffff);
-    d_->thread = QThread::create([job, s, report] {
-        const Progress progress([job](double f, std::string_view) {
-            job->fraction = f;
-            // Never cancel on the final report: the stitch is committed by then.
+    d_->thread = QThread::create([job, work = std::move(work)] {
+        const Progress progress([job](double f, std::string_view stage) {
+            job->fraction = job->base + job->span * f;
+            {
+                const std::lock_guard lock(job->mutex);
+                job->stage = std::string(stage);
+            }
+            // Never cancel on the final report: the work is committed by then.
             return f >= 1.0 || !job->cancel.load();
         });
         try {
-            *report = s->accept(progress);
+            work(progress);
         } catch (const CancelledError&) {
             job->cancelled = true;
         } catch (const std::exception& e) {
@@ -580,26 +778,10 @@ void RemeshWidget::accept() {
         }
     });
     QThread* thread = d_->thread;
-    connect(thread, &QThread::finished, this, [this, job, thread, report, text] {
+    connect(thread, &QThread::finished, this, [this, thread, done = std::move(done)] {
         thread->deleteLater();
         d_->thread = nullptr;
-        setBusy(false);
-        if (!job->error.empty()) {
-            reportError(QString::fromStdString(job->error));
-            return;
-        }
-        if (job->cancelled) {
-            d_->status->setText(tr("Stitching was cancelled; the preview is kept."));
-            return;
-        }
-        d_->undoStack->push(new AcceptCommand(this, text));
-        if (d_->fishbone->hasInput()) {
-            const QSignalBlocker blocker(d_->fishbone); // the accepted grid is done: no rescan
-            d_->fishbone->clear();
-        }
-        d_->lasso->clear();
-        afterMeshChange();
-        emit scanAccepted(*report);
+        done();
     });
     thread->start();
 }
@@ -629,6 +811,7 @@ void RemeshWidget::setGhostVisible(bool visible) {
 }
 
 void RemeshWidget::undoStep() {
+    if (d_->syncingStack) return; // the stack only mirrors the session's history
     waitForWork();
     try {
         d_->session->undo();
@@ -640,6 +823,7 @@ void RemeshWidget::undoStep() {
 }
 
 void RemeshWidget::redoStep() {
+    if (d_->syncingStack) return;
     waitForWork();
     try {
         d_->session->redo();
@@ -679,7 +863,6 @@ void RemeshWidget::setBusy(bool busy, const QString& what) {
     if (busy) {
         d_->job = std::make_shared<Job>();
         d_->busyWhat = what;
-        d_->busyClock.start();
         d_->progress->setFormat(QStringLiteral("%p%"));
         d_->progress->setRange(0, 1000);
         d_->progress->setValue(0);

@@ -19,6 +19,7 @@
 #include <QString>
 #include <QWidget>
 
+#include <functional>
 #include <memory>
 
 class QAction;
@@ -51,9 +52,10 @@ public:
 
     /// Starts a new session on a copy of \p mesh (the reference): the history is cleared, the view shows
     /// the mesh from the initial view. Waits for running work first. An empty, non-triangle or invalid
-    /// mesh is refused: errorOccurred() with one sentence, the previous mesh stays.
+    /// mesh is refused: errorOccurred() with one sentence, the previous mesh stays. \p meshPath names the
+    /// file \p mesh was read from, if any (meshPath(); session files refer to it).
     /// \return whether the mesh was taken.
-    bool setMesh(const Mesh& mesh);
+    bool setMesh(const Mesh& mesh, const QString& meshPath = {});
     /// Reads \p path (fss::readMesh: OFF, OBJ, PLY, STL) and calls setMesh(). On failure the previous
     /// mesh stays and errorOccurred() carries the reader's sentence. \return success
     bool openMesh(const QString& path);
@@ -66,6 +68,31 @@ public:
     /// Writes mesh() to \p path (fss::writeMesh; format by extension). On failure errorOccurred().
     /// \return success
     bool saveMesh(const QString& path);
+    /// The file the reference mesh was read from (openMesh, loadSession; or the file saveSession wrote
+    /// for a mesh given to setMesh); empty otherwise.
+    QString meshPath() const;
+
+    /// Saves the session as a session file (session_file.h): the reference mesh's path and SHA-256, the
+    /// renderer kind, and the event log (every accepted scan, undo and redo). A pending preview is not
+    /// part of it. When the reference has no file (it was given to setMesh), it is first written next to
+    /// \p path as "<name>.input.off" (17 significant digits: the replayed reference is bit-identical).
+    /// Replaying the file (loadSession, `fss-remesh run`, fss::replaySession) with the same renderer kind
+    /// reproduces mesh() exactly. Waits for running work first. On failure errorOccurred() (nothing is
+    /// half-written). \return success
+    bool saveSession(const QString& path);
+    /// Loads a session file: validates it (errors name the offending field), reads its mesh, and replays
+    /// its events on a new session — each scan on the GUI thread, each stitch and the curvature estimate
+    /// on the worker thread, with progress over all events and Cancel. Only when every event has been
+    /// replayed does the new session replace the current one (the undo stack then holds its steps, the
+    /// undone ones redo-able); on a bad file, a failed event or Cancel, the current mesh and history stay
+    /// and errorOccurred() says why (Cancel only sets the status line). The renderer is the recorded kind:
+    /// "gpu" uses the view's GL context (the CPU renderer when the view has none; the status line then
+    /// says the result may differ slightly from the recording), "cpu" the CPU renderer.
+    /// \return whether the replay started (false: the file was refused, or work is running); the result
+    ///         comes later by sessionLoaded() or errorOccurred().
+    bool loadSession(const QString& path);
+    /// Whether a session file is being replayed (loadSession).
+    bool isLoadingSession() const;
 
     /// The undo stack: one command per accepted scan. Prefer undoAction() / redoAction(), which are
     /// disabled while work runs; calling undo()/redo() on the stack meanwhile waits for the work to end.
@@ -115,8 +142,9 @@ public slots:
     void accept();
     /// Drops the preview.
     void reject();
-    /// Asks running work to stop (honoured at the next progress report; a stitch that has started runs
-    /// to its end, since Session::accept has no intermediate report).
+    /// Asks running work to stop, honoured at its next progress report: a stitch stops between patch
+    /// components and trim rounds (Session::accept then leaves the mesh unchanged and the preview stays),
+    /// the curvature estimate between vertex blocks, a session replay (loadSession) at once.
     void cancel();
     /// Shows or hides the reference as a translucent ghost.
     void setGhostVisible(bool visible);
@@ -134,6 +162,8 @@ signals:
     void busyChanged(bool busy);
     /// A preview appeared or went away.
     void previewChanged();
+    /// loadSession() replayed \p path: mesh() is its result and undoStack() its history.
+    void sessionLoaded(const QString& path);
 
 private:
     struct Impl;
@@ -141,8 +171,15 @@ private:
     bool ghost_ = false;
 
     friend class AcceptCommand;
+    struct Replay;
     void undoStep();
     void redoStep();
+    void installSession(std::unique_ptr<Session> session, const QString& meshPath, bool cpuRenderer,
+                        const CurvatureOptions& curvature);
+    void startWork(std::function<void(const Progress&)> work, std::function<void()> done);
+    void replayNext();
+    void finishReplay();
+    void failReplay(const QString& message);
     void afterMeshChange();
     void showPreview();
     void runFishbone();
