@@ -77,6 +77,71 @@ public:
         return winding != 0;
     }
 
+    // inside() for every point of a row: points (xs[j], y), xs non-decreasing and finite, y finite; out[j]
+    // = 1 when inside, else 0. The same exact decisions as inside() point by point: for a fixed y, the
+    // orientation of an edge's line towards (x, y) is the sign of a linear function of x, so along the row
+    // it changes at most twice (left, collinear, right, or the reverse); binary searches with the exact
+    // predicate find those places, and each edge adds its winding to a range of the row. O(k log n + n)
+    // for k edges in the row's band instead of O(k n) predicates.
+    void insideRow(const std::vector<double>& xs, double y, std::vector<std::uint8_t>& out,
+                   std::vector<int>& diff) const {
+        const std::size_t n = xs.size();
+        out.assign(n, 0);
+        if (points_.empty() || n == 0 || !(y >= y0_ && y <= y1_)) return;
+        diff.assign(n + 1, 0);
+        std::vector<std::uint8_t>& boundary = out; // set to 2 where a point lies on an edge
+        const std::size_t m = points_.size();
+        for (std::uint32_t i : bands_[std::size_t(band(y))]) {
+            const Point2& a = points_[i];
+            const Point2& b = points_[(i + 1) % m];
+            auto orient = [&](std::size_t j) { return CGAL::orientation(a, b, Point2(xs[j], y)); };
+            // First index in [0, n) where pred holds, pred being monotone (false … false true … true).
+            auto firstWhere = [&](auto pred) {
+                std::size_t lo = 0, hi = n;
+                while (lo < hi) {
+                    const std::size_t mid = lo + (hi - lo) / 2;
+                    if (pred(orient(mid))) hi = mid;
+                    else lo = mid + 1;
+                }
+                return lo;
+            };
+            // The orientation as a function of x has the sign of −(b.y − a.y): decreasing when the edge
+            // goes up in y (left, collinear, right), increasing when it goes down, constant when level.
+            std::size_t collinearBegin = 0, collinearEnd = 0;
+            if (b.y() > a.y()) {
+                collinearBegin = firstWhere([](CGAL::Orientation o) { return o != CGAL::LEFT_TURN; });
+                collinearEnd = firstWhere([](CGAL::Orientation o) { return o == CGAL::RIGHT_TURN; });
+                if (a.y() <= y && b.y() > y) { // left turns count +1
+                    diff[0] += 1;
+                    diff[collinearBegin] -= 1;
+                }
+            } else if (b.y() < a.y()) {
+                collinearBegin = firstWhere([](CGAL::Orientation o) { return o != CGAL::RIGHT_TURN; });
+                collinearEnd = firstWhere([](CGAL::Orientation o) { return o == CGAL::LEFT_TURN; });
+                if (b.y() <= y) { // a.y > y here is implied by the case below; right turns count −1
+                    if (a.y() > y) {
+                        diff[0] -= 1;
+                        diff[collinearBegin] += 1;
+                    }
+                }
+            } else if (orient(0) == CGAL::COLLINEAR) { // level edge on the row's line
+                collinearBegin = 0;
+                collinearEnd = n;
+            }
+            const double xmin = std::min(a.x(), b.x()), xmax = std::max(a.x(), b.x());
+            const double ymin = std::min(a.y(), b.y()), ymax = std::max(a.y(), b.y());
+            if (ymin <= y && y <= ymax)
+                for (std::size_t j = collinearBegin; j < collinearEnd; ++j)
+                    if (xmin <= xs[j] && xs[j] <= xmax) boundary[j] = 2;
+        }
+        int winding = 0;
+        for (std::size_t j = 0; j < n; ++j) {
+            winding += diff[j];
+            const bool inBox = xs[j] >= x0_ && xs[j] <= x1_;
+            out[j] = inBox && (boundary[j] == 2 || winding != 0) ? 1 : 0;
+        }
+    }
+
 private:
     int band(double y) const {
         if (!(bandHeight_ > 0)) return 0;
@@ -179,11 +244,28 @@ std::size_t applyLasso(SampleGrid& grid, const Lasso& lasso) {
     const int blocks = detail::rowBlocks(grid.rows, 16);
     std::vector<std::size_t> dropped(std::size_t(blocks), 0);
     detail::parallelRows(grid.rows, blocks, [&](int block, int rowBegin, int rowEnd) {
-        for (std::size_t i = grid.index(rowBegin, 0), end = grid.index(rowEnd, 0); i < end; ++i) {
-            Sample& s = grid.samples[i];
-            if (!s.admissible || index.inside(s.screen)) continue;
-            s.admissible = s.valid = false;
-            ++dropped[std::size_t(block)];
+        std::vector<double> xs;
+        std::vector<std::uint8_t> inside;
+        std::vector<int> diff;
+        for (int r = rowBegin; r < rowEnd; ++r) {
+            Sample* row = grid.samples.data() + grid.index(r, 0);
+            const std::size_t n = std::size_t(grid.cols);
+            // A row of one finite y and non-decreasing finite x (every regular grid) is decided at once;
+            // any other row (fishbone grids) sample by sample. Both give inside()'s exact answers.
+            bool asRow = n > 0 && std::isfinite(row[0].screen.y());
+            xs.resize(n);
+            for (std::size_t j = 0; j < n && asRow; ++j) {
+                xs[j] = row[j].screen.x();
+                asRow = row[j].screen.y() == row[0].screen.y() && std::isfinite(xs[j]) &&
+                        (j == 0 || xs[j - 1] <= xs[j]);
+            }
+            if (asRow) index.insideRow(xs, row[0].screen.y(), inside, diff);
+            for (std::size_t j = 0; j < n; ++j) {
+                Sample& s = row[j];
+                if (!s.admissible || (asRow ? inside[j] != 0 : index.inside(s.screen))) continue;
+                s.admissible = s.valid = false;
+                ++dropped[std::size_t(block)];
+            }
         }
     });
     return std::accumulate(dropped.begin(), dropped.end(), std::size_t(0));

@@ -52,25 +52,37 @@ struct JudgeLimits {
     double cosMaxAngle; // cos(maxAngle)
 };
 
-// The 3D tests of a candidate whose screen orientation is already known to be the grid's.
-Verdict judge(const SampleGrid& grid, const Triangle& t, const Viewer& viewer, const JudgeLimits& limits) {
+// Per-sample flags of usableSample (one byte per sample): the tests of judge() that depend on one sample
+// only, computed once per sample instead of once per triangle (a sample is a corner of up to six).
+constexpr std::uint8_t kUsable = 1, kReferenceBackFacing = 2, kSampleGrazing = 4;
+
+std::uint8_t sampleFlags(const Sample& s, const Viewer& viewer, const JudgeLimits& limits) {
+    if (!usable(s)) return 0;
+    std::uint8_t f = kUsable;
+    if (s.normal.squaredNorm() > 0 && !(s.normal.dot(viewer.towards(s.point)) > 0)) f |= kReferenceBackFacing;
+    if (double(s.samplingAngle) > limits.maxAngle) f |= kSampleGrazing;
+    return f;
+}
+
+// The 3D tests of a candidate whose screen orientation is already known to be the grid's; \p flags are
+// the sampleFlags of the grid's samples.
+Verdict judge(const SampleGrid& grid, const std::uint8_t* flags, const Triangle& t, const Viewer& viewer,
+              const JudgeLimits& limits) {
     const Sample& a = grid.samples[t[0]];
     const Sample& b = grid.samples[t[1]];
     const Sample& c = grid.samples[t[2]];
+    const std::uint8_t corners = flags[t[0]] | flags[t[1]] | flags[t[2]];
     const Eigen::Vector3d centroid = (a.point + b.point + c.point) / 3.0;
     const Eigen::Vector3d toViewer = viewer.towards(centroid);
     const Eigen::Vector3d normal = (b.point - a.point).cross(c.point - a.point);
     if (!(normal.dot(toViewer) > 0)) return Verdict::BackFacing;
-    for (const Sample* s : {&a, &b, &c})
-        if (s->normal.squaredNorm() > 0 && !(s->normal.dot(viewer.towards(s->point)) > 0))
-            return Verdict::BackFacing;
+    if (corners & kReferenceBackFacing) return Verdict::BackFacing;
     for (auto [u, v] : {std::pair{&a, &b}, std::pair{&b, &c}, std::pair{&c, &a}}) {
         const double limit = limits.maxEdgeFootprints * std::min(double(u->footprint), double(v->footprint));
         // Squared lengths: no square root in the innermost test.
         if (!(limit >= 0 && (u->point - v->point).squaredNorm() <= limit * limit)) return Verdict::LongEdge;
     }
-    for (const Sample* s : {&a, &b, &c})
-        if (double(s->samplingAngle) > limits.maxAngle) return Verdict::Grazing;
+    if (corners & kSampleGrazing) return Verdict::Grazing;
     if (normal.normalized().dot(toViewer.normalized()) < limits.cosMaxAngle) return Verdict::Grazing;
     return Verdict::Keep;
 }
@@ -179,12 +191,17 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
     patch.vertexOfSample.assign(grid.samples.size(), Mesh::null_vertex());
     TriangulateReport& report = patch.report;
 
-    // Usable samples as one byte each: every sample is a corner of up to four quads.
+    const Viewer viewer(grid.camera);
+    const double maxAngle = options.maxSamplingAngleDeg * std::numbers::pi / 180.0;
+    const JudgeLimits limits{options.maxEdgeFootprints, maxAngle, std::cos(maxAngle)};
+
+    // Usable samples and their own tests (sampleFlags) as one byte each: every sample is a corner of up to
+    // four quads and six triangles.
     const std::size_t sampleCount = grid.samples.size();
     std::vector<std::uint8_t> usableSample(sampleCount);
     detail::parallelRows(grid.rows, detail::rowBlocks(grid.rows, 64), [&](int, int rowBegin, int rowEnd) {
         for (std::size_t i = grid.index(rowBegin, 0), e = grid.index(rowEnd, 0); i < e; ++i)
-            usableSample[i] = usable(grid.samples[i]) ? 1 : 0;
+            usableSample[i] = sampleFlags(grid.samples[i], viewer, limits);
     });
 
     // Candidates: both triangles of every quad with four usable corners, split along (r,c)–(r+1,c+1),
@@ -205,7 +222,7 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
             const std::uint8_t* top = usableSample.data() + grid.index(r, 0);
             const std::uint8_t* bottom = usableSample.data() + grid.index(r + 1, 0);
             for (int c = 0; c + 1 < grid.cols; ++c) {
-                if (!(top[c] & top[c + 1] & bottom[c] & bottom[c + 1])) continue;
+                if (!(top[c] & top[c + 1] & bottom[c] & bottom[c + 1] & kUsable)) continue;
                 const auto i00 = std::uint32_t(grid.index(r, c)), i01 = std::uint32_t(grid.index(r, c + 1)),
                            i10 = std::uint32_t(grid.index(r + 1, c)),
                            i11 = std::uint32_t(grid.index(r + 1, c + 1));
@@ -230,9 +247,6 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
     // orientation too: the grid's orientation is then RIGHT_TURN again).
     const bool mirrored = leftTurns > rightTurns;
 
-    const Viewer viewer(grid.camera);
-    const double maxAngle = options.maxSamplingAngleDeg * std::numbers::pi / 180.0;
-    const JudgeLimits limits{options.maxEdgeFootprints, maxAngle, std::cos(maxAngle)};
     // Judge each block's candidates in place (kept ones compacted to the front), then concatenate.
     std::vector<std::array<std::size_t, 5>> verdicts(std::size_t(blocks), std::array<std::size_t, 5>{});
     detail::parallelRows(blocks, blocks, [&](int b, int, int) {
@@ -242,7 +256,8 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
             Triangle t = in.candidates[k];
             CGAL::Orientation o = in.orientation[k];
             if (mirrored) std::swap(t[1], t[2]), o = CGAL::Orientation(-int(o));
-            const Verdict v = o != CGAL::RIGHT_TURN ? Verdict::Flipped : judge(grid, t, viewer, limits);
+            const Verdict v = o != CGAL::RIGHT_TURN ? Verdict::Flipped
+                                                    : judge(grid, usableSample.data(), t, viewer, limits);
             ++verdicts[std::size_t(b)][std::size_t(v)];
             if (v == Verdict::Keep) in.candidates[kept++] = t;
         }

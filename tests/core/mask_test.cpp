@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -162,6 +163,78 @@ TEST(Lasso, PentagramUsesNonZeroRule) {
     EXPECT_EQ(g.validCount(), expected);
     EXPECT_GT(inCentre, 20u);
     EXPECT_TRUE(fss::insideLasso(star, centre)); // even-odd would say outside
+}
+
+// applyLasso decides a row of one y and non-decreasing x at once (binary searches with the exact
+// predicate per edge) and other rows sample by sample; both must give insideLasso's answer for every
+// sample. Random lassos with corners on the quarter-pixel lattice put corners on sample centres, level
+// edges on sample rows and edges through many centres (the boundary cases); self-intersecting ones test
+// the winding. Grids: regular, with repeated x, mirrored rows (x decreasing) and a row with a NaN.
+TEST(Lasso, RowsAtOnceMatchThePointTest) {
+    std::uint64_t state = 12345;
+    auto next = [&] { // xorshift64*, deterministic on every platform
+        state ^= state >> 12, state ^= state << 25, state ^= state >> 27;
+        return (state * 2685821657736338717ULL) >> 11;
+    };
+    const int rows = 23, cols = 31;
+    std::size_t boundaryHits = 0, insideTotal = 0, outsideTotal = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+        Lasso lasso;
+        const int m = 3 + int(next() % 12);
+        for (int k = 0; k < m; ++k)
+            lasso.points.emplace_back(double(next() % (4 * cols + 9)) / 4.0 - 1.0,
+                                      double(next() % (4 * rows + 9)) / 4.0 - 1.0);
+        try {
+            fss::validateLasso(lasso);
+        } catch (const fss::InvalidInputError&) {
+            continue;
+        }
+        for (int layout = 0; layout < 4; ++layout) {
+            SampleGrid g = flatGrid(rows, cols);
+            for (int r = 0; r < rows; ++r)
+                for (int c = 0; c < cols; ++c) {
+                    fss::Sample& s = g.at(r, c);
+                    if (layout == 1) s.screen.x() = double(c / 2) + 0.5; // pairs of equal x
+                    if (layout == 2 && r % 2 == 1) s.screen.x() = double(cols - c) - 0.5; // mirrored
+                    if (layout == 3 && r == 5 && c == 7) s.screen.x() = std::numeric_limits<double>::quiet_NaN();
+                    s.admissible = s.valid = (next() % 7 != 0);
+                }
+            const SampleGrid before = g;
+            std::size_t expectedDropped = 0;
+            const std::size_t dropped = fss::applyLasso(g, lasso);
+            for (int r = 0; r < rows; ++r)
+                for (int c = 0; c < cols; ++c) {
+                    const fss::Sample& s = before.at(r, c);
+                    const bool in = fss::insideLasso(lasso, s.screen);
+                    const bool keep = s.admissible && in;
+                    expectedDropped += s.admissible && !in;
+                    ASSERT_EQ(g.at(r, c).admissible, keep) << "trial " << trial << " layout " << layout << " at "
+                                                           << r << "," << c;
+                    ASSERT_EQ(g.at(r, c).valid, s.valid && keep);
+                    if (in) {
+                        ++insideTotal;
+                        // On an edge: the plain point test of its segment (exact for these lattice points).
+                        for (int k = 0; k < m; ++k) {
+                            const Eigen::Vector2d a = lasso.points[std::size_t(k)];
+                            const Eigen::Vector2d b = lasso.points[std::size_t((k + 1) % m)];
+                            const Eigen::Vector2d ab = b - a, ap = s.screen - a;
+                            if (ab.x() * ap.y() - ab.y() * ap.x() == 0 && ap.dot(ab) >= 0 &&
+                                ap.dot(ab) <= ab.squaredNorm()) {
+                                ++boundaryHits;
+                                break;
+                            }
+                        }
+                    } else {
+                        ++outsideTotal;
+                    }
+                }
+            EXPECT_EQ(dropped, expectedDropped);
+        }
+    }
+    // The random lassos did exercise both sides and the boundary rule.
+    EXPECT_GT(insideTotal, 10000u);
+    EXPECT_GT(outsideTotal, 10000u);
+    EXPECT_GT(boundaryHits, 200u);
 }
 
 TEST(Lasso, DegenerateLassosAreRejected) {

@@ -42,7 +42,9 @@ struct SampleGrid {
     std::vector<Sample> samples;  ///< rows·cols entries
 
     SampleGrid() = default;
-    SampleGrid(int rows_, int cols_) : rows(rows_), cols(cols_), samples(std::size_t(rows_) * std::size_t(cols_)) {}
+    /// rows_ × cols_ default samples. Large grids get transparent huge pages where the system offers them
+    /// (a 1024² grid is 88 MB: with 4 KiB pages, first touching it costs more than filling it).
+    SampleGrid(int rows_, int cols_);
 
     bool inside(int r, int c) const { return r >= 0 && c >= 0 && r < rows && c < cols; }
     std::size_t index(int r, int c) const { return std::size_t(r) * std::size_t(cols) + std::size_t(c); }
