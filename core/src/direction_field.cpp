@@ -234,7 +234,11 @@ void fillDirectionFields(const Mesh& mesh, const CurvatureField& curvature, cons
                         const Eigen::Vector3d* first = nullptr;
                         for (int k = 0; k < 3; ++k) {
                             if (!curvature.isDefined(v[std::size_t(k)])) continue;
-                            const Eigen::Vector3d& d = curvature.direction(v[std::size_t(k)], useMax);
+                            // By magnitude: Max is the direction of the principal curvature of larger
+                            // |k| (across a crease, convex or concave), Min the other.
+                            const std::size_t vi = v[std::size_t(k)].idx();
+                            const bool swapped = std::abs(curvature.k2[vi]) > std::abs(curvature.k1[vi]);
+                            const Eigen::Vector3d& d = curvature.direction(v[std::size_t(k)], useMax != swapped);
                             if (!first) first = &d;
                             D += (d.dot(*first) < 0 ? -w[std::size_t(k)] : w[std::size_t(k)]) * d;
                         }

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <string>
@@ -75,6 +76,69 @@ std::optional<Eigen::Vector3d> hitOnFace(const Mesh& mesh, FaceIndex f, const Ra
     return ray.origin + t * ray.direction;
 }
 
+/// A sharp edge of the reference as seen from the scan camera (screen positions of its end points).
+struct CreaseSegment {
+    Eigen::Vector2d a, b;
+};
+
+/// The crease edges visible in \p buffers: projected, and kept when the ID buffer shows one of the edge's
+/// two faces within a pixel of the edge's midpoint.
+std::vector<CreaseSegment> visibleCreases(const Mesh& mesh, const std::vector<EdgeIndex>& edges,
+                                          const FrameBuffers& buffers) {
+    std::vector<CreaseSegment> out;
+    if (edges.empty()) return out;
+    const Camera& camera = buffers.camera;
+    const Eigen::Matrix4d vp = camera.viewProjectionMatrix();
+    auto project = [&](const Point3& p) {
+        const Eigen::Vector4d clip = vp * Eigen::Vector4d(p.x(), p.y(), p.z(), 1.0);
+        return Eigen::Vector2d((clip.x() / clip.w() + 1.0) * 0.5 * camera.width,
+                               (1.0 - clip.y() / clip.w()) * 0.5 * camera.height);
+    };
+    const int w = buffers.width(), h = buffers.height();
+    for (EdgeIndex e : edges) {
+        const HalfedgeIndex he = mesh.halfedge(e);
+        const std::uint32_t f0 = std::uint32_t(mesh.face(he).idx()),
+                            f1 = std::uint32_t(mesh.face(mesh.opposite(he)).idx());
+        const Eigen::Vector2d a = project(mesh.point(mesh.source(he))), b = project(mesh.point(mesh.target(he)));
+        if (!a.allFinite() || !b.allFinite()) continue;
+        const Eigen::Vector2d m = 0.5 * (a + b);
+        const int mx = int(std::floor(m.x())), my = int(std::floor(m.y()));
+        bool visible = false;
+        for (int dy = -1; dy <= 1 && !visible; ++dy)
+            for (int dx = -1; dx <= 1 && !visible; ++dx) {
+                const int x = mx + dx, y = my + dy;
+                if (x < 0 || y < 0 || x >= w || y >= h) continue;
+                const std::uint32_t id = buffers.faceAt(x, y);
+                visible = id == f0 || id == f1;
+            }
+        if (visible) out.push_back({a, b});
+    }
+    return out;
+}
+
+/// The point nearest to \p q on a crease segment within \p radius pixels that runs along \p heading
+/// (within 30°), if any.
+std::optional<Eigen::Vector2d> nearestAlongCrease(const std::vector<CreaseSegment>& creases,
+                                                  const Eigen::Vector2d& q, const Eigen::Vector2d& heading,
+                                                  double radius) {
+    const double cosMax = std::cos(30.0 * std::numbers::pi / 180.0);
+    std::optional<Eigen::Vector2d> best;
+    double bestDistance = radius;
+    for (const CreaseSegment& s : creases) {
+        const Eigen::Vector2d d = s.b - s.a;
+        const double len2 = d.squaredNorm();
+        if (!(len2 > 1e-12) || std::abs(d.dot(heading)) < cosMax * std::sqrt(len2)) continue;
+        const double t = std::clamp((q - s.a).dot(d) / len2, 0.0, 1.0);
+        const Eigen::Vector2d c = s.a + t * d;
+        const double dist = (c - q).norm();
+        if (dist <= bestDistance) {
+            bestDistance = dist;
+            best = c;
+        }
+    }
+    return best;
+}
+
 } // namespace
 
 // ---- FishboneCache --------------------------------------------------------------------------------------
@@ -126,7 +190,33 @@ const RayCaster& FishboneCache::rayCaster(const Mesh& reference) {
     return *caster_;
 }
 
+const std::vector<EdgeIndex>& FishboneCache::creaseEdges(const Mesh& reference, double minDihedralDeg) {
+    if (holds(reference) && creases_ && creaseAngleDeg_ == minDihedralDeg) return *creases_;
+    const double cosMax = std::cos(minDihedralDeg * std::numbers::pi / 180.0);
+    auto normal = [&](FaceIndex f) {
+        const HalfedgeIndex h = reference.halfedge(f);
+        const Point3 &a = reference.point(reference.source(h)), &b = reference.point(reference.target(h)),
+                     &c = reference.point(reference.target(reference.next(h)));
+        const Eigen::Vector3d u(b.x() - a.x(), b.y() - a.y(), b.z() - a.z()),
+            v(c.x() - a.x(), c.y() - a.y(), c.z() - a.z());
+        return Eigen::Vector3d(u.cross(v));
+    };
+    std::vector<EdgeIndex> edges;
+    for (EdgeIndex e : reference.edges()) {
+        const HalfedgeIndex h = reference.halfedge(e);
+        if (reference.is_border(e)) continue;
+        const Eigen::Vector3d n0 = normal(reference.face(h)), n1 = normal(reference.face(reference.opposite(h)));
+        const double l = n0.norm() * n1.norm();
+        if (l > 0 && n0.dot(n1) < cosMax * l) edges.push_back(e);
+    }
+    bind(reference);
+    creases_ = std::move(edges);
+    creaseAngleDeg_ = minDihedralDeg;
+    return *creases_;
+}
+
 void FishboneCache::clear() {
+    creases_.reset();
     mesh_ = nullptr;
     vertices_ = faces_ = 0;
     curvature_.reset();
@@ -248,6 +338,10 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
         return std::isfinite(p.x()) && std::isfinite(p.y()) && p.x() >= 0 && p.y() >= 0 &&
                p.x() < params.camera.width && p.y() < params.camera.height;
     };
+    if (!std::isfinite(fb.creaseAngleDeg) || fb.creaseAngleDeg < 0 || fb.creaseAngleDeg >= 180 ||
+        !std::isfinite(fb.creaseSnapRadius) || !(fb.creaseSnapRadius > 0))
+        throw InvalidInputError("The crease angle must lie in [0, 180) degrees and the crease snap radius "
+                                "must be positive.");
     if (fb.seed && !drawnBackbone && !insideImage(*fb.seed))
         throw InvalidInputError("The fishbone seed " + point(*fb.seed) + " lies outside the " +
                                 std::to_string(params.camera.width) + "x" +
@@ -326,16 +420,27 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
             throw InvalidInputError("The fishbone seed " + point(*fb.seed) +
                                     " lies on a flat or isotropic region where no principal direction is "
                                     "defined; pick a point on a curved feature.");
-        backbone = traceBackbone(backboneField, *fb.seed, options);
+        const std::vector<CreaseSegment> creases =
+            fb.creaseAngleDeg > 0 ? visibleCreases(reference, cache.creaseEdges(reference, fb.creaseAngleDeg),
+                                                   buffers)
+                                  : std::vector<CreaseSegment>{};
+        FishboneOptions backboneOptions = options;
+        if (!creases.empty())
+            backboneOptions.backboneTracing.attractor = [&](const Eigen::Vector2d& q,
+                                                            const Eigen::Vector2d& heading) {
+                return nearestAlongCrease(creases, q, heading, fb.creaseSnapRadius);
+            };
+        backbone = traceBackbone(backboneField, *fb.seed, backboneOptions);
     }
     if (backbone.samples.size() < 2)
         throw InvalidInputError("The fishbone backbone has fewer than two samples; pick a point on a longer "
                                 "feature or reduce h.");
     if (!keyRibMode) {
-        std::vector<Rib> ribs;
-        ribs.reserve(backbone.samples.size());
-        for (std::size_t r = 0; r < backbone.samples.size(); ++r)
-            ribs.push_back(traceRib(ribField, backbone, r, options));
+        // The ribs are independent streamlines: traced on the scan threads, each into its own slot
+        // (parallel.h; the grid is the same for any thread count).
+        std::vector<Rib> ribs(backbone.samples.size());
+        detail::parallelItems(ribs.size(), 4,
+                              [&](std::size_t r) { ribs[r] = traceRib(ribField, backbone, r, options); });
         result.fishbone = assembleFishboneGrid(backbone, ribs, h, W, H);
     } else {
         std::vector<KeyRib> keys;

@@ -101,6 +101,9 @@ StreamlineHalf traceStreamlineHalf(const DirectionField& field, const Eigen::Vec
     Eigen::Vector2d p = seed, previous = *start.direction;
     double step = options.step;
     std::size_t steps = 0;
+    // The field at p aligned with `previous`: the last accepted step's end evaluation is exactly the next
+    // step's first (same position, same reference), so each step costs four field samples, not five.
+    std::optional<Evaluation> atP;
     for (;;) {
         if (steps >= options.maxSteps) {
             half.stop = StreamlineStop::StepLimit;
@@ -118,7 +121,8 @@ StreamlineHalf traceStreamlineHalf(const DirectionField& field, const Eigen::Vec
         std::optional<StreamlineStop> failure;
         Eigen::Vector2d delta = Eigen::Vector2d::Zero();
         {
-            const Evaluation k1 = tracer.evaluate(p, previous);
+            if (!atP) atP = tracer.evaluate(p, previous);
+            const Evaluation& k1 = *atP;
             const Evaluation k2 = k1.direction ? tracer.evaluate(p + 0.5 * h * *k1.direction, previous) : k1;
             const Evaluation k3 = k2.direction ? tracer.evaluate(p + 0.5 * h * *k2.direction, previous) : k2;
             const Evaluation k4 = k3.direction ? tracer.evaluate(p + h * *k3.direction, previous) : k3;
@@ -132,10 +136,12 @@ StreamlineHalf traceStreamlineHalf(const DirectionField& field, const Eigen::Vec
         }
         if (!failure && last) delta *= remaining / delta.norm(); // end exactly at maxLength
         Eigen::Vector2d q = p + delta;
+        std::optional<Evaluation> atQ;
         if (!failure) {
-            const Evaluation end = tracer.evaluate(q, previous);
-            if (!end.direction)
-                failure = end.reason;
+            // Aligned with the new heading: if the step is accepted this is the next step's k1.
+            atQ = tracer.evaluate(q, delta);
+            if (!atQ->direction)
+                failure = atQ->reason;
             else if (delta.normalized().dot(previous) < cosMaxTurn)
                 failure = StreamlineStop::SharpTurn;
         }
@@ -148,7 +154,18 @@ StreamlineHalf traceStreamlineHalf(const DirectionField& field, const Eigen::Vec
             break;
         }
 
-        // Accept the step.
+        // Accept the step, moved onto the attracting curve when there is one nearby.
+        if (options.attractor && !last) {
+            if (const std::optional<Eigen::Vector2d> a = options.attractor(q, delta.normalized());
+                a && a->allFinite() && (*a - p).norm() > 1e-9) {
+                const Eigen::Vector2d moved = *a - p;
+                if (Evaluation e = tracer.evaluate(*a, moved); e.direction && moved.dot(previous) > 0) {
+                    q = *a;
+                    delta = moved;
+                    atQ = std::move(e);
+                }
+            }
+        }
         const double len = delta.norm();
         half.points.push_back(q);
         half.length += len;
@@ -168,6 +185,7 @@ StreamlineHalf traceStreamlineHalf(const DirectionField& field, const Eigen::Vec
             }
         }
         p = q;
+        atP = std::move(atQ);
         step = std::min(options.step, 2.0 * step);
     }
     return half;

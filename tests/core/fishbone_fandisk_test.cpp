@@ -6,8 +6,9 @@
 //
 // The fishbone is drawn, as a user would draw it (DESIGN.md §1: hand-drawn backbone and key-ribs as
 // interpolating splines through user points): the backbone through 9 points clicked on the feature line,
-// five straight key-rib strokes across it, blended ribs in between. Traced alternatives are measured
-// and printed too: on fandisk they do not follow this crease (see the test's comment).
+// five straight key-rib strokes across it, blended ribs in between. A fully traced fishbone (backbone from
+// the middle click, with crease following) must meet the same criterion, and its backbone must stay within
+// h/2 of the crease polyline over the whole inner crease.
 #include "fss/fishbone_scan.h"
 #include "fss/mesh_io.h"
 #include "fss/raycast.h"
@@ -249,17 +250,47 @@ TEST(FishboneFandisk, DrawnFishboneRemovesTheAliasingOfACurvedCrease) {
     traced.seed = clicked[4];
     const fss::FishboneScanResult tracedAll =
         fss::scanFishbonePatch(m, renderer, m, renderer, params, traced, cache);
+    // The same without crease following (FishboneParams::creaseAngleDeg = 0): the streamline alone.
+    fss::FishboneParams tracedFree = traced;
+    tracedFree.creaseAngleDeg = 0;
+    const fss::FishboneScanResult tracedNoSnap =
+        fss::scanFishbonePatch(m, renderer, m, renderer, params, tracedFree, cache);
 
     // Away from the ends of the strip (where the lasso cuts it): the middle 3/4 of the crease.
     const std::vector<Vector3d> inner(line.begin() + std::ptrdiff_t(line.size() / 8),
                                       line.end() - std::ptrdiff_t(line.size() / 8));
-    auto drift = [&](const fss::FishboneScanResult& r) {
-        double worst = 0;
-        for (int row = 0; row < r.grid.rows; ++row)
-            if (const fss::Sample& s = r.grid.at(row, r.fishbone.backboneColumn); s.hit)
-                worst = std::max(worst, distanceToPolyline(line, s.point) / hWorld);
-        return worst;
+    // Drift: the largest distance (in h) of a backbone sample inside the lasso from the crease polyline;
+    // mean drift likewise; coverage: the fraction of the inner crease (points every 1/20 edge) within 1h of
+    // the backbone's samples (so that a short backbone cannot pass).
+    struct Drift {
+        double worst = 0, mean = 0, coverage = 0;
+        std::size_t samples = 0;
     };
+    auto driftOf = [&](const fss::FishboneScanResult& r) {
+        Drift d;
+        std::vector<Vector3d> backbone;
+        for (int row = 0; row < r.grid.rows; ++row)
+            if (const fss::Sample& s = r.grid.at(row, r.fishbone.backboneColumn); s.hit && s.admissible) {
+                const double e = distanceToPolyline(line, s.point) / hWorld;
+                d.worst = std::max(d.worst, e);
+                d.mean += e;
+                ++d.samples;
+                backbone.push_back(s.point);
+            }
+        if (d.samples) d.mean /= double(d.samples);
+        std::size_t near = 0, total = 0;
+        for (std::size_t i = 0; i + 1 < inner.size(); ++i)
+            for (int k = 0; k < 20; ++k, ++total) {
+                const Vector3d q = inner[i] + (k / 20.0) * (inner[i + 1] - inner[i]);
+                double best = std::numeric_limits<double>::infinity();
+                for (const Vector3d& b : backbone)
+                    best = std::min(best, (b - q).norm());
+                near += best < hWorld;
+            }
+        d.coverage = total ? double(near) / double(total) : 0;
+        return d;
+    };
+    auto drift = [&](const fss::FishboneScanResult& r) { return driftOf(r).worst; };
     const PatchError g = measure(grid.patch, reference, line, inner, hWorld);
     const PatchError f = measure(fish.patch, reference, line, inner, hWorld);
     const PatchError tr = measure(tracedRibs.patch, reference, line, inner, hWorld);
@@ -271,14 +302,20 @@ TEST(FishboneFandisk, DrawnFishboneRemovesTheAliasingOfACurvedCrease) {
             what, e.faces, e.meanAngleDeg, e.hausdorff, e.hausdorff / hWorld,
             std::size_t(p.mesh.number_of_faces()));
     };
-    std::printf(
-        "[ aliasing, fandisk ] h = 1 pixel = %.5f; backbone off the crease by at most %.3f h (drawn), "
-        "%.3f h (traced)\n",
-        hWorld, drift(fish), drift(tracedAll));
+    const Drift tracedDrift = driftOf(tracedAll), freeDrift = driftOf(tracedNoSnap);
+    std::printf("[ aliasing, fandisk ] h = 1 pixel = %.5f; backbone off the crease by at most %.3f h (drawn)\n",
+                hWorld, drift(fish));
+    std::printf("[ aliasing, fandisk ] traced backbone: %zu samples in the lasso, off the crease by at most %.3f h, "
+                "mean %.3f h, covers %.1f %% of the inner crease; without crease following: at most %.3f h, "
+                "mean %.3f h, covers %.1f %%\n",
+                tracedDrift.samples, tracedDrift.worst, tracedDrift.mean, 100 * tracedDrift.coverage,
+                freeDrift.worst, freeDrift.mean, 100 * freeDrift.coverage);
     print("pixel grid", g, grid.patch);
     print("drawn backbone + key-ribs", f, fish.patch);
     print("drawn backbone, traced ribs", tr, tracedRibs.patch);
     print("traced backbone and ribs", ta, tracedAll.patch);
+    const PatchError tf = measure(tracedNoSnap.patch, reference, line, inner, hWorld);
+    print("traced, no crease following", tf, tracedNoSnap.patch);
 
     EXPECT_GT(g.faces, 500u);
     EXPECT_GT(f.faces, 500u);
@@ -290,6 +327,16 @@ TEST(FishboneFandisk, DrawnFishboneRemovesTheAliasingOfACurvedCrease) {
                       fishFaces = fish.patch.mesh.number_of_faces();
     EXPECT_LT(double(std::max(gridFaces, fishFaces)),
               1.2 * double(std::min(gridFaces, fishFaces))); // same spacing
+
+    // The traced fishbone (backbone from the middle click along the Min direction, which on this concave
+    // crease is the direction of the smaller |k|, and traced ribs): the backbone stays on the crease over
+    // all of it, and the aliasing criterion holds.
+    EXPECT_GT(tracedDrift.samples, 100u);
+    EXPECT_LT(tracedDrift.worst, 0.5);
+    EXPECT_GT(tracedDrift.coverage, 0.99);
+    EXPECT_GT(ta.faces, 500u);
+    EXPECT_GE(g.meanAngleDeg, 2 * ta.meanAngleDeg);
+    EXPECT_LT(ta.hausdorff, g.hausdorff);
 
     // The picture (docs/fishbone_vs_grid_fandisk.png is a copy): both patches from a closer camera aimed at
     // the crease, side by side (pixel grid left, fishbone right).

@@ -85,7 +85,7 @@ Mesh creasedRing(int nu, int nzHalf, bool alternateDiagonals = true) {
             // Alternating diagonals: the triangulation is mirror-symmetric about every meridian plane of
             // an even index, so the fitted principal directions on the ridge are not tilted one way. With
             // one diagonal direction throughout, the jet fits across the sharp ridge tilt the directions
-            // by about a degree and a traced backbone drifts off the ridge (see the second aliasing test).
+            // by about a degree and a plain streamline drifts off the ridge (see the second aliasing test).
             if (!alternateDiagonals || (i + j) % 2 == 0) {
                 m.add_face(a, b, c);
                 m.add_face(a, c, d);
@@ -380,14 +380,16 @@ TEST(FishboneScan, FishboneRemovesTheAliasingOfACurvedCrease) {
     fss::test::writePng(fss::test::tmpPath("fishbone_vs_grid.png").string(), W, view.height, rgb);
 }
 
-// One diagonal direction throughout: the jet fits across the sharp ridge tilt the principal directions and
-// a traced backbone drifts off the ridge (a known limit of tracing along a sharp crease); a hand-drawn
-// backbone still removes the aliasing.
-TEST(FishboneScan, DrawnBackboneRemovesTheAliasingOnASkewTriangulation) {
+// One diagonal direction throughout: the jet fits across the sharp ridge tilt the principal directions by
+// about a degree, and a plain streamline drifted off the ridge (by more than h/2 before crease following,
+// FishboneParams::creaseAngleDeg); the traced backbone now stays on it, and a hand-drawn backbone too.
+TEST(FishboneScan, TracedAndDrawnBackbonesRemoveTheAliasingOnASkewTriangulation) {
     const CreaseScene scene(/*alternateDiagonals=*/false);
     const AliasingRun run = runAliasing(scene, "skew ring");
-    EXPECT_GT(run.tracedDrift, 0.5); // documents the limit measured
+    EXPECT_LT(run.tracedDrift, 0.05);
     EXPECT_LT(run.drawnDrift, 0.05);
+    EXPECT_GE(run.grid.meanAngleDeg, 2 * run.traced.meanAngleDeg);
+    EXPECT_LT(run.traced.hausdorff, 0.5 * run.grid.hausdorff);
     EXPECT_GE(run.grid.meanAngleDeg, 2 * run.drawn.meanAngleDeg);
     EXPECT_LT(run.drawn.hausdorff, 0.5 * run.grid.hausdorff);
 }

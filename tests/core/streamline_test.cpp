@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <functional>
 #include <numbers>
+#include <optional>
 #include <random>
 
 using fss::DirectionField;
@@ -274,4 +275,40 @@ TEST(Streamline, ResampledStreamlineKeepsTheSeed) {
     EXPECT_EQ(line.points.size(), 49u);
     for (std::size_t i = 1; i < line.points.size(); ++i)
         EXPECT_NEAR((line.points[i] - line.points[i - 1]).norm(), 4.0, 1e-9);
+}
+
+// An attracting line (StreamlineOptions::attractor, the fishbone scan's crease following): the field is 3°
+// off the line y = 40.5, so the plain streamline leaves it by L·tan 3°; with the attractor (the line within
+// 1.5 pixels, along the heading) every point stays on it. A line across the heading does not attract.
+TEST(Streamline, AttractorKeepsTheLineOnAnAttractingCurve) {
+    const double tilt = 3 * kPi / 180;
+    const Eigen::Vector2d d(std::cos(tilt), std::sin(tilt));
+    const DirectionField f = makeField(300, 100, [&](const Eigen::Vector2d&) { return d; });
+    const Eigen::Vector2d seed(20.0, 40.5);
+    StreamlineOptions o;
+    o.maxLength = 200;
+    const fss::StreamlineHalf plain = fss::traceStreamlineHalf(f, seed, d, o);
+    EXPECT_NEAR(plain.points.back().y() - 40.5, 200 * std::sin(tilt), 1e-6);
+
+    auto alongLine = [](const Eigen::Vector2d& q, const Eigen::Vector2d& heading) -> std::optional<Eigen::Vector2d> {
+        if (std::abs(q.y() - 40.5) > 1.5 || std::abs(heading.x()) < std::cos(kPi / 6)) return std::nullopt;
+        return Eigen::Vector2d(q.x(), 40.5);
+    };
+    o.attractor = alongLine;
+    const fss::StreamlineHalf held = fss::traceStreamlineHalf(f, seed, d, o);
+    EXPECT_EQ(held.stop, StreamlineStop::MaxLength);
+    ASSERT_GT(held.points.size(), 300u);
+    double worst = 0;
+    for (std::size_t i = 0; i + 1 < held.points.size(); ++i) // the last step (to maxLength) is not moved
+        worst = std::max(worst, std::abs(held.points[i].y() - 40.5));
+    EXPECT_LT(worst, 1e-12);
+    EXPECT_NEAR(held.length, 200.0, 1e-9);
+    EXPECT_GT(held.points.back().x(), 200.0 + seed.x() - 0.1);
+
+    // A field across the line: the attractor declines (heading check), the line crosses it unchanged.
+    const DirectionField across = makeField(300, 100, [](const Eigen::Vector2d&) { return Eigen::Vector2d(0, 1); });
+    o.maxLength = 50;
+    const fss::StreamlineHalf crossing = fss::traceStreamlineHalf(across, Eigen::Vector2d(100, 20), {0, 1}, o);
+    EXPECT_NEAR(crossing.points.back().y(), 70.0, 1e-9);
+    EXPECT_NEAR(crossing.points.back().x(), 100.0, 1e-9);
 }

@@ -22,10 +22,13 @@
 
 namespace fss {
 
-/// Which principal direction a field, backbone or rib follows.
+/// Which principal direction a field, backbone or rib follows. Principal curvatures are ranked by
+/// magnitude here (not by signed value as k1 ≥ k2 in curvature.h), so that Min runs along a crease or a
+/// fillet whether it is convex or concave: on a concave crease (fandisk's curved feature) the signed
+/// minimal curvature is the large negative one across the crease.
 enum class PrincipalDirection {
-    Min, ///< direction of the minimal curvature k2 (along a cylinder's axis, along a rounded crease)
-    Max  ///< direction of the maximal curvature k1 (around a cylinder, across a rounded crease)
+    Min, ///< direction of the principal curvature of smaller |k| (along a cylinder's axis, along a crease)
+    Max  ///< direction of the principal curvature of larger |k| (around a cylinder, across a crease)
 };
 
 /// The other principal direction (the ribs' direction when the backbone follows \p d).
@@ -91,7 +94,8 @@ struct DirectionFieldOptions {
 ///  2. the 3D point p: the pixel centre's viewing ray (Camera::ray) intersected with f's plane, in double
 ///     (the float depth buffer is used only when the ray grazes the plane);
 ///  3. barycentric coordinates (w0, w1, w2) of p in f (clamped to the triangle);
-///  4. the three vertex directions, each flipped to agree with the first defined one (line field), blended
+///  4. the three vertex directions (per vertex the one of smaller |k| for Min, larger |k| for Max, see
+///     PrincipalDirection), each flipped to agree with the first defined one (line field), blended
 ///     D = Σ wᵢ·sᵢ·dᵢ (undefined vertices contribute 0) and projected into the tangent plane of the
 ///     interpolated vertex normal Σ wᵢ·nᵢ (not f's plane: the faceting would tilt D and foreshortening
 ///     near silhouettes magnifies that to degrees on the screen);

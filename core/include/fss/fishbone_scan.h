@@ -53,6 +53,10 @@ public:
     double curvatureSeconds() const { return curvatureSeconds_; }
     /// Seconds the AABB tree took when it was built (0 before).
     double rayCasterSeconds() const { return rayCasterSeconds_; }
+    /// The sharp edges of \p reference: interior edges whose faces' normals differ by more than
+    /// \p minDihedralDeg degrees, found on the first call for this mesh and threshold and cached (a call
+    /// with another threshold recomputes them). Cost O(edges).
+    const std::vector<EdgeIndex>& creaseEdges(const Mesh& reference, double minDihedralDeg);
     /// True when the curvature of \p reference is already cached.
     bool hasCurvature(const Mesh& reference) const;
     /// Forgets everything (the mesh is no longer referenced).
@@ -65,6 +69,8 @@ private:
     std::size_t vertices_ = 0, faces_ = 0;
     std::optional<CurvatureField> curvature_;
     std::unique_ptr<RayCaster> caster_;
+    std::optional<std::vector<EdgeIndex>> creases_;
+    double creaseAngleDeg_ = 0;
     double curvatureSeconds_ = 0, rayCasterSeconds_ = 0;
 };
 
@@ -88,6 +94,16 @@ struct FishboneParams {
     /// A traced backbone needs the seed's interpolated anisotropy to reach this (else the principal
     /// directions are undefined there: flat or umbilic region).
     double minSeedAnisotropy = 0.1;
+    /// Crease following of a traced backbone: where the backbone runs within `creaseSnapRadius` pixels of
+    /// the visible image of a sharp crease of the reference (an edge whose dihedral angle exceeds
+    /// `creaseAngleDeg`, FishboneCache::creaseEdges) and along it (within 30°), each step is moved onto
+    /// the crease (StreamlineOptions::attractor). Without it a backbone seeded on a sharp crease drifts off:
+    /// the principal directions of the faces beside a crease are those of the smooth sides (on fandisk's
+    /// curved crease the min direction of the curved side is across the crease, one triangle away), so
+    /// the crease is no attracting streamline of the field and small errors grow. 0 turns it off.
+    double creaseAngleDeg = 30.0;
+    /// See creaseAngleDeg; pixels (> 0).
+    double creaseSnapRadius = 1.5;
     /// Local search of the hinted ray casts.
     LocalSearchOptions raycast{};
 

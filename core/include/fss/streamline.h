@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <vector>
 
 namespace fss {
@@ -67,6 +68,14 @@ struct StreamlineOptions {
     double maxTurnDeg = 10.0;
     /// Optional region mask: a position p is admissible when insideRegion(p) is true. Empty = no mask.
     std::function<bool(const Eigen::Vector2d&)> insideRegion{};
+    /// Optional attracting curve (the fishbone scan passes the screen image of the reference's sharp creases
+    /// to a traced backbone): after each accepted step (but the one ending at maxLength), attractor(q,
+    /// heading) may return a point to move the step's end q to — the nearest point of a crease running
+    /// along `heading` (unit). The moved end must lie where the field is defined, else q is kept. A
+    /// streamline alone has no restoring force towards a crease: where the field on either side turns away
+    /// from it, every small error grows, and it leaves the crease (see fishbone_scan.h).
+    std::function<std::optional<Eigen::Vector2d>(const Eigen::Vector2d& q, const Eigen::Vector2d& heading)>
+        attractor{};
     /// Safety limit on the number of accepted steps per half.
     std::size_t maxSteps = 1'000'000;
 };
