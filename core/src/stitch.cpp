@@ -960,18 +960,35 @@ private:
                 return x;
             };
             std::vector<char> folded(region_.size(), 0), hidden(region_.size(), 0);
-            for (std::size_t i = 0; i < region_.size(); ++i) {
+            // Only the clusters of overlapping faces that reach a seam face matter: found by a flood over
+            // overlaps from the seam faces (work proportional to the seam and its folds, not to the faces
+            // under the patch).
+            std::vector<char> reached(region_.size(), 0);
+            std::vector<std::size_t> todo;
+            for (std::size_t i = 0; i < region_.size(); ++i)
+                if (isSeam.count(std::uint32_t(region_[i]))) {
+                    reached[i] = 1;
+                    todo.push_back(i);
+                }
+            while (!todo.empty()) {
+                const std::size_t i = todo.back();
+                todo.pop_back();
                 progress_.tick();
-                const Triangle2 t = faceTriangle(region_[i]);
-                regionGrid_.query(t.bbox(), [&](int j) {
-                    if (j <= int(i)) return;
-                    if (!interiorsOverlap(region_[i], region_[std::size_t(j)])) return;
-                    folded[i] = folded[std::size_t(j)] = 1;
-                    parent[std::size_t(find(j))] = find(int(i));
+                regionGrid_.query(faceTriangle(region_[i]).bbox(), [&](int jj) {
+                    const std::size_t j = std::size_t(jj);
+                    if (j == i) return;
+                    // Each pair in the order (lower, higher index), as a scan over all pairs would.
+                    const std::size_t lo = std::min(i, j), hi = std::max(i, j);
+                    if (!interiorsOverlap(region_[lo], region_[hi])) return;
+                    folded[lo] = folded[hi] = 1;
+                    parent[std::size_t(find(int(hi)))] = find(int(lo));
                     // The one farther from the eye where they overlap is hidden there.
-                    const Point2 q = overlapCentre(t, faceTriangle(region_[std::size_t(j)]));
-                    hidden[depthAt(region_[i], q) > depthAt(region_[std::size_t(j)], q) ? i
-                                                                                        : std::size_t(j)] = 1;
+                    const Point2 q = overlapCentre(faceTriangle(region_[lo]), faceTriangle(region_[hi]));
+                    hidden[depthAt(region_[lo], q) > depthAt(region_[hi], q) ? lo : hi] = 1;
+                    if (!reached[j]) {
+                        reached[j] = 1;
+                        todo.push_back(j);
+                    }
                 });
             }
             std::unordered_map<int, bool> clusterAtSeam;
@@ -1002,6 +1019,7 @@ private:
                             std::move(bad));
         }
         // Faces connected to the interior ones, away from the seam, lying under the patch in the view.
+        std::unordered_map<std::uint32_t, double> gapOfVertex;
         while (!stack.empty()) {
             const FaceIndex f = stack.back();
             stack.pop_back();
@@ -1019,7 +1037,14 @@ private:
                 const double tolerance = gapTolerance(g);
                 for (VertexIndex v : CGAL::vertices_around_face(M_.halfedge(g), M_)) {
                     const VProj& p = vproj(v);
-                    if (!p.ok || !(gapToPatch(toVec(M_.point(v)), p.uv) <= tolerance)) under = false;
+                    if (!p.ok) {
+                        under = false;
+                        continue;
+                    }
+                    // Each vertex is asked by every face around it: its gap is computed once.
+                    auto [gap, fresh] = gapOfVertex.try_emplace(std::uint32_t(v), 0.0);
+                    if (fresh) gap->second = gapToPatch(toVec(M_.point(v)), p.uv);
+                    if (!(gap->second <= tolerance)) under = false;
                 }
                 if (!under) {
                     addNear(bad,
