@@ -435,32 +435,73 @@ struct LFace {
 };
 
 // ---------------------------------------------------------------------------------------------------
+// Progress inside one component's computation (which never touches the current mesh, so stopping there
+// abandons the component): the long loops count elementary operations and report every kReportEvery of
+// them, so a cancel is noticed after a bounded amount of work. The fraction advances through [from, to)
+// with the steps of the computation and never goes back (trim rounds retry a component).
+class ComponentProgress {
+public:
+    static constexpr std::size_t kReportEvery = 4096;
+    ComponentProgress(const Progress& progress, double& last, double from, double to)
+        : progress_(progress), last_(last), from_(from), to_(to) {}
+    // Counts n operations; reports (and may throw CancelledError) when enough have accumulated.
+    void tick(std::size_t n = 1) {
+        work_ += n;
+        if (work_ >= kReportEvery) report();
+    }
+    // Enters step `step` (1 ≤ step ≤ steps) of the computation; the application that follows it is the
+    // last share of [from, to).
+    void step(int step, int steps) {
+        stepFraction_ = double(step) / double(steps + 1);
+        tick(0);
+    }
+    void report() {
+        work_ = 0;
+        last_ = std::max(last_, std::min(1.0, from_ + (to_ - from_) * stepFraction_));
+        progress_.report(last_, "stitch");
+    }
+
+private:
+    const Progress& progress_;
+    double& last_;
+    double from_, to_;
+    double stepFraction_ = 0;
+    std::size_t work_ = 0;
+};
+
 class ComponentStitcher {
 public:
     ComponentStitcher(const Mesh& m, const PatchData& p, const View& view, const StitchOptions& o,
                       std::span<const std::uint32_t> ids, const std::vector<int>& faces, bool hasQuality,
-                      bool hasScanId)
+                      bool hasScanId, ComponentProgress& progress)
         : M_(m), P_(p), V_(view), O_(o), ids_(ids), faces_(faces), curHasQuality_(hasQuality),
-          curHasScanId_(hasScanId) {
+          curHasScanId_(hasScanId), progress_(progress) {
         if (hasQuality) curQuality_ = M_.property_map<FaceIndex, float>(props::faceQuality).first;
         if (hasScanId) curScanId_ = M_.property_map<FaceIndex, std::int32_t>(props::faceScanId).first;
     }
 
     Attempt run() {
         Attempt a;
+        // Cancellation points (progress_) lie in the steps' long loops; none of them touches the mesh.
+        constexpr int kSteps = 8;
         if (!setupComponent(a)) return a;
+        progress_.step(1, kSteps);
         if (!findRegion(a)) return a;
         if (!preTrim(a)) return a;
+        progress_.step(2, kSteps);
         if (!splitRegion(a)) return a;
         buildLocalVertices();
         snap();
+        progress_.step(3, kSteps);
         if (!computeCrossings(a)) return a;
         Cdt cdt;
         std::vector<CdtVertex> vh;
         if (!triangulate(cdt, vh, a)) return a;
+        progress_.step(4, kSteps);
         if (!classify(cdt, vh, a)) return a;
         if (!checkCoverage(cdt, vh, a)) return a;
         if (!assemble(cdt, a)) return a;
+        progress_.step(5, kSteps);
         if (!buildAndOptimise(a)) return a;
         a.ok = true;
         return a;
@@ -483,6 +524,7 @@ private:
         std::vector<std::uint64_t> directed;
         directed.reserve(3 * faces_.size());
         for (int f : faces_) {
+            progress_.tick();
             const auto& t = P_.tri[std::size_t(f)];
             for (int k = 0; k < 3; ++k) {
                 directed.push_back(
@@ -751,6 +793,7 @@ private:
                 ids_ = {}; // the ID buffer found nothing valid (stale after earlier components): fall back
             }
             for (int v : samples) {
+                progress_.tick();
                 const Point2& uv = P_.uv[std::size_t(v)];
                 candidatesAt(uv, cands);
                 FaceIndex best;
@@ -777,6 +820,7 @@ private:
         while (!stack.empty()) {
             const FaceIndex f = stack.back();
             stack.pop_back();
+            progress_.tick();
             if (!acceptable(f) || !meetsComponent(f)) continue;
             regionIndex_[std::uint32_t(f)] = int(region_.size());
             region_.push_back(f);
@@ -801,6 +845,7 @@ private:
             regionGrid_.insert(int(i), faceTriangle(region_[i]).bbox());
         std::vector<int> bad;
         for (int v : compVerts_) {
+            progress_.tick();
             const Point2& uv = P_.uv[std::size_t(v)];
             bool inside = false;
             regionGrid_.query(uv.bbox(), [&](int i) {
@@ -884,6 +929,7 @@ private:
         std::vector<FaceIndex> stack;
         std::unordered_set<std::uint32_t> isSeam, isInterior;
         for (FaceIndex f : region_) {
+            progress_.tick();
             const Triangle2 t = faceTriangle(f);
             bool near = false;
             segments.query(grown(t.bbox(), margin_), [&](int i) {
@@ -914,17 +960,35 @@ private:
                 return x;
             };
             std::vector<char> folded(region_.size(), 0), hidden(region_.size(), 0);
-            for (std::size_t i = 0; i < region_.size(); ++i) {
-                const Triangle2 t = faceTriangle(region_[i]);
-                regionGrid_.query(t.bbox(), [&](int j) {
-                    if (j <= int(i)) return;
-                    if (!interiorsOverlap(region_[i], region_[std::size_t(j)])) return;
-                    folded[i] = folded[std::size_t(j)] = 1;
-                    parent[std::size_t(find(j))] = find(int(i));
+            // Only the clusters of overlapping faces that reach a seam face matter: found by a flood over
+            // overlaps from the seam faces (work proportional to the seam and its folds, not to the faces
+            // under the patch).
+            std::vector<char> reached(region_.size(), 0);
+            std::vector<std::size_t> todo;
+            for (std::size_t i = 0; i < region_.size(); ++i)
+                if (isSeam.count(std::uint32_t(region_[i]))) {
+                    reached[i] = 1;
+                    todo.push_back(i);
+                }
+            while (!todo.empty()) {
+                const std::size_t i = todo.back();
+                todo.pop_back();
+                progress_.tick();
+                regionGrid_.query(faceTriangle(region_[i]).bbox(), [&](int jj) {
+                    const std::size_t j = std::size_t(jj);
+                    if (j == i) return;
+                    // Each pair in the order (lower, higher index), as a scan over all pairs would.
+                    const std::size_t lo = std::min(i, j), hi = std::max(i, j);
+                    if (!interiorsOverlap(region_[lo], region_[hi])) return;
+                    folded[lo] = folded[hi] = 1;
+                    parent[std::size_t(find(int(hi)))] = find(int(lo));
                     // The one farther from the eye where they overlap is hidden there.
-                    const Point2 q = overlapCentre(t, faceTriangle(region_[std::size_t(j)]));
-                    hidden[depthAt(region_[i], q) > depthAt(region_[std::size_t(j)], q) ? i
-                                                                                        : std::size_t(j)] = 1;
+                    const Point2 q = overlapCentre(faceTriangle(region_[lo]), faceTriangle(region_[hi]));
+                    hidden[depthAt(region_[lo], q) > depthAt(region_[hi], q) ? lo : hi] = 1;
+                    if (!reached[j]) {
+                        reached[j] = 1;
+                        todo.push_back(j);
+                    }
                 });
             }
             std::unordered_map<int, bool> clusterAtSeam;
@@ -955,9 +1019,11 @@ private:
                             std::move(bad));
         }
         // Faces connected to the interior ones, away from the seam, lying under the patch in the view.
+        std::unordered_map<std::uint32_t, double> gapOfVertex;
         while (!stack.empty()) {
             const FaceIndex f = stack.back();
             stack.pop_back();
+            progress_.tick();
             interior_.push_back(f);
             for (HalfedgeIndex h : CGAL::halfedges_around_face(M_.halfedge(f), M_)) {
                 const FaceIndex g = M_.face(M_.opposite(h));
@@ -971,7 +1037,14 @@ private:
                 const double tolerance = gapTolerance(g);
                 for (VertexIndex v : CGAL::vertices_around_face(M_.halfedge(g), M_)) {
                     const VProj& p = vproj(v);
-                    if (!p.ok || !(gapToPatch(toVec(M_.point(v)), p.uv) <= tolerance)) under = false;
+                    if (!p.ok) {
+                        under = false;
+                        continue;
+                    }
+                    // Each vertex is asked by every face around it: its gap is computed once.
+                    auto [gap, fresh] = gapOfVertex.try_emplace(std::uint32_t(v), 0.0);
+                    if (fresh) gap->second = gapToPatch(toVec(M_.point(v)), p.uv);
+                    if (!(gap->second <= tolerance)) under = false;
                 }
                 if (!under) {
                     addNear(bad,
@@ -1317,6 +1390,7 @@ private:
         CdtFace hint;
         std::size_t inserted = 0;
         for (int i : order) {
+            progress_.tick();
             const CdtVertex v = cdt.insert(L_[std::size_t(i)].uv, hint);
             if (v->info().id >= 0) {
                 addBad(bad, i);
@@ -1334,6 +1408,7 @@ private:
         auto constrain = [&](const std::vector<int>& line) {
             for (std::size_t k = 0; k + 1 < line.size(); ++k) {
                 const std::size_t p = std::size_t(line[k]), q = std::size_t(line[k + 1]);
+                progress_.tick();
                 subEdges_.push_back({line[k], line[k + 1]});
                 cdt.insert_constraint(vh[p], vh[q]);
             }
@@ -1620,6 +1695,7 @@ private:
         double patchArea = 0;
         std::vector<int> bad;
         for (int f : faces_) {
+            progress_.tick();
             const auto& t = P_.tri[std::size_t(f)];
             std::vector<int> poly;
             std::vector<unsigned> edges;
@@ -1796,6 +1872,7 @@ private:
                               [&](VertexIndex v) { return reusedCur.count(loc.star.cur[v]) > 0; });
         std::vector<int> bad;
         for (std::size_t i : growthOrder(faceVs, S)) {
+            progress_.tick();
             const FaceIndex g = S.add_face(faceVs[i][0], faceVs[i][1], faceVs[i][2]);
             if (g == Mesh::null_face()) {
                 for (int id : newFaces_[i].v)
@@ -1820,7 +1897,9 @@ private:
             for (std::size_t j = 0; j + 1 < pe.line.size(); ++j)
                 loc.seam.insert(seamKey(sv[std::size_t(pe.line[j])], sv[std::size_t(pe.line[j + 1])]));
 
+        progress_.step(6, 8);
         if (O_.optimiseSeam) optimise(loc, a.plan);
+        progress_.step(7, 8);
         if (!validate(loc, bordersBefore, a)) return false;
         const bool ok = extractPlan(loc, a);
         return ok;
@@ -1960,6 +2039,7 @@ private:
                 std::sort(cands.begin(), cands.end());
                 std::size_t done = 0;
                 for (const auto& c : cands) {
+                    progress_.tick();
                     const auto [a, b] = c.second;
                     if (S.is_removed(a) || S.is_removed(b)) continue;
                     double s1 = -1, s2 = -1;
@@ -1996,6 +2076,7 @@ private:
             const auto near = seamNeighbourhood(loc);
             std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
             for (FaceIndex f : S.faces()) {
+                progress_.tick();
                 if (loc.star.kept[f]) continue;
                 const HalfedgeIndex h0 = S.halfedge(f);
                 const VertexIndex v[3] = {S.source(h0), S.target(h0), S.target(S.next(h0))};
@@ -2018,6 +2099,7 @@ private:
             std::sort(cands.begin(), cands.end());
             std::size_t done = 0;
             for (const auto& c : cands) {
+                progress_.tick();
                 const auto [a, b] = c.second;
                 if (S.is_removed(a) || S.is_removed(b) || S.halfedge(a, b) == Mesh::null_halfedge()) continue;
                 double s1 = -1, s2 = -1;
@@ -2089,6 +2171,7 @@ private:
         std::sort(order.begin(), order.end());
         std::size_t moved = 0;
         for (std::uint32_t vi : order) {
+            progress_.tick();
             const VertexIndex v(vi);
             if (S.is_removed(v) || loc.locked[v] || loc.star.cur[v] != kNone) continue;
             if (S.halfedge(v) == Mesh::null_halfedge()) continue;
@@ -2170,6 +2253,7 @@ private:
         std::sort(cands.begin(), cands.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
         std::size_t splits = 0;
         for (const auto& [len, e] : cands) {
+            progress_.tick();
             if (S.is_removed(e)) continue;
             const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
             const FaceIndex f = S.face(h), g = S.face(o);
@@ -2240,6 +2324,7 @@ private:
         while (!queue.empty() && flips < maxFlips) {
             const EdgeIndex e = queue.front();
             queue.pop_front();
+            progress_.tick();
             queued.erase(std::uint32_t(e));
             if (S.is_removed(e)) continue;
             const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
@@ -2408,6 +2493,7 @@ private:
         // Faces: not degenerate, facing the camera, no needles.
         bool needles = false;
         for (FaceIndex f : S.faces()) {
+            progress_.tick();
             if (loc.star.kept[f]) continue;
             const HalfedgeIndex h = S.halfedge(f);
             const VertexIndex p = S.source(h), q = S.target(h), r = S.target(S.next(h));
@@ -2462,6 +2548,7 @@ private:
         // No new self-intersections among the local faces.
         std::vector<std::pair<FaceIndex, FaceIndex>> pairs;
         const auto candidates = intersectionCandidates(loc);
+        progress_.tick(candidates.size());
         PMP::self_intersections(candidates, S, std::back_inserter(pairs));
         for (const auto& [f, g] : pairs) {
             if (!loc.star.kept[f]) badFace(f);
@@ -2603,9 +2690,12 @@ private:
             rf.push_back(r);
         }
         const auto order = growthOrderIn(S, sfaces, loc);
-        for (std::size_t i : order)
+        progress_.step(8, 8);
+        for (std::size_t i : order) {
+            progress_.tick();
             if (rehearsal.S.add_face(rf[i][0], rf[i][1], rf[i][2]) == Mesh::null_face())
                 return fail(a, "internal error: the stitch could not be rehearsed");
+        }
         for (std::size_t i : order) {
             plan.faces.push_back(pf[i]);
             plan.quality.push_back(loc.quality[sfaces[i]]);
@@ -2637,6 +2727,7 @@ private:
     std::span<const std::uint32_t> ids_;
     const std::vector<int>& faces_;
     bool curHasQuality_, curHasScanId_;
+    ComponentProgress& progress_;
     Mesh::Property_map<FaceIndex, float> curQuality_;
     Mesh::Property_map<FaceIndex, std::int32_t> curScanId_;
 
@@ -2815,9 +2906,12 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
     std::size_t seamFacesAbove25 = 0;
     const double totalFaces = double(std::max<std::size_t>(P.tri.size(), 1));
     std::size_t facesDone = dropped; // faces stitched, trimmed or dropped so far
+    double lastFraction = 0;         // reported fractions never go back
     while (!work.empty()) {
-        // Cancellation point: between components and trim rounds, never inside an application.
-        progress.report(std::min(1.0, double(facesDone) / totalFaces), "stitch");
+        // Cancellation points: between components and trim rounds, and inside a component's computation
+        // (ComponentProgress), never inside an application.
+        lastFraction = std::max(lastFraction, std::min(1.0, double(facesDone) / totalFaces));
+        progress.report(lastFraction, "stitch");
         Work w = std::move(work.front());
         work.pop_front();
         if (w.faces.size() < options.minComponentFaces) {
@@ -2828,7 +2922,10 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
         }
         const bool curQ = current.property_map<FaceIndex, float>(props::faceQuality).second;
         const bool curS = current.property_map<FaceIndex, std::int32_t>(props::faceScanId).second;
-        ComponentStitcher stitcher(current, P, view, options, faceIds, w.faces, curQ, curS);
+        ComponentProgress componentProgress(progress, lastFraction, double(facesDone) / totalFaces,
+                                            double(facesDone + w.faces.size()) / totalFaces);
+        ComponentStitcher stitcher(current, P, view, options, faceIds, w.faces, curQ, curS,
+                                   componentProgress);
         Attempt a;
         try {
             a = stitcher.run(); // never touches `current`

@@ -399,3 +399,49 @@ TEST(Session, FailedAcceptChangesNothing) {
 }
 
 } // namespace
+
+namespace {
+
+// Issue #6: the Cancel of a progress dialog reaches a stitch inside its (single) component, and the
+// session stays exactly as it was.
+TEST(Session, CancelInsideTheStitchOfOneComponent) {
+    fss::Session session(fss::shapes::uvSphere(100, 51));
+    fss::ScanStep step = isoStep(session.reference(), 256);
+    step.params.quality.forceReplace = true;
+    session.scan(step);
+    const std::string before = fingerprint(session.current());
+    // A full accept, recording the reports: the accept's own "stitch" 0, the stitch's reports, "record", ….
+    std::vector<std::pair<std::string, double>> reports;
+    const fss::StitchReport& report = session.accept(fss::Progress([&](double f, std::string_view stage) {
+        reports.emplace_back(std::string(stage), f);
+        return true;
+    }));
+    ASSERT_EQ(report.piecesStitched, 1) << "the test needs a patch stitched in one round";
+    const auto record =
+        std::find_if(reports.begin(), reports.end(), [](const auto& r) { return r.first == "record"; });
+    ASSERT_NE(record, reports.end());
+    // Reports from inside the stitch: all before "record" but the accept's first and the stitch's first
+    // (before its component).
+    const std::size_t inside = std::size_t(record - reports.begin()) - 2;
+    EXPECT_GE(inside, 5u) << report.facesAdded << " faces added";
+    session.undo();
+    ASSERT_EQ(fingerprint(session.current()), before);
+
+    for (const std::size_t k : {std::size_t(3), 2 + inside / 2, 2 + inside}) {
+        session.scan(step);
+        std::size_t calls = 0;
+        const fss::Progress cancel([&](double, std::string_view stage) {
+            ++calls;
+            EXPECT_EQ(stage, "stitch");
+            return calls < k;
+        });
+        EXPECT_THROW(session.accept(cancel), fss::CancelledError) << k;
+        EXPECT_EQ(calls, k);
+        EXPECT_EQ(fingerprint(session.current()), before);
+        EXPECT_EQ(session.undoCount(), 0u);
+        EXPECT_EQ(session.redoCount(), 1u);
+        ASSERT_NE(session.preview(), nullptr);
+    }
+}
+
+} // namespace

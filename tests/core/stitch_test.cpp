@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -23,6 +24,7 @@
 #include <optional>
 #include <random>
 #include <set>
+#include <string_view>
 #include <unordered_map>
 
 namespace PMP = CGAL::Polygon_mesh_processing;
@@ -583,6 +585,49 @@ TEST(Stitch, FailureLeavesTheMeshBitIdentical) {
     const std::vector<std::uint32_t> wrongSize(10, 0);
     EXPECT_THROW(fss::stitchPatch(m, patch, cam, {}, wrongSize), fss::InvalidInputError);
     expectBitIdentical(m, before);
+}
+
+// Issue #6: a patch that is one big component reports progress (and can be cancelled) many times inside
+// its one round, not only between components; a cancel stops it at once and leaves the mesh as it was
+// (the component's computation never touches the mesh; only a fully checked component is applied).
+TEST(Stitch, CancelInsideOneComponent) {
+    const Mesh grid = fss::shapes::grid(20, 20, 1.0);
+    const Camera cam = downCamera(10.1, 9.9, 30, 7.0, 512);
+    const Mesh patch = makePatch(cam, disk(256, 256, 200), planeZ0());
+    ASSERT_GT(patch.number_of_faces(), 200000u);
+
+    // Uncancelled: one component, one round (no trimming), and many reports inside it.
+    std::vector<double> fractions;
+    Mesh m = grid;
+    const fss::Progress record([&](double f, std::string_view stage) {
+        EXPECT_EQ(stage, "stitch");
+        fractions.push_back(f);
+        return true;
+    });
+    const fss::StitchReport r = fss::stitchPatch(m, patch, cam, {}, {}, record);
+    SCOPED_TRACE(reportText(r) + "\nreports: " + std::to_string(fractions.size()));
+    ASSERT_EQ(r.piecesStitched, 1);
+    ASSERT_EQ(r.patchFacesTrimmed, 0u);
+    // The first report is the one before the component; every other one comes from inside it. The patch
+    // has about 250k faces and the component reports every ComponentProgress::kReportEvery (4096)
+    // operations, each loop over the patch's faces giving about 60 reports.
+    ASSERT_GE(fractions.size(), 50u);
+    EXPECT_EQ(fractions.front(), 0.0);
+    EXPECT_TRUE(std::is_sorted(fractions.begin(), fractions.end()));
+    EXPECT_GT(fractions.back(), 0.5);
+    EXPECT_LT(fractions.back(), 1.0);
+    expectValid(m, {false, 1}, false);
+
+    // Cancelled at the k-th report, early, in the middle and at the last one (after the rehearsal, just
+    // before the component would be applied): stops there and the mesh is bit for bit as before.
+    for (const std::size_t k : {std::size_t(2), fractions.size() / 2, fractions.size()}) {
+        Mesh c = grid;
+        std::size_t calls = 0;
+        const fss::Progress cancelAtK([&](double, std::string_view) { return ++calls < k; });
+        EXPECT_THROW(fss::stitchPatch(c, patch, cam, {}, {}, cancelAtK), fss::CancelledError) << k;
+        EXPECT_EQ(calls, k); // no report after the cancel: the stitch stopped there
+        expectBitIdentical(c, grid);
+    }
 }
 
 namespace {

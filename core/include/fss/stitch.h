@@ -129,10 +129,17 @@ struct StitchReport {
 ///        component could be stitched (the sentence gives the first reason). Strong guarantee: all checks of
 ///        a component run before \p current is touched, so an exception leaves \p current unchanged bit for
 ///        bit (short of running out of memory while a checked component is being applied).
-/// \throw CancelledError when \p progress asks to stop. It is asked before each component (and each trim
-///        round), never while one is being applied: \p current is then a valid mesh that holds the
-///        components glued in before — every invariant holds, but it is not the mesh of before the call.
-///        Callers that need all or nothing stitch a copy (Session::accept does).
+/// \param progress reports (stage "stitch", fractions that never decrease, below 1 until the last component
+///                 is applied) and may cancel: before each component and each trim round, and inside a
+///                 component's computation every few thousand elementary operations (faces visited,
+///                 triangulation insertions, seam collapses and flips, …), so even a patch that is one big
+///                 component stops after a bounded amount of work.
+/// \throw CancelledError when \p progress asks to stop. A component is computed and checked without touching
+///        \p current and then applied without asking \p progress, so a cancel abandons the component being
+///        computed and never interrupts an application: \p current is then a valid mesh that holds the
+///        components glued in before (if any) — every invariant holds, but it is not the mesh of before the
+///        call unless the cancel came during the first component's computation. Callers that need all or
+///        nothing stitch a copy (Session::accept does).
 StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCamera,
                          const StitchOptions& options = {}, std::span<const std::uint32_t> faceIds = {},
                          const Progress& progress = {});
