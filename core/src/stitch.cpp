@@ -1185,6 +1185,15 @@ private:
                 liftOnEdge(best, bestS, pos, q);
                 if (!patchStaysValid(v, q)) continue;
                 if (outer != FaceIndex()) {
+                    // Its two pieces must pass the stitch's angle floor (else the patch keeps its place).
+                    const auto ov = faceVertices(outer);
+                    const Vec3 A = toVec(M_.point(ov[0])), B = toVec(M_.point(ov[1])), C = toVec(M_.point(ov[2]));
+                    const Vec3 U = L_[std::size_t(redges_[std::size_t(best)].u)].pos,
+                               W = L_[std::size_t(redges_[std::size_t(best)].w)].pos;
+                    const Vec3 D = A + B + C - U - W;
+                    const double floor = std::min(std::max(O_.minAngleFloorDeg, O_.outsideMinAngleFloorDeg) * kDeg,
+                                                  0.999 * minAngle(A, B, C));
+                    if (std::min(minAngle(U, pos, D), minAngle(pos, W, D)) < floor) continue;
                     // At most one split edge per outer face (it becomes a fan from the opposite corner).
                     auto [it, fresh] = outerSplits_.try_emplace(std::uint32_t(outer), best);
                     if (!fresh && it->second != best) continue;
