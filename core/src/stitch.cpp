@@ -10,7 +10,9 @@
 //                patch boundary edges (no slivers), compute where patch boundary edges cross mesh edges (the
 //                new vertex lies on the 3D mesh edge, perspective-correct), and build a constrained Delaunay
 //                triangulation of the seam faces' edges and the patch boundary in the view (exact
-//                predicates).
+//                predicates). A patch boundary vertex snapped onto an edge at the region's rim (a crease
+//                whose far face the view does not see) splits that far face too, in its plane (checked in
+//                3D, not in the view); its neighbours are opened to the seam flips.
 //  3. cut, glue  flood-fill the triangulation: which seam face each triangle lies in, inside or outside the
 //                patch. Seam faces are replaced by their outside triangles (in the face's plane: the surface
 //                outside does not move); patch triangles on the boundary are re-triangulated over the seam
@@ -1187,12 +1189,14 @@ private:
                 if (outer != FaceIndex()) {
                     // Its two pieces must pass the stitch's angle floor (else the patch keeps its place).
                     const auto ov = faceVertices(outer);
-                    const Vec3 A = toVec(M_.point(ov[0])), B = toVec(M_.point(ov[1])), C = toVec(M_.point(ov[2]));
+                    const Vec3 A = toVec(M_.point(ov[0])), B = toVec(M_.point(ov[1])),
+                               C = toVec(M_.point(ov[2]));
                     const Vec3 U = L_[std::size_t(redges_[std::size_t(best)].u)].pos,
                                W = L_[std::size_t(redges_[std::size_t(best)].w)].pos;
                     const Vec3 D = A + B + C - U - W;
-                    const double floor = std::min(std::max(O_.minAngleFloorDeg, O_.outsideMinAngleFloorDeg) * kDeg,
-                                                  0.999 * minAngle(A, B, C));
+                    const double floor =
+                        std::min(std::max(O_.minAngleFloorDeg, O_.outsideMinAngleFloorDeg) * kDeg,
+                                 0.999 * minAngle(A, B, C));
                     if (std::min(minAngle(U, pos, D), minAngle(pos, W, D)) < floor) continue;
                     // At most one split edge per outer face (it becomes a fan from the opposite corner).
                     auto [it, fresh] = outerSplits_.try_emplace(std::uint32_t(outer), best);
@@ -1970,8 +1974,8 @@ private:
         return inside;
     }
     Vec3 pt(const Mesh& S, VertexIndex v) const { return toVec(S.point(v)); }
-    // Is the triangle (a, b, c), in place of new face f, oriented as f must be: counter-clockwise in the view,
-    // or, for a piece of a mesh face the view does not see, like that face in 3D?
+    // Is the triangle (a, b, c), in place of new face f, oriented as f must be: counter-clockwise in the
+    // view, or, for a piece of a mesh face the view does not see, like that face in 3D?
     static bool oriented(const Local& loc, FaceIndex f, const Point2& ua, const Point2& ub, const Point2& uc,
                          const Vec3& a, const Vec3& b, const Vec3& c) {
         if (loc.offView[f]) return normalOf(a, b, c).dot(loc.planeNormal[f]) > 0;
@@ -2543,8 +2547,7 @@ private:
             if (loc.star.kept[f]) continue;
             const HalfedgeIndex h = S.halfedge(f);
             const VertexIndex p = S.source(h), q = S.target(h), r = S.target(S.next(h));
-            if (CGAL::collinear(S.point(p), S.point(q), S.point(r)) ||
-                !oriented(loc, f, p, q, r)) {
+            if (CGAL::collinear(S.point(p), S.point(q), S.point(r)) || !oriented(loc, f, p, q, r)) {
                 badFace(f);
             } else if (minAngle(pt(S, p), pt(S, q), pt(S, r)) < loc.minAllowed[f]) {
                 badFace(f);
