@@ -1187,17 +1187,34 @@ private:
                 liftOnEdge(best, bestS, pos, q);
                 if (!patchStaysValid(v, q)) continue;
                 if (outer != FaceIndex()) {
-                    // Its two pieces must pass the stitch's angle floor (else the patch keeps its place).
+                    // Its two pieces must pass the stitch's angle floor (else the patch keeps its place) ...
                     const auto ov = faceVertices(outer);
                     const Vec3 A = toVec(M_.point(ov[0])), B = toVec(M_.point(ov[1])),
                                C = toVec(M_.point(ov[2]));
-                    const Vec3 U = L_[std::size_t(redges_[std::size_t(best)].u)].pos,
-                               W = L_[std::size_t(redges_[std::size_t(best)].w)].pos;
-                    const Vec3 D = A + B + C - U - W;
+                    const REdge& r = redges_[std::size_t(best)];
+                    const Vec3 D = A + B + C - L_[std::size_t(r.u)].pos - L_[std::size_t(r.w)].pos;
+                    // Its neighbours along the edge: the edge's ends or vertices snapped onto it before.
+                    const double sq = lineParam(q, L_[std::size_t(r.u)].uv, L_[std::size_t(r.w)].uv);
+                    double below = 0, above = 1;
+                    Vec3 U = L_[std::size_t(r.u)].pos, W = L_[std::size_t(r.w)].pos;
+                    for (const auto& [sp, other] : r.splits) {
+                        if (sp <= sq && sp >= below) {
+                            below = sp;
+                            U = L_[std::size_t(other)].pos;
+                        }
+                        if (sp > sq && sp <= above) {
+                            above = sp;
+                            W = L_[std::size_t(other)].pos;
+                        }
+                    }
                     const double floor =
                         std::min(std::max(O_.minAngleFloorDeg, O_.outsideMinAngleFloorDeg) * kDeg,
                                  0.999 * minAngle(A, B, C));
-                    if (std::min(minAngle(U, pos, D), minAngle(pos, W, D)) < floor) continue;
+                    // ... and be no worse than the sliver the snap avoids (up to the needle angle).
+                    const double fan = std::min(minAngle(U, pos, D), minAngle(pos, W, D));
+                    if (fan < floor ||
+                        fan < std::min(minAngle(U, P_.pos[std::size_t(v)], W), kNeedleDeg * kDeg))
+                        continue;
                     // At most one split edge per outer face (it becomes a fan from the opposite corner).
                     auto [it, fresh] = outerSplits_.try_emplace(std::uint32_t(outer), best);
                     if (!fresh && it->second != best) continue;
