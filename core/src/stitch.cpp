@@ -10,7 +10,9 @@
 //                patch boundary edges (no slivers), compute where patch boundary edges cross mesh edges (the
 //                new vertex lies on the 3D mesh edge, perspective-correct), and build a constrained Delaunay
 //                triangulation of the seam faces' edges and the patch boundary in the view (exact
-//                predicates).
+//                predicates). A patch boundary vertex snapped onto an edge at the region's rim (a crease
+//                whose far face the view does not see) splits that far face too, in its plane (checked in
+//                3D, not in the view); its neighbours are opened to the seam flips.
 //  3. cut, glue  flood-fill the triangulation: which seam face each triangle lies in, inside or outside the
 //                patch. Seam faces are replaced by their outside triangles (in the face's plane: the surface
 //                outside does not move); patch triangles on the boundary are re-triangulated over the seam
@@ -420,6 +422,7 @@ struct LVert {
     bool alive = true;            // false for patch boundary vertices merged into a region vertex
     bool chain = false;           // lies on the patch boundary (a seam vertex)
     int edgeU = -1, edgeW = -1;   // crossings and vertices snapped onto a mesh edge: that edge's ends
+    bool onOuterEdge = false;     // snapped onto a mesh edge whose other face is not a region face
     Vec3 pos{0, 0, 0};
     Point2 uv{0, 0};
 };
@@ -432,6 +435,7 @@ struct LFace {
     bool patchSide; // a patch face (or a piece of one); else a piece of a mesh face outside the patch
     Vec3 planeNormal{0, 0, 0}; // pieces outside: unit normal of the mesh face they lie in
     double minAllowed = 0;     // smallest angle accepted (radians): the floor, or less if the parent had less
+    bool offView = false;      // a piece of a mesh face the view does not see: checked in 3D, in its plane
 };
 
 // ---------------------------------------------------------------------------------------------------
@@ -1150,6 +1154,24 @@ private:
             if (M_.is_border(g) || !regionIndex_.count(std::uint32_t(M_.face(g)))) return false;
         return true;
     }
+    // The face beyond region edge re when exactly one of its faces is a region face and the other is a
+    // triangle of the mesh that stays (not under the patch); else null.
+    FaceIndex outerFace(int re, const std::unordered_set<std::uint32_t>& interior) const {
+        const HalfedgeIndex h = M_.halfedge(redges_[std::size_t(re)].edge);
+        FaceIndex outer;
+        int inRegion = 0;
+        for (HalfedgeIndex g : {h, M_.opposite(h)}) {
+            if (M_.is_border(g)) return FaceIndex();
+            const FaceIndex f = M_.face(g);
+            if (regionIndex_.count(std::uint32_t(f)))
+                ++inRegion;
+            else
+                outer = f;
+        }
+        if (inRegion != 1 || interior.count(std::uint32_t(outer))) return FaceIndex();
+        if (M_.next(M_.next(M_.next(M_.halfedge(outer)))) != M_.halfedge(outer)) return FaceIndex();
+        return outer;
+    }
     void snap() {
         const double cell = 2.0 * h2_;
         // Snapping distances are a fraction of the local edge lengths on both sides, so that snapped
@@ -1195,8 +1217,16 @@ private:
                 L_[std::size_t(c.lid)].chain = true;
             }
         }
-        // Rule 2: a patch boundary vertex close to a mesh edge moves onto it (an edge split).
+        // Rule 2: a patch boundary vertex close to a mesh edge moves onto it (an edge split). On an edge at
+        // the region's rim (typically a crease whose other face the view does not see) the other face is
+        // split along that edge too.
         {
+            const std::unordered_set<std::uint32_t> interior = [&] {
+                std::unordered_set<std::uint32_t> out;
+                for (FaceIndex f : interior_)
+                    out.insert(std::uint32_t(f));
+                return out;
+            }();
             BucketGrid grid(cell, redges_.size());
             for (std::size_t i = 0; i < redges_.size(); ++i)
                 grid.insert(int(i),
@@ -1222,11 +1252,47 @@ private:
                         bestS = s;
                     }
                 });
-                if (best < 0 || !splittable(best)) continue;
+                if (best < 0) continue;
+                const FaceIndex outer = splittable(best) ? FaceIndex() : outerFace(best, interior);
+                if (!splittable(best) && outer == FaceIndex()) continue;
                 Vec3 pos;
                 Point2 q;
                 liftOnEdge(best, bestS, pos, q);
                 if (!patchStaysValid(v, q)) continue;
+                if (outer != FaceIndex()) {
+                    // Its two pieces must pass the stitch's angle floor (else the patch keeps its place) ...
+                    const auto ov = faceVertices(outer);
+                    const Vec3 A = toVec(M_.point(ov[0])), B = toVec(M_.point(ov[1])),
+                               C = toVec(M_.point(ov[2]));
+                    const REdge& r = redges_[std::size_t(best)];
+                    const Vec3 D = A + B + C - L_[std::size_t(r.u)].pos - L_[std::size_t(r.w)].pos;
+                    // Its neighbours along the edge: the edge's ends or vertices snapped onto it before.
+                    const double sq = lineParam(q, L_[std::size_t(r.u)].uv, L_[std::size_t(r.w)].uv);
+                    double below = 0, above = 1;
+                    Vec3 U = L_[std::size_t(r.u)].pos, W = L_[std::size_t(r.w)].pos;
+                    for (const auto& [sp, other] : r.splits) {
+                        if (sp <= sq && sp >= below) {
+                            below = sp;
+                            U = L_[std::size_t(other)].pos;
+                        }
+                        if (sp > sq && sp <= above) {
+                            above = sp;
+                            W = L_[std::size_t(other)].pos;
+                        }
+                    }
+                    const double floor =
+                        std::min(std::max(O_.minAngleFloorDeg, O_.outsideMinAngleFloorDeg) * kDeg,
+                                 0.999 * minAngle(A, B, C));
+                    // ... and be no worse than the sliver the snap avoids (up to the needle angle).
+                    const double fan = std::min(minAngle(U, pos, D), minAngle(pos, W, D));
+                    if (fan < floor ||
+                        fan < std::min(minAngle(U, P_.pos[std::size_t(v)], W), kNeedleDeg * kDeg))
+                        continue;
+                    // At most one split edge per outer face (it becomes a fan from the opposite corner).
+                    auto [it, fresh] = outerSplits_.try_emplace(std::uint32_t(outer), best);
+                    if (!fresh && it->second != best) continue;
+                    L_[std::size_t(lid)].onOuterEdge = true;
+                }
                 LVert& l = L_[std::size_t(lid)];
                 l.pos = pos;
                 l.uv = q;
@@ -1529,15 +1595,22 @@ private:
             if (!l.alive || !l.chain) continue;
             const CdtVertex v = vh[i];
             bool uncovered = false;
+            CdtFace under;
             auto fc = cdt.incident_faces(v), end = fc;
             do {
-                if (cdt.is_infinite(fc) || fc->info().region < 0) uncovered = true;
+                // On an edge at the region's rim, the side beyond it is not the patch's (split separately).
+                if (cdt.is_infinite(fc) || fc->info().region < 0) {
+                    if (!l.onOuterEdge || fc->info().inside != 0) uncovered = true;
+                } else {
+                    under = fc;
+                }
             } while (++fc != end);
+            if (under == CdtFace()) uncovered = true;
             // Around a seam vertex inside mesh faces or on mesh edges, the seam faces must surround it.
             if (uncovered && l.kind != LVert::Region) addBad(bad, int(i));
             if (l.kind == LVert::PatchBoundary && !uncovered) {
                 // The patch must lie on the surface under it (not on an occluder or another sheet).
-                const FaceIndex f = region_[std::size_t(v->face()->info().region)];
+                const FaceIndex f = region_[std::size_t(under->info().region)];
                 if (gapTo(l.pos, f) > gapTolerance(f)) addBad(bad, int(i));
             }
         }
@@ -1558,7 +1631,7 @@ private:
         auto X = [&](std::size_t i) -> const Vec3& { return L_[std::size_t(poly[i])].pos; };
         if (n == 3) {
             if (!leftTurn(P(0), P(1), P(2))) return false;
-            newFaces_.push_back({{poly[0], poly[1], poly[2]}, q, sid, true, Vec3(0, 0, 0), floor});
+            newFaces_.push_back({{poly[0], poly[1], poly[2]}, q, sid, true, Vec3(0, 0, 0), floor, false});
             return true;
         }
         // diagonal[i][j]: the segment i–j lies inside the polygon and does not run along a triangle edge.
@@ -1613,7 +1686,7 @@ private:
             stack.pop_back();
             if (j == i + 1) continue;
             const std::size_t k = split[i * n + j];
-            newFaces_.push_back({{poly[i], poly[k], poly[j]}, q, sid, true, Vec3(0, 0, 0), floor});
+            newFaces_.push_back({{poly[i], poly[k], poly[j]}, q, sid, true, Vec3(0, 0, 0), floor, false});
             stack.push_back({i, k});
             stack.push_back({k, j});
         }
@@ -1656,7 +1729,63 @@ private:
                          sid,
                          false,
                          n,
-                         floor});
+                         floor,
+                         false});
+        }
+        // Mesh faces outside the region whose edge got seam vertices (a patch boundary along a crease, the
+        // face beyond it unseen): split along that edge in 3D, a fan from the opposite corner in the face's
+        // own plane, so the patch boundary meets the crease without a sliver in front of it.
+        for (const auto& [fi, re] : outerSplits_) {
+            const FaceIndex face(fi);
+            const REdge& r = redges_[std::size_t(re)];
+            if (r.line.size() <= 2) continue;
+            const HalfedgeIndex he = M_.halfedge(r.edge);
+            const bool forward = M_.face(he) == face;
+            std::vector<int> line = r.line; // from the source to the target of `he`
+            if (!forward) std::reverse(line.begin(), line.end());
+            const int apex = regionVertex(M_.target(M_.next(forward ? he : M_.opposite(he))));
+            const auto vs = faceVertices(face);
+            const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
+            const double floor = std::min(std::max(O_.minAngleFloorDeg, O_.outsideMinAngleFloorDeg) * kDeg,
+                                          0.999 * minAngle(A, B, C));
+            replaced_.push_back(face);
+            for (std::size_t k = 0; k + 1 < line.size(); ++k)
+                newFaces_.push_back({{line[k], line[k + 1], apex},
+                                     curHasQuality_ ? curQuality_[face] : kInputFaceQuality,
+                                     curHasScanId_ ? curScanId_[face] : -1,
+                                     false,
+                                     normalOf(A, B, C).normalized(),
+                                     floor,
+                                     !acceptable(face)});
+        }
+        // Their other neighbours open to the seam optimisation too (flips in their planes), as themselves.
+        {
+            std::unordered_set<std::uint32_t> taken;
+            for (FaceIndex f : replaced_)
+                taken.insert(std::uint32_t(f));
+            for (FaceIndex f : interior_)
+                taken.insert(std::uint32_t(f));
+            for (const auto& [fi, re] : outerSplits_) {
+                if (redges_[std::size_t(re)].line.size() <= 2) continue;
+                for (HalfedgeIndex h : CGAL::halfedges_around_face(M_.halfedge(FaceIndex(fi)), M_)) {
+                    const FaceIndex g = M_.face(M_.opposite(h));
+                    if (g == Mesh::null_face() || regionIndex_.count(std::uint32_t(g)) ||
+                        !taken.insert(std::uint32_t(g)).second)
+                        continue;
+                    const auto vs = faceVertices(g);
+                    if (M_.next(M_.next(M_.next(M_.halfedge(g)))) != M_.halfedge(g)) continue;
+                    const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])),
+                               C = toVec(M_.point(vs[2]));
+                    replaced_.push_back(g);
+                    newFaces_.push_back({{regionVertex(vs[0]), regionVertex(vs[1]), regionVertex(vs[2])},
+                                         curHasQuality_ ? curQuality_[g] : kInputFaceQuality,
+                                         curHasScanId_ ? curScanId_[g] : -1,
+                                         false,
+                                         normalOf(A, B, C).normalized(),
+                                         std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C)),
+                                         !acceptable(g)});
+                }
+            }
         }
         // The seam optimisation may also change the faces around the re-triangulated ones (seamRings):
         // they join the faces replaced (by themselves, to begin with).
@@ -1686,7 +1815,8 @@ private:
                                  curHasScanId_ ? curScanId_[g] : -1,
                                  false,
                                  normalOf(A, B, C).normalized(),
-                                 std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C))});
+                                 std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C)),
+                                 false});
                         }
                 ring.swap(next);
             }
@@ -1758,6 +1888,7 @@ private:
         Mesh::Property_map<FaceIndex, bool> patchSide;
         Mesh::Property_map<FaceIndex, Vec3> planeNormal;  // outside pieces: normal of their mesh face
         Mesh::Property_map<FaceIndex, double> minAllowed; // smallest angle accepted (radians)
+        Mesh::Property_map<FaceIndex, bool> offView;      // piece of a mesh face the view does not see
         std::set<std::pair<std::uint32_t, std::uint32_t>> seam;
     };
     static std::pair<std::uint32_t, std::uint32_t> seamKey(VertexIndex a, VertexIndex b) {
@@ -1822,6 +1953,7 @@ private:
         loc.patchSide = S.add_property_map<FaceIndex, bool>("f:patch", false).first;
         loc.planeNormal = S.add_property_map<FaceIndex, Vec3>("f:plane", Vec3(0, 0, 0)).first;
         loc.minAllowed = S.add_property_map<FaceIndex, double>("f:floor", 0.0).first;
+        loc.offView = S.add_property_map<FaceIndex, bool>("f:offview", false).first;
         // Border edges around the replaced faces before (must be the same after: no new holes).
         const auto bordersBefore = bordersAround(loc);
         // Map local ids to S vertices.
@@ -1885,6 +2017,7 @@ private:
             loc.patchSide[g] = newFaces_[i].patchSide;
             loc.planeNormal[g] = newFaces_[i].planeNormal;
             loc.minAllowed[g] = newFaces_[i].minAllowed;
+            loc.offView[g] = newFaces_[i].offView;
         }
         if (!bad.empty()) return fail(a, "its seam would not be manifold", std::move(bad));
         for (VertexIndex v : S.vertices()) {
@@ -1937,6 +2070,17 @@ private:
         return inside;
     }
     Vec3 pt(const Mesh& S, VertexIndex v) const { return toVec(S.point(v)); }
+    // Is the triangle (a, b, c), in place of new face f, oriented as f must be: counter-clockwise in the
+    // view, or, for a piece of a mesh face the view does not see, like that face in 3D?
+    static bool oriented(const Local& loc, FaceIndex f, const Point2& ua, const Point2& ub, const Point2& uc,
+                         const Vec3& a, const Vec3& b, const Vec3& c) {
+        if (loc.offView[f]) return normalOf(a, b, c).dot(loc.planeNormal[f]) > 0;
+        return leftTurn(ua, ub, uc);
+    }
+    bool oriented(const Local& loc, FaceIndex f, VertexIndex a, VertexIndex b, VertexIndex c) const {
+        const Mesh& S = loc.star.S;
+        return oriented(loc, f, loc.uv[a], loc.uv[b], loc.uv[c], pt(S, a), pt(S, b), pt(S, c));
+    }
     // Edges incident to the given vertices (each once, in a deterministic order).
     static std::vector<EdgeIndex> edgesAround(const Mesh& S,
                                               const std::unordered_set<std::uint32_t>& vertices) {
@@ -2008,7 +2152,7 @@ private:
                 const VertexIndex p = S.target(S.next(g)), q = S.source(g);
                 oldMin = std::min(oldMin, minAngle(pt(S, a), pt(S, p), pt(S, q)));
                 if (p == b || q == b) continue;
-                if (!leftTurn(loc.uv[b], loc.uv[p], loc.uv[q])) return false;
+                if (!oriented(loc, f, b, p, q)) return false;
                 if (CGAL::collinear(S.point(b), S.point(p), S.point(q))) return false;
                 const Vec3 n0 = normalOf(pt(S, a), pt(S, p), pt(S, q)),
                            n1 = normalOf(pt(S, b), pt(S, p), pt(S, q));
@@ -2147,7 +2291,8 @@ private:
         double oldMin = std::numbers::pi, newMin = std::numbers::pi;
         for (std::size_t i = 0; i < ring.size(); ++i) {
             const auto [p, q] = ring[i];
-            if (!leftTurn(uv, loc.uv[p], loc.uv[q]) || CGAL::collinear(toPoint(p1), S.point(p), S.point(q)))
+            if (!oriented(loc, faces[i], uv, loc.uv[p], loc.uv[q], p1, pt(S, p), pt(S, q)) ||
+                CGAL::collinear(toPoint(p1), S.point(p), S.point(q)))
                 return 0;
             if (loc.patchSide[faces[i]] &&
                 angleBetween(normalOf(p0, pt(S, p), pt(S, q)), normalOf(p1, pt(S, p), pt(S, q))) >
@@ -2183,6 +2328,7 @@ private:
             Vec3 n(0, 0, 0);
             bool inPlane = true;
             std::vector<std::pair<VertexIndex, VertexIndex>> ring; // (p, q): faces (v, p, q)
+            std::vector<FaceIndex> ringFaces;
             Vec3 centre(0, 0, 0);
             int count = 0;
             for (HalfedgeIndex g : CGAL::halfedges_around_target(S.halfedge(v), S)) {
@@ -2196,6 +2342,7 @@ private:
                 else if (angleBetween(n, loc.planeNormal[f]) > kCoplanar)
                     inPlane = false;
                 ring.push_back({S.target(S.next(g)), S.source(g)});
+                ringFaces.push_back(f);
                 centre += pt(S, S.source(g));
                 ++count;
             }
@@ -2208,8 +2355,9 @@ private:
             if (!V_.project(p1, uv, w)) continue;
             double oldMin = std::numbers::pi, newMin = std::numbers::pi;
             bool valid = true;
-            for (const auto& [p, q] : ring) {
-                if (!leftTurn(uv, loc.uv[p], loc.uv[q]) ||
+            for (std::size_t i = 0; i < ring.size(); ++i) {
+                const auto [p, q] = ring[i];
+                if (!oriented(loc, ringFaces[i], uv, loc.uv[p], loc.uv[q], p1, pt(S, p), pt(S, q)) ||
                     CGAL::collinear(toPoint(p1), S.point(p), S.point(q))) {
                     valid = false;
                     break;
@@ -2262,13 +2410,16 @@ private:
             Point2 uv;
             double w;
             if (!V_.project(mid, uv, w)) continue;
-            // The split must leave all four triangles counter-clockwise in the view.
+            // The split must leave all four triangles counter-clockwise in the view (pieces of a face the
+            // view does not see: oriented like it) ...
             const VertexIndex z = S.target(S.next(h)), u = S.target(S.next(o));
-            if (!leftTurn(loc.uv[x], uv, loc.uv[z]) || !leftTurn(uv, loc.uv[y], loc.uv[z]) ||
-                !leftTurn(loc.uv[y], uv, loc.uv[u]) || !leftTurn(uv, loc.uv[x], loc.uv[u]))
+            const Vec3 X = pt(S, x), Y = pt(S, y), Z = pt(S, z), U = pt(S, u);
+            if (!oriented(loc, f, loc.uv[x], uv, loc.uv[z], X, mid, Z) ||
+                !oriented(loc, f, uv, loc.uv[y], loc.uv[z], mid, Y, Z) ||
+                !oriented(loc, g, loc.uv[y], uv, loc.uv[u], Y, mid, U) ||
+                !oriented(loc, g, uv, loc.uv[x], loc.uv[u], mid, X, U))
                 continue;
             // ... and not make the smallest angle there worse.
-            const Vec3 X = pt(S, x), Y = pt(S, y), Z = pt(S, z), U = pt(S, u);
             if (std::min({minAngle(X, mid, Z), minAngle(mid, Y, Z), minAngle(Y, mid, U),
                           minAngle(mid, X, U)}) < 0.99 * std::min(minAngle(X, Y, Z), minAngle(Y, X, U)))
                 continue;
@@ -2298,6 +2449,7 @@ private:
         loc.patchSide[to] = loc.patchSide[from];
         loc.planeNormal[to] = loc.planeNormal[from];
         loc.minAllowed[to] = loc.minAllowed[from];
+        loc.offView[to] = loc.offView[from];
     }
 
     // -- flips: raise the smallest angle, valence towards 6
@@ -2336,7 +2488,8 @@ private:
             if (S.degree(x) <= 3 || S.degree(y) <= 3) continue;
             if (S.halfedge(z1, z2) != Mesh::null_halfedge()) continue;
             // New faces (x, z2, z1) and (z2, y, z1).
-            if (!leftTurn(loc.uv[x], loc.uv[z2], loc.uv[z1]) || !leftTurn(loc.uv[z2], loc.uv[y], loc.uv[z1]))
+            if (loc.offView[S.face(h)] != loc.offView[S.face(o)] || !oriented(loc, S.face(h), x, z2, z1) ||
+                !oriented(loc, S.face(o), z2, y, z1))
                 continue;
             if (CGAL::collinear(S.point(x), S.point(z2), S.point(z1)) ||
                 CGAL::collinear(S.point(z2), S.point(y), S.point(z1)))
@@ -2497,8 +2650,7 @@ private:
             if (loc.star.kept[f]) continue;
             const HalfedgeIndex h = S.halfedge(f);
             const VertexIndex p = S.source(h), q = S.target(h), r = S.target(S.next(h));
-            if (CGAL::collinear(S.point(p), S.point(q), S.point(r)) ||
-                !leftTurn(loc.uv[p], loc.uv[q], loc.uv[r])) {
+            if (CGAL::collinear(S.point(p), S.point(q), S.point(r)) || !oriented(loc, f, p, q, r)) {
                 badFace(f);
             } else if (minAngle(pt(S, p), pt(S, q), pt(S, r)) < loc.minAllowed[f]) {
                 badFace(f);
@@ -2776,6 +2928,7 @@ private:
     std::unordered_set<std::uint64_t> regionSub_, patchSub_;
     std::vector<FaceIndex> replaced_;
     std::vector<LFace> newFaces_;
+    std::map<std::uint32_t, int> outerSplits_; // face outside the region → the region edge of it split
 };
 
 // ---------------------------------------------------------------------------------------------------

@@ -1,6 +1,6 @@
-// Seam quality (issue #4): fandisk after one 256² iso scan (Camera::standardView Iso, no lasso, the
-// command line's default masks) stitched into the input mesh. Computed from the mesh alone, independently
-// of StitchReport:
+// Seam quality (issue #4): fandisk after one 256² scan (Camera::standardView Iso, and +y so the figures are
+// not tuned to one view; no lasso, the command line's default masks) stitched into the input mesh. Computed
+// from the mesh alone, independently of StitchReport:
 //  - seam vertices: vertices with at least one face made by the scan (props::faceScanId == the scan's id)
 //    and at least one face of the input (scan id −1) around them — where the patch meets the old mesh;
 //  - seam triangles: faces with at least one seam vertex;
@@ -47,31 +47,33 @@ double minAngleDeg(const Mesh& m, FaceIndex f) {
     return best;
 }
 
-} // namespace
+struct SeamFigures {
+    double smallestAngleDeg = 0;   // smallest angle of the seam triangles
+    double fractionAbove25 = 0;    // fraction of seam triangles whose smallest angle is >= 25 degrees
+    std::size_t badValence = 1000; // seam vertices of valence outside 4..8
+};
 
-// DISABLED: the stitcher does not meet these targets yet. Measured at commit time (run with
-// --gtest_also_run_disabled_tests, FSS_SEAM_DEBUG=1 lists the poor faces): smallest seam angle 1.99°
-// (target ≥ 10°), 89.6 % of seam triangles ≥ 25° (target ≥ 90 %), 21 seam vertices of valence 9–10
-// (target 4–8). Nearly all faces below 10° are pieces of old mesh faces outside the patch (a seam crossing
-// and two old vertices, the old vertex far away: fans of the coarser old mesh), the high valences are old
-// mesh vertices snapped onto the patch boundary. Enable it when the seam optimisation reaches the targets.
-TEST(StitchSeam, DISABLED_FandiskIsoScanSeamQuality) {
+// Scans fandisk from `view` at 256², stitches the patch into the input mesh and measures the seam.
+SeamFigures fandiskSeam(fss::StandardView view, const char* name) {
     Mesh ref;
     std::ifstream in(fss::test::meshPath("fandisk.off"));
-    ASSERT_TRUE(in && CGAL::IO::read_OFF(in, ref));
+    EXPECT_TRUE(in && CGAL::IO::read_OFF(in, ref));
     fss::CpuMeshRenderer renderer;
     renderer.setMesh(ref);
     fss::ScanParams params;
-    params.camera = fss::Camera::standardView(fss::StandardView::Iso, fss::boundingBox(ref), 256, 256);
+    params.camera = fss::Camera::standardView(view, fss::boundingBox(ref), 256, 256);
     params.scan.scanId = 1;
     const fss::ScanResult scan = fss::scanPatch(ref, renderer, ref, renderer, params);
     Mesh current = ref;
     const fss::StitchReport report =
         fss::stitchPatch(current, scan.patch.mesh, scan.grid.camera, {}, scan.currentBuffers.faceId);
-    ASSERT_GE(report.componentsStitched, 1);
+    EXPECT_GE(report.componentsStitched, 1);
 
     auto sid = current.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId);
-    ASSERT_TRUE(sid.second);
+    if (!sid.second) {
+        ADD_FAILURE() << "the stitched mesh has no scan ids";
+        return {};
+    }
     std::vector<VertexIndex> seam;
     std::set<FaceIndex> seamFaces;
     std::size_t scanFaces = 0;
@@ -89,8 +91,8 @@ TEST(StitchSeam, DISABLED_FandiskIsoScanSeamQuality) {
         for (auto f : CGAL::faces_around_target(current.halfedge(v), current))
             if (f != Mesh::null_face()) seamFaces.insert(f);
     }
-    ASSERT_GT(scanFaces, 10000u);
-    ASSERT_GT(seam.size(), 100u);
+    EXPECT_GT(scanFaces, 10000u);
+    EXPECT_GT(seam.size(), 100u);
 
     double worst = 180;
     std::size_t above25 = 0;
@@ -141,15 +143,48 @@ TEST(StitchSeam, DISABLED_FandiskIsoScanSeamQuality) {
         badValence += d < 4 || d > 8;
     }
     const double frac = double(above25) / double(seamFaces.size());
-    std::printf("fandisk iso 256^2: %zu patch faces, %zu seam vertices, %zu seam triangles, smallest angle %.2f deg, "
-                "%.1f %% with smallest angle >= 25 deg, %zu seam vertices of valence outside 4..8; valences:",
-                scanFaces, seam.size(), seamFaces.size(), worst, 100.0 * frac, badValence);
+    std::printf(
+        "fandisk %s 256^2: %zu patch faces, %zu seam vertices, %zu seam triangles, smallest angle %.2f deg, "
+        "%.1f %% with smallest angle >= 25 deg, %zu seam vertices of valence outside 4..8; valences:",
+        name, scanFaces, seam.size(), seamFaces.size(), worst, 100.0 * frac, badValence);
     for (const auto& [d, n] : histogram)
         std::printf(" %zu:%zu", d, n);
     std::printf("\n");
-    EXPECT_GE(worst, 10.0);
-    EXPECT_GE(frac, 0.9);
-    EXPECT_EQ(badValence, 0u);
     EXPECT_FALSE(CGAL::Polygon_mesh_processing::does_self_intersect(current));
     EXPECT_TRUE(CGAL::is_closed(current));
+    return {worst, frac, badValence};
+}
+
+} // namespace
+
+// DISABLED: the stitcher does not meet these targets yet. Measured (run with --gtest_also_run_disabled_tests,
+// FSS_SEAM_DEBUG=1 lists the poor faces): iso view — smallest seam angle 9.45° (target ≥ 10°), 91.8 % of seam
+// triangles ≥ 25° (target ≥ 90 %), 10 seam vertices of valence 9–10 (target 4–8); +y view — 9.72°, 90.7 %,
+// 8 vertices of valence 9–10. The faces below 10° are pieces of old faces outside the patch next to points
+// the seam refinement added; the high valences are old crease vertices on the patch boundary (their unseen
+// faces behind the crease plus the patch and old pieces in front). Enable when the seam optimisation
+// reaches the targets.
+TEST(StitchSeam, DISABLED_FandiskScanSeamQuality) {
+    for (const auto& [view, name] :
+         {std::pair{fss::StandardView::Iso, "iso"}, std::pair{fss::StandardView::PosY, "+y"}}) {
+        SCOPED_TRACE(name);
+        const SeamFigures s = fandiskSeam(view, name);
+        EXPECT_GE(s.smallestAngleDeg, 10.0);
+        EXPECT_GE(s.fractionAbove25, 0.9);
+        EXPECT_EQ(s.badValence, 0u);
+    }
+}
+
+// Regression guard for what the criterion test above does not check yet: where the patch boundary runs along
+// a crease whose far face the scan does not see, the boundary is snapped onto the crease edge (the unseen
+// face split along it), so no sliver is left between the patch and the crease. Before that, both views had
+// seam triangles of 1.0–2.0° and 87.0–89.6 % of them ≥ 25°; now 9.45–9.72° and 90.7–91.8 %.
+TEST(StitchSeam, FandiskCreaseSeamHasNoSlivers) {
+    for (const auto& [view, name] :
+         {std::pair{fss::StandardView::Iso, "iso"}, std::pair{fss::StandardView::PosY, "+y"}}) {
+        SCOPED_TRACE(name);
+        const SeamFigures s = fandiskSeam(view, name);
+        EXPECT_GE(s.smallestAngleDeg, 5.0);
+        EXPECT_GE(s.fractionAbove25, 0.9);
+    }
 }

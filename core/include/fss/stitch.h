@@ -8,7 +8,10 @@
 /// and edges are inserted into that projected triangulation as constraints (a constrained Delaunay
 /// triangulation with exact predicates performs the paper's face / edge splits and edge flips); where a
 /// patch boundary edge crosses a mesh edge the new vertex lies *on that mesh edge in 3D*, so the geometry
-/// outside the patch does not move. The mesh faces inside the boundary are removed (those under the patch
+/// outside the patch does not move. A patch boundary vertex within snapping distance of an edge at the rim of
+/// that region (typically a crease whose other face the view does not see) moves onto it and the face beyond
+/// is split along the edge in its own plane, so no sliver is left between the patch and the crease. The mesh
+/// faces inside the boundary are removed (those under the patch
 /// whole), the patch is glued in sharing the boundary vertices, and the seam is optimised: short edges
 /// collapsed, the pieces outside the patch refined towards the patch's edge length (new vertices on the old
 /// surface), edges flipped for angles and valence — never flipping a face in the view, folding the surface
@@ -47,8 +50,10 @@ struct StitchOptions {
     /// A floor (degrees) for the pieces of mesh faces outside the patch only (slivers between the patch
     /// boundary and an old edge the seam cannot change, e.g. at a crease): below it the patch is trimmed
     /// there and retried. The larger of this and minAngleFloorDeg applies to those pieces. Off (0) by
-    /// default: 10 brings the fandisk seam test's angles within bounds (smallest 10.2 deg) but makes
-    /// coarse meshes (icosphere level 3) refuse whole patches.
+    /// default: such pieces are often thin by nature (a big face of a coarse mesh cut near a corner by the
+    /// patch boundary, its old vertices fixed) and then only trimming satisfies a floor; 10 brings the
+    /// fandisk seam test's angles within bounds (smallest 11.1 deg) at the cost of trimming more of the
+    /// patch, and makes coarse meshes (icosphere level 3) refuse whole patches.
     double outsideMinAngleFloorDeg = 0.0;
     /// Current-mesh faces seen at a larger angle between normal and view ray (degrees) are not stitched to;
     /// the patch is trimmed away from them.
@@ -114,15 +119,16 @@ struct StitchReport {
 ///
 /// Each patch component (connected through vertices) is stitched on its own: the region under it is
 /// re-triangulated in the view, the result is checked on a local copy (edge- and vertex-manifold,
-/// consistently oriented, no degenerate or needle faces, every new face facing the camera, no new
-/// self-intersections among the touched faces and their neighbours, border edges — so holes, boundary loops
-/// and closedness — unchanged), the exact sequence of edits is rehearsed on a second local copy, and only
-/// then applied. Where a component cannot be stitched safely (it reaches past a silhouette, the mesh's
-/// border or a hole, a grazing face, a fold or occlusion contour of the mesh in the view, another sheet),
-/// its patch faces there are trimmed and the rest retried; a component that cannot be made stitchable is
-/// skipped and reported. Faces of \p current not under the patch and not within seamRings of its seam keep
-/// their indices, vertices and positions. Removed elements are left as garbage that later additions reuse
-/// (see StitchOptions::collectGarbage); face indices of \p current therefore stay valid between calls.
+/// consistently oriented, no degenerate or needle faces, every new face facing the camera (pieces of a face
+/// the view does not see keep that face's plane and orientation), no new self-intersections among the touched
+/// faces and their neighbours, border edges — so holes, boundary loops and closedness — unchanged), the exact
+/// sequence of edits is rehearsed on a second local copy, and only then applied. Where a component cannot be
+/// stitched safely (it reaches past a silhouette, the mesh's border or a hole, a grazing face, a fold or
+/// occlusion contour of the mesh in the view, another sheet), its patch faces there are trimmed and the rest
+/// retried; a component that cannot be made stitchable is skipped and reported. Faces of \p current not under
+/// the patch and not within seamRings of its seam keep their indices, vertices and positions. Removed
+/// elements are left as garbage that later additions reuse (see StitchOptions::collectGarbage); face indices
+/// of \p current therefore stay valid between calls.
 ///
 /// \return what was done, with seam quality figures.
 /// \throw InvalidInputError when the camera, the patch, the options or the ID buffer are invalid, or when no
