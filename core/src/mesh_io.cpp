@@ -2010,6 +2010,25 @@ Mesh readMesh(const fs::path& path, ReadReport* report, const ReadOptions& optio
     return soupToMesh(src, soup, rep, options);
 }
 
+Mesh canonicalMesh(const Mesh& mesh) {
+    // Exactly what readMesh does with the file writeMesh makes of the mesh, without the file.
+    const FlatMesh flat = flatten(mesh);
+    Soup soup;
+    soup.points = flat.points;
+    soup.polygons.reserve(flat.faces());
+    for (std::size_t f = 0; f < flat.faces(); ++f) {
+        Polygon poly;
+        for (std::size_t j = 0; j < flat.degree(f); ++j)
+            poly.push_back(flat.corner(f, j));
+        soup.polygons.push_back(std::move(poly));
+    }
+    if (flat.hasQuality) soup.quality = flat.quality;
+    if (flat.hasScanId) soup.scanId = flat.scanId;
+    const Source src{"(mesh in memory)", {}};
+    ReadReport report;
+    return soupToMesh(src, soup, report, ReadOptions{});
+}
+
 bool isSupportedMeshFile(const fs::path& path) {
     const std::string ext = lower(path.extension().string());
     return ext == ".off" || ext == ".obj" || ext == ".ply" || ext == ".stl";

@@ -109,6 +109,8 @@ struct Writer {
         t["ribs"] = streamline(p.tracing.ribTracing, f + ".tracing.ribs");
         j["tracing"] = std::move(t);
         j["min_seed_anisotropy"] = number(p.minSeedAnisotropy, f + ".min_seed_anisotropy");
+        j["crease"] = {{"angle_deg", number(p.creaseAngleDeg, f + ".crease.angle_deg")},
+                       {"snap_radius", number(p.creaseSnapRadius, f + ".crease.snap_radius")}};
         j["raycast"] = {{"rings", p.raycast.rings}, {"verify_unoccluded", p.raycast.verifyUnoccluded}};
         return j;
     }
@@ -359,7 +361,7 @@ StreamlineOptions readStreamline(const Node& n) {
 
 FishboneParams readFishbone(const Node& n) {
     n.onlyKeys({"seed", "direction", "h", "key_ribs", "drawn_key_ribs", "drawn_backbone", "tracing",
-                "min_seed_anisotropy", "raycast"});
+                "min_seed_anisotropy", "crease", "raycast"});
     FishboneParams p;
     const Node seed = n.at("seed");
     if (!seed.isNull()) p.seed = seed.vec2();
@@ -383,6 +385,12 @@ FishboneParams readFishbone(const Node& n) {
     p.tracing.backboneTracing = readStreamline(t.at("backbone"));
     p.tracing.ribTracing = readStreamline(t.at("ribs"));
     p.minSeedAnisotropy = n.at("min_seed_anisotropy").inRange(0, 1, false, false);
+    if (n.has("crease")) { // optional: files written before crease following get its defaults
+        const Node c = n.at("crease");
+        c.onlyKeys({"angle_deg", "snap_radius"});
+        p.creaseAngleDeg = c.at("angle_deg").inRange(0, 180, false, true);
+        p.creaseSnapRadius = c.at("snap_radius").positive();
+    }
     const Node r = n.at("raycast");
     r.onlyKeys({"rings", "verify_unoccluded"});
     p.raycast.rings = int(r.at("rings").integer(0, kIntMax, "an integer of at least 0"));

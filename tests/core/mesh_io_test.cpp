@@ -887,3 +887,35 @@ TEST(MeshIoFuzz, CorruptedFilesLoadValidMeshesOrThrowIoError) {
     EXPECT_GT(rejected, 0u);
     EXPECT_GT(loaded, 0u);
 }
+
+// canonicalMesh is what a file of the mesh reads back as: same points, same faces and the same halfedge
+// layout (what makes a session started from memory replay exactly from its saved input file).
+TEST(MeshIo, CanonicalMeshIsTheMeshAsReadBackFromItsFile) {
+    for (const char* name : {"fandisk.off", "mech-holes-shark.off"}) {
+        fss::Mesh m = fss::readMesh(fss::test::meshPath(name));
+        // Disturb the layout: a mesh built in memory need not be in the reader's order.
+        CGAL::Euler::flip_edge(m.halfedge(*std::next(m.edges().begin(), 10)), m);
+        const fss::Mesh canonical = fss::canonicalMesh(m);
+        for (const bool binary : {true, false}) {
+            const auto path = fss::test::tmpPath(std::string("canonical_") + name + (binary ? ".ply" : ".off"));
+            fss::WriteOptions o;
+            o.binary = binary;
+            fss::writeMesh(m, path, o);
+            const fss::Mesh read = fss::readMesh(path);
+            ASSERT_EQ(read.number_of_halfedges(), canonical.number_of_halfedges()) << name;
+            ASSERT_EQ(read.number_of_faces(), canonical.number_of_faces()) << name;
+            for (fss::VertexIndex v : read.vertices()) {
+                ASSERT_EQ(read.point(v), canonical.point(v));
+                ASSERT_EQ(read.halfedge(v), canonical.halfedge(v)) << name << " vertex " << v;
+            }
+            for (fss::HalfedgeIndex h : read.halfedges()) {
+                ASSERT_EQ(read.next(h), canonical.next(h)) << name;
+                ASSERT_EQ(read.target(h), canonical.target(h)) << name;
+                ASSERT_EQ(read.face(h), canonical.face(h)) << name;
+            }
+            for (fss::FaceIndex f : read.faces())
+                ASSERT_EQ(read.halfedge(f), canonical.halfedge(f)) << name;
+        }
+    }
+    EXPECT_THROW(fss::canonicalMesh(fss::Mesh()), fss::IoError);
+}

@@ -187,16 +187,19 @@ private slots:
         const fss::Mesh result = w->mesh();
         const std::filesystem::path file = dir_ / "sphere.session.json";
         QVERIFY(w->saveSession(QString::fromStdString(file.string())));
-        QVERIFY(std::filesystem::exists(dir_ / "sphere.session.input.off"));
-        QCOMPARE(w->meshPath(), QString::fromStdString((dir_ / "sphere.session.input.off").string()));
+        QVERIFY(std::filesystem::exists(dir_ / "sphere.session.input.ply"));
+        QCOMPARE(w->meshPath(), QString::fromStdString((dir_ / "sphere.session.input.ply").string()));
         auto w2 = shownWidget();
         QVERIFY(w2);
         QVERIFY(w2->loadSession(QString::fromStdString(file.string())));
         QVERIFY(waitIdle(*w2));
-        // Written with 17 digits: the same points bit for bit, the same faces.
+        // Written as binary PLY: the same points bit for bit, the same faces.
         QCOMPARE(w2->referenceMesh().number_of_faces(), sphere.number_of_faces());
         for (fss::VertexIndex v : sphere.vertices())
             QVERIFY(w2->referenceMesh().point(v) == sphere.point(v));
+        QVERIFY(identical(w2->referenceMesh(), w->referenceMesh()));
+        QVERIFY2(w2->mesh().number_of_faces() == result.number_of_faces(),
+                 qPrintable(QString("%1 vs %2").arg(w2->mesh().number_of_faces()).arg(result.number_of_faces())));
         QVERIFY(identical(w2->mesh(), result));
     }
 

@@ -36,6 +36,7 @@
 #include <filesystem>
 #include <functional>
 #include <mutex>
+#include <optional>
 #include <string>
 
 namespace fss::widgets {
@@ -113,6 +114,10 @@ struct RemeshWidget::Replay {
 struct RemeshWidget::Impl {
     std::unique_ptr<Session> session;
     QString meshPath;       // the reference's file, if any
+    // A mesh given to setMesh without a file, as given: its file (saveSession) reads back as the
+    // reference, canonicalMesh(memoryInput) (canonicalMesh is not idempotent, so the reference itself
+    // would not).
+    std::optional<Mesh> memoryInput;
     bool cpuRenderer = false; // the session was made with the CPU renderer
     // Set by the session's renderer factory when the view could not give a GPU renderer.
     std::shared_ptr<std::atomic<bool>> cpuFallback = std::make_shared<std::atomic<bool>>(false);
@@ -353,13 +358,16 @@ bool RemeshWidget::setMesh(const Mesh& mesh, const QString& meshPath) {
     auto fallback = std::make_shared<std::atomic<bool>>(false);
     std::unique_ptr<Session> session;
     try {
-        session = std::make_unique<Session>(mesh, widgetSessionOptions(d_->view, false, fallback, {}));
+        // From memory: the layout a file of it would read back as, so saved sessions replay exactly.
+        session = std::make_unique<Session>(meshPath.isEmpty() ? canonicalMesh(mesh) : mesh,
+                                            widgetSessionOptions(d_->view, false, fallback, {}));
     } catch (const std::exception& e) {
         reportError(sentence(e));
         return false;
     }
     d_->cpuFallback = fallback;
     installSession(std::move(session), meshPath, false, {});
+    if (meshPath.isEmpty()) d_->memoryInput = mesh;
     return true;
 }
 
@@ -368,6 +376,7 @@ void RemeshWidget::installSession(std::unique_ptr<Session> session, const QStrin
     d_->undoStack->clear();
     d_->session = std::move(session);
     d_->meshPath = meshPath;
+    d_->memoryInput.reset();
     d_->cpuRenderer = cpuRenderer;
     d_->curvature = curvature;
     d_->mesh = d_->session->current();
@@ -422,14 +431,19 @@ bool RemeshWidget::saveSession(const QString& path) {
         std::filesystem::path meshFile = d_->meshPath.toStdString();
         if (meshFile.empty()) {
             // The reference came from memory: write it next to the session file, exactly.
-            meshFile = file.parent_path() / (file.stem().string() + ".input.off");
+            // Binary PLY: doubles, face quality and scan ids as they are. The mesh as given reads back as
+            // canonicalMesh of it, the reference setMesh made.
+            meshFile = file.parent_path() / (file.stem().string() + ".input.ply");
             WriteOptions exact;
-            exact.precision = 17;
-            writeMesh(d_->session->reference(), meshFile, exact);
+            exact.binary = true;
+            writeMesh(d_->memoryInput ? *d_->memoryInput : d_->session->reference(), meshFile, exact);
         }
         const bool cpu = d_->cpuRenderer || d_->cpuFallback->load();
         saveSessionFile(sessionFileFromSession(*d_->session, meshFile, cpu ? "cpu" : "gpu", d_->curvature), file);
-        if (d_->meshPath.isEmpty()) d_->meshPath = QString::fromStdString(meshFile.string());
+        if (d_->meshPath.isEmpty()) {
+            d_->meshPath = QString::fromStdString(meshFile.string());
+            d_->memoryInput.reset();
+        }
     } catch (const std::exception& e) {
         reportError(sentence(e));
         return false;

@@ -69,6 +69,16 @@ struct ReadOptions {
 ///        The message is one sentence that names the file and, for text formats, the line.
 Mesh readMesh(const std::filesystem::path& path, ReadReport* report = nullptr, const ReadOptions& options = {});
 
+/// The mesh as readMesh (default options) builds it from a binary PLY that writeMesh made of \p mesh:
+/// garbage dropped, vertices and faces re-indexed contiguously in iteration order, the reader's halfedge
+/// layout, face quality and scan ids kept; points bit-identical. Use it when a mesh from memory must behave
+/// exactly like the same mesh read back from a file (session files replay from the file). Not idempotent:
+/// canonicalMesh(canonicalMesh(m)) may differ in layout (the reader's halfedge of a face need not start at
+/// the corner it was given first), so write \p mesh itself, not its canonical form, to get it back.
+/// \throw IoError (naming "(mesh in memory)") when readMesh would refuse such a file: no faces, NaN
+///        coordinates, or nothing left after repair.
+Mesh canonicalMesh(const Mesh& mesh);
+
 /// Options of writeMesh.
 struct WriteOptions {
     bool binary = false;        ///< binary PLY / STL (ascii otherwise); binary PLY stores doubles, STL floats

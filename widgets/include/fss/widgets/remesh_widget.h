@@ -53,7 +53,9 @@ public:
     /// Starts a new session on a copy of \p mesh (the reference): the history is cleared, the view shows
     /// the mesh from the initial view. Waits for running work first. An empty, non-triangle or invalid
     /// mesh is refused: errorOccurred() with one sentence, the previous mesh stays. \p meshPath names the
-    /// file \p mesh was read from, if any (meshPath(); session files refer to it).
+    /// file \p mesh was read from, if any (meshPath(); session files refer to it); without one the session
+    /// starts from canonicalMesh(mesh) (same points and faces, the layout a file of it reads back as, so
+    /// that a saved session replays exactly).
     /// \return whether the mesh was taken.
     bool setMesh(const Mesh& mesh, const QString& meshPath = {});
     /// Reads \p path (fss::readMesh: OFF, OBJ, PLY, STL) and calls setMesh(). On failure the previous
@@ -75,7 +77,7 @@ public:
     /// Saves the session as a session file (session_file.h): the reference mesh's path and SHA-256, the
     /// renderer kind, and the event log (every accepted scan, undo and redo). A pending preview is not
     /// part of it. When the reference has no file (it was given to setMesh), it is first written next to
-    /// \p path as "<name>.input.off" (17 significant digits: the replayed reference is bit-identical).
+    /// \p path as "<name>.input.ply" (binary: the replayed reference is bit-identical).
     /// Replaying the file (loadSession, `fss-remesh run`, fss::replaySession) with the same renderer kind
     /// reproduces mesh() exactly. Waits for running work first. On failure errorOccurred() (nothing is
     /// half-written). \return success
