@@ -248,30 +248,24 @@ void MainWindow::saveDialog() {
     if (!path.isEmpty()) saveMesh(path);
 }
 
-bool MainWindow::openSession(const QString& path) {
+bool MainWindow::reportWidgetFailure(const QString& title, const std::function<bool()>& call) {
     QString error;
     const auto capture = connect(remesh_, &widgets::RemeshWidget::errorOccurred, this,
                                  [&error](const QString& message) { error = message; });
-    const bool started = remesh_->loadSession(path);
+    const bool ok = call();
     disconnect(capture);
-    if (!started) {
-        reportError(tr("Open session"), error);
-        return false;
-    }
+    if (!ok) reportError(title, error);
+    return ok;
+}
+
+bool MainWindow::openSession(const QString& path) {
+    if (!reportWidgetFailure(tr("Open session"), [&] { return remesh_->loadSession(path); })) return false;
     sessionPending_ = true;
     return true;
 }
 
 bool MainWindow::saveSession(const QString& path) {
-    QString error;
-    const auto capture = connect(remesh_, &widgets::RemeshWidget::errorOccurred, this,
-                                 [&error](const QString& message) { error = message; });
-    const bool saved = remesh_->saveSession(path);
-    disconnect(capture);
-    if (!saved) {
-        reportError(tr("Save session"), error);
-        return false;
-    }
+    if (!reportWidgetFailure(tr("Save session"), [&] { return remesh_->saveSession(path); })) return false;
     addRecentFile(path);
     statusBar()->showMessage(tr("Session saved to %1.").arg(QFileInfo(path).fileName()), 5000);
     return true;

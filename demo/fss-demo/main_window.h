@@ -13,6 +13,7 @@
 #include <QString>
 #include <QStringList>
 
+#include <functional>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -97,6 +98,9 @@ signals:
 private:
     void createMenus();
     void reportError(const QString& title, const QString& message);
+    // Runs \p call (a RemeshWidget operation); when it returns false, reports the error the widget
+    // emitted meanwhile under \p title. Returns what \p call returned.
+    bool reportWidgetFailure(const QString& title, const std::function<bool()>& call);
     void updateStatistics();
     void openDialog();
     void saveDialog();
