@@ -9,12 +9,18 @@
 // figures, it hardly changes when other processes compete for the cores); faults = minor page faults of
 // the process during our stages (first touches of freshly allocated memory), per scan.
 //
+// The scans run as an interactive session runs them, one after the other with one fss::ScanWorkspace:
+// each scan's grid and patch are recycled into it when the next scan starts, so the stages refill memory
+// they used before instead of faulting in fresh pages (scan_workspace.h). The first scan, which allocates,
+// is not measured. FSS_SCAN_FRESH=1 measures without a workspace instead (every scan allocates afresh).
+//
 // floor_ms (not part of cpu_ms) is a lower bound for any implementation that returns these results: only
-// making the outputs of a scan of this size, in fresh memory as every scan gets them — the SampleGrid of
-// rows × cols samples (constructed, then one field of every sample written) and the Patch with the
-// patch's vertex, edge and face counts (Surface_mesh sized once, its points, halfedge connectivity and
-// our three properties written with trivial values, vertexOfSample) — and no computation at all.
-// floor_over_gpu = floor_ms / (render_ms + read_ms): the ratio no implementation can go below.
+// making the outputs of a scan of this size in the same memory as the scans (recycled, or fresh with
+// FSS_SCAN_FRESH=1) — the SampleGrid of rows × cols samples (one field of every sample written) and the
+// Patch with the patch's vertex, edge and face counts (Surface_mesh sized, its points, halfedge
+// connectivity and our three properties written with trivial values, vertexOfSample) — and no
+// computation at all. floor_over_gpu = floor_ms / (render_ms + read_ms): the ratio no implementation
+// can go below.
 //
 // What a real scan pays: setMesh() uploads the mesh to the GL at the first render after it, once; every
 // later scan of the same mesh renders without an upload (Rasterizer::uploadCount). So the scene renders
@@ -26,6 +32,7 @@
 #include "fss/parallel.h"
 #include "fss/render/rasterizer.h"
 #include "fss/scan.h"
+#include "fss/scan_workspace.h"
 #include "fss/shapes.h"
 #include "fss/triangulate.h"
 
@@ -43,15 +50,19 @@ namespace {
 
 // The outputs of a scan with the given grid and patch sizes, written without computing anything (see
 // floor_ms in the file comment). Returns something that depends on every output so nothing is elided.
-std::size_t writeOutputsOnly(int rows, int cols, std::size_t vertices, std::size_t edges, std::size_t faces) {
-    fss::SampleGrid grid(rows, cols);
+// \p grid and \p patch are the storage to write into: empty ones (fresh memory) or those of the last call.
+std::size_t writeOutputsOnly(int rows, int cols, std::size_t vertices, std::size_t edges, std::size_t faces,
+                             fss::SampleGrid& grid, fss::Patch& patch) {
+    grid.rows = rows;
+    grid.cols = cols;
+    grid.samples.resize(std::size_t(rows) * std::size_t(cols));
     for (fss::Sample& s : grid.samples)
         s.quality = 1.0f;
-    fss::Patch patch;
     patch.rows = rows;
     patch.cols = cols;
     patch.vertexOfSample.assign(grid.samples.size(), fss::Mesh::null_vertex());
     fss::Mesh& mesh = patch.mesh;
+    mesh.resize(0, 0, 0);
     mesh.resize(fss::Mesh::size_type(vertices), fss::Mesh::size_type(edges), fss::Mesh::size_type(faces));
     auto gridIndex =
         mesh.add_property_map<fss::VertexIndex, fss::GridIndex>(fss::props::vertexGridIndex, fss::GridIndex{}).first;
@@ -135,36 +146,54 @@ void BM_ScanStages(benchmark::State& state) {
     double render = 0, read = 0, sample = 0, lassoMs = 0, quality = 0, morph = 0, tri = 0, work = 0;
     double faults = 0, floor = 0;
     std::size_t patchFaces = 0;
+    const bool fresh = std::getenv("FSS_SCAN_FRESH") && std::atoi(std::getenv("FSS_SCAN_FRESH")) != 0;
+    fss::ScanWorkspace workspace;
+    fss::SampleGrid grid, floorGrid;
+    fss::Patch patch, floorPatch;
+    // One unmeasured scan: the workspace's first use allocates, as a session's first scan does.
+    const auto scanOnce = [&](const fss::FrameBuffers& buffers, auto&& timed) {
+        if (!fresh) { // the previous scan's outputs are no longer needed
+            workspace.recycle(std::move(grid));
+            workspace.recycle(std::move(patch));
+        } else {
+            workspace.release();
+            grid = fss::SampleGrid();
+            patch = fss::Patch();
+        }
+        timed([&] { grid = fss::sampleRegularGrid(buffers, scene.mesh, workspace); }, sample);
+        timed([&] { fss::applyLasso(grid, lasso); }, lassoMs);
+        // The current mesh is the input itself here, with face qualities (without them the mask need not
+        // know which face is closest): every sample looks up its face.
+        timed([&] { fss::applyQualityMask(grid, scene.current, buffers); }, quality);
+        timed([&] { fss::applyMorphology(grid, {.radius = 1}, workspace); }, morph);
+        timed([&] { patch = fss::triangulateGrid(grid, {}, workspace); }, tri);
+    };
+    scanOnce(scene.rasterizer.render(camera), [](auto&& stage, double&) { stage(); });
+    writeOutputsOnly(grid.rows, grid.cols, patch.mesh.number_of_vertices(), patch.mesh.number_of_edges(),
+                     patch.mesh.number_of_faces(), floorGrid, floorPatch);
     const std::uint64_t uploads = scene.rasterizer.uploadCount();
     for (auto _ : state) {
         const fss::FrameBuffers buffers = scene.rasterizer.render(camera);
         render += scene.rasterizer.lastStats().renderSeconds * 1e3;
         read += scene.rasterizer.lastStats().readSeconds * 1e3;
         const double cpu0 = processCpuMs(), faults0 = minorFaults();
-        auto t = Clock::now();
-        fss::SampleGrid grid = fss::sampleRegularGrid(buffers, scene.mesh);
-        sample += msSince(t);
-        t = Clock::now();
-        fss::applyLasso(grid, lasso);
-        lassoMs += msSince(t);
-        // The current mesh is the input itself here, with face qualities (without them the mask need not
-        // know which face is closest): every sample looks up its face.
-        t = Clock::now();
-        fss::applyQualityMask(grid, scene.current, buffers);
-        quality += msSince(t);
-        t = Clock::now();
-        fss::applyMorphology(grid, {.radius = 1});
-        morph += msSince(t);
-        t = Clock::now();
-        const fss::Patch patch = fss::triangulateGrid(grid);
-        tri += msSince(t);
+        scanOnce(buffers, [&](auto&& stage, double& ms) {
+            const auto t = Clock::now();
+            stage();
+            ms += msSince(t);
+        });
         work += processCpuMs() - cpu0;
         faults += minorFaults() - faults0;
         patchFaces = patch.mesh.number_of_faces();
         benchmark::DoNotOptimize(patchFaces);
-        t = Clock::now();
+        if (fresh) {
+            floorGrid = fss::SampleGrid();
+            floorPatch = fss::Patch();
+        }
+        const auto t = Clock::now();
         benchmark::DoNotOptimize(writeOutputsOnly(grid.rows, grid.cols, patch.mesh.number_of_vertices(),
-                                                  patch.mesh.number_of_edges(), patchFaces));
+                                                  patch.mesh.number_of_edges(), patchFaces, floorGrid,
+                                                  floorPatch));
         floor += msSince(t);
     }
     if (scene.rasterizer.uploadCount() != uploads) {

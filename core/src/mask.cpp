@@ -4,6 +4,7 @@
 #include "fss/raycast.h"
 
 #include "detail/parallel_rows.h"
+#include "detail/scan_workspace_impl.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
@@ -160,10 +161,11 @@ void requireRadius(int radius) {
 }
 
 // Number of set entries in the window [i − radius, i + radius] along rows (axis 0) or columns (axis 1),
-// entries outside the grid counting as unset. O(rows · cols), independent of the radius.
-std::vector<std::uint16_t> windowCounts(const std::vector<std::uint8_t>& in, int rows, int cols, int radius,
-                                        bool alongColumns) {
-    std::vector<std::uint16_t> out(in.size(), 0);
+// entries outside the grid counting as unset, into \p out (every entry written). O(rows · cols), independent
+// of the radius.
+void windowCounts(const std::vector<std::uint8_t>& in, int rows, int cols, int radius, bool alongColumns,
+                  std::vector<std::uint16_t>& out) {
+    out.resize(in.size());
     if (alongColumns) { // row by row with one running count per column: sequential memory access
         std::vector<int> count(std::size_t(std::max(cols, 0)), 0);
         auto addRow = [&](int r, int sign) {
@@ -180,7 +182,7 @@ std::vector<std::uint16_t> windowCounts(const std::vector<std::uint8_t>& in, int
             for (int c = 0; c < cols; ++c)
                 o[c] = std::uint16_t(count[std::size_t(c)]);
         }
-        return out;
+        return;
     }
     const int lines = alongColumns ? cols : rows, length = alongColumns ? rows : cols;
     auto at = [&](int line, int i) {
@@ -196,14 +198,6 @@ std::vector<std::uint16_t> windowCounts(const std::vector<std::uint8_t>& in, int
             out[at(line, i)] = std::uint16_t(count);
         }
     }
-    return out;
-}
-
-std::vector<std::uint8_t> validFlags(const SampleGrid& grid) {
-    std::vector<std::uint8_t> v(grid.samples.size());
-    for (std::size_t i = 0; i < v.size(); ++i)
-        v[i] = grid.samples[i].valid ? 1 : 0;
-    return v;
 }
 
 void requireGridShape(const SampleGrid& grid) {
@@ -346,10 +340,9 @@ std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameB
 namespace {
 
 // The morphology works on one byte per sample (a Sample is ~90 bytes: every pass over the grid's
-// samples streams all of them through memory).
-struct Flags {
-    std::vector<std::uint8_t> valid, admissible;
-};
+// samples streams all of them through memory), in the buffers of a ScanWorkspace: valid, admissible, and
+// square and counts as scratch.
+using Scratch = ScanWorkspace::Impl;
 
 // Calls body(begin, end) over blocks of the grid's samples (whole rows), one block per thread.
 template <class Body> void forSampleBlocks(const SampleGrid& grid, Body&& body) {
@@ -358,17 +351,16 @@ template <class Body> void forSampleBlocks(const SampleGrid& grid, Body&& body) 
     });
 }
 
-Flags flagsOf(const SampleGrid& grid) {
-    Flags f;
-    f.valid.resize(grid.samples.size());
-    f.admissible.resize(grid.samples.size());
+// Fills f.valid (and f.admissible when \p withAdmissible) from the grid's samples.
+void flagsOf(const SampleGrid& grid, Scratch& f, bool withAdmissible) {
+    f.valid.resize(grid.samples.size()); // every entry written below
+    if (withAdmissible) f.admissible.resize(grid.samples.size());
     forSampleBlocks(grid, [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
             f.valid[i] = grid.samples[i].valid ? 1 : 0;
-            f.admissible[i] = grid.samples[i].admissible ? 1 : 0;
+            if (withAdmissible) f.admissible[i] = grid.samples[i].admissible ? 1 : 0;
         }
     });
-    return f;
 }
 
 void storeValid(SampleGrid& grid, const std::vector<std::uint8_t>& valid) {
@@ -385,18 +377,18 @@ std::size_t clearAll(std::vector<std::uint8_t>& valid) {
     return removed;
 }
 
-std::size_t erodeFlags(std::vector<std::uint8_t>& valid, int rows, int cols, int radius) {
+std::size_t erodeFlags(std::vector<std::uint8_t>& valid, int rows, int cols, int radius, Scratch& scratch) {
     if (radius == 0 || valid.empty()) return 0;
     const long long side = 2LL * radius + 1;
     if (side > std::min(rows, cols)) return clearAll(valid); // no square fits in the grid
     // Separable: a full square = full rows of full columns.
-    std::vector<std::uint8_t> rowsFull(valid.size());
-    {
-        const auto counts = windowCounts(valid, rows, cols, radius, false);
-        for (std::size_t i = 0; i < counts.size(); ++i)
-            rowsFull[i] = (long long)counts[i] == side ? 1 : 0;
-    }
-    const auto counts = windowCounts(rowsFull, rows, cols, radius, true);
+    std::vector<std::uint8_t>& rowsFull = scratch.square;
+    std::vector<std::uint16_t>& counts = scratch.counts;
+    rowsFull.resize(valid.size()); // every entry written below
+    windowCounts(valid, rows, cols, radius, false, counts);
+    for (std::size_t i = 0; i < counts.size(); ++i)
+        rowsFull[i] = (long long)counts[i] == side ? 1 : 0;
+    windowCounts(rowsFull, rows, cols, radius, true, counts);
     std::size_t removed = 0;
     for (std::size_t i = 0; i < counts.size(); ++i) {
         if (valid[i] && (long long)counts[i] != side) {
@@ -408,16 +400,16 @@ std::size_t erodeFlags(std::vector<std::uint8_t>& valid, int rows, int cols, int
 }
 
 std::size_t dilateFlags(std::vector<std::uint8_t>& valid, const std::vector<std::uint8_t>& admissible,
-                        int rows, int cols, int radius) {
+                        int rows, int cols, int radius, Scratch& scratch) {
     if (radius == 0 || valid.empty()) return 0;
     radius = std::min(radius, std::max(rows, cols)); // larger squares cover the grid all the same
-    std::vector<std::uint8_t> rowsAny(valid.size());
-    {
-        const auto counts = windowCounts(valid, rows, cols, radius, false);
-        for (std::size_t i = 0; i < counts.size(); ++i)
-            rowsAny[i] = counts[i] > 0 ? 1 : 0;
-    }
-    const auto counts = windowCounts(rowsAny, rows, cols, radius, true);
+    std::vector<std::uint8_t>& rowsAny = scratch.square;
+    std::vector<std::uint16_t>& counts = scratch.counts;
+    rowsAny.resize(valid.size()); // every entry written below
+    windowCounts(valid, rows, cols, radius, false, counts);
+    for (std::size_t i = 0; i < counts.size(); ++i)
+        rowsAny[i] = counts[i] > 0 ? 1 : 0;
+    windowCounts(rowsAny, rows, cols, radius, true, counts);
     std::size_t added = 0;
     for (std::size_t i = 0; i < counts.size(); ++i) {
         if (!valid[i] && admissible[i] && counts[i] > 0) {
@@ -428,12 +420,14 @@ std::size_t dilateFlags(std::vector<std::uint8_t>& valid, const std::vector<std:
     return added;
 }
 
-std::size_t removeUntriangulatableFlags(std::vector<std::uint8_t>& valid, int rows, int cols) {
+std::size_t removeUntriangulatableFlags(std::vector<std::uint8_t>& valid, int rows, int cols,
+                                        Scratch& scratch) {
     if (rows < 2 || cols < 2) return clearAll(valid);
     auto at = [&](int r, int c) { return valid[std::size_t(r) * std::size_t(cols) + std::size_t(c)]; };
     // quadFull(r, c): the quad with top-left corner (r, c) has four valid corners.
     const int qr = rows - 1, qc = cols - 1;
-    std::vector<std::uint8_t> quadFull(std::size_t(qr) * std::size_t(qc));
+    std::vector<std::uint8_t>& quadFull = scratch.square;
+    quadFull.resize(std::size_t(qr) * std::size_t(qc)); // every entry written below
     for (int r = 0; r < qr; ++r)
         for (int c = 0; c < qc; ++c)
             quadFull[std::size_t(r) * qc + c] = at(r, c) && at(r, c + 1) && at(r + 1, c) && at(r + 1, c + 1);
@@ -458,38 +452,52 @@ std::size_t removeUntriangulatableFlags(std::vector<std::uint8_t>& valid, int ro
 std::size_t erode(SampleGrid& grid, int radius) {
     requireRadius(radius);
     requireGridShape(grid);
-    std::vector<std::uint8_t> valid = validFlags(grid);
-    const std::size_t removed = erodeFlags(valid, grid.rows, grid.cols, radius);
-    if (removed) storeValid(grid, valid);
+    Scratch f;
+    flagsOf(grid, f, false);
+    const std::size_t removed = erodeFlags(f.valid, grid.rows, grid.cols, radius, f);
+    if (removed) storeValid(grid, f.valid);
     return removed;
 }
 
 std::size_t dilate(SampleGrid& grid, int radius) {
     requireRadius(radius);
     requireGridShape(grid);
-    Flags f = flagsOf(grid);
-    const std::size_t added = dilateFlags(f.valid, f.admissible, grid.rows, grid.cols, radius);
+    Scratch f;
+    flagsOf(grid, f, true);
+    const std::size_t added = dilateFlags(f.valid, f.admissible, grid.rows, grid.cols, radius, f);
     if (added) storeValid(grid, f.valid);
     return added;
 }
 
 std::size_t removeUntriangulatableSamples(SampleGrid& grid) {
     requireGridShape(grid);
-    std::vector<std::uint8_t> valid = validFlags(grid);
-    const std::size_t removed = removeUntriangulatableFlags(valid, grid.rows, grid.cols);
-    if (removed) storeValid(grid, valid);
+    Scratch f;
+    flagsOf(grid, f, false);
+    const std::size_t removed = removeUntriangulatableFlags(f.valid, grid.rows, grid.cols, f);
+    if (removed) storeValid(grid, f.valid);
     return removed;
 }
 
 MorphologyReport applyMorphology(SampleGrid& grid, const MorphologyOptions& options) {
+    ScanWorkspace workspace;
+    return applyMorphology(grid, options, workspace);
+}
+
+MorphologyReport applyMorphology(SampleGrid& grid, const MorphologyOptions& options,
+                                 ScanWorkspace& workspace) {
     requireRadius(options.radius);
+    if (options.dilateRadius < -1)
+        throw InvalidInputError("The dilation radius " + std::to_string(options.dilateRadius) +
+                                " is negative.");
     requireGridShape(grid);
+    const int dilateRadius = options.dilateRadius < 0 ? options.radius : options.dilateRadius;
     // One read and one write of the samples for all three steps.
-    Flags f = flagsOf(grid);
+    Scratch& f = workspace.impl();
+    flagsOf(grid, f, true);
     MorphologyReport report;
-    report.eroded = erodeFlags(f.valid, grid.rows, grid.cols, options.radius);
-    report.restored = dilateFlags(f.valid, f.admissible, grid.rows, grid.cols, options.radius);
-    report.untriangulatable = removeUntriangulatableFlags(f.valid, grid.rows, grid.cols);
+    report.eroded = erodeFlags(f.valid, grid.rows, grid.cols, options.radius, f);
+    report.restored = dilateFlags(f.valid, f.admissible, grid.rows, grid.cols, dilateRadius, f);
+    report.untriangulatable = removeUntriangulatableFlags(f.valid, grid.rows, grid.cols, f);
     if (report.eroded || report.restored || report.untriangulatable) storeValid(grid, f.valid);
     return report;
 }

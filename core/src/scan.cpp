@@ -3,13 +3,16 @@
 #include "fss/camera_projector.h"
 #include "fss/error.h"
 
+#include "detail/huge_pages.h"
 #include "detail/parallel_rows.h"
+#include "detail/scan_workspace_impl.h"
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <utility>
 
 namespace fss {
 namespace {
@@ -91,6 +94,12 @@ void setSampleOnSurface(Sample& sample, const Mesh& reference, const CameraProje
 
 SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& reference,
                              const ScanOptions& options, const Progress& progress) {
+    ScanWorkspace workspace;
+    return sampleRegularGrid(referenceBuffers, reference, workspace, options, progress);
+}
+
+SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& reference,
+                             ScanWorkspace& workspace, const ScanOptions& options, const Progress& progress) {
     const Camera& camera = referenceBuffers.camera;
     camera.validate();
     const int w = camera.width, h = camera.height;
@@ -100,7 +109,12 @@ SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& r
                                 " depth and " + std::to_string(referenceBuffers.faceId.size()) +
                                 " face-id values instead of " + std::to_string(n) + " for a " +
                                 std::to_string(w) + "x" + std::to_string(h) + " camera.");
-    SampleGrid grid(h, w);
+    // The recycled samples of the workspace, if any: every sample is written below.
+    SampleGrid grid;
+    grid.rows = h;
+    grid.cols = w;
+    grid.samples = std::exchange(workspace.impl().samples, {});
+    detail::resizeWithHugePages(grid.samples, n);
     grid.camera = camera;
     grid.scanId = options.scanId;
     const CameraProjector projector(camera);
@@ -118,9 +132,13 @@ SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& r
                 if (block == 0) progress.report(double(r - rowBegin) / double(rowEnd - rowBegin), "Sampling");
                 for (int c = 0; c < w; ++c) {
                     Sample& s = grid.at(r, c);
-                    s.screen = {c + 0.5, r + 0.5};
                     const std::uint32_t id = referenceBuffers.faceAt(c, r);
-                    if (id == FrameBuffers::kNoFace) continue;
+                    if (id == FrameBuffers::kNoFace) {
+                        s = Sample{};
+                        s.screen = {c + 0.5, r + 0.5};
+                        continue;
+                    }
+                    s.screen = {c + 0.5, r + 0.5};
                     const FaceIndex f(id);
                     if (f != cachedFace) { // checked once per run of pixels showing the same face
                         if (std::size_t(id) >= reference.num_faces() || reference.is_removed(f) ||

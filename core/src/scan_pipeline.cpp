@@ -37,6 +37,13 @@ FrameBuffers CpuMeshRenderer::render(const Camera& camera) {
 
 ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, const Mesh& current,
                      MeshRenderer& currentRenderer, const ScanParams& params, const Progress& progress) {
+    ScanWorkspace workspace;
+    return scanPatch(reference, referenceRenderer, current, currentRenderer, params, workspace, progress);
+}
+
+ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, const Mesh& current,
+                     MeshRenderer& currentRenderer, const ScanParams& params, ScanWorkspace& workspace,
+                     const Progress& progress) {
     const auto start = Clock::now();
     params.camera.validate();
     if (params.erodeRadius < 0 || params.dilateRadius < 0)
@@ -65,7 +72,7 @@ ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, con
 
     progress.report(0.4, "sample");
     t = Clock::now();
-    result.grid = sampleRegularGrid(referenceBuffers, reference, params.scan);
+    result.grid = sampleRegularGrid(referenceBuffers, reference, workspace, params.scan);
     result.timings.sample = secondsSince(t);
     result.counts.covered = result.grid.hitCount();
     result.counts.frontFacing = result.grid.admissibleCount();
@@ -87,15 +94,14 @@ ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, con
 
     progress.report(0.7, "morphology");
     t = Clock::now();
-    erode(result.grid, params.erodeRadius);
-    dilate(result.grid, params.dilateRadius);
-    removeUntriangulatableSamples(result.grid);
+    applyMorphology(result.grid, {.radius = params.erodeRadius, .dilateRadius = params.dilateRadius},
+                    workspace);
     result.timings.morphology = secondsSince(t);
     result.counts.afterMorphology = result.grid.validCount();
 
     progress.report(0.8, "triangulate");
     t = Clock::now();
-    result.patch = triangulateGrid(result.grid, params.triangulate);
+    result.patch = triangulateGrid(result.grid, params.triangulate, workspace);
     result.timings.triangulate = secondsSince(t);
     if (result.patch.mesh.number_of_faces() == 0) {
         if (result.counts.afterQuality == 0)

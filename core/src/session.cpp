@@ -57,6 +57,16 @@ struct Session::Impl {
     std::size_t forgotten = 0; // oldest steps dropped beyond maxUndoSteps
     std::vector<SessionEvent> events;
     FishboneCache fishboneCache;
+    // Scan after scan at one size reuses the same memory: a dropped preview's grid and patch go back here.
+    ScanWorkspace workspace;
+
+    // Drops the preview, keeping its grid's and patch's storage for the next scan (moves only).
+    void dropPreview() {
+        if (!preview) return;
+        workspace.recycle(std::move(preview->grid));
+        workspace.recycle(std::move(preview->patch));
+        preview.reset();
+    }
 
     MeshRenderer& rendererOfCurrent() {
         if (!currentRendererValid) {
@@ -108,20 +118,23 @@ const ScanPreview& Session::scan(const ScanStep& step, const Progress& progress)
         preview.fishbone = std::move(result.fishbone);
         preview.currentBuffers = std::move(result.currentBuffers);
     } else {
-        ScanResult result =
-            scanPatch(d.reference, *d.referenceRenderer, current, currentRenderer, step.params, progress);
+        ScanResult result = scanPatch(d.reference, *d.referenceRenderer, current, currentRenderer,
+                                      step.params, d.workspace, progress);
         preview.grid = std::move(result.grid);
         preview.patch = std::move(result.patch);
         preview.currentBuffers = std::move(result.currentBuffers);
     }
     preview.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    d.dropPreview(); // the new scan succeeded: the old preview's storage serves the next one
     d.preview = std::move(preview);
     return *d.preview;
 }
 
 const ScanPreview* Session::preview() const { return impl_->preview ? &*impl_->preview : nullptr; }
 
-void Session::reject() { impl_->preview.reset(); }
+void Session::reject() {
+    impl_->dropPreview();
+}
 
 const StitchReport& Session::accept(const Progress& progress) {
     Impl& d = *impl_;
@@ -157,7 +170,7 @@ const StitchReport& Session::accept(const Progress& progress) {
         ++d.forgotten;
     }
     d.applied = d.history.size();
-    d.preview.reset();
+    d.dropPreview();
     return d.history.back().report;
 }
 
@@ -171,7 +184,7 @@ void Session::undo() {
     if (!canUndo()) throw InvalidInputError("There is nothing to undo.");
     d.events.reserve(d.events.size() + 1);
     d.history[d.applied - 1].delta.applyBackward(d.current);
-    d.preview.reset();
+    d.dropPreview();
     --d.applied;
     d.currentRendererValid = false;
     d.events.push_back({SessionEvent::Kind::Undo, {}});
@@ -182,7 +195,7 @@ void Session::redo() {
     if (!canRedo()) throw InvalidInputError("There is nothing to redo.");
     d.events.reserve(d.events.size() + 1);
     d.history[d.applied].delta.applyForward(d.current);
-    d.preview.reset();
+    d.dropPreview();
     ++d.applied;
     d.currentRendererValid = false;
     d.events.push_back({SessionEvent::Kind::Redo, {}});

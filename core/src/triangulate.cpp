@@ -4,6 +4,7 @@
 #include "fss/scan.h"
 
 #include "detail/parallel_rows.h"
+#include "detail/scan_workspace_impl.h"
 
 #include <algorithm>
 #include <array>
@@ -15,7 +16,7 @@ namespace fss {
 namespace {
 
 using Point2 = Kernel::Point_2;
-using Triangle = std::array<std::uint32_t, 3>; // sample indices, counter-clockwise as seen by the camera
+using Triangle = ScanWorkspace::Impl::Triangle; // sample indices, counter-clockwise as seen by the camera
 
 bool usable(const Sample& s) {
     return s.valid && s.hit && s.point.allFinite();
@@ -90,23 +91,29 @@ Verdict judge(const SampleGrid& grid, const std::uint8_t* flags, const Triangle&
 // Removes triangles until every vertex has a single fan (the largest one is kept; ties keep the fan
 // with the lowest triangle index). Returns the number of pinched vertices found.
 std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, std::vector<bool>& alive,
-                                 std::size_t sampleCount, std::size_t& removedTriangles) {
+                                 std::size_t sampleCount, std::size_t& removedTriangles,
+                                 ScanWorkspace::Impl& w) {
     // Triangles incident to each sample (compressed rows).
-    std::vector<std::uint32_t> offset(sampleCount + 1, 0);
+    std::vector<std::uint32_t>& offset = w.offset;
+    offset.assign(sampleCount + 1, 0);
     for (const Triangle& t : triangles)
         for (std::uint32_t v : t)
             ++offset[v + 1];
     for (std::size_t i = 0; i < sampleCount; ++i)
         offset[i + 1] += offset[i];
-    std::vector<std::uint32_t> incident(offset.back());
+    std::vector<std::uint32_t>& incident = w.incident;
+    incident.resize(offset.back()); // every entry is written below
     {
-        std::vector<std::uint32_t> fill(offset.begin(), offset.end() - 1);
+        std::vector<std::uint32_t>& fill = w.fill;
+        fill.assign(offset.begin(), offset.end() - 1);
         for (std::uint32_t ti = 0; ti < triangles.size(); ++ti)
             for (std::uint32_t v : triangles[ti])
                 incident[fill[v]++] = ti;
     }
-    std::vector<std::uint32_t> work;
-    std::vector<bool> queued(sampleCount, false);
+    std::vector<std::uint32_t>& work = w.work;
+    work.clear();
+    std::vector<bool>& queued = w.queued;
+    queued.assign(sampleCount, false);
     for (std::uint32_t v = 0; v < sampleCount; ++v)
         if (offset[v + 1] - offset[v] > 1) work.push_back(v), queued[v] = true;
 
@@ -168,9 +175,33 @@ std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, std::vector<b
     return pinched;
 }
 
+// True when \p mesh has exactly the properties triangulateGrid gives a patch (so that, emptied and resized,
+// it is the same as a new mesh with them).
+bool hasPatchPropertiesOnly(const Mesh& mesh) {
+    static const Mesh reference = [] {
+        Mesh m;
+        m.add_property_map<VertexIndex, GridIndex>(props::vertexGridIndex, GridIndex{});
+        m.add_property_map<FaceIndex, float>(props::faceQuality, kInputFaceQuality);
+        m.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1);
+        return m;
+    }();
+    return mesh.properties<VertexIndex>() == reference.properties<VertexIndex>() &&
+           mesh.properties<HalfedgeIndex>() == reference.properties<HalfedgeIndex>() &&
+           mesh.properties<EdgeIndex>() == reference.properties<EdgeIndex>() &&
+           mesh.properties<FaceIndex>() == reference.properties<FaceIndex>() &&
+           mesh.property_map<VertexIndex, GridIndex>(props::vertexGridIndex).second &&
+           mesh.property_map<FaceIndex, float>(props::faceQuality).second &&
+           mesh.property_map<FaceIndex, std::int32_t>(props::faceScanId).second;
+}
+
 } // namespace
 
 Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options) {
+    ScanWorkspace workspace;
+    return triangulateGrid(grid, options, workspace);
+}
+
+Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options, ScanWorkspace& workspace) {
     if (grid.rows < 0 || grid.cols < 0 ||
         grid.samples.size() != std::size_t(grid.rows) * std::size_t(grid.cols))
         throw InvalidInputError("The sample grid holds " + std::to_string(grid.samples.size()) +
@@ -184,7 +215,14 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
                                 std::to_string(options.maxSamplingAngleDeg) +
                                 " degrees is outside the range (0, 90].");
 
+    ScanWorkspace::Impl& w = workspace.impl();
     Patch patch;
+    if (w.hasPatch) { // a recycled patch: its arrays are refilled below, every value written
+        patch = std::move(w.patch);
+        w.patch = Patch();
+        w.hasPatch = false;
+        patch.report = {};
+    }
     patch.rows = grid.rows;
     patch.cols = grid.cols;
     patch.scanId = grid.scanId;
@@ -198,7 +236,8 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
     // Usable samples and their own tests (sampleFlags) as one byte each: every sample is a corner of up to
     // four quads and six triangles.
     const std::size_t sampleCount = grid.samples.size();
-    std::vector<std::uint8_t> usableSample(sampleCount);
+    std::vector<std::uint8_t>& usableSample = w.sampleFlags;
+    usableSample.resize(sampleCount); // every entry is written below
     detail::parallelRows(grid.rows, detail::rowBlocks(grid.rows, 64), [&](int, int rowBegin, int rowEnd) {
         for (std::size_t i = grid.index(rowBegin, 0), e = grid.index(rowEnd, 0); i < e; ++i)
             usableSample[i] = sampleFlags(grid.samples[i], viewer, limits);
@@ -210,12 +249,14 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
     // result does not depend on the number of blocks.
     const int quadRows = std::max(grid.rows - 1, 0);
     const int blocks = detail::rowBlocks(quadRows, 16);
-    struct Block {
-        std::vector<Triangle> candidates;
-        std::vector<CGAL::Orientation> orientation; // of each candidate, as listed
-        std::size_t quads = 0;
-    };
-    std::vector<Block> block(static_cast<std::size_t>(blocks));
+    using Block = ScanWorkspace::Impl::Block;
+    std::vector<Block>& block = w.blocks;
+    block.resize(static_cast<std::size_t>(blocks));
+    for (Block& b : block) {
+        b.candidates.clear();
+        b.orientation.clear();
+        b.quads = 0;
+    }
     detail::parallelRows(quadRows, blocks, [&](int b, int rowBegin, int rowEnd) {
         Block& out = block[std::size_t(b)];
         for (int r = rowBegin; r < rowEnd; ++r) {
@@ -262,9 +303,10 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
             if (v == Verdict::Keep) in.candidates[kept++] = t;
         }
         in.candidates.resize(kept);
-        in.orientation = {};
+        in.orientation.clear();
     });
-    std::vector<Triangle> triangles;
+    std::vector<Triangle>& triangles = w.triangles;
+    triangles.clear();
     {
         std::size_t total = 0;
         for (const Block& b : block)
@@ -272,7 +314,7 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
         triangles.reserve(total);
         for (Block& b : block) {
             triangles.insert(triangles.end(), b.candidates.begin(), b.candidates.end());
-            b.candidates = {};
+            b.candidates.clear();
         }
     }
     for (const auto& v : verdicts) {
@@ -282,9 +324,10 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
         report.grazing += v[std::size_t(Verdict::Grazing)];
     }
 
-    std::vector<bool> alive(triangles.size(), true);
+    std::vector<bool>& alive = w.alive;
+    alive.assign(triangles.size(), true);
     report.nonManifoldVertices =
-        makeVerticesManifold(triangles, alive, grid.samples.size(), report.nonManifoldTriangles);
+        makeVerticesManifold(triangles, alive, grid.samples.size(), report.nonManifoldTriangles, w);
 
     // The halfedge structure directly (Surface_mesh::add_face searches each new edge around its vertex,
     // and add_vertex / add_edge / add_face grow every property array one element at a time). Pass 1
@@ -297,8 +340,10 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
                      std::to_string(sample) + ".");
     };
     constexpr std::uint32_t kNone = std::uint32_t(-1);
-    std::vector<std::uint32_t> vertexOf(sampleCount, kNone); // patch vertex of each sample
-    std::vector<std::uint32_t> sampleOf;                     // sample of each patch vertex
+    std::vector<std::uint32_t>& vertexOf = w.vertexOf; // patch vertex of each sample
+    vertexOf.assign(sampleCount, kNone);
+    std::vector<std::uint32_t>& sampleOf = w.sampleOf; // sample of each patch vertex
+    sampleOf.clear();
     std::size_t faceCount = 0;
     for (std::size_t k = 0; k < triangles.size(); ++k) {
         if (!alive[k]) continue;
@@ -310,7 +355,8 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
         }
     }
     const auto cols = std::uint32_t(grid.cols);
-    std::vector<std::uint32_t> edgeSlot(3 * sampleOf.size(), kNone); // edge index per slot
+    std::vector<std::uint32_t>& edgeSlot = w.edgeSlot; // edge index per slot
+    edgeSlot.assign(3 * sampleOf.size(), kNone);
     auto slotOf = [&](std::uint32_t i, std::uint32_t j) -> std::uint32_t& {
         const std::uint32_t lo = std::min(i, j), d = std::max(i, j) - lo;
         const std::size_t type = d == 1 ? 0 : d == cols ? 1 : d == cols + 1 ? 2 : 3;
@@ -328,6 +374,10 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
     }
 
     Mesh& mesh = patch.mesh;
+    // A recycled mesh is emptied and resized: its arrays keep their memory and get the default values a
+    // new mesh's would (Surface_mesh's property arrays fill new elements with their default).
+    if (!hasPatchPropertiesOnly(mesh)) mesh = Mesh();
+    mesh.resize(0, 0, 0);
     mesh.resize(Mesh::size_type(sampleOf.size()), Mesh::size_type(edgeCount), Mesh::size_type(faceCount));
     auto gridIndex = mesh.add_property_map<VertexIndex, GridIndex>(props::vertexGridIndex, GridIndex{}).first;
     auto quality = mesh.add_property_map<FaceIndex, float>(props::faceQuality, kInputFaceQuality).first;
@@ -342,7 +392,8 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options)
     }
     // An edge's first halfedge (2e) runs the way the first face that used it traverses it; the second
     // face finds it already made and takes the opposite halfedge, which must run the other way round.
-    std::vector<std::uint8_t> edgeMade(edgeCount, 0);
+    std::vector<std::uint8_t>& edgeMade = w.edgeMade;
+    edgeMade.assign(edgeCount, 0);
     std::uint32_t faceIndex = 0;
     for (std::size_t k = 0; k < triangles.size(); ++k) {
         if (!alive[k]) continue;

@@ -6,10 +6,14 @@
 #include "fss/shapes.h"
 #include "test_data.h"
 
+#include <CGAL/boost/graph/Euler_operations.h>
 #include <CGAL/boost/graph/IO/polygon_mesh_io.h>
 #include <CGAL/boost/graph/helpers.h>
 
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
 
 namespace {
 
@@ -128,4 +132,99 @@ TEST(ScanPipeline, CpuRendererNeedsAMesh) {
     fss::CpuMeshRenderer renderer;
     EXPECT_THROW(renderer.render(fss::Camera{}), fss::InvalidInputError);
     EXPECT_THROW(renderer.setMesh(fss::Mesh{}), fss::InvalidInputError);
+}
+
+namespace {
+
+// Every field of two grids and two patches, exactly (the workspace must not change any result).
+void expectSameScan(const fss::ScanResult& a, const fss::ScanResult& b) {
+    ASSERT_EQ(a.grid.rows, b.grid.rows);
+    ASSERT_EQ(a.grid.cols, b.grid.cols);
+    ASSERT_EQ(a.grid.samples.size(), b.grid.samples.size());
+    std::size_t differing = 0;
+    for (std::size_t i = 0; i < a.grid.samples.size(); ++i) {
+        const fss::Sample& s = a.grid.samples[i];
+        const fss::Sample& t = b.grid.samples[i];
+        const bool same = s.screen == t.screen && s.point == t.point && s.normal == t.normal &&
+                          s.face == t.face && s.samplingAngle == t.samplingAngle &&
+                          s.footprint == t.footprint &&
+                          (s.quality == t.quality || (std::isnan(s.quality) && std::isnan(t.quality))) &&
+                          s.hit == t.hit && s.admissible == t.admissible && s.valid == t.valid;
+        differing += same ? 0 : 1;
+    }
+    EXPECT_EQ(differing, 0u);
+    EXPECT_EQ(a.counts.afterMorphology, b.counts.afterMorphology);
+    const fss::Mesh& m = a.patch.mesh;
+    const fss::Mesh& n = b.patch.mesh;
+    EXPECT_EQ(a.patch.vertexOfSample, b.patch.vertexOfSample);
+    ASSERT_EQ(m.number_of_vertices(), n.number_of_vertices());
+    ASSERT_EQ(m.number_of_halfedges(), n.number_of_halfedges());
+    ASSERT_EQ(m.number_of_faces(), n.number_of_faces());
+    EXPECT_EQ(m.properties<fss::VertexIndex>(), n.properties<fss::VertexIndex>());
+    EXPECT_EQ(m.properties<fss::FaceIndex>(), n.properties<fss::FaceIndex>());
+    const auto gm = m.property_map<fss::VertexIndex, fss::GridIndex>(fss::props::vertexGridIndex).first;
+    const auto gn = n.property_map<fss::VertexIndex, fss::GridIndex>(fss::props::vertexGridIndex).first;
+    const auto qm = m.property_map<fss::FaceIndex, float>(fss::props::faceQuality).first;
+    const auto qn = n.property_map<fss::FaceIndex, float>(fss::props::faceQuality).first;
+    const auto im = m.property_map<fss::FaceIndex, std::int32_t>(fss::props::faceScanId).first;
+    const auto in = n.property_map<fss::FaceIndex, std::int32_t>(fss::props::faceScanId).first;
+    std::size_t vertices = 0, halfedges = 0, faces = 0;
+    for (const fss::VertexIndex v : m.vertices())
+        vertices += (m.point(v) == n.point(v) && gm[v] == gn[v] && m.halfedge(v) == n.halfedge(v)) ? 0 : 1;
+    for (const fss::HalfedgeIndex h : m.halfedges())
+        halfedges += (m.target(h) == n.target(h) && m.next(h) == n.next(h) && m.face(h) == n.face(h)) ? 0 : 1;
+    for (const fss::FaceIndex f : m.faces())
+        faces += (m.halfedge(f) == n.halfedge(f) && qm[f] == qn[f] && im[f] == in[f]) ? 0 : 1;
+    EXPECT_EQ(vertices, 0u);
+    EXPECT_EQ(halfedges, 0u);
+    EXPECT_EQ(faces, 0u);
+}
+
+} // namespace
+
+// A workspace that served other scans (larger, smaller, other views, recycled or edited results) changes
+// nothing: every scan equals the same scan without a workspace, field by field.
+TEST(ScanPipeline, WorkspaceReusedBetweenScansGivesTheSameResults) {
+    const fss::Mesh ref = load("fandisk.off");
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(ref);
+    struct View {
+        fss::StandardView view;
+        int w, h, erode, dilate;
+        bool lasso;
+    };
+    const std::vector<View> views = {{fss::StandardView::Iso, 96, 96, 1, 1, false},
+                                     {fss::StandardView::PosX, 64, 80, 2, 1, true},
+                                     {fss::StandardView::Iso, 96, 96, 1, 1, false},
+                                     {fss::StandardView::NegZ, 120, 100, 0, 2, false},
+                                     {fss::StandardView::PosY, 48, 48, 1, 1, true}};
+    fss::ScanWorkspace workspace;
+    for (std::size_t k = 0; k < views.size(); ++k) {
+        SCOPED_TRACE(k);
+        const View& v = views[k];
+        fss::ScanParams params;
+        params.camera = fss::Camera::standardView(v.view, bbox(ref), v.w, v.h);
+        params.erodeRadius = v.erode;
+        params.dilateRadius = v.dilate;
+        params.scan.scanId = int(k);
+        if (v.lasso)
+            params.lasso =
+                fss::Lasso{{{0.2 * v.w, 0.1 * v.h}, {0.9 * v.w, 0.3 * v.h}, {0.5 * v.w, 0.9 * v.h}}};
+        const fss::ScanResult fresh = fss::scanPatch(ref, renderer, ref, renderer, params);
+        fss::ScanResult reused = fss::scanPatch(ref, renderer, ref, renderer, params, workspace);
+        expectSameScan(fresh, reused);
+        if (k == 2) { // an edited patch is not refilled; one with an extra property is refilled without it
+            CGAL::Euler::remove_face(reused.patch.mesh.halfedge(*reused.patch.mesh.faces().begin()),
+                                     reused.patch.mesh);
+        }
+        if (k == 3) reused.patch.mesh.add_property_map<fss::VertexIndex, int>("v:extra", 0);
+        workspace.recycle(std::move(reused.grid));
+        workspace.recycle(std::move(reused.patch));
+        EXPECT_EQ(reused.grid.samples.size(), 0u);
+    }
+    workspace.release();
+    fss::ScanParams params;
+    params.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(ref), 64, 64);
+    expectSameScan(fss::scanPatch(ref, renderer, ref, renderer, params),
+                   fss::scanPatch(ref, renderer, ref, renderer, params, workspace));
 }

@@ -15,6 +15,7 @@
 #include "fss/frame_buffers.h"
 #include "fss/mesh.h"
 #include "fss/sample_grid.h"
+#include "fss/scan_workspace.h"
 
 #include <Eigen/Core>
 
@@ -102,6 +103,8 @@ struct MorphologyOptions {
     /// Radius of the opening (erode, then dilate). 1 removes isolated samples, one- and two-sample-wide
     /// spikes and bridges; 0 only removes untriangulatable samples.
     int radius = 1;
+    /// Radius of the dilation when it differs from the erosion's; -1 (the default) = `radius`.
+    int dilateRadius = -1;
 };
 
 /// What applyMorphology changed.
@@ -111,8 +114,14 @@ struct MorphologyReport {
     std::size_t untriangulatable = 0; ///< samples removed by removeUntriangulatableSamples
 };
 
-/// The paper's morphology step: erode(radius), dilate(radius), removeUntriangulatableSamples.
-/// \throw InvalidInputError when options.radius < 0.
+/// The paper's morphology step: erode(radius), dilate(dilateRadius, or radius when it is -1),
+/// removeUntriangulatableSamples — the same result as calling the three, with one read and one write of
+/// the samples. \throw InvalidInputError when options.radius < 0 or options.dilateRadius < -1.
 MorphologyReport applyMorphology(SampleGrid& grid, const MorphologyOptions& options = {});
+
+/// As applyMorphology above, with the per-sample buffers of \p workspace (scan_workspace.h) instead of
+/// fresh ones.
+MorphologyReport applyMorphology(SampleGrid& grid, const MorphologyOptions& options,
+                                 ScanWorkspace& workspace);
 
 } // namespace fss

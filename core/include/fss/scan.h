@@ -25,6 +25,7 @@
 #include "fss/mesh.h"
 #include "fss/progress.h"
 #include "fss/sample_grid.h"
+#include "fss/scan_workspace.h"
 
 #include <Eigen/Core>
 
@@ -82,5 +83,12 @@ void setSampleOnSurface(Sample& sample, const Mesh& reference, const CameraProje
 ///        face id is not a triangle of \p reference. CancelledError through \p progress (once per row).
 SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& reference,
                              const ScanOptions& options = {}, const Progress& progress = {});
+
+/// As sampleRegularGrid above, filling the sample storage recycled into \p workspace (scan_workspace.h)
+/// when there is some: the same grid, without allocating when the workspace has served a scan of this
+/// size before.
+SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& reference,
+                             ScanWorkspace& workspace, const ScanOptions& options = {},
+                             const Progress& progress = {});
 
 } // namespace fss

@@ -13,6 +13,7 @@
 #include "fss/progress.h"
 #include "fss/sample_grid.h"
 #include "fss/scan.h"
+#include "fss/scan_workspace.h"
 #include "fss/triangulate.h"
 
 #include <cstddef>
@@ -102,5 +103,12 @@ struct ScanResult {
 ///        CancelledError through \p progress.
 ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, const Mesh& current,
                      MeshRenderer& currentRenderer, const ScanParams& params, const Progress& progress = {});
+
+/// As scanPatch above, with the buffers of \p workspace (scan_workspace.h): the same result; scan after
+/// scan of one size (recycling each result's grid and patch into the workspace once it is no longer
+/// needed) allocates no new memory in the CPU stages.
+ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, const Mesh& current,
+                     MeshRenderer& currentRenderer, const ScanParams& params, ScanWorkspace& workspace,
+                     const Progress& progress = {});
 
 } // namespace fss

@@ -25,6 +25,7 @@
 
 #include "fss/mesh.h"
 #include "fss/sample_grid.h"
+#include "fss/scan_workspace.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -94,5 +95,10 @@ struct Patch {
 /// \throw InvalidInputError when the grid's sample count differs from rows × cols, maxEdgeFootprints is
 ///        not positive or maxSamplingAngleDeg is not in (0, 90].
 Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options = {});
+
+/// As triangulateGrid above, with the scratch buffers of \p workspace and, when a patch was recycled into
+/// it, that patch's storage (scan_workspace.h): the same patch, without allocating when the workspace has
+/// served a scan of this size before.
+Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options, ScanWorkspace& workspace);
 
 } // namespace fss

@@ -16,7 +16,8 @@ void adviseHugePages(const void* p, std::size_t bytes);
 /// Buffers below this size are left alone (malloc serves them from memory it already has).
 inline constexpr std::size_t kHugePageAdviceBytes = std::size_t(8) << 20;
 
-/// Resizes the empty vector \p v to \p n value-initialised elements, advising huge pages for its memory
+/// Resizes \p v to \p n elements (when it must grow, its old elements are dropped and all n are
+/// value-initialised; otherwise the caller overwrites them), advising huge pages for its memory
 /// before the elements are written.
 template <class T> void resizeWithHugePages(std::vector<T>& v, std::size_t n) {
     if (v.capacity() < n) {

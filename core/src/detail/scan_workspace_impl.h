@@ -1,0 +1,42 @@
+#pragma once
+// Internal (not installed): what a ScanWorkspace holds. Every stage that uses a buffer sizes and fills it
+// completely before reading it, so nothing of an earlier scan leaks into a later one.
+#include "fss/sample_grid.h"
+#include "fss/scan_workspace.h"
+#include "fss/triangulate.h"
+
+#include <CGAL/enum.h>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace fss {
+
+struct ScanWorkspace::Impl {
+    // Recycled outputs (ScanWorkspace::recycle).
+    std::vector<Sample> samples;
+    Patch patch;
+    bool hasPatch = false;
+
+    // Morphology (mask.cpp): one byte per sample.
+    std::vector<std::uint8_t> valid, admissible, square;
+    std::vector<std::uint16_t> counts;
+
+    // Triangulation (triangulate.cpp).
+    using Triangle = std::array<std::uint32_t, 3>;
+    struct Block {
+        std::vector<Triangle> candidates;
+        std::vector<CGAL::Orientation> orientation; // of each candidate, as listed
+        std::size_t quads = 0;
+    };
+    std::vector<std::uint8_t> sampleFlags;
+    std::vector<Block> blocks;
+    std::vector<Triangle> triangles;
+    std::vector<bool> alive, queued;
+    std::vector<std::uint32_t> offset, incident, fill, work;
+    std::vector<std::uint32_t> vertexOf, sampleOf, edgeSlot;
+    std::vector<std::uint8_t> edgeMade;
+};
+
+} // namespace fss
