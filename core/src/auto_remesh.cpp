@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <unordered_set>
@@ -272,6 +273,23 @@ Lasso bandLasso(const Polyline2& line, double halfWidth) {
     return lasso;
 }
 
+/// Pixels of \p buffers (rendered from \p current) within \p radius pixels (Chebyshev) of a pixel that shows
+/// a face of \p current left from the input (props::faceScanId < 0); all false when no pixel shows one.
+std::vector<char> pixelsNearInputFaces(Mesh& current, const FrameBuffers& buffers, int radius) {
+    auto ids = scanIds(current);
+    const int W = buffers.width(), H = buffers.height();
+    std::vector<char> near(buffers.faceId.size(), 0);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const std::uint32_t f = buffers.faceAt(x, y);
+            if (f == FrameBuffers::kNoFace || ids[FaceIndex(f)] >= 0) continue;
+            for (int dy = std::max(-radius, -y); dy <= radius && y + dy < H; ++dy)
+                for (int dx = std::max(-radius, -x); dx <= radius && x + dx < W; ++dx)
+                    near[buffers.index(x + dx, y + dy)] = 1;
+        }
+    return near;
+}
+
 /// The regular scan of autoRemesh: scanPatch's stages, with the quality mask overridden (samples
 /// re-admitted) where the current mesh shows an input face within \p fillRadius pixels.
 struct RegularScan {
@@ -308,22 +326,7 @@ RegularScan regularScan(const Mesh& reference, MeshRenderer& referenceRenderer, 
     applyQualityMask(grid, current, out.currentBuffers, q);
     if (fillRadius >= 0) {
         // Pixels that show an input face of the current mesh, dilated by fillRadius.
-        auto ids = scanIds(current);
-        const int W = grid.cols, H = grid.rows;
-        std::vector<char> input(std::size_t(W) * std::size_t(H), 0);
-        for (int y = 0; y < H; ++y)
-            for (int x = 0; x < W; ++x) {
-                const std::uint32_t f = out.currentBuffers.faceAt(x, y);
-                if (f != FrameBuffers::kNoFace && ids[FaceIndex(f)] < 0) input[grid.index(y, x)] = 1;
-            }
-        std::vector<char> near(input.size(), 0);
-        for (int y = 0; y < H; ++y)
-            for (int x = 0; x < W; ++x) {
-                if (!input[grid.index(y, x)]) continue;
-                for (int dy = -fillRadius; dy <= fillRadius; ++dy)
-                    for (int dx = -fillRadius; dx <= fillRadius; ++dx)
-                        if (grid.inside(y + dy, x + dx)) near[grid.index(y + dy, x + dx)] = 1;
-            }
+        const std::vector<char> near = pixelsNearInputFaces(current, out.currentBuffers, fillRadius);
         for (std::size_t i = 0; i < grid.samples.size(); ++i)
             if (admissibleBefore[i] && near[i]) grid.samples[i].admissible = grid.samples[i].valid = true;
     }
@@ -334,6 +337,190 @@ RegularScan regularScan(const Mesh& reference, MeshRenderer& referenceRenderer, 
     if (out.patch.mesh.number_of_faces() == 0)
         throw InvalidInputError("No sample of the view is better than the mesh already there.");
     return out;
+}
+
+/// The partition of the reference surface among the initial views: label[f] is the view whose scan owns
+/// reference face f (−1: no view sees it well enough; the follow-up views handle those faces).
+///
+/// Each face starts with the view that sees it most frontally among the views in which it is visible
+/// (its centroid not behind the depth buffer) at a sampling angle ≤ maxAngle. The labelling is then
+/// smoothed by iterated conditional modes on a Potts energy, Σ_f area_f·(1/cos θ_fl − 1) +
+/// β·Σ_{shared edges} length·[labels differ], which shortens the borders between regions, and connected
+/// pieces of a label smaller than minIslandArea are merged into the neighbouring label they share the
+/// longest border with (when that view sees all of them). Few compact regions: few seams.
+std::vector<int> partitionAmongViews(const Mesh& reference, const std::vector<FrameBuffers>& views,
+                                     double maxAngleDeg, double beta, double minIslandArea, int rounds) {
+    const std::size_t nf = reference.number_of_faces() + reference.number_of_removed_faces();
+    const std::size_t nv = views.size();
+    const double cosMin = std::cos(maxAngleDeg * std::numbers::pi / 180.0);
+    std::vector<FaceGeometry> geo(nf);
+    for (FaceIndex f : reference.faces())
+        geo[f.idx()] = faceGeometry(reference, f);
+    // cost[f·nv + v]: data term of label v at face f, infinity when v may not own f.
+    const double inf = std::numeric_limits<double>::infinity();
+    std::vector<double> cost(nf * nv, inf);
+    for (std::size_t v = 0; v < nv; ++v) {
+        const FrameBuffers& fb = views[v];
+        const Camera& cam = fb.camera;
+        const Eigen::Vector3d toEye = -cam.viewDirection();
+        for (FaceIndex f : reference.faces()) {
+            const FaceGeometry& g = geo[f.idx()];
+            const double c = g.normal.dot(toEye);
+            if (g.area <= 0 || c < cosMin) continue;
+            const Eigen::Vector3d s = cam.project(g.centroid);
+            const int px = int(std::floor(s.x())), py = int(std::floor(s.y()));
+            if (px < 0 || py < 0 || px >= fb.width() || py >= fb.height()) continue;
+            bool visible = fb.faceAt(px, py) == std::uint32_t(f.idx());
+            if (!visible && fb.covered(px, py)) {
+                // The face is thinner than a pixel or its centroid falls next to its pixels: compare depths,
+                // with a tolerance of the depth a surface at this angle spans within a pixel or two.
+                const Eigen::Vector3d p = cam.unprojectPixelCentre(px, py, fb.depthAt(px, py));
+                const double footprint = cam.pixelFootprint(p);
+                const double tan = std::sqrt(std::max(0.0, 1.0 - c * c)) / c;
+                visible = cam.viewDepth(g.centroid) <= cam.viewDepth(p) + footprint * (1.0 + 2.0 * tan);
+            }
+            if (visible) cost[f.idx() * nv + v] = g.area * (1.0 / c - 1.0);
+        }
+    }
+    std::vector<int> label(nf, -1);
+    for (FaceIndex f : reference.faces()) {
+        double best = inf;
+        for (std::size_t v = 0; v < nv; ++v)
+            if (cost[f.idx() * nv + v] < best) best = cost[f.idx() * nv + v], label[f.idx()] = int(v);
+    }
+    auto edgeLength = [&](HalfedgeIndex h) {
+        return (toEigen(reference.point(reference.target(h))) - toEigen(reference.point(reference.source(h))))
+            .norm();
+    };
+    // Iterated conditional modes.
+    std::vector<double> border(nv);
+    for (int round = 0; round < rounds; ++round) {
+        std::size_t changed = 0;
+        for (FaceIndex f : reference.faces()) {
+            if (label[f.idx()] < 0) continue;
+            std::fill(border.begin(), border.end(), 0.0);
+            double total = 0;
+            for (HalfedgeIndex h : CGAL::halfedges_around_face(reference.halfedge(f), reference)) {
+                const FaceIndex o = reference.face(reference.opposite(h));
+                const double len = edgeLength(h);
+                total += len;
+                if (o != Mesh::null_face() && label[o.idx()] >= 0) border[std::size_t(label[o.idx()])] += len;
+            }
+            int best = label[f.idx()];
+            double bestCost = inf;
+            for (std::size_t v = 0; v < nv; ++v) {
+                const double c = cost[f.idx() * nv + v] + beta * (total - border[v]);
+                if (c < bestCost) bestCost = c, best = int(v);
+            }
+            if (best != label[f.idx()]) label[f.idx()] = best, ++changed;
+        }
+        if (changed == 0) break;
+    }
+    // Islands: connected pieces of one label with a small area join their longest-bordering neighbour.
+    for (int round = 0; round < 4; ++round) {
+        std::size_t merged = 0;
+        std::vector<char> seen(nf, 0);
+        for (FaceIndex f : reference.faces()) {
+            if (seen[f.idx()] || label[f.idx()] < 0) continue;
+            const int l = label[f.idx()];
+            std::vector<FaceIndex> piece{f}, stack{f};
+            seen[f.idx()] = 1;
+            double area = 0;
+            std::fill(border.begin(), border.end(), 0.0);
+            while (!stack.empty()) {
+                const FaceIndex g = stack.back();
+                stack.pop_back();
+                area += geo[g.idx()].area;
+                for (HalfedgeIndex h : CGAL::halfedges_around_face(reference.halfedge(g), reference)) {
+                    const FaceIndex o = reference.face(reference.opposite(h));
+                    if (o == Mesh::null_face()) continue;
+                    if (label[o.idx()] == l) {
+                        if (!seen[o.idx()]) seen[o.idx()] = 1, stack.push_back(o), piece.push_back(o);
+                    } else if (label[o.idx()] >= 0) {
+                        border[std::size_t(label[o.idx()])] += edgeLength(h);
+                    }
+                }
+            }
+            if (area >= minIslandArea) continue;
+            std::vector<std::size_t> order(nv);
+            for (std::size_t v = 0; v < nv; ++v)
+                order[v] = v;
+            std::sort(order.begin(), order.end(),
+                      [&](std::size_t a, std::size_t b) { return border[a] > border[b]; });
+            for (std::size_t v : order) {
+                if (border[v] <= 0) break;
+                const bool allSeen = std::all_of(piece.begin(), piece.end(),
+                                                 [&](FaceIndex g) { return cost[g.idx() * nv + v] < inf; });
+                if (!allSeen) continue;
+                for (FaceIndex g : piece)
+                    label[g.idx()] = int(v);
+                ++merged;
+                break;
+            }
+        }
+        if (merged == 0) break;
+    }
+    return label;
+}
+
+/// The scan of one region of the partition: the samples of \p ref (the reference rendered from the view)
+/// on faces the view owns, plus a margin of \p marginPx pixels around them (so that the patch overlaps its
+/// neighbours and the stitch has something to zipper), replacing whatever the current mesh has there.
+///
+/// With \p restrictTo (one flag per pixel), only samples on flagged pixels are kept: the fill pass uses it
+/// to rescan, on the same pixel grid, the parts of a region still left from the input.
+Patch regionScan(const Mesh& reference, const FrameBuffers& ref, const std::vector<int>& owner, int view,
+                 std::int32_t scanId, int marginPx, double marginMaxAngleDeg, int morphologyRadius,
+                 const std::vector<char>* restrictTo = nullptr) {
+    ScanOptions so;
+    so.scanId = scanId;
+    SampleGrid grid = sampleRegularGrid(ref, reference, so);
+    const int W = grid.cols, H = grid.rows;
+    std::vector<char> own(grid.samples.size(), 0);
+    for (std::size_t i = 0; i < grid.samples.size(); ++i) {
+        const Sample& s = grid.samples[i];
+        own[i] = s.admissible && s.face != Sample::kNoFace && owner[s.face] == view;
+    }
+    // The margin stays on the surface around the region (reference faces within 3·marginPx vertex rings of
+    // it): dilating on the screen alone would also reach across occlusion contours onto other sheets.
+    std::vector<char> nearRegion(owner.size(), 0);
+    for (FaceIndex f : reference.faces())
+        if (owner[f.idx()] == view) nearRegion[f.idx()] = 1;
+    for (int ring = 0; ring < 3 * marginPx; ++ring) {
+        std::vector<char> vertexNear(reference.number_of_vertices() + reference.number_of_removed_vertices(),
+                                     0);
+        for (FaceIndex f : reference.faces())
+            if (nearRegion[f.idx()])
+                for (VertexIndex v : CGAL::vertices_around_face(reference.halfedge(f), reference))
+                    vertexNear[v.idx()] = 1;
+        for (FaceIndex f : reference.faces())
+            for (VertexIndex v : CGAL::vertices_around_face(reference.halfedge(f), reference))
+                if (vertexNear[v.idx()]) nearRegion[f.idx()] = 1;
+    }
+    const float maxAngle = float(marginMaxAngleDeg * std::numbers::pi / 180.0);
+    std::vector<char> keep(own);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            if (!own[grid.index(y, x)]) continue;
+            for (int dy = -marginPx; dy <= marginPx; ++dy)
+                for (int dx = -marginPx; dx <= marginPx; ++dx) {
+                    if (!grid.inside(y + dy, x + dx)) continue;
+                    const std::size_t j = grid.index(y + dy, x + dx);
+                    const Sample& s = grid.samples[j];
+                    if (s.admissible && s.samplingAngle <= maxAngle && s.face != Sample::kNoFace &&
+                        nearRegion[s.face])
+                        keep[j] = 1;
+                }
+        }
+    for (std::size_t i = 0; i < grid.samples.size(); ++i)
+        if (!keep[i] || (restrictTo && !(*restrictTo)[i]))
+            grid.samples[i].admissible = grid.samples[i].valid = false;
+    erode(grid, morphologyRadius);
+    dilate(grid, morphologyRadius);
+    removeUntriangulatableSamples(grid);
+    Patch patch = triangulateGrid(grid, TriangulateOptions{});
+    if (patch.mesh.number_of_faces() == 0) throw InvalidInputError("The view owns no part of the surface.");
+    return patch;
 }
 
 } // namespace
@@ -356,8 +543,14 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
     if (!(options.maxSamplingAngleDeg > options.servedAngleDeg && options.maxSamplingAngleDeg <= 85) ||
         !(options.followUpMaxSamplingAngleDeg > 0 && options.followUpMaxSamplingAngleDeg <= 85))
         throw InvalidInputError("The largest sampling angles must be in (served angle, 85] degrees.");
-    if (options.initialFillRadius < -1 || options.initialFillRadius > 16)
-        throw InvalidInputError("The fill radius of the initial views must be in [-1, 16] pixels.");
+    if (options.regionMarginPx < 0 || options.regionMarginPx > 16)
+        throw InvalidInputError("The region margin of the initial views must be in [0, 16] pixels.");
+    if (!(options.regionMarginMaxSamplingAngleDeg > 0 && options.regionMarginMaxSamplingAngleDeg <= 85))
+        throw InvalidInputError(
+            "The largest sampling angle of the region margins must be in (0, 85] degrees.");
+    if (options.regionFillPasses < 0) throw InvalidInputError("The region fill passes must not be negative.");
+    if (!(options.partitionSmoothing >= 0) || !(options.minRegionArea >= 0))
+        throw InvalidInputError("The partition smoothing and the smallest region area must not be negative.");
     if (options.maxViews < 1) throw InvalidInputError("The view budget must be at least one view.");
     if (!(options.footprintRatio > 0.1 && options.footprintRatio <= 4))
         throw InvalidInputError("The footprint ratio must be in (0.1, 4].");
@@ -532,31 +725,54 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
     }
     result.planSeconds += secondsSince(tPlan);
 
-    const int initialFill = options.initialFillRadius;
-    for (std::size_t i = 0; i < views.size() && budgetLeft(); ++i) {
-        progress.report(0.3 + 0.4 * double(i) / double(views.size()),
-                        "scan " + std::to_string(i + 1) + "/" + std::to_string(views.size()));
-        const auto t0 = Clock::now();
-        AutoStep step;
-        step.kind = AutoStep::Kind::Initial;
-        step.scanId = nextScanId++;
-        try {
-            step.camera = frameParallel(views[i], corners, footprint, 2 * L);
-            auto ts = Clock::now();
-            RegularScan scan =
-                regularScan(reference, *referenceRenderer, current, *currentRenderer, step.camera,
-                            step.scanId, initialFill, options.maxSamplingAngleDeg, options);
-            result.scanSeconds += secondsSince(ts);
-            step.camera = scan.camera;
-            step.patchFaces = scan.patch.mesh.number_of_faces();
-            stitchInto(step, scan.patch.mesh, scan.camera, scan.currentBuffers.faceId);
-        } catch (const CancelledError&) {
-            throw;
-        } catch (const Error& e) {
-            step.note = e.what();
-        }
-        finishStep(step, t0);
+    // The partition of the surface among the views: each region is scanned once, by its own view.
+    tPlan = Clock::now();
+    std::vector<FrameBuffers> viewBuffers;
+    for (const Eigen::Vector3d& d : views) {
+        progress.report(0.3, "plan");
+        viewBuffers.push_back(referenceRenderer->render(frameParallel(d, corners, footprint, 2 * L)));
     }
+    const std::vector<int> owner =
+        partitionAmongViews(reference, viewBuffers, options.maxSamplingAngleDeg,
+                            options.partitionSmoothing * L, options.minRegionArea * L * L, 30);
+    result.planSeconds += secondsSince(tPlan);
+
+    // Pass 0 scans each view's region; the fill passes then let each view rescan, on the same pixel grid as
+    // its first patch, the parts of its region (and margin) still left from the input, where the stitch
+    // trimmed its first patch.
+    for (int pass = 0; pass <= options.regionFillPasses; ++pass)
+        for (std::size_t i = 0; i < views.size() && budgetLeft(); ++i) {
+            if (pass > 0 && measureCoverage(current).fraction() >= options.coverageGoal) break;
+            progress.report(0.3 + 0.4 * double(pass * views.size() + i) /
+                                      double((options.regionFillPasses + 1) * views.size()),
+                            "scan " + std::to_string(i + 1) + "/" + std::to_string(views.size()));
+            const auto t0 = Clock::now();
+            AutoStep step;
+            step.kind = pass == 0 ? AutoStep::Kind::Initial : AutoStep::Kind::RegionFill;
+            step.camera = viewBuffers[i].camera;
+            try {
+                auto ts = Clock::now();
+                const FrameBuffers currentBuffers = currentRenderer->render(step.camera);
+                std::vector<char> nearInput;
+                if (pass > 0) {
+                    nearInput = pixelsNearInputFaces(current, currentBuffers, options.regionMarginPx + 1);
+                    if (std::find(nearInput.begin(), nearInput.end(), 1) == nearInput.end()) continue;
+                }
+                step.scanId = nextScanId++;
+                const Patch patch =
+                    regionScan(reference, viewBuffers[i], owner, int(i), step.scanId, options.regionMarginPx,
+                               options.regionMarginMaxSamplingAngleDeg, options.morphologyRadius,
+                               pass > 0 ? &nearInput : nullptr);
+                result.scanSeconds += secondsSince(ts);
+                step.patchFaces = patch.mesh.number_of_faces();
+                stitchInto(step, patch.mesh, step.camera, currentBuffers.faceId);
+            } catch (const CancelledError&) {
+                throw;
+            } catch (const Error& e) {
+                step.note = e.what();
+            }
+            finishStep(step, t0);
+        }
 
     // 3. Follow-up views aimed at the regions still left from the input.
     for (int round = 0; round < options.followUpRounds && budgetLeft(); ++round) {

@@ -24,6 +24,8 @@ const char* kindName(AutoStep::Kind kind) {
     switch (kind) {
     case AutoStep::Kind::Initial:
         return "initial";
+    case AutoStep::Kind::RegionFill:
+        return "region-fill";
     case AutoStep::Kind::FollowUp:
         return "follow-up";
     case AutoStep::Kind::Fishbone:

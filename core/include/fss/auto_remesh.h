@@ -11,9 +11,14 @@
 ///     on the sphere: each next view is the direction that sees, nearly frontally, the largest area of the
 ///     reference not yet served by an earlier view (normals only, occlusion ignored). CAD faces get exactly
 ///     frontal views; curved regions get more views, about one per cone of normals.
-///  3. **The quality mask keeps the best view of each region.** Scans are chained: each scan's quality
-///     mask runs against the current mesh (scan_pipeline.h), so a later view replaces an earlier one only
-///     where it samples clearly better, and each patch is stitched in at once (stitch.h).
+///  3. **One region per view.** The reference surface is partitioned among the initial views: each face goes
+///     to the view that sees it (not occluded) most frontally, then the labelling is smoothed (a Potts energy
+///     minimised by iterated conditional modes: sampling-angle cost against border length) and small islands
+///     join their neighbours, so the regions are few and compact with short borders. Each view's scan keeps
+///     only the samples on its region plus a margin of a few pixels over its neighbours and replaces whatever
+///     is there, so every region is covered once by one regular grid and the seams run along the borders.
+///     Each patch is stitched in at once (stitch.h). Where the stitch trimmed a patch, the same view then
+///     rescans what its region still has from the input, on the same pixel grid (the fill pass).
 ///  4. **Coverage-driven follow-up views.** Faces still left from the input (props::faceScanId < 0) are
 ///     grouped into connected regions; for each, several directions around its mean normal are rendered and
 ///     the one that sees most of the region (occlusion included) is scanned, framed on the region, and
@@ -53,16 +58,26 @@ struct AutoOptions {
     /// A face counts as served by a view when the angle between its normal and the view direction is
     /// at most this (degrees); the greedy view plan stops when every face is served. In (0, 80].
     double servedAngleDeg = 40.0;
-    /// Samples of an initial view seen at a larger angle between view ray and surface normal (degrees) are
-    /// left to other views: the patch of a view ends where it sees the surface well, away from its
-    /// silhouettes and occlusion contours, where the stitch is clean. In (servedAngleDeg, 85].
+    /// A reference face may be owned by an initial view only when that view sees it (not occluded) at an
+    /// angle between view ray and surface normal of at most this (degrees). In (servedAngleDeg, 85].
     double maxSamplingAngleDeg = 60.0;
     /// The same limit for the follow-up views.
     double followUpMaxSamplingAngleDeg = 70.0;
-    /// The initial views also take samples over already scanned faces within this many pixels of a face
-    /// left from the input (−1: none), so that no thin strip of input faces survives between two patches
-    /// (e.g. between a feature-line band and a frontal patch).
-    int initialFillRadius = 1;
+    /// Weight β of the region borders in the partition of the surface among the initial views, in edge
+    /// lengths: a border of length ℓ costs β·L·ℓ against the sum of area·(1/cos θ − 1) of the faces (θ their
+    /// sampling angle in the view that owns them). Larger: fewer, more compact regions and shorter seams.
+    double partitionSmoothing = 0.5;
+    /// Connected pieces of a view's region smaller than this area (in L²) join a neighbouring region.
+    double minRegionArea = 60.0;
+    /// Each initial view's patch extends this many pixels beyond its region, over its neighbours, so that
+    /// the patches overlap and the stitch zippers each into the last (no strip of input faces between).
+    int regionMarginPx = 2;
+    /// Margin samples seen at a larger sampling angle (degrees) are left out: a margin reaching over a
+    /// crease onto a face the view sees at a grazing angle makes a seam the stitch refuses. In (0, 85].
+    double regionMarginMaxSamplingAngleDeg = 70.0;
+    /// Passes in which every initial view rescans, on its own pixel grid, the parts of its region still left
+    /// from the input (where the stitch trimmed its first patch), before the follow-up views.
+    int regionFillPasses = 1;
     /// Faces whose served area share is below this fraction of the total area do not justify a view of
     /// their own in the initial plan (the follow-up views handle them).
     double minViewAreaFraction = 0.002;
@@ -102,7 +117,9 @@ struct AutoOptions {
 
 /// What happened to one scan of autoRemesh.
 struct AutoStep {
-    enum class Kind { Initial, FollowUp, Fishbone };
+    /// Initial: a view's region; RegionFill: the same view rescanning what its region still has from the
+    /// input (AutoOptions::regionFillPasses); FollowUp: a view aimed at faces still left from the input.
+    enum class Kind { Initial, RegionFill, FollowUp, Fishbone };
     Kind kind = Kind::Initial;
     Camera camera;                     ///< the scan camera (width × height = resolution)
     std::int32_t scanId = -1;          ///< id on the faces it made (props::faceScanId)
