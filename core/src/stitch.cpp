@@ -1980,6 +1980,7 @@ private:
         Mesh::Property_map<FaceIndex, double> minAllowed; // smallest angle accepted (radians)
         Mesh::Property_map<FaceIndex, bool> offView;      // piece of a mesh face the view does not see
         std::set<std::pair<std::uint32_t, std::uint32_t>> seam;
+        Star pristine; // the star as copied from the current mesh, for the rehearsal
     };
     static std::pair<std::uint32_t, std::uint32_t> seamKey(VertexIndex a, VertexIndex b) {
         return std::minmax(std::uint32_t(a), std::uint32_t(b));
@@ -2035,6 +2036,10 @@ private:
         Local loc;
         Mesh& S = loc.star.S;
         if (!buildStar(M_, replaced_, loc.star)) return fail(a, "the mesh is not manifold near its seam");
+        // A copy is cheaper than building the star again (the copied maps address the copy's arrays).
+        loc.pristine = loc.star;
+        loc.pristine.cur = loc.pristine.S.property_map<VertexIndex, std::uint32_t>("v:cur").first;
+        loc.pristine.kept = loc.pristine.S.property_map<FaceIndex, bool>("f:kept").first;
         loc.lid = S.add_property_map<VertexIndex, int>("v:lid", -1).first;
         loc.uv = S.add_property_map<VertexIndex, Point2>("v:uv", Point2(0, 0)).first;
         loc.locked = S.add_property_map<VertexIndex, bool>("v:locked", false).first;
@@ -2886,10 +2891,8 @@ private:
         for (FaceIndex f : replaced_)
             if (!unchanged.count(std::uint32_t(f))) plan.removed.push_back(f);
         std::unordered_set<std::uint32_t> reused;
-        // Order faces for growth in the rehearsal mesh: build it first (same star, same removals).
-        Star rehearsal;
-        if (!buildStar(M_, replaced_, rehearsal))
-            return fail(a, "internal error: the star could not be rebuilt");
+        // Order faces for growth in the rehearsal mesh: the star as copied (same star, same removals).
+        Star& rehearsal = loc.pristine;
         for (const auto& fv : faces)
             for (VertexIndex v : fv) {
                 const std::uint32_t c = loc.star.cur[v];
