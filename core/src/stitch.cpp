@@ -240,6 +240,64 @@ private:
 };
 
 // ---------------------------------------------------------------------------------------------------
+// Map from mesh indices (vertex or face numbers, never kNone) to values: open addressing with linear
+// probing. The searches over the faces under a patch look indices up millions of times; this is several
+// times faster than std::unordered_map there. Pointers to values stay valid until the next insertion.
+template <class V> class IndexMap {
+public:
+    // The value of key and whether it was inserted now (then set to `init`).
+    std::pair<V*, bool> try_emplace(std::uint32_t key, const V& init = V()) {
+        if (2 * (size_ + 1) > keys_.size()) grow();
+        std::size_t i = slot(key);
+        if (keys_[i] == key) return {&values_[i], false};
+        keys_[i] = key;
+        values_[i] = init;
+        ++size_;
+        return {&values_[i], true};
+    }
+    bool insert(std::uint32_t key) { return try_emplace(key).second; }
+    V& operator[](std::uint32_t key) { return *try_emplace(key).first; }
+    const V* find(std::uint32_t key) const {
+        if (keys_.empty()) return nullptr;
+        const std::size_t i = slot(key);
+        return keys_[i] == key ? &values_[i] : nullptr;
+    }
+    std::size_t count(std::uint32_t key) const { return find(key) ? 1 : 0; }
+    std::size_t size() const { return size_; }
+    void clear() {
+        keys_.clear();
+        values_.clear();
+        size_ = 0;
+    }
+
+private:
+    static constexpr std::uint32_t kEmpty = kNone;
+    std::size_t slot(std::uint32_t key) const {
+        const std::size_t mask = keys_.size() - 1;
+        std::size_t i = (std::size_t(key) * 0x9E3779B97F4A7C15ull) >> 20 & mask;
+        while (keys_[i] != key && keys_[i] != kEmpty)
+            i = (i + 1) & mask;
+        return i;
+    }
+    void grow() {
+        std::vector<std::uint32_t> keys(std::max<std::size_t>(64, 2 * keys_.size()), kEmpty);
+        std::vector<V> values(keys.size());
+        keys.swap(keys_);
+        values.swap(values_);
+        for (std::size_t j = 0; j < keys.size(); ++j)
+            if (keys[j] != kEmpty) {
+                const std::size_t i = slot(keys[j]);
+                keys_[i] = keys[j];
+                values_[i] = std::move(values[j]);
+            }
+    }
+    std::vector<std::uint32_t> keys_;
+    std::vector<V> values_;
+    std::size_t size_ = 0;
+};
+using IndexSet = IndexMap<char>;
+
+// ---------------------------------------------------------------------------------------------------
 // The patch, projected once.
 struct PatchData {
     std::vector<Vec3> pos;
@@ -637,15 +695,15 @@ private:
         double w = 0;
         bool ok = false;
     };
-    const VProj& vproj(VertexIndex v) {
+    VProj vproj(VertexIndex v) {
         auto [it, fresh] = vcache_.try_emplace(std::uint32_t(v));
-        if (fresh) it->second.ok = V_.project(toVec(M_.point(v)), it->second.uv, it->second.w);
-        return it->second;
+        if (fresh) it->ok = V_.project(toVec(M_.point(v)), it->uv, it->w);
+        return *it;
     }
     // Triangle face, in front of the eye, counter-clockwise in the view and not grazing.
     bool acceptable(FaceIndex f) {
-        auto [it, fresh] = accept_.try_emplace(std::uint32_t(f), false);
-        if (!fresh) return it->second;
+        auto [it, fresh] = accept_.try_emplace(std::uint32_t(f), 0);
+        if (!fresh) return *it != 0;
         const HalfedgeIndex h = M_.halfedge(f);
         if (M_.next(M_.next(M_.next(h))) != h) return false;
         const VertexIndex a = M_.source(h), b = M_.target(h), c = M_.target(M_.next(h));
@@ -655,8 +713,8 @@ private:
         const Vec3 n = normalOf(A, B, C);
         if (!(n.norm() > 0)) return false;
         const double cosView = n.normalized().dot(V_.towardsViewer((A + B + C) / 3.0));
-        it->second = cosView >= std::cos(O_.maxViewAngleDeg * kDeg);
-        return it->second;
+        *it = char(cosView >= std::cos(O_.maxViewAngleDeg * kDeg));
+        return *it != 0;
     }
     std::array<VertexIndex, 3> faceVertices(FaceIndex f) const {
         const HalfedgeIndex h = M_.halfedge(f);
@@ -670,7 +728,10 @@ private:
     double gapTo(const Vec3& p, FaceIndex f) const {
         const auto v = faceVertices(f);
         const Vec3 A = toVec(M_.point(v[0])), B = toVec(M_.point(v[1])), C = toVec(M_.point(v[2]));
-        const Vec3 n = normalOf(A, B, C);
+        return gapToPlane(p, A, normalOf(A, B, C));
+    }
+    // Distance from p to the plane through A with normal n along p's view ray.
+    double gapToPlane(const Vec3& p, const Vec3& A, const Vec3& n) const {
         Vec3 o, d;
         V_.rayThrough(p, o, d);
         const double den = n.dot(d);
@@ -695,14 +756,25 @@ private:
         const Triangle2 t = faceTriangle(f);
         const double r2 = margin_ * margin_;
         const double tolerance = gapTolerance(f);
+        const auto fv = faceVertices(f);
+        const Vec3 A = toVec(M_.point(fv[0]));
+        const Vec3 n = normalOf(A, toVec(M_.point(fv[1])), toVec(M_.point(fv[2])));
+        const CGAL::Bbox_2 box = grown(t.bbox(), margin_);
         bool hit = false;
-        compGrid_.query(grown(t.bbox(), margin_), [&](int i) {
+        // Cheap tests first (this runs for every face under the patch): a patch triangle whose box misses
+        // the face's box grown by the snapping distance is farther than that; the gaps along the view rays
+        // need no triangle test; a corner of either triangle inside the other means they meet.
+        compGrid_.query(box, [&](int i) {
             if (hit) return;
             const int pf = faces_[std::size_t(i)];
-            const Triangle2 p = patchTriangle(pf);
-            if (!CGAL::do_intersect(t, p) && CGAL::squared_distance(t, p) > r2) return;
+            if (!CGAL::do_overlap(box, triBox(pf))) return;
+            bool onSheet = false;
             for (int v : P_.tri[std::size_t(pf)])
-                if (gapTo(P_.pos[std::size_t(v)], f) <= tolerance) hit = true;
+                if (gapToPlane(P_.pos[std::size_t(v)], A, n) <= tolerance) onSheet = true;
+            if (!onSheet) return;
+            const Triangle2 p = patchTriangle(pf);
+            hit = inTriangle(p[0], t[0], t[1], t[2]) || inTriangle(t[0], p[0], p[1], p[2]) ||
+                  CGAL::do_intersect(t, p) || CGAL::squared_distance(t, p) <= r2;
         });
         return hit;
     }
@@ -817,10 +889,10 @@ private:
         }
         if (seeds.empty()) return fail(a, "no visible face of the mesh lies under it in the scan's view");
         // Grow over faces sharing a vertex, keeping the acceptable ones that meet the component in the view.
-        std::unordered_set<std::uint32_t> visited;
+        IndexSet visited;
         std::vector<FaceIndex> stack;
         for (FaceIndex f : seeds)
-            if (visited.insert(std::uint32_t(f)).second) stack.push_back(f);
+            if (visited.insert(std::uint32_t(f))) stack.push_back(f);
         while (!stack.empty()) {
             const FaceIndex f = stack.back();
             stack.pop_back();
@@ -830,7 +902,7 @@ private:
             region_.push_back(f);
             for (VertexIndex v : faceVertices(f))
                 for (FaceIndex g : CGAL::faces_around_target(M_.halfedge(v), M_))
-                    if (g != Mesh::null_face() && visited.insert(std::uint32_t(g)).second) stack.push_back(g);
+                    if (g != Mesh::null_face() && visited.insert(std::uint32_t(g))) stack.push_back(g);
         }
         if (region_.empty()) return fail(a, "no visible face of the mesh lies under it in the scan's view");
         return true;
@@ -931,7 +1003,7 @@ private:
         const double reach2 = margin_ * margin_; // the snapping distance
         std::vector<FaceIndex> seam;
         std::vector<FaceIndex> stack;
-        std::unordered_set<std::uint32_t> isSeam, isInterior;
+        IndexSet isSeam, isInterior;
         for (FaceIndex f : region_) {
             progress_.tick();
             const Triangle2 t = faceTriangle(f);
@@ -1023,7 +1095,7 @@ private:
                             std::move(bad));
         }
         // Faces connected to the interior ones, away from the seam, lying under the patch in the view.
-        std::unordered_map<std::uint32_t, double> gapOfVertex;
+        IndexMap<double> gapOfVertex;
         while (!stack.empty()) {
             const FaceIndex f = stack.back();
             stack.pop_back();
@@ -1047,8 +1119,8 @@ private:
                     }
                     // Each vertex is asked by every face around it: its gap is computed once.
                     auto [gap, fresh] = gapOfVertex.try_emplace(std::uint32_t(v), 0.0);
-                    if (fresh) gap->second = gapToPatch(toVec(M_.point(v)), p.uv);
-                    if (!(gap->second <= tolerance)) under = false;
+                    if (fresh) *gap = gapToPatch(toVec(M_.point(v)), p.uv);
+                    if (!(*gap <= tolerance)) under = false;
                 }
                 if (!under) {
                     addNear(bad,
@@ -1135,6 +1207,11 @@ private:
     Point2 L_uvOfPatch(int v) const {
         auto it = lidOfPatch_.find(v);
         return it == lidOfPatch_.end() ? P_.uv[std::size_t(v)] : L_[std::size_t(it->second)].uv;
+    }
+    // Current 3D position of a patch vertex (moved by snapping when on the boundary).
+    const Vec3& posOfPatch(int v) const {
+        auto it = lidOfPatch_.find(v);
+        return it == lidOfPatch_.end() ? P_.pos[std::size_t(v)] : L_[std::size_t(it->second)].pos;
     }
     // Lift a point at 2D parameter s of region edge re onto the 3D mesh edge.
     void liftOnEdge(int re, double s, Vec3& pos, Point2& uv) {
@@ -1345,6 +1422,12 @@ private:
                 });
                 auto& pe = pedges_[e];
                 const Point2 A = L_uvOfPatch(pe.a), B = L_uvOfPatch(pe.b), C = L_uvOfPatch(pe.opposite);
+                const Vec3 A3 = posOfPatch(pe.a), B3 = posOfPatch(pe.b), C3 = posOfPatch(pe.opposite);
+                // The floor the final check applies to the pieces of this patch triangle.
+                const double floor =
+                    std::min(O_.minAngleFloorDeg * kDeg,
+                             0.999 * minAngle(P_.pos[std::size_t(pe.a)], P_.pos[std::size_t(pe.b)],
+                                              P_.pos[std::size_t(pe.opposite)]));
                 std::vector<std::pair<double, int>> taken; // sorted by s
                 for (const Cand& c : cs) {
                     const auto pos = std::lower_bound(taken.begin(), taken.end(), std::pair{c.s, -1});
@@ -1353,6 +1436,13 @@ private:
                     const Point2& v = L_[std::size_t(c.lid)].uv;
                     if (!leftTurn(prev, v, C) || !leftTurn(v, next, C)) continue;
                     if (!(lineParam(v, prev, next) > 0 && lineParam(v, prev, next) < 1)) continue;
+                    // The fan's pieces must pass the final check's angle floor in 3D: a mesh vertex in line
+                    // with the patch triangle's other corners (a patch vertex snapped onto a mesh edge
+                    // through it) would leave a needle no triangulation of that triangle avoids.
+                    const Vec3& prev3 = pos == taken.begin() ? A3 : L_[std::size_t(std::prev(pos)->second)].pos;
+                    const Vec3& next3 = pos == taken.end() ? B3 : L_[std::size_t(pos->second)].pos;
+                    const Vec3& v3 = L_[std::size_t(c.lid)].pos;
+                    if (minAngle(prev3, v3, C3) < floor || minAngle(v3, next3, C3) < floor) continue;
                     taken.insert(pos, {c.s, c.lid});
                 }
                 for (const auto& [sp, lid] : taken) {
@@ -1890,6 +1980,7 @@ private:
         Mesh::Property_map<FaceIndex, double> minAllowed; // smallest angle accepted (radians)
         Mesh::Property_map<FaceIndex, bool> offView;      // piece of a mesh face the view does not see
         std::set<std::pair<std::uint32_t, std::uint32_t>> seam;
+        Star pristine; // the star as copied from the current mesh, for the rehearsal
     };
     static std::pair<std::uint32_t, std::uint32_t> seamKey(VertexIndex a, VertexIndex b) {
         return std::minmax(std::uint32_t(a), std::uint32_t(b));
@@ -1945,6 +2036,10 @@ private:
         Local loc;
         Mesh& S = loc.star.S;
         if (!buildStar(M_, replaced_, loc.star)) return fail(a, "the mesh is not manifold near its seam");
+        // A copy is cheaper than building the star again (the copied maps address the copy's arrays).
+        loc.pristine = loc.star;
+        loc.pristine.cur = loc.pristine.S.property_map<VertexIndex, std::uint32_t>("v:cur").first;
+        loc.pristine.kept = loc.pristine.S.property_map<FaceIndex, bool>("f:kept").first;
         loc.lid = S.add_property_map<VertexIndex, int>("v:lid", -1).first;
         loc.uv = S.add_property_map<VertexIndex, Point2>("v:uv", Point2(0, 0)).first;
         loc.locked = S.add_property_map<VertexIndex, bool>("v:locked", false).first;
@@ -2796,10 +2891,8 @@ private:
         for (FaceIndex f : replaced_)
             if (!unchanged.count(std::uint32_t(f))) plan.removed.push_back(f);
         std::unordered_set<std::uint32_t> reused;
-        // Order faces for growth in the rehearsal mesh: build it first (same star, same removals).
-        Star rehearsal;
-        if (!buildStar(M_, replaced_, rehearsal))
-            return fail(a, "internal error: the star could not be rebuilt");
+        // Order faces for growth in the rehearsal mesh: the star as copied (same star, same removals).
+        Star& rehearsal = loc.pristine;
         for (const auto& fv : faces)
             for (VertexIndex v : fv) {
                 const std::uint32_t c = loc.star.cur[v];
@@ -2908,14 +3001,14 @@ private:
     BucketGrid compGrid_;
 
     // ---- current mesh
-    std::unordered_map<std::uint32_t, VProj> vcache_;
-    std::unordered_map<std::uint32_t, bool> accept_;
+    IndexMap<VProj> vcache_;
+    IndexMap<char> accept_; // bool (a char: vector<bool> has no addressable elements)
     bool fallbackBuilt_ = false;
     std::vector<FaceIndex> fallback_;
     BucketGrid fallbackGrid_;
     std::vector<FaceIndex> region_;   // faces re-triangulated in the view (near the seam)
     std::vector<FaceIndex> interior_; // faces under the patch, removed whole
-    std::unordered_map<std::uint32_t, int> regionIndex_;
+    IndexMap<int> regionIndex_;
     BucketGrid regionGrid_;
 
     // ---- local problem

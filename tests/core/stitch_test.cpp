@@ -2,6 +2,7 @@
 // Patches are built here as a scan would: a regular grid of pixel centres unprojected onto an analytic
 // surface (plane, sphere), quads split along one diagonal, oriented towards the camera.
 #include "fss/error.h"
+#include "fss/scan_pipeline.h"
 #include "fss/shapes.h"
 #include "fss/stitch.h"
 
@@ -969,4 +970,35 @@ TEST(Stitch, TorusSeenObliquelyWithSelfOcclusion) {
         EXPECT_GT(PMP::volume(m), 0.0);
         std::printf("torus scan %d: %s\n", n, reportText(r).c_str());
     }
+}
+
+// A dense mesh (mesh edges as long as the patch's, as in the stitch benchmark at 1M faces): a mesh vertex in
+// line with patch vertices snapped onto mesh edges must not be snapped onto a patch boundary edge where that
+// leaves a needle no triangulation of the patch triangle avoids (the component then failed its final check
+// and was trimmed and rebuilt).
+TEST(Stitch, DenseMeshStitchesInOneRoundWithoutTrimming) {
+    Mesh m = fss::shapes::uvSphere(1000, 501); // 1M faces
+    fss::ScanParams p;
+    p.camera.width = p.camera.height = 256;
+    p.camera.focal = {0, 0, 0};
+    p.camera.eye = Vec3(1, 0.3, 0.2).normalized() * 3.0;
+    p.camera.up = {0, 0, 1};
+    p.camera.viewAngleDeg = 25;
+    p.camera.fitClippingRange(Eigen::AlignedBox3d(Vec3(-1, -1, -1), Vec3(1, 1, 1)));
+    fss::Lasso lasso;
+    for (int i = 0; i < 64; ++i) {
+        const double a = 2 * std::numbers::pi * i / 64;
+        lasso.points.emplace_back(128 + 100 * std::cos(a), 128 + 100 * std::sin(a));
+    }
+    p.lasso = lasso;
+    p.scan.scanId = 1;
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(m);
+    const fss::ScanResult scan = fss::scanPatch(m, renderer, m, renderer, p);
+    const fss::StitchReport r = fss::stitchPatch(m, scan.patch.mesh, p.camera);
+    SCOPED_TRACE(reportText(r));
+    EXPECT_EQ(r.componentsStitched, 1);
+    EXPECT_EQ(r.piecesStitched, 1);
+    EXPECT_EQ(r.patchFacesTrimmed, 0u);
+    expectValid(m, {true, 0}, false);
 }
