@@ -2597,34 +2597,42 @@ private:
             seamVs.insert(a);
             seamVs.insert(b);
         }
+        // Flips the candidate (flipAllowed) with the largest smallest angle after, above `above` and, when the
+        // smallest angle before was larger, at least `floor`; none that raises a seam vertex above
+        // kMaxSeamValence. Returns whether it flipped.
+        std::size_t flips = 0;
+        auto flipBest = [&](const std::vector<HalfedgeIndex>& candidates, double above, double floor) {
+            HalfedgeIndex best = Mesh::null_halfedge();
+            double bestMin = above;
+            bool bestNearPlanar = false;
+            for (HalfedgeIndex h : candidates) {
+                double oldMin = 0, newMin = 0;
+                bool nearPlanar = false;
+                if (!flipAllowed(loc, h, near, oldMin, newMin, nearPlanar)) continue;
+                if (newMin < std::min(oldMin, floor) || newMin <= bestMin) continue;
+                const VertexIndex z1 = S.target(S.next(h)), z2 = S.target(S.next(S.opposite(h)));
+                if ((seamVs.count(std::uint32_t(z1)) && S.degree(z1) >= kMaxSeamValence) ||
+                    (seamVs.count(std::uint32_t(z2)) && S.degree(z2) >= kMaxSeamValence))
+                    continue;
+                best = h;
+                bestMin = newMin;
+                bestNearPlanar = nearPlanar;
+            }
+            if (best == Mesh::null_halfedge()) return false;
+            flip(loc, best, bestNearPlanar);
+            ++flips;
+            return true;
+        };
         std::vector<std::uint32_t> order(seamVs.begin(), seamVs.end());
         std::sort(order.begin(), order.end());
-        std::size_t flips = 0;
         for (std::uint32_t vi : order) {
             const VertexIndex v(vi);
             for (int guard = 0; guard < 4; ++guard) {
                 progress_.tick();
                 if (S.is_removed(v) || S.halfedge(v) == Mesh::null_halfedge() || S.degree(v) <= kMaxSeamValence)
                     break;
-                HalfedgeIndex best = Mesh::null_halfedge();
-                double bestMin = -1;
-                bool bestNearPlanar = false;
-                for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(v), S)) {
-                    double oldMin = 0, newMin = 0;
-                    bool nearPlanar = false;
-                    if (!flipAllowed(loc, h, near, oldMin, newMin, nearPlanar)) continue;
-                    if (newMin < std::min(oldMin, kValenceFlipMinDeg * kDeg) || newMin <= bestMin) continue;
-                    const VertexIndex z1 = S.target(S.next(h)), z2 = S.target(S.next(S.opposite(h)));
-                    if ((seamVs.count(std::uint32_t(z1)) && S.degree(z1) >= kMaxSeamValence) ||
-                        (seamVs.count(std::uint32_t(z2)) && S.degree(z2) >= kMaxSeamValence))
-                        continue;
-                    best = h;
-                    bestMin = newMin;
-                    bestNearPlanar = nearPlanar;
-                }
-                if (best == Mesh::null_halfedge()) break;
-                flip(loc, best, bestNearPlanar);
-                ++flips;
+                const auto around = CGAL::halfedges_around_target(S.halfedge(v), S);
+                if (!flipBest({around.begin(), around.end()}, -1.0, kValenceFlipMinDeg * kDeg)) break;
             }
         }
         // Faces near the seam with a small angle: the flip of one of their edges that raises the smallest
@@ -2649,24 +2657,8 @@ private:
             if (std::abs(minAngle(pt(S, S.source(h0)), pt(S, S.target(h0)), pt(S, S.target(S.next(h0)))) - ang) >
                 1e-12)
                 continue; // changed by an earlier flip
-            HalfedgeIndex best = Mesh::null_halfedge();
-            double bestMin = ang + 0.5 * kDeg;
-            bool bestNearPlanar = false;
-            for (HalfedgeIndex h : CGAL::halfedges_around_face(h0, S)) {
-                double oldMin = 0, newMin = 0;
-                bool nearPlanar = false;
-                if (!flipAllowed(loc, h, near, oldMin, newMin, nearPlanar) || newMin <= bestMin) continue;
-                const VertexIndex z1 = S.target(S.next(h)), z2 = S.target(S.next(S.opposite(h)));
-                if ((seamVs.count(std::uint32_t(z1)) && S.degree(z1) >= kMaxSeamValence) ||
-                    (seamVs.count(std::uint32_t(z2)) && S.degree(z2) >= kMaxSeamValence))
-                    continue;
-                best = h;
-                bestMin = newMin;
-                bestNearPlanar = nearPlanar;
-            }
-            if (best == Mesh::null_halfedge()) continue;
-            flip(loc, best, bestNearPlanar);
-            ++flips;
+            const auto sides = CGAL::halfedges_around_face(h0, S);
+            flipBest({sides.begin(), sides.end()}, ang + 0.5 * kDeg, 0.0);
         }
         plan.flips += flips;
     }
