@@ -2240,16 +2240,9 @@ private:
         for (int pass = 0; pass < 3; ++pass) {
             const auto near = seamNeighbourhood(loc);
             Candidates cands;
-            for (FaceIndex f : S.faces()) {
-                progress_.tick();
-                if (loc.star.kept[f]) continue;
+            for (const auto& [ang, f] : thinFaces(loc, near)) {
                 const HalfedgeIndex h0 = S.halfedge(f);
                 const VertexIndex v[3] = {S.source(h0), S.target(h0), S.target(S.next(h0))};
-                if (!near.count(std::uint32_t(v[0])) && !near.count(std::uint32_t(v[1])) &&
-                    !near.count(std::uint32_t(v[2])))
-                    continue;
-                const double ang = minAngle(pt(S, v[0]), pt(S, v[1]), pt(S, v[2]));
-                if (ang >= kNeedleDeg * kDeg) continue;
                 int best = 0;
                 double bestLen = std::numeric_limits<double>::infinity();
                 for (int k = 0; k < 3; ++k) {
@@ -2586,6 +2579,27 @@ private:
         plan.flips += flips;
     }
 
+    // The new faces near the seam (a vertex in `near`) whose smallest angle is below kNeedleDeg, with that
+    // angle, smallest first.
+    std::vector<std::pair<double, FaceIndex>> thinFaces(const Local& loc,
+                                                        const std::unordered_set<std::uint32_t>& near) {
+        const Mesh& S = loc.star.S;
+        std::vector<std::pair<double, FaceIndex>> thin;
+        for (FaceIndex f : S.faces()) {
+            progress_.tick();
+            if (loc.star.kept[f]) continue;
+            const HalfedgeIndex h0 = S.halfedge(f);
+            const VertexIndex v[3] = {S.source(h0), S.target(h0), S.target(S.next(h0))};
+            if (!near.count(std::uint32_t(v[0])) && !near.count(std::uint32_t(v[1])) &&
+                !near.count(std::uint32_t(v[2])))
+                continue;
+            const double ang = minAngle(pt(S, v[0]), pt(S, v[1]), pt(S, v[2]));
+            if (ang < kNeedleDeg * kDeg) thin.push_back({ang, f});
+        }
+        std::sort(thin.begin(), thin.end());
+        return thin;
+    }
+
     // -- valence: a seam vertex with more than kMaxSeamValence edges loses one by the flip of one of them
     // (every check of flipAllowed) that keeps the smallest angle there at least min(before, 15°) and
     // raises no seam vertex above kMaxSeamValence; the best such flip (largest smallest angle) first.
@@ -2637,20 +2651,7 @@ private:
         }
         // Faces near the seam with a small angle: the flip of one of their edges that raises the smallest
         // angle there most (valence aside, but raising no seam vertex above kMaxSeamValence).
-        std::vector<std::pair<double, FaceIndex>> thin;
-        for (FaceIndex f : S.faces()) {
-            progress_.tick();
-            if (loc.star.kept[f]) continue;
-            const HalfedgeIndex h0 = S.halfedge(f);
-            const VertexIndex v[3] = {S.source(h0), S.target(h0), S.target(S.next(h0))};
-            if (!near.count(std::uint32_t(v[0])) && !near.count(std::uint32_t(v[1])) &&
-                !near.count(std::uint32_t(v[2])))
-                continue;
-            const double ang = minAngle(pt(S, v[0]), pt(S, v[1]), pt(S, v[2]));
-            if (ang < kNeedleDeg * kDeg) thin.push_back({ang, f});
-        }
-        std::sort(thin.begin(), thin.end());
-        for (const auto& [ang, f] : thin) {
+        for (const auto& [ang, f] : thinFaces(loc, near)) {
             progress_.tick();
             if (S.is_removed(f)) continue;
             const HalfedgeIndex h0 = S.halfedge(f);
