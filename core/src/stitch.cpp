@@ -145,6 +145,10 @@ double segmentGap(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& s) {
 constexpr double kNearPlanarFlipGap = 0.05;
 // Faces near the seam with a smaller angle (degrees) get a collapse of their shortest edge tried.
 constexpr double kNeedleDeg = 20.0;
+// Seam vertices with more edges get flips that take one away (valencePass).
+constexpr std::size_t kMaxSeamValence = 8;
+// ... unless the flip leaves an angle below this (degrees) where there was none.
+constexpr double kValenceFlipMinDeg = 15.0;
 
 Vec3 normalOf(const Vec3& a, const Vec3& b, const Vec3& c) {
     return (b - a).cross(c - a);
@@ -1862,18 +1866,8 @@ private:
                     if (g == Mesh::null_face() || regionIndex_.count(std::uint32_t(g)) ||
                         !taken.insert(std::uint32_t(g)).second)
                         continue;
-                    const auto vs = faceVertices(g);
                     if (M_.next(M_.next(M_.next(M_.halfedge(g)))) != M_.halfedge(g)) continue;
-                    const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])),
-                               C = toVec(M_.point(vs[2]));
-                    replaced_.push_back(g);
-                    newFaces_.push_back({{regionVertex(vs[0]), regionVertex(vs[1]), regionVertex(vs[2])},
-                                         curHasQuality_ ? curQuality_[g] : kInputFaceQuality,
-                                         curHasScanId_ ? curScanId_[g] : -1,
-                                         false,
-                                         normalOf(A, B, C).normalized(),
-                                         std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C)),
-                                         !acceptable(g)});
+                    openAsItself(g, !acceptable(g));
                 }
             }
         }
@@ -1895,21 +1889,28 @@ private:
                                 continue;
                             taken.insert(std::uint32_t(g));
                             next.push_back(g);
-                            replaced_.push_back(g);
-                            const auto vs = faceVertices(g);
-                            const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])),
-                                       C = toVec(M_.point(vs[2]));
-                            newFaces_.push_back(
-                                {{regionVertex(vs[0]), regionVertex(vs[1]), regionVertex(vs[2])},
-                                 curHasQuality_ ? curQuality_[g] : kInputFaceQuality,
-                                 curHasScanId_ ? curScanId_[g] : -1,
-                                 false,
-                                 normalOf(A, B, C).normalized(),
-                                 std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C)),
-                                 false});
+                            openAsItself(g, false);
                         }
                 ring.swap(next);
             }
+            // The faces the view does not see around the mesh vertices on the seam (behind a crease the
+            // patch boundary runs along): flips among them (in their plane) bring those vertices' valence
+            // down, where the patch's faces in front have raised it.
+            std::vector<FaceIndex> unseen;
+            for (const auto& pe : pedges_)
+                for (int id : pe.line) {
+                    const LVert& l = L_[std::size_t(id)];
+                    if (l.kind != LVert::Region) continue;
+                    const VertexIndex v(l.cur);
+                    for (FaceIndex g : CGAL::faces_around_target(M_.halfedge(v), M_))
+                        if (g != Mesh::null_face() && !taken.count(std::uint32_t(g)) && !acceptable(g) &&
+                            M_.next(M_.next(M_.next(M_.halfedge(g)))) == M_.halfedge(g)) {
+                            taken.insert(std::uint32_t(g));
+                            unseen.push_back(g);
+                        }
+                }
+            for (FaceIndex g : unseen)
+                openAsItself(g, true);
         }
         // Patch faces, the boundary ones re-triangulated over the seam vertices of their edges.
         double patchArea = 0;
@@ -1953,6 +1954,20 @@ private:
         if (std::abs(patchArea - insideArea) > 1e-6 * insideArea)
             return fail(a, "it overlaps itself in the scan's view");
         return true;
+    }
+    // Opens mesh face g to the seam optimisation: replaced by itself (a face the optimisation may flip, in
+    // its plane); `offView` when the scan's view does not see it (checked in 3D).
+    void openAsItself(FaceIndex g, bool offView) {
+        const auto vs = faceVertices(g);
+        const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
+        replaced_.push_back(g);
+        newFaces_.push_back({{regionVertex(vs[0]), regionVertex(vs[1]), regionVertex(vs[2])},
+                             curHasQuality_ ? curQuality_[g] : kInputFaceQuality,
+                             curHasScanId_ ? curScanId_[g] : -1,
+                             false,
+                             normalOf(A, B, C).normalized(),
+                             std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C)),
+                             offView});
     }
     int localOfPatch(int p) {
         auto it = lidOfPatch_.find(p);
@@ -2265,31 +2280,37 @@ private:
             score = newMin;
             return true;
         };
+        // Collapses the candidate edges (a, b), by increasing key, each in the direction that leaves the larger
+        // smallest angle around (edges gone or changed by earlier collapses are skipped).
+        using Candidates = std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>>;
+        auto collapseEach = [&](Candidates& cands) {
+            std::sort(cands.begin(), cands.end());
+            std::size_t done = 0;
+            for (const auto& c : cands) {
+                progress_.tick();
+                const auto [a, b] = c.second;
+                if (S.is_removed(a) || S.is_removed(b) || S.halfedge(a, b) == Mesh::null_halfedge()) continue;
+                double s1 = -1, s2 = -1;
+                const bool ok1 = tryCollapse(a, b, s1), ok2 = tryCollapse(b, a, s2);
+                if (!ok1 && !ok2) continue;
+                const VertexIndex from = (ok1 && (!ok2 || s1 >= s2)) ? a : b, to = from == a ? b : a;
+                collapse(loc, from, to);
+                ++done;
+            }
+            plan.collapses += done;
+            return done;
+        };
         auto collapsePass = [&] {
             for (int pass = 0; pass < 4; ++pass) {
                 const auto near = seamNeighbourhood(loc);
-                std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
+                Candidates cands;
                 for (EdgeIndex e : edgesAround(S, near)) {
                     const HalfedgeIndex h = S.halfedge(e);
                     const VertexIndex a = S.source(h), b = S.target(h);
                     const double len = (pt(S, a) - pt(S, b)).norm();
                     if (len < shortEdge) cands.push_back({len, {a, b}});
                 }
-                std::sort(cands.begin(), cands.end());
-                std::size_t done = 0;
-                for (const auto& c : cands) {
-                    progress_.tick();
-                    const auto [a, b] = c.second;
-                    if (S.is_removed(a) || S.is_removed(b)) continue;
-                    double s1 = -1, s2 = -1;
-                    const bool ok1 = tryCollapse(a, b, s1), ok2 = tryCollapse(b, a, s2);
-                    if (!ok1 && !ok2) continue;
-                    const VertexIndex from = (ok1 && (!ok2 || s1 >= s2)) ? a : b, to = from == a ? b : a;
-                    collapse(loc, from, to);
-                    ++done;
-                }
-                plan.collapses += done;
-                if (done == 0) break;
+                if (collapseEach(cands) == 0) break;
             }
         };
         collapsePass();
@@ -2313,17 +2334,10 @@ private:
         // in their planes) raises the smallest angle around; then flip again.
         for (int pass = 0; pass < 3; ++pass) {
             const auto near = seamNeighbourhood(loc);
-            std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
-            for (FaceIndex f : S.faces()) {
-                progress_.tick();
-                if (loc.star.kept[f]) continue;
+            Candidates cands;
+            for (const auto& [ang, f] : thinFaces(loc, near)) {
                 const HalfedgeIndex h0 = S.halfedge(f);
                 const VertexIndex v[3] = {S.source(h0), S.target(h0), S.target(S.next(h0))};
-                if (!near.count(std::uint32_t(v[0])) && !near.count(std::uint32_t(v[1])) &&
-                    !near.count(std::uint32_t(v[2])))
-                    continue;
-                const double ang = minAngle(pt(S, v[0]), pt(S, v[1]), pt(S, v[2]));
-                if (ang >= kNeedleDeg * kDeg) continue;
                 int best = 0;
                 double bestLen = std::numeric_limits<double>::infinity();
                 for (int k = 0; k < 3; ++k) {
@@ -2335,23 +2349,10 @@ private:
                 }
                 cands.push_back({ang, {v[best], v[(best + 1) % 3]}});
             }
-            std::sort(cands.begin(), cands.end());
-            std::size_t done = 0;
-            for (const auto& c : cands) {
-                progress_.tick();
-                const auto [a, b] = c.second;
-                if (S.is_removed(a) || S.is_removed(b) || S.halfedge(a, b) == Mesh::null_halfedge()) continue;
-                double s1 = -1, s2 = -1;
-                const bool ok1 = tryCollapse(a, b, s1), ok2 = tryCollapse(b, a, s2);
-                if (!ok1 && !ok2) continue;
-                const VertexIndex from = (ok1 && (!ok2 || s1 >= s2)) ? a : b, to = from == a ? b : a;
-                collapse(loc, from, to);
-                ++done;
-            }
-            plan.collapses += done;
-            if (done == 0) break;
+            if (collapseEach(cands) == 0) break;
             flipPass(loc, plan);
         }
+        valencePass(loc, plan);
     }
 
     // A seam vertex on a mesh edge (a crossing, a snapped patch vertex) slides along that edge towards the
@@ -2514,6 +2515,14 @@ private:
                 !oriented(loc, g, loc.uv[y], uv, loc.uv[u], Y, mid, U) ||
                 !oriented(loc, g, uv, loc.uv[x], loc.uv[u], mid, X, U))
                 continue;
+            // ... not put the new vertex nearer than a short seam edge to a neighbour of the edge's ends (two
+            // vertices that close leave a thin piece no collapse can remove outside the patch) ...
+            const double shortEdge = O_.collapseEdgeRatio * h3_;
+            bool crowded = false;
+            for (VertexIndex end : {x, y})
+                for (VertexIndex n : CGAL::vertices_around_target(S.halfedge(end), S))
+                    crowded = crowded || (n != x && n != y && (mid - pt(S, n)).norm() < shortEdge);
+            if (crowded) continue;
             // ... and not make the smallest angle there worse.
             if (std::min({minAngle(X, mid, Z), minAngle(mid, Y, Z), minAngle(Y, mid, U),
                           minAngle(mid, X, U)}) < 0.99 * std::min(minAngle(X, Y, Z), minAngle(Y, X, U)))
@@ -2547,11 +2556,79 @@ private:
         loc.offView[to] = loc.offView[from];
     }
 
+    // A flip of the edge of halfedge h (x → y, faces (x, y, z1) and (y, x, z2) → (x, z2, z1), (z2, y, z1)) that
+    // the seam optimisation may make: both faces new and near the seam, not a seam edge, no vertex left with
+    // fewer than three edges, no edge doubled, every new face oriented as its kind must be (in the view, or
+    // in 3D for pieces the view does not see) and not degenerate (exact); on the patch side no normal turns
+    // more than maxNormalChangeDeg, outside it the surface stays (see below). Sets the smallest angles
+    // before and after, and `nearPlanar` when the flip joins pieces of two nearly coplanar mesh faces.
+    bool flipAllowed(const Local& loc, HalfedgeIndex h, const std::unordered_set<std::uint32_t>& near,
+                     double& oldMin, double& newMin, bool& nearPlanar) const {
+        const Mesh& S = loc.star.S;
+        const double maxTurn = O_.maxNormalChangeDeg * kDeg;
+        auto isNewFace = [&](FaceIndex f) { return f != Mesh::null_face() && !loc.star.kept[f]; };
+        const HalfedgeIndex o = S.opposite(h);
+        if (!isNewFace(S.face(h)) || !isNewFace(S.face(o))) return false;
+        const VertexIndex x = S.source(h), y = S.target(h), z1 = S.target(S.next(h)), z2 = S.target(S.next(o));
+        if (!near.count(std::uint32_t(x)) || !near.count(std::uint32_t(y))) return false;
+        if (loc.seam.count(seamKey(x, y)) || z1 == z2) return false;
+        if (S.degree(x) <= 3 || S.degree(y) <= 3) return false;
+        if (S.halfedge(z1, z2) != Mesh::null_halfedge()) return false;
+        // New faces (x, z2, z1) and (z2, y, z1).
+        if (loc.offView[S.face(h)] != loc.offView[S.face(o)] || !oriented(loc, S.face(h), x, z2, z1) ||
+            !oriented(loc, S.face(o), z2, y, z1))
+            return false;
+        if (CGAL::collinear(S.point(x), S.point(z2), S.point(z1)) ||
+            CGAL::collinear(S.point(z2), S.point(y), S.point(z1)))
+            return false;
+        const Vec3 X = pt(S, x), Y = pt(S, y), Z1 = pt(S, z1), Z2 = pt(S, z2);
+        const Vec3 o1 = normalOf(X, Y, Z1), o2 = normalOf(Y, X, Z2), n1 = normalOf(X, Z2, Z1),
+                   n2 = normalOf(Z2, Y, Z1);
+        // On the patch side a flip may not turn a normal more than maxNormalChangeDeg. Outside the patch
+        // it may not change the surface: the pieces are coplanar, or they are pieces of one mesh face
+        // (tilted only where they reach a patch vertex) and the new ones are tilted no more.
+        const bool patchSide = loc.patchSide[S.face(h)];
+        if (patchSide != loc.patchSide[S.face(o)]) return false;
+        nearPlanar = false;
+        const double turn = std::max(
+            {angleBetween(o1, n1), angleBetween(o1, n2), angleBetween(o2, n1), angleBetween(o2, n2)});
+        if (patchSide) {
+            if (turn > maxTurn) return false;
+        } else if (turn > kCoplanar) {
+            const Vec3 &p1 = loc.planeNormal[S.face(h)], &p2 = loc.planeNormal[S.face(o)];
+            bool allowed = false;
+            if (angleBetween(p1, p2) <= kCoplanar) {
+                const double tilt = std::max(angleBetween(o1, p1), angleBetween(o2, p1));
+                allowed = std::max(angleBetween(n1, p1), angleBetween(n2, p1)) <= tilt + kCoplanar &&
+                          turn <= maxTurn;
+            }
+            // Pieces of two mesh faces that are nearly coplanar (a smoothly curved part of the mesh): the
+            // flip moves the surface by the gap between the two diagonals, allowed up to a small
+            // fraction of the patch's edge length (far below a pixel footprint).
+            nearPlanar = !allowed && turn <= maxTurn && segmentGap(X, Y, Z1, Z2) <= kNearPlanarFlipGap * h3_;
+            if (!allowed && !nearPlanar) return false;
+        }
+        oldMin = std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2));
+        newMin = std::min(minAngle(X, Z2, Z1), minAngle(Z2, Y, Z1));
+        return true;
+    }
+    // Flips the edge of h (checked by flipAllowed).
+    void flip(Local& loc, HalfedgeIndex h, bool nearPlanar) {
+        Mesh& S = loc.star.S;
+        const HalfedgeIndex o = S.opposite(h);
+        CGAL::Euler::flip_edge(h, S);
+        if (nearPlanar) // the new pieces keep their own planes from now on
+            for (HalfedgeIndex g : {h, o}) {
+                const FaceIndex f = S.face(g);
+                const HalfedgeIndex k = S.halfedge(f);
+                loc.planeNormal[f] =
+                    normalOf(pt(S, S.source(k)), pt(S, S.target(k)), pt(S, S.target(S.next(k)))).normalized();
+            }
+    }
+
     // -- flips: raise the smallest angle, valence towards 6
     void flipPass(Local& loc, Plan& plan) {
         Mesh& S = loc.star.S;
-        const double maxTurn = O_.maxNormalChangeDeg * kDeg;
-        auto isNewFace = [&](FaceIndex f) { return f != Mesh::null_face() && !loc.star.kept[f]; };
         const auto near = seamNeighbourhood(loc);
         auto valenceCost = [&](VertexIndex v, int delta) {
             const int target = S.is_border(v) ? 4 : 6;
@@ -2575,50 +2652,11 @@ private:
             queued.erase(std::uint32_t(e));
             if (S.is_removed(e)) continue;
             const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
-            if (!isNewFace(S.face(h)) || !isNewFace(S.face(o))) continue;
+            double oldMin = 0, newMin = 0;
+            bool nearPlanar = false;
+            if (!flipAllowed(loc, h, near, oldMin, newMin, nearPlanar)) continue;
             const VertexIndex x = S.source(h), y = S.target(h), z1 = S.target(S.next(h)),
                               z2 = S.target(S.next(o));
-            if (!near.count(std::uint32_t(x)) || !near.count(std::uint32_t(y))) continue;
-            if (loc.seam.count(seamKey(x, y)) || z1 == z2) continue;
-            if (S.degree(x) <= 3 || S.degree(y) <= 3) continue;
-            if (S.halfedge(z1, z2) != Mesh::null_halfedge()) continue;
-            // New faces (x, z2, z1) and (z2, y, z1).
-            if (loc.offView[S.face(h)] != loc.offView[S.face(o)] || !oriented(loc, S.face(h), x, z2, z1) ||
-                !oriented(loc, S.face(o), z2, y, z1))
-                continue;
-            if (CGAL::collinear(S.point(x), S.point(z2), S.point(z1)) ||
-                CGAL::collinear(S.point(z2), S.point(y), S.point(z1)))
-                continue;
-            const Vec3 X = pt(S, x), Y = pt(S, y), Z1 = pt(S, z1), Z2 = pt(S, z2);
-            const Vec3 o1 = normalOf(X, Y, Z1), o2 = normalOf(Y, X, Z2), n1 = normalOf(X, Z2, Z1),
-                       n2 = normalOf(Z2, Y, Z1);
-            // On the patch side a flip may not turn a normal more than maxNormalChangeDeg. Outside the patch
-            // it may not change the surface: the pieces are coplanar, or they are pieces of one mesh face
-            // (tilted only where they reach a patch vertex) and the new ones are tilted no more.
-            const bool patchSide = loc.patchSide[S.face(h)];
-            if (patchSide != loc.patchSide[S.face(o)]) continue;
-            bool nearPlanar = false;
-            const double turn = std::max(
-                {angleBetween(o1, n1), angleBetween(o1, n2), angleBetween(o2, n1), angleBetween(o2, n2)});
-            if (patchSide) {
-                if (turn > maxTurn) continue;
-            } else if (turn > kCoplanar) {
-                const Vec3 &p1 = loc.planeNormal[S.face(h)], &p2 = loc.planeNormal[S.face(o)];
-                bool allowed = false;
-                if (angleBetween(p1, p2) <= kCoplanar) {
-                    const double tilt = std::max(angleBetween(o1, p1), angleBetween(o2, p1));
-                    allowed = std::max(angleBetween(n1, p1), angleBetween(n2, p1)) <= tilt + kCoplanar &&
-                              turn <= maxTurn;
-                }
-                // Pieces of two mesh faces that are nearly coplanar (a smoothly curved part of the mesh): the
-                // flip moves the surface by the gap between the two diagonals, allowed up to a small
-                // fraction of the patch's edge length (far below a pixel footprint).
-                nearPlanar =
-                    !allowed && turn <= maxTurn && segmentGap(X, Y, Z1, Z2) <= kNearPlanarFlipGap * h3_;
-                if (!allowed && !nearPlanar) continue;
-            }
-            const double oldMin = std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2));
-            const double newMin = std::min(minAngle(X, Z2, Z1), minAngle(Z2, Y, Z1));
             const int devOld =
                 valenceCost(x, 0) + valenceCost(y, 0) + valenceCost(z1, 0) + valenceCost(z2, 0);
             const int devNew =
@@ -2626,20 +2664,97 @@ private:
             // Score: smallest angle in degrees minus 3° per unit of valence deviation.
             const double gain = (newMin - oldMin) / kDeg - 3.0 * double(devNew - devOld);
             if (!(gain > 0.5) || newMin < std::min(oldMin, 20.0 * kDeg)) continue;
-            CGAL::Euler::flip_edge(h, S);
+            flip(loc, h, nearPlanar);
             ++flips;
-            if (nearPlanar) // the new pieces keep their own planes from now on
-                for (HalfedgeIndex g : {h, o}) {
-                    const FaceIndex f = S.face(g);
-                    const HalfedgeIndex k = S.halfedge(f);
-                    loc.planeNormal[f] =
-                        normalOf(pt(S, S.source(k)), pt(S, S.target(k)), pt(S, S.target(S.next(k))))
-                            .normalized();
-                }
             for (HalfedgeIndex g : {S.next(h), S.prev(h), S.next(o), S.prev(o)}) {
                 const EdgeIndex ge = S.edge(g);
                 if (queued.insert(std::uint32_t(ge)).second) queue.push_back(ge);
             }
+        }
+        plan.flips += flips;
+    }
+
+    // The new faces near the seam (a vertex in `near`) whose smallest angle is below kNeedleDeg, with that
+    // angle, smallest first.
+    std::vector<std::pair<double, FaceIndex>> thinFaces(const Local& loc,
+                                                        const std::unordered_set<std::uint32_t>& near) {
+        const Mesh& S = loc.star.S;
+        std::vector<std::pair<double, FaceIndex>> thin;
+        for (FaceIndex f : S.faces()) {
+            progress_.tick();
+            if (loc.star.kept[f]) continue;
+            const HalfedgeIndex h0 = S.halfedge(f);
+            const VertexIndex v[3] = {S.source(h0), S.target(h0), S.target(S.next(h0))};
+            if (!near.count(std::uint32_t(v[0])) && !near.count(std::uint32_t(v[1])) &&
+                !near.count(std::uint32_t(v[2])))
+                continue;
+            const double ang = minAngle(pt(S, v[0]), pt(S, v[1]), pt(S, v[2]));
+            if (ang < kNeedleDeg * kDeg) thin.push_back({ang, f});
+        }
+        std::sort(thin.begin(), thin.end());
+        return thin;
+    }
+
+    // -- valence: a seam vertex with more than kMaxSeamValence edges loses one by the flip of one of them
+    // (every check of flipAllowed) that keeps the smallest angle there at least min(before, 15°) and
+    // raises no seam vertex above kMaxSeamValence; the best such flip (largest smallest angle) first.
+    void valencePass(Local& loc, Plan& plan) {
+        Mesh& S = loc.star.S;
+        const auto near = seamNeighbourhood(loc);
+        std::unordered_set<std::uint32_t> seamVs;
+        for (const auto& [a, b] : loc.seam) {
+            seamVs.insert(a);
+            seamVs.insert(b);
+        }
+        // Flips the candidate (flipAllowed) with the largest smallest angle after, above `above` and, when the
+        // smallest angle before was larger, at least `floor`; none that raises a seam vertex above
+        // kMaxSeamValence. Returns whether it flipped.
+        std::size_t flips = 0;
+        auto flipBest = [&](const std::vector<HalfedgeIndex>& candidates, double above, double floor) {
+            HalfedgeIndex best = Mesh::null_halfedge();
+            double bestMin = above;
+            bool bestNearPlanar = false;
+            for (HalfedgeIndex h : candidates) {
+                double oldMin = 0, newMin = 0;
+                bool nearPlanar = false;
+                if (!flipAllowed(loc, h, near, oldMin, newMin, nearPlanar)) continue;
+                if (newMin < std::min(oldMin, floor) || newMin <= bestMin) continue;
+                const VertexIndex z1 = S.target(S.next(h)), z2 = S.target(S.next(S.opposite(h)));
+                if ((seamVs.count(std::uint32_t(z1)) && S.degree(z1) >= kMaxSeamValence) ||
+                    (seamVs.count(std::uint32_t(z2)) && S.degree(z2) >= kMaxSeamValence))
+                    continue;
+                best = h;
+                bestMin = newMin;
+                bestNearPlanar = nearPlanar;
+            }
+            if (best == Mesh::null_halfedge()) return false;
+            flip(loc, best, bestNearPlanar);
+            ++flips;
+            return true;
+        };
+        std::vector<std::uint32_t> order(seamVs.begin(), seamVs.end());
+        std::sort(order.begin(), order.end());
+        for (std::uint32_t vi : order) {
+            const VertexIndex v(vi);
+            for (int guard = 0; guard < 4; ++guard) {
+                progress_.tick();
+                if (S.is_removed(v) || S.halfedge(v) == Mesh::null_halfedge() || S.degree(v) <= kMaxSeamValence)
+                    break;
+                const auto around = CGAL::halfedges_around_target(S.halfedge(v), S);
+                if (!flipBest({around.begin(), around.end()}, -1.0, kValenceFlipMinDeg * kDeg)) break;
+            }
+        }
+        // Faces near the seam with a small angle: the flip of one of their edges that raises the smallest
+        // angle there most (valence aside, but raising no seam vertex above kMaxSeamValence).
+        for (const auto& [ang, f] : thinFaces(loc, near)) {
+            progress_.tick();
+            if (S.is_removed(f)) continue;
+            const HalfedgeIndex h0 = S.halfedge(f);
+            if (std::abs(minAngle(pt(S, S.source(h0)), pt(S, S.target(h0)), pt(S, S.target(S.next(h0)))) - ang) >
+                1e-12)
+                continue; // changed by an earlier flip
+            const auto sides = CGAL::halfedges_around_face(h0, S);
+            flipBest({sides.begin(), sides.end()}, ang + 0.5 * kDeg, 0.0);
         }
         plan.flips += flips;
     }
