@@ -5,7 +5,9 @@
 //  * regular:  scanPatch with the same camera at the resolution whose covered-pixel count equals the
 //    fishbone's sample count (calibrated once before timing: covered ∝ resolution²).
 // Both scans run alternately in the same loop; counters: fishbone_ms, regular_ms, ratio =
-// fishbone_ms / regular_ms, the two sample counts, and the stage times of the fishbone scan. Curvature and
+// fishbone_ms / regular_ms, the two sample counts, and the stage times of the fishbone scan. The direction
+// fields are lazy (computed per tile while tracing, so their cost is in f_trace_ms); f_dir_pixels counts the
+// pixels they computed. Curvature and
 // the AABB tree are per-reference precomputations (cached in FishboneCache, as the Session keeps them):
 // measured once before the loop and reported as curvature_ms / aabb_ms, not in fishbone_ms.
 #include "fss/fishbone_scan.h"
@@ -90,7 +92,7 @@ void BM_FishboneVsRegular(benchmark::State& state) {
     regParams.camera.width = regParams.camera.height = res;
 
     double fishMs = 0, regMs = 0, dirMs = 0, traceMs = 0, castMs = 0, renderMs = 0, maskMs = 0, triMs = 0;
-    std::size_t regSamples = 0;
+    std::size_t regSamples = 0, dirPixels = 0;
     for (auto _ : state) {
         t = Clock::now();
         const fss::FishboneScanResult f =
@@ -100,6 +102,7 @@ void BM_FishboneVsRegular(benchmark::State& state) {
         const fss::ScanResult r = fss::scanPatch(scene.mesh, renderer, scene.mesh, renderer, regParams);
         regMs += msSince(t);
         regSamples = r.counts.covered;
+        dirPixels = f.counts.directionPixels;
         renderMs += f.timings.renderReference * 1e3;
         dirMs += f.timings.directionField * 1e3;
         traceMs += f.timings.tracing * 1e3;
@@ -119,6 +122,7 @@ void BM_FishboneVsRegular(benchmark::State& state) {
     state.counters["f_render_ms"] = renderMs / n;
     state.counters["f_dirfield_ms"] = dirMs / n;
     state.counters["f_trace_ms"] = traceMs / n;
+    state.counters["f_dir_pixels"] = double(dirPixels);
     state.counters["f_raycast_ms"] = castMs / n;
     state.counters["f_masks_ms"] = maskMs / n;
     state.counters["f_tri_ms"] = triMs / n;

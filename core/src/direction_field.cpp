@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <string>
 
@@ -60,42 +62,290 @@ std::string pixelName(int x, int y) {
 
 } // namespace
 
-DirectionField::DirectionField(int w, int h) : width(w), height(h) {
-    if (w < 0 || h < 0) throw InvalidInputError("A direction field cannot have a negative size.");
-    const std::size_t n = std::size_t(w) * std::size_t(h);
-    direction.assign(n, Eigen::Vector2d::Zero());
-    anisotropy.assign(n, 0.0f);
-    valid.assign(n, 0);
-}
+namespace {
 
-void DirectionField::setPixel(int x, int y, const Eigen::Vector2d& dir, double aniso) {
-    const std::size_t i = index(x, y);
+// Normalises and stores one pixel's values (DirectionField::setPixel's rule, shared by the lazy tiles so
+// both give the same bits). Returns whether the pixel is valid.
+bool storePixel(Eigen::Vector2d& direction, float& anisotropy, const Eigen::Vector2d& dir, double aniso) {
     const double len = dir.norm();
     if (!(len > 0) || !std::isfinite(len) || !std::isfinite(aniso)) {
-        direction[i].setZero();
-        anisotropy[i] = 0;
-        valid[i] = 0;
-        return;
+        direction.setZero();
+        anisotropy = 0;
+        return false;
     }
-    direction[i] = dir / len;
-    anisotropy[i] = float(std::clamp(aniso, 0.0, 1.0));
-    valid[i] = 1;
+    direction = dir / len;
+    anisotropy = float(std::clamp(aniso, 0.0, 1.0));
+    return true;
 }
 
-std::size_t DirectionField::validCount() const {
-    std::size_t n = 0;
-    for (auto v : valid)
-        n += v != 0;
-    return n;
-}
+// The face a pixel shows: its vertices, corner positions and (unnormalised) normal. Neighbouring pixels
+// mostly show the same face, so the last one is kept (PixelFrame::face).
+struct FaceGeometry {
+    std::uint32_t id = FrameBuffers::kNoFace;
+    std::array<VertexIndex, 3> v;
+    Eigen::Vector3d a, b, c, n;
+    double n2 = 0;
+};
 
-std::optional<DirectionSample> DirectionField::sample(const Eigen::Vector2d& pos,
-                                                      const Eigen::Vector2d& reference,
-                                                      double straightBelow) const {
+// What the per-pixel computation of both principal directions shares: the face, the barycentric
+// coordinates, the surface point, the interpolated normal and vertex anisotropy.
+struct PixelFrame {
+    FaceGeometry face;
+    std::array<double, 3> w;
+    Eigen::Vector3d p, N;
+    double aniso = 0;
+    double eps = 0; // 10⁻³ pixel footprints at p
+};
+
+// The inputs of a direction field with their checks, and the per-pixel computation (header, steps 1–6).
+class FieldSource {
+public:
+    FieldSource(const Mesh& mesh, const CurvatureField& curvature, const FrameBuffers& buffers)
+        : mesh_(mesh), curvature_(curvature), buffers_(buffers), projector_((validate(), buffers.camera)),
+          faceSlots_(mesh.number_of_faces() + mesh.number_of_removed_faces()) {}
+
+    int width() const { return buffers_.camera.width; }
+    int height() const { return buffers_.camera.height; }
+
+    // Steps 1–3 and the shared part of 4: false where the pixel can have no direction (background,
+    // degenerate face, barycentric coordinates all clamped away). \p fr keeps the last face between
+    // calls. \throw InvalidInputError for a face id that is no triangle of the mesh.
+    bool frame(int x, int y, PixelFrame& fr) const {
+        const std::uint32_t id = buffers_.faceAt(x, y);
+        if (id == FrameBuffers::kNoFace) return false;
+        if (id != fr.face.id) fr.face = faceGeometry(id, x, y);
+        const FaceGeometry& face = fr.face;
+        const std::array<VertexIndex, 3>& v = face.v;
+        const Eigen::Vector3d &a = face.a, &b = face.b, &c = face.c, &n = face.n;
+        const double n2 = face.n2;
+        if (!(n2 > 0)) return false; // degenerate face: no plane, no direction
+
+        // 3D point under the pixel centre: ray ∩ face plane (double), depth buffer as fallback.
+        const Ray ray = projector_.ray(x + 0.5, y + 0.5);
+        const double denom = n.dot(ray.direction);
+        Eigen::Vector3d p;
+        if (std::abs(denom) > 1e-12 * std::sqrt(n2))
+            p = ray.origin + (n.dot(a - ray.origin) / denom) * ray.direction;
+        else
+            p = projector_.unproject(x + 0.5, y + 0.5, double(buffers_.depthAt(x, y)));
+
+        // Barycentric coordinates, clamped to the triangle (the pixel centre may lie a hair outside).
+        std::array<double, 3>& w = fr.w;
+        w = {n.dot((b - p).cross(c - p)) / n2, n.dot((c - p).cross(a - p)) / n2,
+             n.dot((a - p).cross(b - p)) / n2};
+        double sum = 0;
+        for (double& wi : w)
+            sum += (wi = std::max(0.0, wi));
+        if (!(sum > 0)) return false;
+        for (double& wi : w)
+            wi /= sum;
+        fr.p = w[0] * a + w[1] * b + w[2] * c;
+
+        // Into the tangent plane of the interpolated vertex normal (the smooth surface's plane at p). The
+        // face plane would tilt D by up to half the dihedral angle of the faceting, which the
+        // foreshortening near silhouettes turns into screen errors of degrees.
+        Eigen::Vector3d N = Eigen::Vector3d::Zero();
+        double aniso = 0;
+        for (int k = 0; k < 3; ++k) {
+            N += w[std::size_t(k)] * curvature_.normal[v[std::size_t(k)].idx()];
+            if (curvature_.isDefined(v[std::size_t(k)]))
+                aniso += w[std::size_t(k)] * curvature_.anisotropy[v[std::size_t(k)].idx()];
+        }
+        if (!(N.norm() > 1e-9)) N = n;
+        N.normalize();
+        fr.N = N;
+        fr.aniso = aniso;
+        fr.eps = 1e-3 * projector_.pixelFootprint(fr.p);
+        return true;
+    }
+
+    // Steps 4–6 for one principal direction: false where it has no screen direction; else the unnormalised
+    // screen direction and the anisotropy to store.
+    bool direction(const PixelFrame& fr, bool useMax, Eigen::Vector2d& screen, double& anisotropy) const {
+        // Line field: align every vertex direction with the first defined one, then blend.
+        Eigen::Vector3d D = Eigen::Vector3d::Zero();
+        const Eigen::Vector3d* first = nullptr;
+        for (int k = 0; k < 3; ++k) {
+            const VertexIndex vk = fr.face.v[std::size_t(k)];
+            if (!curvature_.isDefined(vk)) continue;
+            // By magnitude: Max is the direction of the principal curvature of larger |k| (across a crease,
+            // convex or concave), Min the other.
+            const std::size_t vi = vk.idx();
+            const bool swapped = std::abs(curvature_.k2[vi]) > std::abs(curvature_.k1[vi]);
+            const Eigen::Vector3d& d = curvature_.direction(vk, useMax != swapped);
+            if (!first) first = &d;
+            D += (d.dot(*first) < 0 ? -fr.w[std::size_t(k)] : fr.w[std::size_t(k)]) * d;
+        }
+        D -= D.dot(fr.N) * fr.N;
+        const double coherence = D.norm();
+        if (!(coherence > 1e-9)) return false;
+        const Eigen::Vector3d unit = D / coherence;
+        screen = projector_.project(fr.p + fr.eps * unit) - projector_.project(fr.p - fr.eps * unit);
+        // A direction along the viewing ray projects to (almost) nothing: no screen direction.
+        if (!(screen.norm() > 1e-6 * 2e-3)) return false;
+        anisotropy = fr.aniso * std::min(1.0, coherence);
+        return true;
+    }
+
+private:
+    FaceGeometry faceGeometry(std::uint32_t id, int x, int y) const {
+        const FaceIndex f(id);
+        if (std::size_t(id) >= faceSlots_ || mesh_.is_removed(f))
+            throw InvalidInputError("The face id " + std::to_string(id) + " at pixel " + pixelName(x, y) +
+                                    " is not a face of the mesh.");
+        FaceGeometry g;
+        int nv = 0;
+        for (VertexIndex u : CGAL::vertices_around_face(mesh_.halfedge(f), mesh_)) {
+            if (nv == 3) throw InvalidInputError("Face " + std::to_string(id) + " is not a triangle.");
+            g.v[std::size_t(nv++)] = u;
+        }
+        if (nv != 3) throw InvalidInputError("Face " + std::to_string(id) + " is not a triangle.");
+        g.a = toEigen(mesh_.point(g.v[0]));
+        g.b = toEigen(mesh_.point(g.v[1]));
+        g.c = toEigen(mesh_.point(g.v[2]));
+        g.n = (g.b - g.a).cross(g.c - g.a);
+        g.n2 = g.n.squaredNorm();
+        g.id = id;
+        return g;
+    }
+
+    void validate() const {
+        const Camera& camera = buffers_.camera;
+        camera.validate();
+        const std::size_t pixels = std::size_t(camera.width) * std::size_t(camera.height);
+        if (buffers_.faceId.size() != pixels || buffers_.depth.size() != pixels)
+            throw InvalidInputError("The frame buffers do not have width × height entries.");
+        const std::size_t slots = mesh_.number_of_vertices() + mesh_.number_of_removed_vertices();
+        if (curvature_.size() != slots || curvature_.d1.size() != slots || curvature_.d2.size() != slots ||
+            curvature_.anisotropy.size() != slots || curvature_.defined.size() != slots ||
+            curvature_.normal.size() != slots)
+            throw InvalidInputError("The curvature field does not belong to this mesh (it has " +
+                                    std::to_string(curvature_.size()) + " vertices, the mesh " +
+                                    std::to_string(slots) + ").");
+    }
+
+    const Mesh& mesh_;
+    const CurvatureField& curvature_;
+    const FrameBuffers& buffers_;
+    Projector projector_;
+    std::size_t faceSlots_;
+};
+
+// One computed tile of a lazy field: the pixels [x0, x0 + w) × [y0, y0 + h), row-major.
+struct DirectionTile {
+    int x0 = 0, y0 = 0, w = 0, h = 0;
+    std::vector<DirectionPixel> pixels;
+    const DirectionPixel& at(int x, int y) const {
+        return pixels[std::size_t(y - y0) * std::size_t(w) + std::size_t(x - x0)];
+    }
+};
+
+} // namespace
+
+namespace detail {
+
+// The tile cache of a lazy DirectionField. A tile is computed by the first thread that needs it and
+// published with one compare-exchange; a thread that loses the race drops its own (identical) copy.
+struct LazyDirectionTiles {
+    LazyDirectionTiles(const Mesh& mesh, const CurvatureField& curvature, const FrameBuffers& buffers,
+                       bool max, int size)
+        : source(mesh, curvature, buffers), useMax(max), tileSize(size),
+          tilesX((source.width() + size - 1) / size), tilesY((source.height() + size - 1) / size),
+          tiles(std::size_t(tilesX) * std::size_t(tilesY)) {}
+    LazyDirectionTiles(const LazyDirectionTiles&) = delete;
+    LazyDirectionTiles& operator=(const LazyDirectionTiles&) = delete;
+    ~LazyDirectionTiles() {
+        for (auto& t : tiles)
+            delete t.load(std::memory_order_acquire);
+    }
+
+    // The tile holding pixel (x, y), computed on first use. \pre (x, y) inside the image.
+    const DirectionTile& tileOf(int x, int y) const {
+        std::atomic<const DirectionTile*>& slot =
+            tiles[std::size_t(y / tileSize) * std::size_t(tilesX) + std::size_t(x / tileSize)];
+        if (const DirectionTile* t = slot.load(std::memory_order_acquire)) return *t;
+        auto made = std::make_unique<const DirectionTile>(compute(x / tileSize * tileSize, y / tileSize * tileSize));
+        const DirectionTile* expected = nullptr;
+        if (slot.compare_exchange_strong(expected, made.get(), std::memory_order_acq_rel,
+                                         std::memory_order_acquire))
+            return *made.release();
+        return *expected; // another thread published the same tile first
+    }
+
+    std::size_t computedPixels() const {
+        std::size_t n = 0;
+        for (const auto& t : tiles)
+            if (const DirectionTile* p = t.load(std::memory_order_acquire)) n += std::size_t(p->w) * std::size_t(p->h);
+        return n;
+    }
+
+    FieldSource source;
+    bool useMax;
+    int tileSize, tilesX, tilesY;
+
+private:
+    DirectionTile compute(int x0, int y0) const {
+        DirectionTile t;
+        t.x0 = x0;
+        t.y0 = y0;
+        t.w = std::min(tileSize, source.width() - x0);
+        t.h = std::min(tileSize, source.height() - y0);
+        t.pixels.resize(std::size_t(t.w) * std::size_t(t.h));
+        PixelFrame fr;
+        Eigen::Vector2d screen;
+        double aniso = 0;
+        for (int y = y0; y < y0 + t.h; ++y)
+            for (int x = x0; x < x0 + t.w; ++x)
+                if (source.frame(x, y, fr) && source.direction(fr, useMax, screen, aniso)) {
+                    DirectionPixel& px = t.pixels[std::size_t(y - y0) * std::size_t(t.w) + std::size_t(x - x0)];
+                    px.valid = storePixel(px.direction, px.anisotropy, screen, aniso);
+                }
+        return t;
+    }
+
+    mutable std::vector<std::atomic<const DirectionTile*>> tiles;
+};
+
+} // namespace detail
+
+namespace {
+
+// Pixel access for DirectionField::sample: the stored arrays.
+struct StoredPixels {
+    const DirectionField& f;
+    struct Ref {
+        const Eigen::Vector2d& direction;
+        float anisotropy;
+        bool valid;
+    };
+    Ref at(int x, int y) const {
+        const std::size_t k = f.index(x, y);
+        return {f.direction[k], f.anisotropy[k], f.valid[k] != 0};
+    }
+};
+
+// Pixel access for DirectionField::sample: the tiles of a lazy field (the last tile is remembered; the
+// four neighbours of a sample usually share one).
+struct TiledPixels {
+    const detail::LazyDirectionTiles& tiles;
+    mutable const DirectionTile* last = nullptr;
+    using Ref = const DirectionPixel&;
+    Ref at(int x, int y) const {
+        if (!last || x < last->x0 || y < last->y0 || x >= last->x0 + last->w || y >= last->y0 + last->h)
+            last = &tiles.tileOf(x, y);
+        return last->at(x, y);
+    }
+};
+
+// DirectionField::sample on either storage (see its documentation).
+template <class Pixels>
+std::optional<DirectionSample> bilinearSample(const Pixels& pixels, int width, int height,
+                                              const Eigen::Vector2d& pos, const Eigen::Vector2d& reference,
+                                              double straightBelow) {
     if (!(pos.x() >= 0 && pos.y() >= 0 && pos.x() <= width && pos.y() <= height)) return std::nullopt;
     // The pixel containing pos decides coverage (so background stops are pixel-exact).
     const int cx = std::min(int(pos.x()), width - 1), cy = std::min(int(pos.y()), height - 1);
-    if (!isValid(cx, cy)) return std::nullopt;
+    if (cx < 0 || cy < 0 || !pixels.at(cx, cy).valid) return std::nullopt;
     // Bilinear weights between the four nearest pixel centres.
     const double gx = pos.x() - 0.5, gy = pos.y() - 0.5;
     const int x0 = int(std::floor(gx)), y0 = int(std::floor(gy));
@@ -106,19 +356,20 @@ std::optional<DirectionSample> DirectionField::sample(const Eigen::Vector2d& pos
         if (!unitReference) unitReference = reference.normalized();
         return *unitReference;
     };
-    const bool interior = x0 >= 0 && y0 >= 0 && x0 + 1 < width && y0 + 1 < height;
     Eigen::Vector2d dir = Eigen::Vector2d::Zero();
     double aniso = 0, weight = 0;
     for (int j = 0; j < 2; ++j)
         for (int i = 0; i < 2; ++i) {
             const int x = x0 + i, y = y0 + j;
-            const std::size_t k = std::size_t(y) * std::size_t(width) + std::size_t(x);
-            if (!(interior ? valid[k] != 0 : isValid(x, y))) continue;
+            if (x < 0 || y < 0 || x >= width || y >= height) continue;
+            typename Pixels::Ref px = pixels.at(x, y);
+            if (!px.valid) continue;
             const double w = (i ? fx : 1 - fx) * (j ? fy : 1 - fy);
             if (w <= 0) continue;
-            const double a = double(anisotropy[k]);
-            Eigen::Vector2d d =
-                direction[k].dot(reference) < 0 ? Eigen::Vector2d(-direction[k]) : direction[k];
+            const double a = double(px.anisotropy);
+            // Line field: flip to agree with the reference (a multiplication by ±1, exact, without a branch
+            // that a line field's arbitrary signs would mispredict).
+            Eigen::Vector2d d = (1.0 - 2.0 * double(px.direction.dot(reference) < 0)) * px.direction;
             if (straightBelow > 0 && a < 2 * straightBelow) {
                 const double f = std::clamp((a - straightBelow) / straightBelow, 0.0, 1.0);
                 d = f * d + (1 - f) * unitRef();
@@ -126,135 +377,91 @@ std::optional<DirectionSample> DirectionField::sample(const Eigen::Vector2d& pos
             // Well-defined directions dominate ill-defined ones; the floor keeps an all-isotropic
             // neighbourhood (a plane, anisotropy 0) a plain bilinear average.
             dir += (w * std::max(a, kMinDirectionWeight)) * d;
-            aniso += w * double(anisotropy[k]);
+            aniso += w * a;
             weight += w;
         }
     if (weight <= 0) {
         // pos sits exactly on the containing pixel's far edge with zero weight everywhere else.
-        const std::size_t k = index(cx, cy);
-        if (straightBelow > 0 && double(anisotropy[k]) < straightBelow)
-            return DirectionSample{unitRef(), double(anisotropy[k])};
-        const Eigen::Vector2d& d = direction[k];
-        return DirectionSample{d.dot(reference) < 0 ? Eigen::Vector2d(-d) : d, double(anisotropy[k])};
+        typename Pixels::Ref px = pixels.at(cx, cy);
+        if (straightBelow > 0 && double(px.anisotropy) < straightBelow)
+            return DirectionSample{unitRef(), double(px.anisotropy)};
+        const Eigen::Vector2d& d = px.direction;
+        return DirectionSample{d.dot(reference) < 0 ? Eigen::Vector2d(-d) : d, double(px.anisotropy)};
     }
     const double len = dir.norm();
     if (!(len > 1e-12)) return std::nullopt;
     return DirectionSample{dir / len, aniso / weight};
 }
 
+} // namespace
+
+DirectionField::DirectionField(int w, int h) : width(w), height(h) {
+    if (w < 0 || h < 0) throw InvalidInputError("A direction field cannot have a negative size.");
+    const std::size_t n = std::size_t(w) * std::size_t(h);
+    direction.assign(n, Eigen::Vector2d::Zero());
+    anisotropy.assign(n, 0.0f);
+    valid.assign(n, 0);
+}
+
+DirectionPixel DirectionField::pixel(int x, int y) const {
+    if (lazy_) return lazy_->tileOf(x, y).at(x, y);
+    const std::size_t i = index(x, y);
+    return {direction[i], anisotropy[i], valid[i] != 0};
+}
+
+void DirectionField::setPixel(int x, int y, const Eigen::Vector2d& dir, double aniso) {
+    if (lazy_) throw InvalidInputError("The pixels of a lazy direction field are computed, not set.");
+    const std::size_t i = index(x, y);
+    valid[i] = storePixel(direction[i], anisotropy[i], dir, aniso) ? 1 : 0;
+}
+
+std::size_t DirectionField::validCount() const {
+    std::size_t n = 0;
+    if (lazy_) {
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x < width; ++x)
+                n += pixel(x, y).valid;
+        return n;
+    }
+    for (auto v : valid)
+        n += v != 0;
+    return n;
+}
+
+std::size_t DirectionField::computedPixels() const {
+    return lazy_ ? lazy_->computedPixels() : std::size_t(width) * std::size_t(height);
+}
+
+std::optional<DirectionSample> DirectionField::sample(const Eigen::Vector2d& pos,
+                                                      const Eigen::Vector2d& reference,
+                                                      double straightBelow) const {
+    if (lazy_) return bilinearSample(TiledPixels{*lazy_}, width, height, pos, reference, straightBelow);
+    return bilinearSample(StoredPixels{*this}, width, height, pos, reference, straightBelow);
+}
+
 namespace {
 
-// Fills the requested fields (either pointer may be null) in one pass over the pixels: the face lookup,
-// the ray/plane point and the barycentric coordinates are shared by both principal directions.
+// Fills the requested stored fields (either pointer may be null) in one pass over the pixels: the face
+// lookup, the ray/plane point and the barycentric coordinates are shared by both principal directions.
 void fillDirectionFields(const Mesh& mesh, const CurvatureField& curvature, const FrameBuffers& buffers,
                          DirectionField* minField, DirectionField* maxField) {
-    const Camera& camera = buffers.camera;
-    camera.validate();
-    const std::size_t pixels = std::size_t(camera.width) * std::size_t(camera.height);
-    if (buffers.faceId.size() != pixels || buffers.depth.size() != pixels)
-        throw InvalidInputError("The frame buffers do not have width × height entries.");
-    const std::size_t slots = mesh.number_of_vertices() + mesh.number_of_removed_vertices();
-    if (curvature.size() != slots || curvature.d1.size() != slots || curvature.d2.size() != slots ||
-        curvature.anisotropy.size() != slots || curvature.defined.size() != slots ||
-        curvature.normal.size() != slots)
-        throw InvalidInputError("The curvature field does not belong to this mesh (it has " +
-                                std::to_string(curvature.size()) + " vertices, the mesh " +
-                                std::to_string(slots) + ").");
-    const std::size_t faceSlots = mesh.number_of_faces() + mesh.number_of_removed_faces();
-    if (minField) *minField = DirectionField(camera.width, camera.height);
-    if (maxField) *maxField = DirectionField(camera.width, camera.height);
-    const Projector projector(camera);
+    const FieldSource source(mesh, curvature, buffers);
+    const int width = source.width(), height = source.height();
+    if (minField) *minField = DirectionField(width, height);
+    if (maxField) *maxField = DirectionField(width, height);
     // Rows in blocks, one per thread (parallel.h): every pixel is computed on its own.
-    detail::parallelRows(
-        camera.height, detail::rowBlocks(camera.height, 16), [&](int, int rowBegin, int rowEnd) {
-            for (int y = rowBegin; y < rowEnd; ++y)
-                for (int x = 0; x < camera.width; ++x) {
-                    const std::uint32_t id = buffers.faceAt(x, y);
-                    if (id == FrameBuffers::kNoFace) continue;
-                    const FaceIndex f(id);
-                    if (std::size_t(id) >= faceSlots || mesh.is_removed(f))
-                        throw InvalidInputError("The face id " + std::to_string(id) + " at pixel " +
-                                                pixelName(x, y) + " is not a face of the mesh.");
-                    std::array<VertexIndex, 3> v;
-                    int nv = 0;
-                    for (VertexIndex w : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
-                        if (nv == 3)
-                            throw InvalidInputError("Face " + std::to_string(id) + " is not a triangle.");
-                        v[std::size_t(nv++)] = w;
-                    }
-                    if (nv != 3)
-                        throw InvalidInputError("Face " + std::to_string(id) + " is not a triangle.");
-                    const Eigen::Vector3d a = toEigen(mesh.point(v[0])), b = toEigen(mesh.point(v[1])),
-                                          c = toEigen(mesh.point(v[2]));
-                    const Eigen::Vector3d n = (b - a).cross(c - a);
-                    const double n2 = n.squaredNorm();
-                    if (!(n2 > 0)) continue; // degenerate face: no plane, no direction
-
-                    // 3D point under the pixel centre: ray ∩ face plane (double), depth buffer as fallback.
-                    const Ray ray = projector.ray(x + 0.5, y + 0.5);
-                    const double denom = n.dot(ray.direction);
-                    Eigen::Vector3d p;
-                    if (std::abs(denom) > 1e-12 * std::sqrt(n2))
-                        p = ray.origin + (n.dot(a - ray.origin) / denom) * ray.direction;
-                    else
-                        p = projector.unproject(x + 0.5, y + 0.5, double(buffers.depthAt(x, y)));
-
-                    // Barycentric coordinates, clamped to the triangle (the pixel centre may lie a hair
-                    // outside).
-                    std::array<double, 3> w = {n.dot((b - p).cross(c - p)) / n2,
-                                               n.dot((c - p).cross(a - p)) / n2,
-                                               n.dot((a - p).cross(b - p)) / n2};
-                    double sum = 0;
-                    for (double& wi : w)
-                        sum += (wi = std::max(0.0, wi));
-                    if (!(sum > 0)) continue;
-                    for (double& wi : w)
-                        wi /= sum;
-                    p = w[0] * a + w[1] * b + w[2] * c;
-
-                    // Into the tangent plane of the interpolated vertex normal (the smooth surface's plane at
-                    // p). The face plane would tilt D by up to half the dihedral angle of the faceting, which
-                    // the foreshortening near silhouettes turns into screen errors of degrees.
-                    Eigen::Vector3d N = Eigen::Vector3d::Zero();
-                    double aniso = 0;
-                    for (int k = 0; k < 3; ++k) {
-                        N += w[std::size_t(k)] * curvature.normal[v[std::size_t(k)].idx()];
-                        if (curvature.isDefined(v[std::size_t(k)]))
-                            aniso += w[std::size_t(k)] * curvature.anisotropy[v[std::size_t(k)].idx()];
-                    }
-                    if (!(N.norm() > 1e-9)) N = n;
-                    N.normalize();
-                    const double eps = 1e-3 * projector.pixelFootprint(p);
-
-                    for (DirectionField* field : {minField, maxField}) {
-                        if (!field) continue;
-                        const bool useMax = field == maxField;
-                        // Line field: align every vertex direction with the first defined one, then blend.
-                        Eigen::Vector3d D = Eigen::Vector3d::Zero();
-                        const Eigen::Vector3d* first = nullptr;
-                        for (int k = 0; k < 3; ++k) {
-                            if (!curvature.isDefined(v[std::size_t(k)])) continue;
-                            // By magnitude: Max is the direction of the principal curvature of larger
-                            // |k| (across a crease, convex or concave), Min the other.
-                            const std::size_t vi = v[std::size_t(k)].idx();
-                            const bool swapped = std::abs(curvature.k2[vi]) > std::abs(curvature.k1[vi]);
-                            const Eigen::Vector3d& d = curvature.direction(v[std::size_t(k)], useMax != swapped);
-                            if (!first) first = &d;
-                            D += (d.dot(*first) < 0 ? -w[std::size_t(k)] : w[std::size_t(k)]) * d;
-                        }
-                        D -= D.dot(N) * N;
-                        const double coherence = D.norm();
-                        if (!(coherence > 1e-9)) continue;
-                        const Eigen::Vector3d unit = D / coherence;
-                        const Eigen::Vector2d screen =
-                            projector.project(p + eps * unit) - projector.project(p - eps * unit);
-                        // A direction along the viewing ray projects to (almost) nothing: no screen
-                        // direction.
-                        if (!(screen.norm() > 1e-6 * 2e-3)) continue;
-                        field->setPixel(x, y, screen, aniso * std::min(1.0, coherence));
-                    }
-                }
-        });
+    detail::parallelRows(height, detail::rowBlocks(height, 16), [&](int, int rowBegin, int rowEnd) {
+        PixelFrame fr;
+        Eigen::Vector2d screen;
+        double aniso = 0;
+        for (int y = rowBegin; y < rowEnd; ++y)
+            for (int x = 0; x < width; ++x) {
+                if (!source.frame(x, y, fr)) continue;
+                for (DirectionField* field : {minField, maxField})
+                    if (field && source.direction(fr, field == maxField, screen, aniso))
+                        field->setPixel(x, y, screen, aniso);
+            }
+    });
 }
 
 } // namespace
@@ -274,6 +481,19 @@ DirectionFieldPair computeDirectionFields(const Mesh& mesh, const CurvatureField
     DirectionFieldPair pair;
     fillDirectionFields(mesh, curvature, buffers, &pair.min, &pair.max);
     return pair;
+}
+
+DirectionField lazyDirectionField(const Mesh& mesh, const CurvatureField& curvature, const FrameBuffers& buffers,
+                                  const LazyDirectionFieldOptions& options) {
+    if (options.tileSize < 1)
+        throw InvalidInputError("The tile size of a lazy direction field must be at least 1 pixel, not " +
+                                std::to_string(options.tileSize) + ".");
+    DirectionField field;
+    field.lazy_ = std::make_shared<const detail::LazyDirectionTiles>(
+        mesh, curvature, buffers, options.direction == PrincipalDirection::Max, options.tileSize);
+    field.width = buffers.camera.width;
+    field.height = buffers.camera.height;
+    return field;
 }
 
 } // namespace fss

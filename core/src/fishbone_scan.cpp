@@ -397,16 +397,12 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
             throw InvalidInputError("The fishbone seed " + point(*fb.seed) +
                                     " lies on the background; pick a point on the surface.");
     }
-    if (tracedBackbone && tracedRibs) {
-        DirectionFieldPair both = computeDirectionFields(reference, *curvature, buffers);
-        const bool backboneIsMin = fb.direction == PrincipalDirection::Min;
-        backboneField = std::move(backboneIsMin ? both.min : both.max);
-        ribField = std::move(backboneIsMin ? both.max : both.min);
-    } else if (tracedBackbone) {
-        backboneField = computeDirectionField(reference, *curvature, buffers, {fb.direction});
-    } else if (tracedRibs) {
-        ribField = computeDirectionField(reference, *curvature, buffers, {otherDirection(fb.direction)});
-    }
+    // Lazy fields: a tile of pixels is computed when the backbone or a rib first comes near it, so the cost
+    // follows the area the fishbone covers (the backbone's field is needed only along the backbone).
+    if (tracedBackbone)
+        backboneField = lazyDirectionField(reference, *curvature, buffers, {fb.direction});
+    if (tracedRibs)
+        ribField = lazyDirectionField(reference, *curvature, buffers, {otherDirection(fb.direction)});
     result.timings.directionField = secondsSince(t);
 
     progress.report(0.4, "tracing");
@@ -468,6 +464,7 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
         result.fishbone = keyRibFishbone(backbone, std::move(keys), options, W, H);
     }
     result.timings.tracing = secondsSince(t);
+    result.counts.directionPixels = backboneField.computedPixels() + ribField.computedPixels();
     result.counts.rows = result.fishbone.rows;
     result.counts.cols = result.fishbone.cols;
     result.counts.ribVertices = result.fishbone.presentCount();

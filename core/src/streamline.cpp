@@ -202,7 +202,7 @@ Streamline traceStreamline(const DirectionField& field, const Eigen::Vector2d& s
         throw InvalidInputError("The streamline seed " + pointName(seed) +
                                 " lies on the background or outside the image.");
     Eigen::Vector2d reference = preferredDirection;
-    if (!reference.allFinite() || reference.isZero()) reference = field.direction[field.index(cx, cy)];
+    if (!reference.allFinite() || reference.isZero()) reference = field.pixel(cx, cy).direction;
     const std::optional<DirectionSample> s = field.sample(seed, reference);
     if (!s)
         throw InvalidInputError("The direction field is undefined at the streamline seed " + pointName(seed) +

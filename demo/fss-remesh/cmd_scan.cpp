@@ -198,6 +198,7 @@ ScanRun fishboneScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& 
     j["counts"] = {{"rows", c.rows},
                    {"cols", c.cols},
                    {"rib_vertices", c.ribVertices},
+                   {"direction_pixels", c.directionPixels},
                    {"covered", c.covered},
                    {"front_facing", c.frontFacing},
                    {"on_hint_face", c.onHintFace},

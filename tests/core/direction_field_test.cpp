@@ -13,7 +13,10 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <cstdint>
 #include <optional>
+#include <string>
+#include <thread>
 #include <vector>
 
 using fss::DirectionField;
@@ -232,4 +235,144 @@ TEST(DirectionField, BothFieldsInOnePassEqualTwoSingleFields) {
         ASSERT_EQ(both.min.direction[i], mn.direction[i]) << i;
         ASSERT_EQ(both.max.direction[i], mx.direction[i]) << i;
     }
+}
+
+namespace {
+
+// A torus seen obliquely (both principal directions well defined almost everywhere) with its buffers.
+struct TorusScene {
+    fss::Mesh mesh = fss::shapes::torus(60, 30, 1.0, 0.35);
+    fss::CurvatureField curv = fss::estimateCurvature(mesh);
+    fss::FrameBuffers fb;
+    TorusScene() {
+        fss::Camera cam;
+        cam.eye = {2.5, 1.0, 3.0};
+        cam.width = 90; // neither divisible by the tile sizes below nor square
+        cam.height = 77;
+        cam.fitClippingRange(
+            Eigen::AlignedBox3d(Eigen::Vector3d(-1.4, -1.4, -0.4), Eigen::Vector3d(1.4, 1.4, 0.4)));
+        fb = fss::test::bruteForceRaster(mesh, cam);
+    }
+};
+
+// Sub-pixel positions spread over the image, including its border and corners.
+std::vector<Eigen::Vector2d> probePositions(int w, int h) {
+    std::vector<Eigen::Vector2d> out = {{0, 0}, {double(w), double(h)}, {double(w), 0}, {0.5, double(h)}};
+    std::uint32_t state = 12345;
+    auto next = [&] {
+        state = state * 1664525u + 1013904223u;
+        return double(state >> 8) / double(1u << 24);
+    };
+    for (int i = 0; i < 3000; ++i)
+        out.emplace_back(next() * w, next() * h);
+    return out;
+}
+
+void expectSameSample(const std::optional<fss::DirectionSample>& a, const std::optional<fss::DirectionSample>& b,
+                      const Eigen::Vector2d& p) {
+    ASSERT_EQ(a.has_value(), b.has_value()) << p.transpose();
+    if (!a) return;
+    ASSERT_EQ(a->direction, b->direction) << p.transpose();
+    ASSERT_EQ(a->anisotropy, b->anisotropy) << p.transpose();
+}
+
+} // namespace
+
+TEST(DirectionField, LazyFieldEqualsStoredFieldBitForBit) {
+    const TorusScene s;
+    for (PrincipalDirection dir : {PrincipalDirection::Min, PrincipalDirection::Max}) {
+        const DirectionField stored = fss::computeDirectionField(s.mesh, s.curv, s.fb, {dir});
+        ASSERT_GT(stored.validCount(), 2000u);
+        for (int tile : {1, 7, 16, 500}) {
+            SCOPED_TRACE("tile " + std::to_string(tile));
+            // Samples first (the tiles are computed by sample), then every pixel.
+            const DirectionField lazy = fss::lazyDirectionField(s.mesh, s.curv, s.fb, {dir, tile});
+            EXPECT_TRUE(lazy.isLazy());
+            EXPECT_EQ(lazy.computedPixels(), 0u);
+            EXPECT_EQ(lazy.width, stored.width);
+            EXPECT_EQ(lazy.height, stored.height);
+            for (const Eigen::Vector2d& p : probePositions(lazy.width, lazy.height)) {
+                const Eigen::Vector2d ref(std::cos(p.x()), std::sin(p.y()));
+                expectSameSample(lazy.sample(p, ref), stored.sample(p, ref), p);
+                expectSameSample(lazy.sample(p, ref, 0.3), stored.sample(p, ref, 0.3), p);
+            }
+            for (int y = 0; y < lazy.height; ++y)
+                for (int x = 0; x < lazy.width; ++x) {
+                    const fss::DirectionPixel px = lazy.pixel(x, y);
+                    const std::size_t i = stored.index(x, y);
+                    ASSERT_EQ(px.valid, stored.valid[i] != 0) << x << "," << y;
+                    ASSERT_EQ(px.direction, stored.direction[i]) << x << "," << y;
+                    ASSERT_EQ(px.anisotropy, stored.anisotropy[i]) << x << "," << y;
+                    ASSERT_EQ(lazy.isValid(x, y), stored.isValid(x, y));
+                }
+            EXPECT_EQ(lazy.computedPixels(), std::size_t(lazy.width) * std::size_t(lazy.height));
+            EXPECT_EQ(lazy.validCount(), stored.validCount());
+        }
+    }
+}
+
+TEST(DirectionField, LazyFieldComputesOnlyTheTilesItIsAskedFor) {
+    const TorusScene s;
+    const DirectionField stored = fss::computeDirectionField(s.mesh, s.curv, s.fb, {PrincipalDirection::Min});
+    // Tile corners (8k, 8k) whose pixel is on the torus: the first and the last, at least two tiles apart.
+    std::vector<int> onSurface;
+    for (int k = 1; k < 9; ++k)
+        if (stored.isValid(8 * k, 8 * k)) onSurface.push_back(k);
+    ASSERT_GE(onSurface.size(), 2u);
+    const int corner = onSurface.front(), far = onSurface.back();
+    ASSERT_GE(far - corner, 2);
+    const DirectionField lazy = fss::lazyDirectionField(s.mesh, s.curv, s.fb, {PrincipalDirection::Min, 8});
+    // A sample in the middle of a tile touches that tile only.
+    (void)lazy.sample({8.0 * far + 4.5, 8.0 * far + 4.5}, {1, 0});
+    EXPECT_EQ(lazy.computedPixels(), 64u);
+    // On a tile corner on the surface: the four tiles around it.
+    EXPECT_TRUE(lazy.sample({8.0 * corner, 8.0 * corner}, {1, 0}));
+    EXPECT_EQ(lazy.computedPixels(), 5u * 64u);
+    // A bottom-right border tile is smaller (90 = 11·8 + 2, 77 = 9·8 + 5).
+    (void)lazy.isValid(89, 76);
+    EXPECT_EQ(lazy.computedPixels(), 5u * 64u + 2u * 5u);
+    // A copy shares the computed tiles.
+    const DirectionField copy = lazy;
+    EXPECT_EQ(copy.computedPixels(), lazy.computedPixels());
+}
+
+TEST(DirectionField, LazyFieldIsThreadSafe) {
+    const TorusScene s;
+    const DirectionField stored = fss::computeDirectionField(s.mesh, s.curv, s.fb, {PrincipalDirection::Max});
+    const DirectionField lazy = fss::lazyDirectionField(s.mesh, s.curv, s.fb, {PrincipalDirection::Max, 4});
+    const std::vector<Eigen::Vector2d> probes = probePositions(lazy.width, lazy.height);
+    // Every thread samples the same positions in the same order: they race for the same tiles.
+    std::vector<std::vector<std::optional<fss::DirectionSample>>> results(4);
+    std::vector<std::thread> threads;
+    for (std::size_t t = 0; t < results.size(); ++t)
+        threads.emplace_back([&, t] {
+            for (const Eigen::Vector2d& p : probes)
+                results[t].push_back(lazy.sample(p, {1, 1}));
+        });
+    for (std::thread& t : threads)
+        t.join();
+    for (const auto& r : results)
+        for (std::size_t i = 0; i < probes.size(); ++i)
+            expectSameSample(r[i], stored.sample(probes[i], {1, 1}), probes[i]);
+}
+
+TEST(DirectionField, LazyFieldBadInputsThrow) {
+    const TorusScene s;
+    EXPECT_THROW(fss::lazyDirectionField(s.mesh, s.curv, s.fb, {PrincipalDirection::Min, 0}),
+                 fss::InvalidInputError);
+    const fss::CurvatureField other = fss::estimateCurvature(fss::shapes::icosphere(2));
+    EXPECT_THROW(fss::lazyDirectionField(s.mesh, other, s.fb), fss::InvalidInputError);
+    fss::FrameBuffers bad = s.fb;
+    bad.depth.pop_back();
+    EXPECT_THROW(fss::lazyDirectionField(s.mesh, s.curv, bad), fss::InvalidInputError);
+    // A bad face id throws when its tile is computed, not before, and again on the next access.
+    bad = s.fb;
+    bad.faceId[bad.index(60, 50)] = 100000;
+    const DirectionField lazy = fss::lazyDirectionField(s.mesh, s.curv, bad, {PrincipalDirection::Min, 8});
+    EXPECT_NO_THROW((void)lazy.pixel(10, 10));
+    EXPECT_THROW((void)lazy.pixel(61, 51), fss::InvalidInputError);
+    EXPECT_THROW((void)lazy.sample({60.5, 50.5}, {1, 0}), fss::InvalidInputError);
+    // Lazy pixels are computed, not set.
+    DirectionField copy = lazy;
+    EXPECT_THROW(copy.setPixel(1, 1, {1, 0}), fss::InvalidInputError);
 }

@@ -17,6 +17,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -42,28 +43,61 @@ struct DirectionSample {
     double anisotropy = 0;           ///< in [0, 1], how well the direction is defined (see DirectionField)
 };
 
+/// Options of lazyDirectionField().
+struct LazyDirectionFieldOptions {
+    /// Which principal direction to interpolate and project.
+    PrincipalDirection direction = PrincipalDirection::Max;
+    /// Side of the square pixel tiles computed at once (≥ 1; tiles at the right and bottom border may be
+    /// smaller). Small tiles waste less work beside a streamline, large ones cost less bookkeeping.
+    int tileSize = 8;
+};
+
+namespace detail {
+struct LazyDirectionTiles; // the tile cache of a lazy field (direction_field.cpp)
+} // namespace detail
+
+/// The stored values of one pixel of a DirectionField.
+struct DirectionPixel {
+    Eigen::Vector2d direction = Eigen::Vector2d::Zero(); ///< unit screen direction (zero where invalid)
+    float anisotropy = 0;                                 ///< in [0, 1]; 0 where invalid
+    bool valid = false;                                   ///< the pixel has a direction
+};
+
 /// A 2D line field on the pixels of an image: per pixel a unit screen direction (defined up to sign), an
 /// anisotropy in [0, 1] and a validity flag. Values belong to the pixel centres (x+½, y+½).
 /// Row 0 is the top image row. Synthetic fields can be filled with setPixel() (tests, hand-made fields).
+///
+/// A field is either *stored* (computeDirectionField, or the size constructor and setPixel): every pixel
+/// is in the three arrays; or *lazy* (lazyDirectionField): the arrays are empty and each tile of pixels is
+/// computed on the first access through isValid(), pixel(), sample() or validCount(), so a streamline pays
+/// only for the area it crosses. Both give the same values for the same pixel. Copies of a lazy field share
+/// its tile cache; access is thread-safe (tiles may be filled from several threads at once).
 struct DirectionField {
     int width = 0;
     int height = 0;
-    std::vector<Eigen::Vector2d> direction; ///< unit screen direction per pixel (zero where invalid)
-    std::vector<float> anisotropy;          ///< per pixel, in [0, 1]; 0 where invalid
-    std::vector<std::uint8_t> valid;        ///< 1 where the pixel has a direction
+    std::vector<Eigen::Vector2d> direction; ///< unit screen direction per pixel (zero where invalid); empty if lazy
+    std::vector<float> anisotropy;          ///< per pixel, in [0, 1]; 0 where invalid; empty if lazy
+    std::vector<std::uint8_t> valid;        ///< 1 where the pixel has a direction; empty if lazy
 
     DirectionField() = default;
-    /// An all-invalid field of the given size. \throw InvalidInputError for a negative size.
+    /// An all-invalid stored field of the given size. \throw InvalidInputError for a negative size.
     DirectionField(int width, int height);
 
     std::size_t index(int x, int y) const { return std::size_t(y) * std::size_t(width) + std::size_t(x); }
     bool inside(int x, int y) const { return x >= 0 && y >= 0 && x < width && y < height; }
-    bool isValid(int x, int y) const { return inside(x, y) && valid[index(x, y)] != 0; }
+    /// True when (x, y) lies inside the image and the pixel has a direction.
+    bool isValid(int x, int y) const { return inside(x, y) && pixel(x, y).valid; }
+    /// The values of pixel (x, y), stored or lazy. \pre inside(x, y).
+    DirectionPixel pixel(int x, int y) const;
     /// Stores a direction (normalised here; a zero or non-finite vector makes the pixel invalid).
-    /// \pre inside(x, y).
+    /// \pre inside(x, y). \throw InvalidInputError on a lazy field (its pixels are computed, not set).
     void setPixel(int x, int y, const Eigen::Vector2d& dir, double anisotropy = 1.0);
-    /// Number of valid pixels.
+    /// Number of valid pixels (computes every tile of a lazy field).
     std::size_t validCount() const;
+    /// True for a field made by lazyDirectionField.
+    bool isLazy() const { return lazy_ != nullptr; }
+    /// Pixels computed so far: width·height for a stored field, the computed tiles' pixels for a lazy one.
+    std::size_t computedPixels() const;
 
     /// Bilinear sampling at the sub-pixel position \p pos between the four nearest pixel centres: each
     /// neighbour's direction is first flipped to agree with \p reference (line field) and weighted by its
@@ -80,6 +114,11 @@ struct DirectionField {
     /// \pre reference is non-zero (its sign decides the result's: a non-negative dot with it).
     std::optional<DirectionSample> sample(const Eigen::Vector2d& pos, const Eigen::Vector2d& reference,
                                           double straightBelow = 0) const;
+
+private:
+    friend DirectionField lazyDirectionField(const Mesh&, const CurvatureField&, const FrameBuffers&,
+                                             const LazyDirectionFieldOptions&);
+    std::shared_ptr<const detail::LazyDirectionTiles> lazy_;
 };
 
 /// Options of computeDirectionField().
@@ -127,5 +166,17 @@ struct DirectionFieldPair {
 /// coordinates are shared). Preconditions and errors as computeDirectionField.
 DirectionFieldPair computeDirectionFields(const Mesh& mesh, const CurvatureField& curvature,
                                           const FrameBuffers& buffers);
+
+/// The direction field of computeDirectionField, computed lazily: per tile of tileSize² pixels on the
+/// first access (DirectionField::isValid, pixel, sample, validCount), so a fishbone pays only for the
+/// pixels its backbone and ribs come near, not for every covered pixel (DESIGN.md §5: work proportional
+/// to the patch). Every pixel's values are exactly those of computeDirectionField.
+/// The field refers to \p mesh, \p curvature and \p buffers: they must outlive it (and its copies) and
+/// stay unchanged. Preconditions as computeDirectionField; sizes and the curvature are checked here,
+/// the face ids when a tile is computed.
+/// \throw InvalidInputError when a precondition is violated or tileSize < 1 (a bad face id throws from
+///        the access that computes its tile).
+DirectionField lazyDirectionField(const Mesh& mesh, const CurvatureField& curvature, const FrameBuffers& buffers,
+                                  const LazyDirectionFieldOptions& options = {});
 
 } // namespace fss

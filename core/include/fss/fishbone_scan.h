@@ -2,7 +2,8 @@
 /// \file fishbone_scan.h
 /// One feature-sensitive ("fishbone") scan from camera to patch (DESIGN.md §1, "Feature-sensitive
 /// (fishbone) grid", last paragraph; Vorsatz, Rössl, Kobbelt, Seidel, VMV 2000): render the *reference*
-/// mesh from the scan camera, build the screen direction fields of its principal curvature directions,
+/// mesh from the scan camera, build the screen direction fields of its principal curvature directions
+/// (lazily: only the pixel tiles the streamlines come near are computed, lazyDirectionField),
 /// trace (or take the drawn) backbone and ribs into a FishboneGrid, cast a ray from the eye through every
 /// rib vertex onto the reference surface — the ID buffer's face under the vertex is the first guess, a
 /// local search around it finishes, the AABB tree is the fallback — and then mask and triangulate the
@@ -118,8 +119,9 @@ struct FishboneTimings {
     double rayCasterBuild = 0;  ///< AABB tree of the reference (0 when the cache held it)
     double renderReference = 0; ///< render + read-back of the reference
     double renderCurrent = 0;   ///< render of the current mesh (0 when it is the reference)
-    double directionField = 0;  ///< the screen direction field(s)
-    double tracing = 0;         ///< backbone, ribs, grid assembly
+    double directionField = 0;  ///< setting up the (lazy) screen direction fields
+    double tracing = 0;         ///< backbone, ribs, grid assembly, and computing the direction fields' tiles
+                                ///< the streamlines come near (FishboneCounts::directionPixels)
     double rayCasting = 0;      ///< rib vertex → ray → sample
     double masks = 0;           ///< lasso + quality mask + morphology
     double triangulate = 0;
@@ -130,6 +132,7 @@ struct FishboneTimings {
 struct FishboneCounts {
     int rows = 0, cols = 0;          ///< grid size (rows = ribs)
     std::size_t ribVertices = 0;     ///< present entries of the fishbone grid
+    std::size_t directionPixels = 0; ///< direction field pixels computed (backbone's + ribs' fields)
     std::size_t covered = 0;         ///< rays that hit the reference
     std::size_t frontFacing = 0;     ///< of those, on front-facing faces
     std::size_t onHintFace = 0;      ///< hits on the ID buffer's face under the rib vertex itself
