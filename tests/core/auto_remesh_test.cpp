@@ -40,11 +40,12 @@ TEST(AutoRemesh, EdgeLengthForVertexCountMatchesARegularTriangulation) {
     EXPECT_THROW(fss::edgeLengthForVertexCount(1.0, 0), fss::InvalidInputError);
 }
 
-// The greedy Gauss-map plan gives exactly one frontal view per side of a cube. Measured (CPU renderer):
-// coverage 0.896. Each frontal patch ends at the last pixel centre before a sharp edge, so a strip about one
-// edge length wide is left along the 12 edges; the follow-up views fill it only in part (seams across a 90°
-// edge are refused by the stitch's 10° angle floor), and where they do, they bevel the edge (area 5.93).
-// The feature-line scans (next test) are the remedy.
+// The greedy Gauss-map plan gives exactly one frontal view per side of a cube. Each frontal patch ends at the
+// last pixel centre before a sharp edge, so a strip about one edge length wide is left along the 12 edges;
+// the follow-up views fill it in part, and where they do, their pixel grid bevels the edge: the surface stays
+// within one footprint of the cube, but area is cut off. Measured (CPU renderer): coverage 0.9645, area 5.866
+// (-2.2 %), Hausdorff 0.48 L to the cube and 0.68 L from it. (Before the stitch stopped snapping mesh vertices into needles,
+// fewer follow-up pieces went in: coverage 0.9495, area 5.93.) The feature-line scans (below) are the remedy.
 TEST(AutoRemesh, CubeGetsOneFrontalViewPerSide) {
     const fss::Mesh cube = fss::shapes::cube(6, 1.0);
     fss::AutoOptions o;
@@ -61,7 +62,7 @@ TEST(AutoRemesh, CubeGetsOneFrontalViewPerSide) {
             EXPECT_TRUE(s.stitched) << s.note;
         }
     EXPECT_EQ(initial, 6);
-    EXPECT_GE(r.coverage, 0.85);
+    EXPECT_GE(r.coverage, 0.95);
     EXPECT_NEAR(scannedAreaFraction(r.mesh), r.coverage, 1e-9);
     fss::MetricsOptions mo;
     mo.reference = &cube;
@@ -70,7 +71,12 @@ TEST(AutoRemesh, CubeGetsOneFrontalViewPerSide) {
     EXPECT_EQ(m.nonManifoldVertices, 0u);
     EXPECT_EQ(m.degenerateFaces, 0u);
     EXPECT_EQ(m.selfIntersections, std::optional<std::size_t>(0));
-    EXPECT_NEAR(m.area, 6.0, 0.02 * 6.0);
+    // Bevels: the area lost is bounded by the strips the follow-up views fill (12 edges × 1 × about one edge
+    // length each side), and every point stays within one footprint (the edge length) of the cube.
+    EXPECT_NEAR(m.area, 6.0, 0.03 * 6.0);
+    ASSERT_TRUE(m.hausdorffToRef.has_value());
+    EXPECT_LE(*m.hausdorffToRef, r.edgeLength) << "L = " << r.edgeLength;
+    EXPECT_LE(*m.hausdorffFromRef, r.edgeLength);
     EXPECT_GE(m.minAngleDeg, 10.0);
     EXPECT_NEAR(double(m.vertices), 1500.0, 0.25 * 1500.0);
 }
