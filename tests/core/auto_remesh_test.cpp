@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace {
@@ -200,6 +201,25 @@ TEST(AutoRemesh, BadOptionsAreRefusedWithOneSentence) {
     EXPECT_THROW(fss::autoRemesh(cube, o), fss::InvalidInputError);
     o = {};
     o.servedAngleDeg = 100;
+    EXPECT_THROW(fss::autoRemesh(cube, o), fss::InvalidInputError);
+    // The region partition's options.
+    o = {};
+    o.regionMarginPx = -1;
+    EXPECT_THROW(fss::autoRemesh(cube, o), fss::InvalidInputError);
+    o = {};
+    o.regionMarginPx = 17;
+    EXPECT_THROW(fss::autoRemesh(cube, o), fss::InvalidInputError);
+    o = {};
+    o.regionMarginMaxSamplingAngleDeg = 90;
+    EXPECT_THROW(fss::autoRemesh(cube, o), fss::InvalidInputError);
+    o = {};
+    o.regionFillPasses = -1;
+    EXPECT_THROW(fss::autoRemesh(cube, o), fss::InvalidInputError);
+    o = {};
+    o.partitionSmoothing = std::numeric_limits<double>::quiet_NaN();
+    EXPECT_THROW(fss::autoRemesh(cube, o), fss::InvalidInputError);
+    o = {};
+    o.minRegionArea = -1;
     EXPECT_THROW(fss::autoRemesh(cube, o), fss::InvalidInputError);
     EXPECT_THROW(fss::autoRemesh(fss::Mesh{}, {}), fss::InvalidInputError);
 }
