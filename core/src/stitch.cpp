@@ -62,6 +62,7 @@ using Point2 = Kernel::Point_2;
 using Triangle2 = Kernel::Triangle_2;
 using Segment2 = Kernel::Segment_2;
 using Vec3 = Eigen::Vector3d;
+using Triangle3 = Kernel::Triangle_3;
 
 constexpr std::uint32_t kNone = 0xFFFFFFFFu;
 constexpr double kDeg = std::numbers::pi / 180.0;
@@ -149,6 +150,12 @@ constexpr double kNeedleDeg = 20.0;
 constexpr std::size_t kMaxSeamValence = 8;
 // ... unless the flip leaves an angle below this (degrees) where there was none.
 constexpr double kValenceFlipMinDeg = 15.0;
+// In the last smoothing, a vertex whose smallest angle around stays below this (degrees) after moving to its
+// neighbours' centre searches for a better place: a compass search halving its step kSearchLevels times, in
+// at most kSearchRounds rounds.
+constexpr double kSearchBelowDeg = 20.0;
+constexpr int kSearchLevels = 6;
+constexpr int kSearchRounds = 64;
 
 Vec3 normalOf(const Vec3& a, const Vec3& b, const Vec3& c) {
     return (b - a).cross(c - a);
@@ -2353,6 +2360,10 @@ private:
             flipPass(loc, plan);
         }
         valencePass(loc, plan);
+        // -- last smoothing: the vertices added outside the patch whose smallest angle around is still small
+        // search their plane for a better place (no flips after it, so the valences stay).
+        for (int pass = 0; pass < 2; ++pass)
+            if (smoothOutside(loc, true) == 0) break;
     }
 
     // A seam vertex on a mesh edge (a crossing, a snapped patch vertex) slides along that edge towards the
@@ -2405,8 +2416,19 @@ private:
         return 1;
     }
 
-    std::size_t smoothOutside(Local& loc) {
+    // Moves the free vertices near the seam where that raises the smallest angle around them, keeping the
+    // surface: a seam vertex on a mesh edge along that edge (slideAlongEdge); a vertex inside one mesh face
+    // (pieces of one plane) to its neighbours' centre in that plane. With `search` also, by a compass search
+    // for the largest smallest angle: a vertex among nearly coplanar pieces (a smoothly curved part of the
+    // mesh) within their mean plane, never farther than kNearPlanarFlipGap × the patch's edge length from
+    // the surface before; a vertex on the mesh edge between two planes along that edge's line; and a patch
+    // boundary vertex inside a mesh face whose faces, patch side included, all lie in that face's plane (no
+    // patch normal turning more than maxNormalChangeDeg, no face below its floor). Every face stays
+    // oriented in the view (exact test).
+    // Returns how many vertices moved.
+    std::size_t smoothOutside(Local& loc, bool search = false) {
         Mesh& S = loc.star.S;
+        const double maxTurn = O_.maxNormalChangeDeg * kDeg;
         const auto near = seamNeighbourhood(loc);
         std::vector<std::uint32_t> order(near.begin(), near.end());
         std::sort(order.begin(), order.end());
@@ -2416,54 +2438,137 @@ private:
             const VertexIndex v(vi);
             if (S.is_removed(v) || loc.locked[v] || loc.star.cur[v] != kNone) continue;
             if (S.halfedge(v) == Mesh::null_halfedge()) continue;
-            if (loc.lid[v] >= 0) {
+            // A seam vertex on a mesh edge slides along it; with `search`, one inside a mesh face (a patch
+            // boundary vertex) moves like the points added outside, its patch side included.
+            const bool onEdge = loc.lid[v] >= 0 && L_[std::size_t(loc.lid[v])].edgeU >= 0;
+            if (onEdge || (loc.lid[v] >= 0 && !search)) {
                 moved += slideAlongEdge(loc, v);
                 continue;
             }
-            // All faces around: pieces of one mesh face (a Steiner point inside it, not on a mesh edge).
-            Vec3 n(0, 0, 0);
-            bool inPlane = true;
+            const bool withPatch = loc.lid[v] >= 0;
+            // All faces around: pieces of one mesh face (a Steiner point inside it, not on a mesh edge), or of
+            // two (a point on the mesh edge between them: it moves along that edge's line).
+            std::vector<Vec3> planes;
+            bool outside = true;
             std::vector<std::pair<VertexIndex, VertexIndex>> ring; // (p, q): faces (v, p, q)
             std::vector<FaceIndex> ringFaces;
             Vec3 centre(0, 0, 0);
-            int count = 0;
             for (HalfedgeIndex g : CGAL::halfedges_around_target(S.halfedge(v), S)) {
                 const FaceIndex f = S.face(g);
-                if (f == Mesh::null_face() || loc.star.kept[f] || loc.patchSide[f]) {
-                    inPlane = false;
+                if (f == Mesh::null_face() || loc.star.kept[f] || (loc.patchSide[f] && !withPatch)) {
+                    outside = false;
                     break;
                 }
-                if (count == 0)
-                    n = loc.planeNormal[f];
-                else if (angleBetween(n, loc.planeNormal[f]) > kCoplanar)
-                    inPlane = false;
+                const Vec3 n = loc.patchSide[f] ? normalOf(pt(S, v), pt(S, S.target(S.next(g))), pt(S, S.source(g)))
+                                                : loc.planeNormal[f];
+                if (std::none_of(planes.begin(), planes.end(),
+                                 [&](const Vec3& m) { return angleBetween(n, m) <= kCoplanar; }))
+                    planes.push_back(n);
                 ring.push_back({S.target(S.next(g)), S.source(g)});
                 ringFaces.push_back(f);
                 centre += pt(S, S.source(g));
-                ++count;
             }
-            if (!inPlane || count < 3) continue;
-            centre /= double(count);
+            // Without `search` only a point inside one mesh face moves (to its neighbours' centre); a patch
+            // boundary vertex only where all its faces lie in one plane.
+            if (!outside || ring.size() < 3 || ((!search || withPatch) && planes.size() != 1)) continue;
+            centre /= double(ring.size());
             const Vec3 p0 = pt(S, v);
-            const Vec3 p1 = centre - n * n.dot(centre - p0);
-            Point2 uv;
-            double w;
-            if (!V_.project(p1, uv, w)) continue;
-            double oldMin = std::numbers::pi, newMin = std::numbers::pi;
-            bool valid = true;
-            for (std::size_t i = 0; i < ring.size(); ++i) {
-                const auto [p, q] = ring[i];
-                if (!oriented(loc, ringFaces[i], uv, loc.uv[p], loc.uv[q], p1, pt(S, p), pt(S, q)) ||
-                    CGAL::collinear(toPoint(p1), S.point(p), S.point(q))) {
-                    valid = false;
-                    break;
-                }
-                oldMin = std::min(oldMin, minAngle(p0, pt(S, p), pt(S, q)));
-                newMin = std::min(newMin, minAngle(p1, pt(S, p), pt(S, q)));
+            // The directions v may move in: the plane's (the mean plane where the pieces' planes differ by
+            // little: a smoothly curved part of the mesh) and, between two planes, the line where they meet.
+            Vec3 mean(0, 0, 0);
+            double spread = 0;
+            for (const Vec3& n : planes) {
+                mean += n.normalized();
+                for (const Vec3& m : planes)
+                    spread = std::max(spread, angleBetween(n, m));
             }
-            if (!valid || !(newMin > oldMin)) continue;
-            S.point(v) = toPoint(p1);
-            loc.uv[v] = uv;
+            mean.normalize();
+            std::vector<Vec3> dirs;
+            if (planes.size() == 1 || spread <= maxTurn) {
+                const Vec3 e1 = mean.unitOrthogonal(), e2 = mean.cross(e1);
+                for (int k = 0; k < 8; ++k) {
+                    const double t = double(k) * std::numbers::pi / 4.0;
+                    dirs.push_back(std::cos(t) * e1 + std::sin(t) * e2);
+                }
+            }
+            if (planes.size() == 2) {
+                const Vec3 d = planes[0].cross(planes[1]).normalized();
+                if (d.allFinite()) {
+                    dirs.push_back(d);
+                    dirs.push_back(-d);
+                }
+            }
+            if (dirs.empty()) continue;
+            const Vec3 target = centre - mean * mean.dot(centre - p0);
+            // How far a point moved to lies from the surface around v before (zero in one plane).
+            std::vector<Triangle3> before;
+            for (const auto& [p, q] : ring)
+                before.emplace_back(toPoint(p0), S.point(p), S.point(q));
+            const double maxGap = kNearPlanarFlipGap * h3_;
+            auto offSurface = [&](const Vec3& p1) {
+                if (planes.size() == 1) return false;
+                double d2 = std::numeric_limits<double>::infinity();
+                for (const Triangle3& t : before)
+                    d2 = std::min(d2, CGAL::to_double(CGAL::squared_distance(toPoint(p1), t)));
+                return !(d2 <= maxGap * maxGap);
+            };
+            // The smallest angle around v moved to p1, or -1 where a face would turn over in the view (or,
+            // unseen, against its plane) or degenerate.
+            auto score = [&](const Vec3& p1, Point2& uv) {
+                double w;
+                if (offSurface(p1) || !V_.project(p1, uv, w)) return -1.0;
+                double m = std::numbers::pi;
+                for (std::size_t i = 0; i < ring.size(); ++i) {
+                    const auto [p, q] = ring[i];
+                    if (!oriented(loc, ringFaces[i], uv, loc.uv[p], loc.uv[q], p1, pt(S, p), pt(S, q)) ||
+                        CGAL::collinear(toPoint(p1), S.point(p), S.point(q)))
+                        return -1.0;
+                    if (loc.patchSide[ringFaces[i]] &&
+                        angleBetween(normalOf(p0, pt(S, p), pt(S, q)), normalOf(p1, pt(S, p), pt(S, q))) > maxTurn)
+                        return -1.0;
+                    const double after = minAngle(p1, pt(S, p), pt(S, q));
+                    if (withPatch && after < loc.minAllowed[ringFaces[i]]) return -1.0;
+                    m = std::min(m, after);
+                }
+                return m;
+            };
+            double oldMin = std::numbers::pi, nearest = std::numeric_limits<double>::infinity();
+            for (const auto& [p, q] : ring) {
+                oldMin = std::min(oldMin, minAngle(p0, pt(S, p), pt(S, q)));
+                nearest = std::min(nearest, (pt(S, p) - p0).norm());
+            }
+            Vec3 best = p0;
+            Point2 bestUv = loc.uv[v];
+            double bestMin = oldMin;
+            // Keeps p1 when it beats the best so far.
+            auto consider = [&](const Vec3& p1) {
+                Point2 uv;
+                const double m = score(p1, uv);
+                if (!(m > bestMin)) return false;
+                best = p1;
+                bestUv = uv;
+                bestMin = m;
+                return true;
+            };
+            consider(target);
+            // With `search`, where the smallest angle around stays below kSearchBelowDeg: a compass search
+            // (the step halved when no direction helps) for the position with the largest smallest angle.
+            if (search && bestMin < kSearchBelowDeg * kDeg) {
+                double step = 0.25 * nearest;
+                for (int level = 0, round = 0; level < kSearchLevels && round < kSearchRounds; ++round) {
+                    bool improved = false;
+                    const Vec3 from = best;
+                    for (const Vec3& d : dirs)
+                        improved = consider(from + step * d) || improved;
+                    if (!improved) {
+                        step *= 0.5;
+                        ++level;
+                    }
+                }
+            }
+            if (!(bestMin > oldMin)) continue;
+            S.point(v) = toPoint(best);
+            loc.uv[v] = bestUv;
             ++moved;
         }
         return moved;

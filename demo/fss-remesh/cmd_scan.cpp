@@ -9,6 +9,7 @@
 #include "fss/error.h"
 #include "fss/fishbone_scan.h"
 #include "fss/mesh_io.h"
+#include "fss/raycast.h"
 #include "fss/render/gpu_mesh_renderer.h"
 #include "fss/scan_pipeline.h"
 #include "fss/stitch.h"
@@ -274,6 +275,32 @@ bool sameFile(const std::string& a, const std::string& b) {
     return !ec && same;
 }
 
+// The largest distance of a vertex of CURRENT from MESH's surface that --into accepts, as a fraction of
+// MESH's bounding-box diagonal. A mesh remeshed from MESH has its vertices on MESH's surface or on the chords
+// of earlier patches, far closer than this.
+constexpr double kIntoMaxOffRatio = 0.01;
+
+// --into CURRENT must be a remeshing of MESH: a patch of MESH stitched into an unrelated mesh would bridge
+// the gap between the two surfaces with its seam.
+void requireRemeshingOf(const Mesh& current, const std::string& currentPath, const Mesh& reference,
+                        const std::string& referencePath, const Eigen::AlignedBox3d& box) {
+    const RayCaster surface(reference);
+    double farthest = 0;
+    for (VertexIndex v : current.vertices()) {
+        const auto& p = current.point(v);
+        const SurfacePoint s = surface.closestPoint({p.x(), p.y(), p.z()});
+        if (s.face != Mesh::null_face()) farthest = std::max(farthest, s.distance);
+    }
+    const double limit = kIntoMaxOffRatio * box.diagonal().norm();
+    if (farthest > limit) {
+        std::ostringstream text;
+        text << "Nothing was stitched: " << currentPath << " is not a remeshing of " << referencePath
+             << " (a vertex of it lies " << farthest << " from that surface, more than " << limit
+             << ", 1 % of its bounding-box diagonal).";
+        throw InvalidInputError(text.str());
+    }
+}
+
 } // namespace
 
 int runScan(const std::vector<std::string>& args) {
@@ -324,7 +351,8 @@ int runScan(const std::vector<std::string>& args) {
              "Stitch the patch into the mesh CURRENT and write the result to OUT instead of the patch. MESH stays "
              "the reference the samples come from; CURRENT's faces decide where the scan is better (quality "
              "mask) and are replaced there. Give MESH itself for the first scan and chain through .ply files, "
-             "which keep each face's quality and scan id.", &intoPath, &haveInto);
+             "which keep each face's quality and scan id. CURRENT must be a remeshing of MESH (every "
+             "vertex within 1 % of MESH's bounding-box diagonal from its surface).", &intoPath, &haveInto);
     p.option("--scan-id", "N", "Scan id stored on the patch faces (default 0; with --into one more than the "
                                "largest in CURRENT).", &scanIdText, &haveScanId);
     p.option("--renderer", "R", "auto (GPU, else CPU), gpu (head-less OpenGL) or cpu (ray casting).",
@@ -373,7 +401,10 @@ int runScan(const std::vector<std::string>& args) {
 
     // The current mesh: the reference itself (first scan, or --into MESH) or the mesh of --into.
     std::optional<Mesh> intoMesh;
-    if (haveInto && !sameFile(intoPath, meshPath)) intoMesh = readMesh(intoPath);
+    if (haveInto && !sameFile(intoPath, meshPath)) {
+        intoMesh = readMesh(intoPath);
+        requireRemeshingOf(*intoMesh, intoPath, reference, meshPath, box);
+    }
     const Mesh& current = intoMesh ? *intoMesh : reference;
     if (haveInto && !haveScanId) params.scan.scanId = nextScanId(current);
 
