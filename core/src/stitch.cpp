@@ -156,6 +156,10 @@ constexpr double kValenceFlipMinDeg = 15.0;
 constexpr double kSearchBelowDeg = 20.0;
 constexpr int kSearchLevels = 6;
 constexpr int kSearchRounds = 64;
+// ... and a seam vertex on a mesh edge tries this many evenly spaced points of the edge, keeping this
+// fraction of the edge clear at each end.
+constexpr int kSlideSamples = 48;
+constexpr double kSlideEnd = 0.02;
 
 Vec3 normalOf(const Vec3& a, const Vec3& b, const Vec3& c) {
     return (b - a).cross(c - a);
@@ -2368,14 +2372,15 @@ private:
 
     // A seam vertex on a mesh edge (a crossing, a snapped patch vertex) slides along that edge towards the
     // centre of its neighbours where that raises the smallest angle around it: the pieces outside stay in
-    // their faces' planes; the patch side turns no normal more than maxNormalChangeDeg.
-    int slideAlongEdge(Local& loc, VertexIndex v) {
+    // their faces' planes; the patch side turns no normal more than maxNormalChangeDeg; no face falls below
+    // its floor. With `search`, where the smallest angle around stays below kSearchBelowDeg, the best of
+    // kSlideSamples evenly spaced points of the edge is taken when it is better still.
+    int slideAlongEdge(Local& loc, VertexIndex v, bool search) {
         Mesh& S = loc.star.S;
         const LVert& l = L_[std::size_t(loc.lid[v])];
         if (l.edgeU < 0) return 0;
         const Vec3 U = L_[std::size_t(l.edgeU)].pos, W = L_[std::size_t(l.edgeW)].pos;
         Vec3 centre(0, 0, 0);
-        int count = 0;
         std::vector<std::pair<VertexIndex, VertexIndex>> ring;
         std::vector<FaceIndex> faces;
         for (HalfedgeIndex g : CGAL::halfedges_around_target(S.halfedge(v), S)) {
@@ -2384,35 +2389,53 @@ private:
             ring.push_back({S.target(S.next(g)), S.source(g)});
             faces.push_back(f);
             centre += pt(S, S.source(g));
-            ++count;
         }
-        if (count < 3) return 0;
-        centre /= double(count);
+        if (ring.size() < 3) return 0;
+        centre /= double(ring.size());
         const double len2 = (W - U).squaredNorm();
         if (!(len2 > 0)) return 0;
-        const double t = std::clamp((centre - U).dot(W - U) / len2, 0.02, 0.98);
-        const Vec3 p0 = pt(S, v), p1 = U + t * (W - U);
-        Point2 uv;
-        double w;
-        if (!V_.project(p1, uv, w)) return 0;
-        double oldMin = std::numbers::pi, newMin = std::numbers::pi;
-        for (std::size_t i = 0; i < ring.size(); ++i) {
-            const auto [p, q] = ring[i];
-            if (!oriented(loc, faces[i], uv, loc.uv[p], loc.uv[q], p1, pt(S, p), pt(S, q)) ||
-                CGAL::collinear(toPoint(p1), S.point(p), S.point(q)))
-                return 0;
-            if (loc.patchSide[faces[i]] &&
-                angleBetween(normalOf(p0, pt(S, p), pt(S, q)), normalOf(p1, pt(S, p), pt(S, q))) >
-                    O_.maxNormalChangeDeg * kDeg)
-                return 0;
-            const double before = minAngle(p0, pt(S, p), pt(S, q)), after = minAngle(p1, pt(S, p), pt(S, q));
-            if (after < loc.minAllowed[faces[i]]) return 0;
-            oldMin = std::min(oldMin, before);
-            newMin = std::min(newMin, after);
-        }
-        if (!(newMin > oldMin)) return 0;
-        S.point(v) = toPoint(p1);
-        loc.uv[v] = uv;
+        const Vec3 p0 = pt(S, v);
+        double oldMin = std::numbers::pi;
+        for (const auto& [p, q] : ring)
+            oldMin = std::min(oldMin, minAngle(p0, pt(S, p), pt(S, q)));
+        // The smallest angle around v moved to U + t (W - U), or -1 where a check fails.
+        auto score = [&](double t, Point2& uv) {
+            const Vec3 p1 = U + t * (W - U);
+            double w;
+            if (!V_.project(p1, uv, w)) return -1.0;
+            double newMin = std::numbers::pi;
+            for (std::size_t i = 0; i < ring.size(); ++i) {
+                const auto [p, q] = ring[i];
+                if (!oriented(loc, faces[i], uv, loc.uv[p], loc.uv[q], p1, pt(S, p), pt(S, q)) ||
+                    CGAL::collinear(toPoint(p1), S.point(p), S.point(q)))
+                    return -1.0;
+                if (loc.patchSide[faces[i]] &&
+                    angleBetween(normalOf(p0, pt(S, p), pt(S, q)), normalOf(p1, pt(S, p), pt(S, q))) >
+                        O_.maxNormalChangeDeg * kDeg)
+                    return -1.0;
+                const double after = minAngle(p1, pt(S, p), pt(S, q));
+                if (after < loc.minAllowed[faces[i]]) return -1.0;
+                newMin = std::min(newMin, after);
+            }
+            return newMin;
+        };
+        double bestMin = oldMin, bestT = -1;
+        Point2 bestUv;
+        auto consider = [&](double t) {
+            Point2 uv;
+            const double m = score(t, uv);
+            if (!(m > bestMin)) return;
+            bestMin = m;
+            bestT = t;
+            bestUv = uv;
+        };
+        consider(std::clamp((centre - U).dot(W - U) / len2, kSlideEnd, 1.0 - kSlideEnd));
+        if (search && bestMin < kSearchBelowDeg * kDeg)
+            for (int k = 0; k <= kSlideSamples; ++k)
+                consider(kSlideEnd + (1.0 - 2.0 * kSlideEnd) * double(k) / double(kSlideSamples));
+        if (bestT < 0) return 0;
+        S.point(v) = toPoint(U + bestT * (W - U));
+        loc.uv[v] = bestUv;
         return 1;
     }
 
@@ -2442,7 +2465,7 @@ private:
             // boundary vertex) moves like the points added outside, its patch side included.
             const bool onEdge = loc.lid[v] >= 0 && L_[std::size_t(loc.lid[v])].edgeU >= 0;
             if (onEdge || (loc.lid[v] >= 0 && !search)) {
-                moved += slideAlongEdge(loc, v);
+                moved += slideAlongEdge(loc, v, search);
                 continue;
             }
             const bool withPatch = loc.lid[v] >= 0;
@@ -2468,9 +2491,8 @@ private:
                 ringFaces.push_back(f);
                 centre += pt(S, S.source(g));
             }
-            // Without `search` only a point inside one mesh face moves (to its neighbours' centre); a patch
-            // boundary vertex only where all its faces lie in one plane.
-            if (!outside || ring.size() < 3 || ((!search || withPatch) && planes.size() != 1)) continue;
+            // Without `search` only a point inside one mesh face moves (to its neighbours' centre).
+            if (!outside || ring.size() < 3 || (!search && planes.size() != 1)) continue;
             centre /= double(ring.size());
             const Vec3 p0 = pt(S, v);
             // The directions v may move in: the plane's (the mean plane where the pieces' planes differ by
@@ -2491,7 +2513,7 @@ private:
                     dirs.push_back(std::cos(t) * e1 + std::sin(t) * e2);
                 }
             }
-            if (planes.size() == 2) {
+            if (planes.size() == 2 && !withPatch) { // (the patch's planes are not exact: no line between them)
                 const Vec3 d = planes[0].cross(planes[1]).normalized();
                 if (d.allFinite()) {
                     dirs.push_back(d);
@@ -2506,7 +2528,7 @@ private:
                 before.emplace_back(toPoint(p0), S.point(p), S.point(q));
             const double maxGap = kNearPlanarFlipGap * h3_;
             auto offSurface = [&](const Vec3& p1) {
-                if (planes.size() == 1) return false;
+                if (planes.size() == 1 && !withPatch) return false;
                 double d2 = std::numeric_limits<double>::infinity();
                 for (const Triangle3& t : before)
                     d2 = std::min(d2, CGAL::to_double(CGAL::squared_distance(toPoint(p1), t)));
