@@ -146,8 +146,9 @@ double segmentGap(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& s) {
 constexpr double kNearPlanarFlipGap = 0.05;
 // Faces near the seam with a smaller angle (degrees) get a collapse of their shortest edge tried.
 constexpr double kNeedleDeg = 20.0;
-// Seam vertices with more edges get flips that take one away (valencePass).
+// Seam vertices with more edges get flips that take one away, with fewer one that adds one (valencePass).
 constexpr std::size_t kMaxSeamValence = 8;
+constexpr std::size_t kMinSeamValence = 4;
 // ... unless the flip leaves an angle below this (degrees) where there was none.
 constexpr double kValenceFlipMinDeg = 15.0;
 // In the last smoothing, a vertex whose smallest angle around stays below this (degrees) after moving to its
@@ -2870,6 +2871,25 @@ private:
                 const auto around = CGAL::halfedges_around_target(S.halfedge(v), S);
                 if (!flipBest({around.begin(), around.end()}, -1.0, kValenceFlipMinDeg * kDeg)) break;
             }
+        }
+        // A seam vertex with fewer than kMinSeamValence edges gains one by the flip of the edge opposite it
+        // in one of its faces (every check of flipAllowed; the smallest angle there at least min(before,
+        // 15°); the edge's ends keep kMinSeamValence edges when on the seam, 3 otherwise); the best first.
+        for (std::uint32_t vi : order) {
+            const VertexIndex v(vi);
+            progress_.tick();
+            if (S.is_removed(v) || S.halfedge(v) == Mesh::null_halfedge() || S.is_border(v) ||
+                S.degree(v) >= kMinSeamValence)
+                continue;
+            std::vector<HalfedgeIndex> opposite;
+            for (HalfedgeIndex g : CGAL::halfedges_around_target(S.halfedge(v), S)) {
+                const HalfedgeIndex h = S.next(S.next(g)); // the side of g's face across from v
+                bool keeps = !S.is_border(S.opposite(h));
+                for (VertexIndex end : {S.source(h), S.target(h)})
+                    keeps = keeps && S.degree(end) > (seamVs.count(std::uint32_t(end)) ? kMinSeamValence : 3u);
+                if (keeps) opposite.push_back(h);
+            }
+            flipBest(opposite, -1.0, kValenceFlipMinDeg * kDeg);
         }
         // Faces near the seam with a small angle: the flip of one of their edges that raises the smallest
         // angle there most (valence aside, but raising no seam vertex above kMaxSeamValence).
