@@ -89,64 +89,111 @@ Verdict judge(const SampleGrid& grid, const std::uint8_t* flags, const Triangle&
 }
 
 // Removes triangles until every vertex has a single fan (the largest one is kept; ties keep the fan
-// with the lowest triangle index). Returns the number of pinched vertices found.
-std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, std::vector<bool>& alive,
-                                 std::size_t sampleCount, std::size_t& removedTriangles,
-                                 ScanWorkspace::Impl& w) {
-    // Triangles incident to each sample (compressed rows).
-    std::vector<std::uint32_t>& offset = w.offset;
-    offset.assign(sampleCount + 1, 0);
+// with the lowest triangle index), compacting \p triangles to the survivors in their order. Returns the
+// number of pinched vertices found. \p triangles are grid triangles in quad order (row-major quads, for
+// each quad first {i00, i10, i11} then {i00, i11, i01}, or both with their last two corners swapped when
+// \p mirrored), as the candidates are made.
+//
+// Vertex v = (r, c) lies in at most six grid triangles; in triangle order they are: quad (r−1, c−1) both
+// halves, quad (r−1, c) first half, quad (r, c−1) second half, quad (r, c) both halves. So one byte per
+// sample — which halves of the quad whose top-left corner it is exist and are still alive — gives each
+// vertex's fan in triangle order without an incidence list, and a triangle's rank in that order is
+// 2·(top-left sample) + half. The work list is the one an incidence-list version would make: first every
+// vertex in two or more triangles, in increasing order, taken from the back (here read lazily, downwards),
+// then the vertices of removed triangles pushed on top when not already waiting.
+std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, int rows, int cols, bool mirrored,
+                                 std::size_t& removedTriangles, ScanWorkspace::Impl& w) {
+    if (triangles.empty()) return 0;
+    constexpr std::uint8_t kExists[2] = {1, 2}, kAlive[2] = {4, 8};
+    const std::size_t sampleCount = std::size_t(rows) * std::size_t(cols);
+    const auto ucols = std::uint32_t(cols);
+    std::vector<std::uint8_t>& quad = w.quadHalves; // by top-left sample
+    quad.assign(sampleCount, 0);
+    auto halfOf = [&](const Triangle& t) { return (t[1] == t[0] + ucols || t[2] == t[0] + ucols) ? 0 : 1; };
     for (const Triangle& t : triangles)
-        for (std::uint32_t v : t)
-            ++offset[v + 1];
-    for (std::size_t i = 0; i < sampleCount; ++i)
-        offset[i + 1] += offset[i];
-    std::vector<std::uint32_t>& incident = w.incident;
-    incident.resize(offset.back()); // every entry is written below
-    {
-        std::vector<std::uint32_t>& fill = w.fill;
-        fill.assign(offset.begin(), offset.end() - 1);
-        for (std::uint32_t ti = 0; ti < triangles.size(); ++ti)
-            for (std::uint32_t v : triangles[ti])
-                incident[fill[v]++] = ti;
-    }
+        quad[t[0]] |= std::uint8_t(kExists[halfOf(t)] | kAlive[halfOf(t)]);
+    // The corners of half h of the quad at top-left sample q, in the triangle's vertex order.
+    auto corners = [&](std::uint32_t q, int h) -> Triangle {
+        Triangle t = h == 0 ? Triangle{q, q + ucols, q + ucols + 1} : Triangle{q, q + ucols + 1, q + 1};
+        if (mirrored) std::swap(t[1], t[2]);
+        return t;
+    };
+    struct Slot {
+        std::uint32_t quad;
+        int half;
+    };
+    // The (up to six) triangles around v = (r, c) that exist, alive or all, in triangle order.
+    auto fanAt = [&](std::uint32_t v, std::uint32_t r, std::uint32_t c, bool aliveOnly, std::array<Slot, 6>& out) {
+        std::size_t n = 0;
+        auto take = [&](std::uint32_t q, int h) {
+            if (quad[q] & (aliveOnly ? kAlive[h] : kExists[h])) out[n++] = {q, h};
+        };
+        if (r > 0 && c > 0) take(v - ucols - 1, 0), take(v - ucols - 1, 1);
+        if (r > 0) take(v - ucols, 0);
+        if (c > 0) take(v - 1, 1);
+        take(v, 0), take(v, 1);
+        return n;
+    };
+    auto fanOf = [&](std::uint32_t v, bool aliveOnly, std::array<Slot, 6>& out) {
+        return fanAt(v, v / ucols, v % ucols, aliveOnly, out);
+    };
+    auto initialCount = [&](std::uint32_t v) {
+        std::array<Slot, 6> all;
+        return fanOf(v, false, all);
+    };
+    std::vector<std::uint8_t>& pushed = w.pushed; // on the work list above the initial vertices
+    pushed.assign(sampleCount, 0);
     std::vector<std::uint32_t>& work = w.work;
     work.clear();
-    std::vector<bool>& queued = w.queued;
-    queued.assign(sampleCount, false);
-    for (std::uint32_t v = 0; v < sampleCount; ++v)
-        if (offset[v + 1] - offset[v] > 1) work.push_back(v), queued[v] = true;
+    // Initial vertices not yet taken: those ≤ next (and in two or more triangles); next = (nextRow, nextCol).
+    std::int64_t next = std::int64_t(sampleCount) - 1;
+    std::uint32_t nextRow = std::uint32_t(rows - 1), nextCol = std::uint32_t(cols - 1);
+    auto waiting = [&](std::uint32_t x) { return pushed[x] || (std::int64_t(x) <= next && initialCount(x) > 1); };
 
     std::size_t pinched = 0;
-    std::vector<std::uint32_t> fan, component;
-    while (!work.empty()) {
-        const std::uint32_t v = work.back();
-        work.pop_back();
-        queued[v] = false;
-        fan.clear();
-        for (std::uint32_t k = offset[v]; k < offset[v + 1]; ++k)
-            if (alive[incident[k]]) fan.push_back(incident[k]);
+    std::array<Slot, 6> fan;
+    std::array<Triangle, 6> tri;
+    std::array<std::uint32_t, 6> component;
+    for (;;) {
+        std::uint32_t v = 0;
+        if (!work.empty()) {
+            v = work.back();
+            work.pop_back();
+            pushed[v] = 0;
+        } else {
+            // Down to the next vertex that was initially in two or more triangles (row and column
+            // counted along, no division per sample).
+            bool found = false;
+            while (next >= 0 && !found) {
+                found = fanAt(std::uint32_t(next), nextRow, nextCol, false, fan) > 1;
+                v = std::uint32_t(next--);
+                if (nextCol > 0) --nextCol;
+                else nextCol = ucols - 1, --nextRow;
+            }
+            if (!found) break;
+        }
+        const std::size_t n = fanOf(v, true, fan);
         // A grid vertex lies in at most the six grid triangles around it, which form one closed fan:
         // all six alive means manifold (the common interior case, skipped without the search below).
-        if (fan.size() < 2 || fan.size() == 6) continue;
+        if (n < 2 || n == 6) continue;
+        for (std::size_t i = 0; i < n; ++i)
+            tri[i] = corners(fan[i].quad, fan[i].half);
         // Connected components of the triangles around v: two are adjacent when they share an edge at v,
         // i.e. a vertex other than v.
-        component.assign(fan.size(), std::uint32_t(-1));
+        component.fill(std::uint32_t(-1));
         std::uint32_t components = 0;
-        for (std::size_t s = 0; s < fan.size(); ++s) {
+        for (std::size_t s = 0; s < n; ++s) {
             if (component[s] != std::uint32_t(-1)) continue;
             component[s] = components;
             for (bool grown = true; grown;) {
                 grown = false;
-                for (std::size_t i = 0; i < fan.size(); ++i) {
+                for (std::size_t i = 0; i < n; ++i) {
                     if (component[i] != components) continue;
-                    for (std::size_t j = 0; j < fan.size(); ++j) {
+                    for (std::size_t j = 0; j < n; ++j) {
                         if (component[j] != std::uint32_t(-1)) continue;
                         bool shares = false;
-                        for (std::uint32_t x : triangles[fan[i]])
-                            if (x != v && std::find(triangles[fan[j]].begin(), triangles[fan[j]].end(), x) !=
-                                              triangles[fan[j]].end())
-                                shares = true;
+                        for (std::uint32_t x : tri[i])
+                            if (x != v && std::find(tri[j].begin(), tri[j].end(), x) != tri[j].end()) shares = true;
                         if (shares) component[j] = components, grown = true;
                     }
                 }
@@ -155,23 +202,27 @@ std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, std::vector<b
         }
         if (components < 2) continue;
         ++pinched;
-        std::vector<std::size_t> size(components, 0);
-        std::vector<std::uint32_t> lowest(components, std::uint32_t(-1));
-        for (std::size_t i = 0; i < fan.size(); ++i) {
+        // Per component: size and lowest rank (2·quad + half, in triangle order).
+        std::array<std::size_t, 6> size{};
+        std::array<std::uint64_t, 6> lowest;
+        lowest.fill(std::uint64_t(-1));
+        for (std::size_t i = 0; i < n; ++i) {
             ++size[component[i]];
-            lowest[component[i]] = std::min(lowest[component[i]], fan[i]);
+            lowest[component[i]] = std::min(lowest[component[i]], 2 * std::uint64_t(fan[i].quad) + fan[i].half);
         }
         std::uint32_t keep = 0;
         for (std::uint32_t k = 1; k < components; ++k)
             if (size[k] > size[keep] || (size[k] == size[keep] && lowest[k] < lowest[keep])) keep = k;
-        for (std::size_t i = 0; i < fan.size(); ++i) {
+        for (std::size_t i = 0; i < n; ++i) {
             if (component[i] == keep) continue;
-            alive[fan[i]] = false;
+            quad[fan[i].quad] &= std::uint8_t(~kAlive[fan[i].half]);
             ++removedTriangles;
-            for (std::uint32_t x : triangles[fan[i]])
-                if (x != v && !queued[x]) work.push_back(x), queued[x] = true;
+            for (std::uint32_t x : tri[i])
+                if (x != v && !waiting(x)) work.push_back(x), pushed[x] = 1;
         }
     }
+    if (removedTriangles > 0)
+        std::erase_if(triangles, [&](const Triangle& t) { return !(quad[t[0]] & kAlive[halfOf(t)]); });
     return pinched;
 }
 
@@ -324,10 +375,8 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
         report.grazing += v[std::size_t(Verdict::Grazing)];
     }
 
-    std::vector<bool>& alive = w.alive;
-    alive.assign(triangles.size(), true);
     report.nonManifoldVertices =
-        makeVerticesManifold(triangles, alive, grid.samples.size(), report.nonManifoldTriangles, w);
+        makeVerticesManifold(triangles, grid.rows, grid.cols, mirrored, report.nonManifoldTriangles, w);
 
     // The halfedge structure directly (Surface_mesh::add_face searches each new edge around its vertex,
     // and add_vertex / add_edge / add_face grow every property array one element at a time). Pass 1
@@ -346,7 +395,6 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     sampleOf.clear();
     std::size_t faceCount = 0;
     for (std::size_t k = 0; k < triangles.size(); ++k) {
-        if (!alive[k]) continue;
         ++faceCount;
         for (std::uint32_t i : triangles[k]) {
             if (vertexOf[i] != kNone) continue;
@@ -365,7 +413,6 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     };
     std::uint32_t edgeCount = 0;
     for (std::size_t k = 0; k < triangles.size(); ++k) {
-        if (!alive[k]) continue;
         const Triangle& t = triangles[k];
         for (std::size_t j = 0; j < 3; ++j) {
             std::uint32_t& slot = slotOf(t[j], t[(j + 1) % 3]);
@@ -374,10 +421,13 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     }
 
     Mesh& mesh = patch.mesh;
-    // A recycled mesh is emptied and resized: its arrays keep their memory and get the default values a
-    // new mesh's would (Surface_mesh's property arrays fill new elements with their default).
+    // A recycled mesh (one with exactly our properties and nothing removed, ScanWorkspace::recycle) is
+    // resized without being emptied first: its arrays keep their memory and their old values, and every
+    // value of every element is written below — points, grid indices, vertex, halfedge (target, face,
+    // next, prev) and face connectivity, face qualities and scan ids — while its removed flags are all
+    // false already. Emptying it first would make resize write every array once more (as much as filling
+    // it). Any other mesh is replaced by a new one.
     if (!hasPatchPropertiesOnly(mesh)) mesh = Mesh();
-    mesh.resize(0, 0, 0);
     mesh.resize(Mesh::size_type(sampleOf.size()), Mesh::size_type(edgeCount), Mesh::size_type(faceCount));
     auto gridIndex = mesh.add_property_map<VertexIndex, GridIndex>(props::vertexGridIndex, GridIndex{}).first;
     auto quality = mesh.add_property_map<FaceIndex, float>(props::faceQuality, kInputFaceQuality).first;
@@ -396,7 +446,6 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     edgeMade.assign(edgeCount, 0);
     std::uint32_t faceIndex = 0;
     for (std::size_t k = 0; k < triangles.size(); ++k) {
-        if (!alive[k]) continue;
         const Triangle& t = triangles[k];
         const FaceIndex f(faceIndex++);
         std::array<HalfedgeIndex, 3> h;
@@ -409,6 +458,7 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
                 edgeMade[e] = 1;
                 mesh.set_target(first, toVertex);
                 mesh.set_target(mesh.opposite(first), VertexIndex(vertexOf[from]));
+                mesh.set_face(mesh.opposite(first), Mesh::null_face()); // until a second face takes it
                 h[j] = first;
             } else {
                 h[j] = mesh.opposite(first); // the other face's halfedge runs to → from
@@ -426,8 +476,10 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     }
     // Border halfedges follow each other around the patch's boundary; a border vertex points to its
     // incoming one. Vertex-manifold: at most one border halfedge leaves each vertex.
-    std::vector<HalfedgeIndex> borderFrom(sampleOf.size());
-    std::vector<HalfedgeIndex> borders;
+    std::vector<HalfedgeIndex>& borderFrom = w.borderFrom;
+    borderFrom.assign(sampleOf.size(), HalfedgeIndex());
+    std::vector<HalfedgeIndex>& borders = w.borders;
+    borders.clear();
     for (const std::uint32_t e : edgeSlot) {
         if (e == kNone) continue;
         const HalfedgeIndex slot(2 * e);

@@ -33,10 +33,11 @@ struct ScanWorkspace::Impl {
     std::vector<std::uint8_t> sampleFlags;
     std::vector<Block> blocks;
     std::vector<Triangle> triangles;
-    std::vector<bool> alive, queued;
-    std::vector<std::uint32_t> offset, incident, fill, work;
+    std::vector<std::uint8_t> quadHalves, pushed;
+    std::vector<std::uint32_t> work;
     std::vector<std::uint32_t> vertexOf, sampleOf, edgeSlot;
     std::vector<std::uint8_t> edgeMade;
+    std::vector<Mesh::Halfedge_index> borderFrom, borders;
 };
 
 } // namespace fss
