@@ -20,8 +20,7 @@ struct ScanWorkspace::Impl {
     bool hasPatch = false;
 
     // Morphology (mask.cpp): one byte per sample.
-    std::vector<std::uint8_t> valid, admissible, square;
-    std::vector<std::uint16_t> counts;
+    std::vector<std::uint8_t> valid, admissible, original, square;
 
     // Triangulation (triangulate.cpp).
     using Triangle = std::array<std::uint32_t, 3>;
