@@ -77,7 +77,11 @@ float sampleQuality(double footprint, double samplingAngle, double qualityAngleL
 }
 
 float triangleQuality(const Sample& a, const Sample& b, const Sample& c) {
-    return float((double(a.quality) + double(b.quality) + double(c.quality)) / 3.0);
+    return triangleQuality(a.quality, b.quality, c.quality);
+}
+
+float triangleQuality(float qa, float qb, float qc) {
+    return float((double(qa) + double(qb) + double(qc)) / 3.0);
 }
 
 void setSampleOnSurface(Sample& sample, const Mesh& reference, const Camera& camera, FaceIndex face,
@@ -149,11 +153,11 @@ SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& r
                         g = faceGeometry(reference, f);
                         cachedFace = f;
                     }
-                    const Eigen::Vector3d unprojected =
-                        projector.unprojectPixelCentre(c, r, referenceBuffers.depthAt(c, r));
+                    // The pixel centre at its depth, and the viewing ray through it (s.screen).
+                    const auto [unprojected, ray] =
+                        projector.unprojectPixelCentreWithRay(c, r, referenceBuffers.depthAt(c, r));
                     // Snap along the viewing ray onto the face's plane (removes depth quantisation).
                     Eigen::Vector3d point = unprojected;
-                    const Ray ray = projector.ray(s.screen.x(), s.screen.y());
                     const double denom = g.normal.dot(ray.direction);
                     if (g.normal.squaredNorm() > 0 && std::abs(denom) > 1e-12) {
                         const Eigen::Vector3d snapped =

@@ -287,11 +287,16 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     // Usable samples and their own tests (sampleFlags) as one byte each: every sample is a corner of up to
     // four quads and six triangles.
     const std::size_t sampleCount = grid.samples.size();
+    // The samples' q as well, in a dense array, for the faces' qualities at the end.
     std::vector<std::uint8_t>& usableSample = w.sampleFlags;
     usableSample.resize(sampleCount); // every entry is written below
+    std::vector<float>& sampleQuality = w.sampleQuality;
+    sampleQuality.resize(sampleCount); // every entry is written below
     detail::parallelRows(grid.rows, detail::rowBlocks(grid.rows, 64), [&](int, int rowBegin, int rowEnd) {
-        for (std::size_t i = grid.index(rowBegin, 0), e = grid.index(rowEnd, 0); i < e; ++i)
+        for (std::size_t i = grid.index(rowBegin, 0), e = grid.index(rowEnd, 0); i < e; ++i) {
             usableSample[i] = sampleFlags(grid.samples[i], viewer, limits);
+            sampleQuality[i] = grid.samples[i].quality;
+        }
     });
 
     // Candidates: both triangles of every quad with four usable corners, split along (r,c)–(r+1,c+1),
@@ -471,7 +476,7 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
             mesh.set_next(h[j], h[(j + 1) % 3]);
             mesh.set_halfedge(mesh.target(h[j]), h[j]);
         }
-        quality[f] = triangleQuality(grid.samples[t[0]], grid.samples[t[1]], grid.samples[t[2]]);
+        quality[f] = triangleQuality(sampleQuality[t[0]], sampleQuality[t[1]], sampleQuality[t[2]]);
         scanId[f] = grid.scanId;
     }
     // Border halfedges follow each other around the patch's boundary; a border vertex points to its

@@ -30,6 +30,7 @@ struct ScanWorkspace::Impl {
         std::size_t quads = 0;
     };
     std::vector<std::uint8_t> sampleFlags;
+    std::vector<float> sampleQuality;
     std::vector<Block> blocks;
     std::vector<Triangle> triangles;
     std::vector<std::uint8_t> quadHalves, pushed;
