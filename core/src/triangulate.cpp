@@ -65,14 +65,13 @@ std::uint8_t sampleFlags(const Sample& s, const Viewer& viewer, const JudgeLimit
     return f;
 }
 
-// The 3D tests of a candidate whose screen orientation is already known to be the grid's; \p flags are
-// the sampleFlags of the grid's samples.
-Verdict judge(const SampleGrid& grid, const std::uint8_t* flags, const Triangle& t, const Viewer& viewer,
+// The 3D tests of a candidate whose screen orientation is already known to be the grid's; \p corners are
+// the sampleFlags of its three samples, or-ed.
+Verdict judge(const SampleGrid& grid, std::uint8_t corners, const Triangle& t, const Viewer& viewer,
               const JudgeLimits& limits) {
     const Sample& a = grid.samples[t[0]];
     const Sample& b = grid.samples[t[1]];
     const Sample& c = grid.samples[t[2]];
-    const std::uint8_t corners = flags[t[0]] | flags[t[1]] | flags[t[2]];
     const Eigen::Vector3d centroid = (a.point + b.point + c.point) / 3.0;
     const Eigen::Vector3d toViewer = viewer.towards(centroid);
     const Eigen::Vector3d normal = (b.point - a.point).cross(c.point - a.point);
@@ -284,25 +283,21 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     const double maxAngle = options.maxSamplingAngleDeg * std::numbers::pi / 180.0;
     const JudgeLimits limits{options.maxEdgeFootprints, maxAngle, std::cos(maxAngle)};
 
-    // Usable samples and their own tests (sampleFlags) as one byte each: every sample is a corner of up to
-    // four quads and six triangles.
+    // One pass over the quad rows, in blocks, one per thread (parallel.h), with the samples of a quad row
+    // in cache: their own tests (sampleFlags, one byte per sample of the two rows at hand: every sample is
+    // a corner of up to four quads and six triangles), the candidates — both triangles of every quad with
+    // four usable corners, split along (r,c)–(r+1,c+1), in the vertex order that is counter-clockwise on
+    // the screen for a regular grid — their exact screen orientation and their 3D tests (judge). Which
+    // orientation is the grid's is only known once every candidate is counted: a fishbone grid may be
+    // mirrored on the screen, its majority orientation is then the grid's and the vertex order is reversed
+    // so that the faces still face the camera (which reverses the exact orientation too). A candidate is
+    // judged in the one order in which it is not flipped: as made if it turns right (kept if the grid is
+    // not mirrored), reversed if it turns left (kept if the grid is mirrored). The blocks' kept candidates
+    // are concatenated in row order, so the result does not depend on the number of blocks.
+    // The samples' q go into a dense array for the faces' qualities at the end.
     const std::size_t sampleCount = grid.samples.size();
-    // The samples' q as well, in a dense array, for the faces' qualities at the end.
-    std::vector<std::uint8_t>& usableSample = w.sampleFlags;
-    usableSample.resize(sampleCount); // every entry is written below
     std::vector<float>& sampleQuality = w.sampleQuality;
     sampleQuality.resize(sampleCount); // every entry is written below
-    detail::parallelRows(grid.rows, detail::rowBlocks(grid.rows, 64), [&](int, int rowBegin, int rowEnd) {
-        for (std::size_t i = grid.index(rowBegin, 0), e = grid.index(rowEnd, 0); i < e; ++i) {
-            usableSample[i] = sampleFlags(grid.samples[i], viewer, limits);
-            sampleQuality[i] = grid.samples[i].quality;
-        }
-    });
-
-    // Candidates: both triangles of every quad with four usable corners, split along (r,c)–(r+1,c+1),
-    // in the vertex order that is counter-clockwise on the screen for a regular grid. Quad rows in
-    // blocks, one per thread (parallel.h); the blocks' candidates are concatenated in row order, so the
-    // result does not depend on the number of blocks.
     const int quadRows = std::max(grid.rows - 1, 0);
     const int blocks = detail::rowBlocks(quadRows, 16);
     using Block = ScanWorkspace::Impl::Block;
@@ -310,23 +305,57 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     block.resize(static_cast<std::size_t>(blocks));
     for (Block& b : block) {
         b.candidates.clear();
-        b.orientation.clear();
-        b.quads = 0;
+        b.keptIf.clear();
+        b.quads = b.rightTurns = b.leftTurns = 0;
+        b.verdicts = {};
+        b.top.resize(std::size_t(grid.cols)); // every entry written before it is read
+        b.bottom.resize(std::size_t(grid.cols));
     }
-    detail::parallelRows(quadRows, blocks, [&](int b, int rowBegin, int rowEnd) {
+    constexpr std::uint8_t kKeptIfNotMirrored = 1, kKeptIfMirrored = 2;
+    detail::parallelRows(std::max(quadRows, 1), blocks, [&](int b, int rowBegin, int rowEnd) {
         Block& out = block[std::size_t(b)];
-        for (int r = rowBegin; r < rowEnd; ++r) {
-            const std::uint8_t* top = usableSample.data() + grid.index(r, 0);
-            const std::uint8_t* bottom = usableSample.data() + grid.index(r + 1, 0);
+        // This block's sample rows for the dense q: its quad rows' top rows, and the last row for the last.
+        const int qualityEnd = rowEnd == std::max(quadRows, 1) ? grid.rows : rowEnd;
+        auto flagRow = [&](int r, std::vector<std::uint8_t>& flags) {
+            const Sample* row = grid.samples.data() + grid.index(r, 0);
+            for (int c = 0; c < grid.cols; ++c)
+                flags[std::size_t(c)] = sampleFlags(row[c], viewer, limits);
+            if (r >= rowBegin && r < qualityEnd)
+                for (int c = 0; c < grid.cols; ++c)
+                    sampleQuality[grid.index(r, c)] = row[c].quality;
+        };
+        if (rowBegin < grid.rows) flagRow(rowBegin, out.bottom);
+        for (int r = rowBegin; r < rowEnd && r + 1 < grid.rows; ++r) {
+            std::swap(out.top, out.bottom);
+            flagRow(r + 1, out.bottom);
+            const std::uint8_t* top = out.top.data();
+            const std::uint8_t* bottom = out.bottom.data();
             for (int c = 0; c + 1 < grid.cols; ++c) {
                 if (!(top[c] & top[c + 1] & bottom[c] & bottom[c + 1] & kUsable)) continue;
                 const auto i00 = std::uint32_t(grid.index(r, c)), i01 = std::uint32_t(grid.index(r, c + 1)),
                            i10 = std::uint32_t(grid.index(r + 1, c)),
                            i11 = std::uint32_t(grid.index(r + 1, c + 1));
                 ++out.quads;
-                for (const Triangle& t : {Triangle{i00, i10, i11}, Triangle{i00, i11, i01}}) {
-                    out.candidates.push_back(t);
-                    out.orientation.push_back(screenOrientation(grid, t));
+                const std::uint8_t lower = top[c] | bottom[c] | bottom[c + 1], upper = top[c] | bottom[c + 1] | top[c + 1];
+                for (const auto& [t, corners] : {std::pair{Triangle{i00, i10, i11}, lower}, std::pair{Triangle{i00, i11, i01}, upper}}) {
+                    const CGAL::Orientation o = screenOrientation(grid, t);
+                    out.rightTurns += (o == CGAL::RIGHT_TURN);
+                    out.leftTurns += (o == CGAL::LEFT_TURN);
+                    // [0]: the verdicts if the grid is not mirrored, [1]: if it is.
+                    if (o == CGAL::RIGHT_TURN) {
+                        const Verdict v = judge(grid, corners, t, viewer, limits);
+                        ++out.verdicts[0][std::size_t(v)];
+                        ++out.verdicts[1][std::size_t(Verdict::Flipped)];
+                        if (v == Verdict::Keep) out.candidates.push_back(t), out.keptIf.push_back(kKeptIfNotMirrored);
+                    } else if (o == CGAL::LEFT_TURN) {
+                        const Verdict v = judge(grid, corners, Triangle{t[0], t[2], t[1]}, viewer, limits);
+                        ++out.verdicts[0][std::size_t(Verdict::Flipped)];
+                        ++out.verdicts[1][std::size_t(v)];
+                        if (v == Verdict::Keep) out.candidates.push_back(t), out.keptIf.push_back(kKeptIfMirrored);
+                    } else {
+                        ++out.verdicts[0][std::size_t(Verdict::Flipped)];
+                        ++out.verdicts[1][std::size_t(Verdict::Flipped)];
+                    }
                 }
             }
         }
@@ -334,33 +363,11 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     std::size_t rightTurns = 0, leftTurns = 0;
     for (const Block& b : block) {
         report.quads += b.quads;
-        for (const CGAL::Orientation o : b.orientation) {
-            rightTurns += (o == CGAL::RIGHT_TURN);
-            leftTurns += (o == CGAL::LEFT_TURN);
-        }
+        rightTurns += b.rightTurns;
+        leftTurns += b.leftTurns;
     }
-    // A fishbone grid may be mirrored on the screen: its majority orientation is the grid's, and the
-    // vertex order is reversed so that the faces still face the camera (which reverses the exact
-    // orientation too: the grid's orientation is then RIGHT_TURN again).
     const bool mirrored = leftTurns > rightTurns;
-
-    // Judge each block's candidates in place (kept ones compacted to the front), then concatenate.
-    std::vector<std::array<std::size_t, 5>> verdicts(std::size_t(blocks), std::array<std::size_t, 5>{});
-    detail::parallelRows(blocks, blocks, [&](int b, int, int) {
-        Block& in = block[std::size_t(b)];
-        std::size_t kept = 0;
-        for (std::size_t k = 0; k < in.candidates.size(); ++k) {
-            Triangle t = in.candidates[k];
-            CGAL::Orientation o = in.orientation[k];
-            if (mirrored) std::swap(t[1], t[2]), o = CGAL::Orientation(-int(o));
-            const Verdict v = o != CGAL::RIGHT_TURN ? Verdict::Flipped
-                                                    : judge(grid, usableSample.data(), t, viewer, limits);
-            ++verdicts[std::size_t(b)][std::size_t(v)];
-            if (v == Verdict::Keep) in.candidates[kept++] = t;
-        }
-        in.candidates.resize(kept);
-        in.orientation.clear();
-    });
+    const std::uint8_t kept = mirrored ? kKeptIfMirrored : kKeptIfNotMirrored;
     std::vector<Triangle>& triangles = w.triangles;
     triangles.clear();
     {
@@ -369,11 +376,18 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
             total += b.candidates.size();
         triangles.reserve(total);
         for (Block& b : block) {
-            triangles.insert(triangles.end(), b.candidates.begin(), b.candidates.end());
+            for (std::size_t k = 0; k < b.candidates.size(); ++k) {
+                if (b.keptIf[k] != kept) continue;
+                Triangle t = b.candidates[k];
+                if (mirrored) std::swap(t[1], t[2]);
+                triangles.push_back(t);
+            }
             b.candidates.clear();
+            b.keptIf.clear();
         }
     }
-    for (const auto& v : verdicts) {
+    for (const Block& b : block) {
+        const auto& v = b.verdicts[mirrored ? 1 : 0];
         report.flipped += v[std::size_t(Verdict::Flipped)];
         report.backFacing += v[std::size_t(Verdict::BackFacing)];
         report.longEdges += v[std::size_t(Verdict::LongEdge)];

@@ -5,8 +5,6 @@
 #include "fss/scan_workspace.h"
 #include "fss/triangulate.h"
 
-#include <CGAL/enum.h>
-
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -25,11 +23,12 @@ struct ScanWorkspace::Impl {
     // Triangulation (triangulate.cpp).
     using Triangle = std::array<std::uint32_t, 3>;
     struct Block {
-        std::vector<Triangle> candidates;
-        std::vector<CGAL::Orientation> orientation; // of each candidate, as listed
-        std::size_t quads = 0;
+        std::vector<Triangle> candidates;      // kept by the 3D tests in one of the two orders
+        std::vector<std::uint8_t> keptIf;      // of each candidate: kept if the grid is not mirrored, or if it is
+        std::vector<std::uint8_t> top, bottom; // sample flags of the two rows of the quad row at hand
+        std::size_t quads = 0, rightTurns = 0, leftTurns = 0;
+        std::array<std::array<std::size_t, 5>, 2> verdicts{}; // per verdict, if not mirrored / if mirrored
     };
-    std::vector<std::uint8_t> sampleFlags;
     std::vector<float> sampleQuality;
     std::vector<Block> blocks;
     std::vector<Triangle> triangles;
