@@ -461,6 +461,7 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     }
     // An edge's first halfedge (2e) runs the way the first face that used it traverses it; the second
     // face finds it already made and takes the opposite halfedge, which must run the other way round.
+    // edgeMade counts the faces of each edge: the opposite halfedge of an edge with one is a border.
     std::vector<std::uint8_t>& edgeMade = w.edgeMade;
     edgeMade.assign(edgeCount, 0);
     std::uint32_t faceIndex = 0;
@@ -482,6 +483,7 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
             } else {
                 h[j] = mesh.opposite(first); // the other face's halfedge runs to → from
                 if (mesh.target(h[j]) != toVertex || mesh.face(h[j]) != Mesh::null_face()) throw fail(from);
+                edgeMade[e] = 2;
             }
         }
         mesh.set_halfedge(f, h[0]);
@@ -500,15 +502,12 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     std::vector<HalfedgeIndex>& borders = w.borders;
     borders.clear();
     for (const std::uint32_t e : edgeSlot) {
-        if (e == kNone) continue;
-        const HalfedgeIndex slot(2 * e);
-        for (const HalfedgeIndex b : {slot, mesh.opposite(slot)}) {
-            if (mesh.face(b) != Mesh::null_face()) continue;
-            HalfedgeIndex& out = borderFrom[mesh.source(b).idx()];
-            if (out != HalfedgeIndex()) throw fail(sampleOf[mesh.source(b).idx()]);
-            out = b;
-            borders.push_back(b);
-        }
+        if (e == kNone || edgeMade[e] != 1) continue; // the first halfedge (2e) has its face
+        const HalfedgeIndex b = mesh.opposite(HalfedgeIndex(2 * e));
+        HalfedgeIndex& out = borderFrom[mesh.source(b).idx()];
+        if (out != HalfedgeIndex()) throw fail(sampleOf[mesh.source(b).idx()]);
+        out = b;
+        borders.push_back(b);
     }
     for (const HalfedgeIndex b : borders) {
         const VertexIndex end = mesh.target(b);
