@@ -256,45 +256,71 @@ std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameB
     const int blocks = detail::rowBlocks(grid.rows, 16);
     std::vector<std::size_t> dropped(std::size_t(blocks), 0);
     detail::parallelRows(grid.rows, blocks, [&](int block, int rowBegin, int rowEnd) {
-        FaceIndex cachedHint = Mesh::null_face();
-        std::array<Eigen::Vector3d, 3> hintCorner;
-        for (std::size_t i = grid.index(rowBegin, 0), end = grid.index(rowEnd, 0); i < end; ++i) {
-            Sample& s = grid.samples[i];
-            if (!s.admissible) continue;
-            const double fx = std::floor(s.screen.x()), fy = std::floor(s.screen.y());
-            if (!(fx >= 0 && fy >= 0 && fx < currentBuffers.width() && fy < currentBuffers.height()))
-                continue;
-            const std::uint32_t id = currentBuffers.faceAt(int(fx), int(fy));
-            if (id == FrameBuffers::kNoFace) continue;
-            const FaceIndex hint(id);
-            if (hint != cachedHint) { // neighbouring samples mostly share the face under their pixels
-                if (std::size_t(id) >= current.num_faces() || current.is_removed(hint))
-                    throw InvalidInputError("The current mesh's face-id buffer names face " +
-                                            std::to_string(id) + ", which the current mesh does not have.");
-                const HalfedgeIndex h = current.halfedge(hint);
-                for (const auto& [corner, v] :
-                     {std::pair{0, current.source(h)}, std::pair{1, current.target(h)},
-                      std::pair{2, current.target(current.next(h))}}) {
-                    const Point3& p = current.point(v);
-                    hintCorner[std::size_t(corner)] = {p.x(), p.y(), p.z()};
+        // Row by row: first the faces under the row's admissible samples (one entry per run of samples
+        // over the same face, as neighbouring samples mostly share it), then those faces' corners and
+        // qualities — lookups in the current mesh that do not depend on each other, so the processor
+        // overlaps their cache misses — then the samples' tests.
+        struct HintFace {
+            FaceIndex face;
+            std::array<Eigen::Vector3d, 3> corner;
+            float quality = kInputFaceQuality;
+        };
+        std::vector<HintFace> hints;
+        std::vector<std::uint32_t> hintOf(std::size_t(grid.cols));
+        constexpr std::uint32_t kNoHint = std::uint32_t(-1);
+        for (int r = rowBegin; r < rowEnd; ++r) {
+            Sample* row = grid.samples.data() + grid.index(r, 0);
+            hints.clear();
+            for (int c = 0; c < grid.cols; ++c) {
+                hintOf[std::size_t(c)] = kNoHint;
+                const Sample& s = row[c];
+                if (!s.admissible) continue;
+                const double fx = std::floor(s.screen.x()), fy = std::floor(s.screen.y());
+                if (!(fx >= 0 && fy >= 0 && fx < currentBuffers.width() && fy < currentBuffers.height()))
+                    continue;
+                const std::uint32_t id = currentBuffers.faceAt(int(fx), int(fy));
+                if (id == FrameBuffers::kNoFace) continue;
+                const FaceIndex hint(id);
+                if (hints.empty() || hints.back().face != hint) {
+                    if (std::size_t(id) >= current.num_faces() || current.is_removed(hint))
+                        throw InvalidInputError("The current mesh's face-id buffer names face " +
+                                                std::to_string(id) + ", which the current mesh does not have.");
+                    hints.push_back({hint, {}, kInputFaceQuality});
                 }
-                cachedHint = hint;
+                hintOf[std::size_t(c)] = std::uint32_t(hints.size() - 1);
             }
-            float faceQ = kInputFaceQuality;
-            if (hasQuality) { // without qualities every face has kInputFaceQuality: no need to know which
-                FaceIndex closest = hint;
-                // Fast path: the sample lies on the face under its pixel (up to rounding), as almost always
-                // where the current mesh is the reference; any closer face is closer by less than that.
-                const Eigen::Vector3d q =
-                    closestPointOnTriangle(s.point, hintCorner[0], hintCorner[1], hintCorner[2]);
-                if (!((q - s.point).norm() <= kOnFaceFootprints * double(s.footprint)))
-                    closest = closestPointNear(current, s.point, hint, search).face;
-                faceQ = qualityMap[closest];
+            // Without qualities every face has kInputFaceQuality: no need to know which is closest.
+            if (hasQuality) {
+                for (HintFace& hf : hints) {
+                    const HalfedgeIndex h = current.halfedge(hf.face);
+                    for (const auto& [corner, v] :
+                         {std::pair{0, current.source(h)}, std::pair{1, current.target(h)},
+                          std::pair{2, current.target(current.next(h))}}) {
+                        const Point3& p = current.point(v);
+                        hf.corner[std::size_t(corner)] = {p.x(), p.y(), p.z()};
+                    }
+                    hf.quality = qualityMap[hf.face];
+                }
             }
-            if (std::isnan(faceQ)) faceQ = kInputFaceQuality;
-            if (double(s.quality) < (1.0 - options.margin) * double(faceQ)) continue;
-            s.admissible = s.valid = false;
-            ++dropped[std::size_t(block)];
+            for (int c = 0; c < grid.cols; ++c) {
+                if (hintOf[std::size_t(c)] == kNoHint) continue;
+                Sample& s = row[c];
+                const HintFace& hf = hints[hintOf[std::size_t(c)]];
+                float faceQ = kInputFaceQuality;
+                if (hasQuality) {
+                    // Fast path: the sample lies on the face under its pixel (up to rounding), as almost
+                    // always where the current mesh is the reference; any closer face is closer by less.
+                    const Eigen::Vector3d q = closestPointOnTriangle(s.point, hf.corner[0], hf.corner[1], hf.corner[2]);
+                    if ((q - s.point).norm() <= kOnFaceFootprints * double(s.footprint))
+                        faceQ = hf.quality;
+                    else
+                        faceQ = qualityMap[closestPointNear(current, s.point, hf.face, search).face];
+                }
+                if (std::isnan(faceQ)) faceQ = kInputFaceQuality;
+                if (double(s.quality) < (1.0 - options.margin) * double(faceQ)) continue;
+                s.admissible = s.valid = false;
+                ++dropped[std::size_t(block)];
+            }
         }
     });
     return std::accumulate(dropped.begin(), dropped.end(), std::size_t(0));
