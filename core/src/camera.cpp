@@ -157,7 +157,8 @@ Ray CameraProjector::ray(double sx, double sy) const {
     return r;
 }
 
-CameraProjector::PixelCentre CameraProjector::unprojectPixelCentreWithRay(int px, int py, double depth) const {
+CameraProjector::PixelCentre CameraProjector::unprojectPixelCentreWithRay(int px, int py,
+                                                                          double depth) const {
     const double sx = px + 0.5, sy = py + 0.5;
     const Eigen::Matrix4d& m = inverseViewProjection_;
     // unproject's product m · (x, y, z, 1) = ((m₀x + m₁y) + m₂z) + m₃ per coordinate.

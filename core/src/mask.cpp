@@ -284,7 +284,8 @@ std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameB
                 if (hints.empty() || hints.back().face != hint) {
                     if (std::size_t(id) >= current.num_faces() || current.is_removed(hint))
                         throw InvalidInputError("The current mesh's face-id buffer names face " +
-                                                std::to_string(id) + ", which the current mesh does not have.");
+                                                std::to_string(id) +
+                                                ", which the current mesh does not have.");
                     hints.push_back({hint, {}, kInputFaceQuality});
                 }
                 hintOf[std::size_t(c)] = std::uint32_t(hints.size() - 1);
@@ -310,7 +311,8 @@ std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameB
                 if (hasQuality) {
                     // Fast path: the sample lies on the face under its pixel (up to rounding), as almost
                     // always where the current mesh is the reference; any closer face is closer by less.
-                    const Eigen::Vector3d q = closestPointOnTriangle(s.point, hf.corner[0], hf.corner[1], hf.corner[2]);
+                    const Eigen::Vector3d q =
+                        closestPointOnTriangle(s.point, hf.corner[0], hf.corner[1], hf.corner[2]);
                     if ((q - s.point).norm() <= kOnFaceFootprints * double(s.footprint))
                         faceQ = hf.quality;
                     else
@@ -353,7 +355,8 @@ template <class Step> std::size_t inRowBlocks(int rows, int cols, Step&& step) {
     std::barrier barrier(blocks);
     const std::function<void()> sync = [&barrier] { barrier.arrive_and_wait(); };
     std::vector<std::size_t> sums(std::size_t(blocks), 0);
-    std::vector<std::vector<int>> counts(std::size_t(blocks), std::vector<int>(std::size_t(std::max(cols, 0))));
+    std::vector<std::vector<int>> counts(std::size_t(blocks),
+                                         std::vector<int>(std::size_t(std::max(cols, 0))));
     detail::parallelRows(rows, blocks, [&](int b, int rowBegin, int rowEnd) {
         sums[std::size_t(b)] = step(RowBlock{rows, cols, rowBegin, rowEnd, sync, counts[std::size_t(b)]});
     });
@@ -363,8 +366,8 @@ template <class Step> std::size_t inRowBlocks(int rows, int cols, Step&& step) {
 // out = pred(number of set entries of `in` in the window [c − radius, c + radius] of the same row),
 // entries outside the grid counting as unset, for the block's rows.
 template <class Pred>
-void rowWindows(const RowBlock& b, const std::vector<std::uint8_t>& in, int radius, std::vector<std::uint8_t>& out,
-                Pred pred) {
+void rowWindows(const RowBlock& b, const std::vector<std::uint8_t>& in, int radius,
+                std::vector<std::uint8_t>& out, Pred pred) {
     const int cols = b.cols;
     for (int r = b.rowBegin; r < b.rowEnd; ++r) {
         const std::uint8_t* row = in.data() + std::size_t(r) * std::size_t(cols);
@@ -383,7 +386,8 @@ void rowWindows(const RowBlock& b, const std::vector<std::uint8_t>& in, int radi
 // visit(index, count) for the block's entries, count = number of set entries of `in` in the window
 // [r − radius, r + radius] of the same column (outside the grid unset); row by row, one running count per
 // column, so memory is read in order.
-template <class Visit> void columnWindows(const RowBlock& b, const std::vector<std::uint8_t>& in, int radius, Visit visit) {
+template <class Visit>
+void columnWindows(const RowBlock& b, const std::vector<std::uint8_t>& in, int radius, Visit visit) {
     const int rows = b.rows, cols = b.cols;
     std::vector<int>& count = b.count;
     std::fill(count.begin(), count.end(), 0);
@@ -463,7 +467,8 @@ std::size_t dilateBlock(const RowBlock& b, std::vector<std::uint8_t>& valid,
     return added;
 }
 
-std::size_t removeUntriangulatableBlock(const RowBlock& b, std::vector<std::uint8_t>& valid, Scratch& scratch) {
+std::size_t removeUntriangulatableBlock(const RowBlock& b, std::vector<std::uint8_t>& valid,
+                                        Scratch& scratch) {
     const int rows = b.rows, cols = b.cols;
     std::size_t removed = 0;
     if (rows < 2 || cols < 2) {
@@ -482,7 +487,8 @@ std::size_t removeUntriangulatableBlock(const RowBlock& b, std::vector<std::uint
                 at(r, c) && at(r, c + 1) && at(r + 1, c) && at(r + 1, c + 1);
     b.sync();
     auto full = [&](int r, int c) {
-        return r >= 0 && c >= 0 && r < qr && c < qc && quadFull[std::size_t(r) * std::size_t(cols) + std::size_t(c)];
+        return r >= 0 && c >= 0 && r < qr && c < qc &&
+               quadFull[std::size_t(r) * std::size_t(cols) + std::size_t(c)];
     };
     for (int r = b.rowBegin; r < b.rowEnd; ++r) {
         for (int c = 0; c < cols; ++c) {

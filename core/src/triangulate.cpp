@@ -122,7 +122,8 @@ std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, int rows, int
         int half;
     };
     // The (up to six) triangles around v = (r, c) that exist, alive or all, in triangle order.
-    auto fanAt = [&](std::uint32_t v, std::uint32_t r, std::uint32_t c, bool aliveOnly, std::array<Slot, 6>& out) {
+    auto fanAt = [&](std::uint32_t v, std::uint32_t r, std::uint32_t c, bool aliveOnly,
+                     std::array<Slot, 6>& out) {
         std::size_t n = 0;
         auto take = [&](std::uint32_t q, int h) {
             if (quad[q] & (aliveOnly ? kAlive[h] : kExists[h])) out[n++] = {q, h};
@@ -147,7 +148,9 @@ std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, int rows, int
     // Initial vertices not yet taken: those ≤ next (and in two or more triangles); next = (nextRow, nextCol).
     std::int64_t next = std::int64_t(sampleCount) - 1;
     std::uint32_t nextRow = std::uint32_t(rows - 1), nextCol = std::uint32_t(cols - 1);
-    auto waiting = [&](std::uint32_t x) { return pushed[x] || (std::int64_t(x) <= next && initialCount(x) > 1); };
+    auto waiting = [&](std::uint32_t x) {
+        return pushed[x] || (std::int64_t(x) <= next && initialCount(x) > 1);
+    };
 
     std::size_t pinched = 0;
     std::array<Slot, 6> fan;
@@ -166,8 +169,10 @@ std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, int rows, int
             while (next >= 0 && !found) {
                 found = fanAt(std::uint32_t(next), nextRow, nextCol, false, fan) > 1;
                 v = std::uint32_t(next--);
-                if (nextCol > 0) --nextCol;
-                else nextCol = ucols - 1, --nextRow;
+                if (nextCol > 0)
+                    --nextCol;
+                else
+                    nextCol = ucols - 1, --nextRow;
             }
             if (!found) break;
         }
@@ -192,7 +197,8 @@ std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, int rows, int
                         if (component[j] != std::uint32_t(-1)) continue;
                         bool shares = false;
                         for (std::uint32_t x : tri[i])
-                            if (x != v && std::find(tri[j].begin(), tri[j].end(), x) != tri[j].end()) shares = true;
+                            if (x != v && std::find(tri[j].begin(), tri[j].end(), x) != tri[j].end())
+                                shares = true;
                         if (shares) component[j] = components, grown = true;
                     }
                 }
@@ -207,7 +213,8 @@ std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, int rows, int
         lowest.fill(std::uint64_t(-1));
         for (std::size_t i = 0; i < n; ++i) {
             ++size[component[i]];
-            lowest[component[i]] = std::min(lowest[component[i]], 2 * std::uint64_t(fan[i].quad) + fan[i].half);
+            lowest[component[i]] =
+                std::min(lowest[component[i]], 2 * std::uint64_t(fan[i].quad) + fan[i].half);
         }
         std::uint32_t keep = 0;
         for (std::uint32_t k = 1; k < components; ++k)
@@ -276,7 +283,6 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     patch.rows = grid.rows;
     patch.cols = grid.cols;
     patch.scanId = grid.scanId;
-    patch.vertexOfSample.assign(grid.samples.size(), Mesh::null_vertex());
     TriangulateReport& report = patch.report;
 
     const Viewer viewer(grid.camera);
@@ -336,8 +342,10 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
                            i10 = std::uint32_t(grid.index(r + 1, c)),
                            i11 = std::uint32_t(grid.index(r + 1, c + 1));
                 ++out.quads;
-                const std::uint8_t lower = top[c] | bottom[c] | bottom[c + 1], upper = top[c] | bottom[c + 1] | top[c + 1];
-                for (const auto& [t, corners] : {std::pair{Triangle{i00, i10, i11}, lower}, std::pair{Triangle{i00, i11, i01}, upper}}) {
+                const std::uint8_t lower = top[c] | bottom[c] | bottom[c + 1],
+                                   upper = top[c] | bottom[c + 1] | top[c + 1];
+                for (const auto& [t, corners] :
+                     {std::pair{Triangle{i00, i10, i11}, lower}, std::pair{Triangle{i00, i11, i01}, upper}}) {
                     const CGAL::Orientation o = screenOrientation(grid, t);
                     out.rightTurns += (o == CGAL::RIGHT_TURN);
                     out.leftTurns += (o == CGAL::LEFT_TURN);
@@ -346,12 +354,14 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
                         const Verdict v = judge(grid, corners, t, viewer, limits);
                         ++out.verdicts[0][std::size_t(v)];
                         ++out.verdicts[1][std::size_t(Verdict::Flipped)];
-                        if (v == Verdict::Keep) out.candidates.push_back(t), out.keptIf.push_back(kKeptIfNotMirrored);
+                        if (v == Verdict::Keep)
+                            out.candidates.push_back(t), out.keptIf.push_back(kKeptIfNotMirrored);
                     } else if (o == CGAL::LEFT_TURN) {
                         const Verdict v = judge(grid, corners, Triangle{t[0], t[2], t[1]}, viewer, limits);
                         ++out.verdicts[0][std::size_t(Verdict::Flipped)];
                         ++out.verdicts[1][std::size_t(v)];
-                        if (v == Verdict::Keep) out.candidates.push_back(t), out.keptIf.push_back(kKeptIfMirrored);
+                        if (v == Verdict::Keep)
+                            out.candidates.push_back(t), out.keptIf.push_back(kKeptIfMirrored);
                     } else {
                         ++out.verdicts[0][std::size_t(Verdict::Flipped)];
                         ++out.verdicts[1][std::size_t(Verdict::Flipped)];
@@ -451,50 +461,63 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     auto gridIndex = mesh.add_property_map<VertexIndex, GridIndex>(props::vertexGridIndex, GridIndex{}).first;
     auto quality = mesh.add_property_map<FaceIndex, float>(props::faceQuality, kInputFaceQuality).first;
     auto scanId = mesh.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1).first;
-    for (std::uint32_t v = 0; v < sampleOf.size(); ++v) {
-        const std::uint32_t i = sampleOf[v];
-        const Eigen::Vector3d& p = grid.samples[i].point;
-        const VertexIndex vi(v);
-        mesh.point(vi) = Point3(p.x(), p.y(), p.z());
-        gridIndex[vi] = {std::int32_t(i / std::size_t(grid.cols)), std::int32_t(i % std::size_t(grid.cols))};
-        patch.vertexOfSample[i] = vi;
-    }
+    // The vertices' points, grid indices and vertexOfSample (task 1) and the connectivity and face
+    // properties (task 0) write different arrays: two threads fill them at once where there are two.
+    auto fillVertices = [&] {
+        patch.vertexOfSample.assign(grid.samples.size(), Mesh::null_vertex());
+        for (std::uint32_t v = 0; v < sampleOf.size(); ++v) {
+            const std::uint32_t i = sampleOf[v];
+            const Eigen::Vector3d& p = grid.samples[i].point;
+            const VertexIndex vi(v);
+            mesh.point(vi) = Point3(p.x(), p.y(), p.z());
+            gridIndex[vi] = {std::int32_t(i / std::size_t(grid.cols)),
+                             std::int32_t(i % std::size_t(grid.cols))};
+            patch.vertexOfSample[i] = vi;
+        }
+    };
     // An edge's first halfedge (2e) runs the way the first face that used it traverses it; the second
     // face finds it already made and takes the opposite halfedge, which must run the other way round.
     // edgeMade counts the faces of each edge: the opposite halfedge of an edge with one is a border.
     std::vector<std::uint8_t>& edgeMade = w.edgeMade;
     edgeMade.assign(edgeCount, 0);
-    std::uint32_t faceIndex = 0;
-    for (std::size_t k = 0; k < triangles.size(); ++k) {
-        const Triangle& t = triangles[k];
-        const FaceIndex f(faceIndex++);
-        std::array<HalfedgeIndex, 3> h;
-        for (std::size_t j = 0; j < 3; ++j) {
-            const std::uint32_t from = t[j], to = t[(j + 1) % 3];
-            const std::uint32_t e = slotOf(from, to);
-            const HalfedgeIndex first(2 * e);
-            const VertexIndex toVertex(vertexOf[to]);
-            if (!edgeMade[e]) {
-                edgeMade[e] = 1;
-                mesh.set_target(first, toVertex);
-                mesh.set_target(mesh.opposite(first), VertexIndex(vertexOf[from]));
-                mesh.set_face(mesh.opposite(first), Mesh::null_face()); // until a second face takes it
-                h[j] = first;
-            } else {
-                h[j] = mesh.opposite(first); // the other face's halfedge runs to → from
-                if (mesh.target(h[j]) != toVertex || mesh.face(h[j]) != Mesh::null_face()) throw fail(from);
-                edgeMade[e] = 2;
+    auto fillFaces = [&] {
+        std::uint32_t faceIndex = 0;
+        for (std::size_t k = 0; k < triangles.size(); ++k) {
+            const Triangle& t = triangles[k];
+            const FaceIndex f(faceIndex++);
+            std::array<HalfedgeIndex, 3> h;
+            for (std::size_t j = 0; j < 3; ++j) {
+                const std::uint32_t from = t[j], to = t[(j + 1) % 3];
+                const std::uint32_t e = slotOf(from, to);
+                const HalfedgeIndex first(2 * e);
+                const VertexIndex toVertex(vertexOf[to]);
+                if (!edgeMade[e]) {
+                    edgeMade[e] = 1;
+                    mesh.set_target(first, toVertex);
+                    mesh.set_target(mesh.opposite(first), VertexIndex(vertexOf[from]));
+                    mesh.set_face(mesh.opposite(first), Mesh::null_face()); // until a second face takes it
+                    h[j] = first;
+                } else {
+                    h[j] = mesh.opposite(first); // the other face's halfedge runs to → from
+                    if (mesh.target(h[j]) != toVertex || mesh.face(h[j]) != Mesh::null_face())
+                        throw fail(from);
+                    edgeMade[e] = 2;
+                }
             }
+            mesh.set_halfedge(f, h[0]);
+            for (std::size_t j = 0; j < 3; ++j) {
+                mesh.set_face(h[j], f);
+                mesh.set_next(h[j], h[(j + 1) % 3]);
+                mesh.set_halfedge(mesh.target(h[j]), h[j]);
+            }
+            quality[f] = triangleQuality(sampleQuality[t[0]], sampleQuality[t[1]], sampleQuality[t[2]]);
+            scanId[f] = grid.scanId;
         }
-        mesh.set_halfedge(f, h[0]);
-        for (std::size_t j = 0; j < 3; ++j) {
-            mesh.set_face(h[j], f);
-            mesh.set_next(h[j], h[(j + 1) % 3]);
-            mesh.set_halfedge(mesh.target(h[j]), h[j]);
-        }
-        quality[f] = triangleQuality(sampleQuality[t[0]], sampleQuality[t[1]], sampleQuality[t[2]]);
-        scanId[f] = grid.scanId;
-    }
+    };
+    detail::parallelRows(2, std::min(scanThreads(), 2), [&](int, int taskBegin, int taskEnd) {
+        for (int task = taskBegin; task < taskEnd; ++task)
+            task == 0 ? fillFaces() : fillVertices();
+    });
     // Border halfedges follow each other around the patch's boundary; a border vertex points to its
     // incoming one. Vertex-manifold: at most one border halfedge leaves each vertex.
     std::vector<HalfedgeIndex>& borderFrom = w.borderFrom;

@@ -23,8 +23,8 @@ struct ScanWorkspace::Impl {
     // Triangulation (triangulate.cpp).
     using Triangle = std::array<std::uint32_t, 3>;
     struct Block {
-        std::vector<Triangle> candidates;      // kept by the 3D tests in one of the two orders
-        std::vector<std::uint8_t> keptIf;      // of each candidate: kept if the grid is not mirrored, or if it is
+        std::vector<Triangle> candidates; // kept by the 3D tests in one of the two orders
+        std::vector<std::uint8_t> keptIf; // of each candidate: kept if the grid is not mirrored, or if it is
         std::vector<std::uint8_t> top, bottom; // sample flags of the two rows of the quad row at hand
         std::size_t quads = 0, rightTurns = 0, leftTurns = 0;
         std::array<std::array<std::size_t, 5>, 2> verdicts{}; // per verdict, if not mirrored / if mirrored
