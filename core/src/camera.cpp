@@ -157,6 +157,24 @@ Ray CameraProjector::ray(double sx, double sy) const {
     return r;
 }
 
+CameraProjector::PixelCentre CameraProjector::unprojectPixelCentreWithRay(int px, int py,
+                                                                          double depth) const {
+    const double sx = px + 0.5, sy = py + 0.5;
+    const Eigen::Matrix4d& m = inverseViewProjection_;
+    // unproject's product m · (x, y, z, 1) = ((m₀x + m₁y) + m₂z) + m₃ per coordinate.
+    const Eigen::Vector4d xy = m.col(0) * (2.0 * sx / width_ - 1.0) + m.col(1) * (1.0 - 2.0 * sy / height_);
+    auto at = [&](double z) {
+        const Eigen::Vector4d w = (xy + m.col(2) * z) + m.col(3) * 1.0;
+        return Eigen::Vector3d(w.head<3>() / w.w());
+    };
+    PixelCentre out;
+    out.point = at(2.0 * depth - 1.0);
+    const Eigen::Vector3d a = at(2.0 * 0.0 - 1.0), b = at(2.0 * 1.0 - 1.0);
+    out.ray.origin = parallel_ ? a : eye_;
+    out.ray.direction = (b - a).normalized();
+    return out;
+}
+
 double Camera::viewDepth(const Eigen::Vector3d& p) const { return (p - eye).dot(viewDirection()); }
 
 double Camera::pixelFootprint(const Eigen::Vector3d& p) const {

@@ -10,8 +10,11 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <barrier>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <numeric>
 #include <string>
 #include <utility>
@@ -160,46 +163,6 @@ void requireRadius(int radius) {
         throw InvalidInputError("The morphology radius " + std::to_string(radius) + " is negative.");
 }
 
-// Number of set entries in the window [i − radius, i + radius] along rows (axis 0) or columns (axis 1),
-// entries outside the grid counting as unset, into \p out (every entry written). O(rows · cols), independent
-// of the radius.
-void windowCounts(const std::vector<std::uint8_t>& in, int rows, int cols, int radius, bool alongColumns,
-                  std::vector<std::uint16_t>& out) {
-    out.resize(in.size());
-    if (alongColumns) { // row by row with one running count per column: sequential memory access
-        std::vector<int> count(std::size_t(std::max(cols, 0)), 0);
-        auto addRow = [&](int r, int sign) {
-            const std::uint8_t* row = in.data() + std::size_t(r) * cols;
-            for (int c = 0; c < cols; ++c)
-                count[std::size_t(c)] += sign * row[c];
-        };
-        for (int i = 0; i < std::min(radius, rows); ++i)
-            addRow(i, 1);
-        for (int i = 0; i < rows; ++i) {
-            if (i + radius < rows) addRow(i + radius, 1);
-            if (i - radius - 1 >= 0) addRow(i - radius - 1, -1);
-            std::uint16_t* o = out.data() + std::size_t(i) * cols;
-            for (int c = 0; c < cols; ++c)
-                o[c] = std::uint16_t(count[std::size_t(c)]);
-        }
-        return;
-    }
-    const int lines = alongColumns ? cols : rows, length = alongColumns ? rows : cols;
-    auto at = [&](int line, int i) {
-        return alongColumns ? std::size_t(i) * cols + line : std::size_t(line) * cols + i;
-    };
-    for (int line = 0; line < lines; ++line) {
-        int count = 0;
-        for (int i = 0; i < std::min(radius, length); ++i)
-            count += in[at(line, i)];
-        for (int i = 0; i < length; ++i) {
-            if (i + radius < length) count += in[at(line, i + radius)];
-            if (i - radius - 1 >= 0) count -= in[at(line, i - radius - 1)];
-            out[at(line, i)] = std::uint16_t(count);
-        }
-    }
-}
-
 void requireGridShape(const SampleGrid& grid) {
     if (grid.rows < 0 || grid.cols < 0 ||
         grid.samples.size() != std::size_t(grid.rows) * std::size_t(grid.cols))
@@ -293,45 +256,73 @@ std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameB
     const int blocks = detail::rowBlocks(grid.rows, 16);
     std::vector<std::size_t> dropped(std::size_t(blocks), 0);
     detail::parallelRows(grid.rows, blocks, [&](int block, int rowBegin, int rowEnd) {
-        FaceIndex cachedHint = Mesh::null_face();
-        std::array<Eigen::Vector3d, 3> hintCorner;
-        for (std::size_t i = grid.index(rowBegin, 0), end = grid.index(rowEnd, 0); i < end; ++i) {
-            Sample& s = grid.samples[i];
-            if (!s.admissible) continue;
-            const double fx = std::floor(s.screen.x()), fy = std::floor(s.screen.y());
-            if (!(fx >= 0 && fy >= 0 && fx < currentBuffers.width() && fy < currentBuffers.height()))
-                continue;
-            const std::uint32_t id = currentBuffers.faceAt(int(fx), int(fy));
-            if (id == FrameBuffers::kNoFace) continue;
-            const FaceIndex hint(id);
-            if (hint != cachedHint) { // neighbouring samples mostly share the face under their pixels
-                if (std::size_t(id) >= current.num_faces() || current.is_removed(hint))
-                    throw InvalidInputError("The current mesh's face-id buffer names face " +
-                                            std::to_string(id) + ", which the current mesh does not have.");
-                const HalfedgeIndex h = current.halfedge(hint);
-                for (const auto& [corner, v] :
-                     {std::pair{0, current.source(h)}, std::pair{1, current.target(h)},
-                      std::pair{2, current.target(current.next(h))}}) {
-                    const Point3& p = current.point(v);
-                    hintCorner[std::size_t(corner)] = {p.x(), p.y(), p.z()};
+        // Row by row: first the faces under the row's admissible samples (one entry per run of samples
+        // over the same face, as neighbouring samples mostly share it), then those faces' corners and
+        // qualities — lookups in the current mesh that do not depend on each other, so the processor
+        // overlaps their cache misses — then the samples' tests.
+        struct HintFace {
+            FaceIndex face;
+            std::array<Eigen::Vector3d, 3> corner;
+            float quality = kInputFaceQuality;
+        };
+        std::vector<HintFace> hints;
+        std::vector<std::uint32_t> hintOf(std::size_t(grid.cols));
+        constexpr std::uint32_t kNoHint = std::uint32_t(-1);
+        for (int r = rowBegin; r < rowEnd; ++r) {
+            Sample* row = grid.samples.data() + grid.index(r, 0);
+            hints.clear();
+            for (int c = 0; c < grid.cols; ++c) {
+                hintOf[std::size_t(c)] = kNoHint;
+                const Sample& s = row[c];
+                if (!s.admissible) continue;
+                const double fx = std::floor(s.screen.x()), fy = std::floor(s.screen.y());
+                if (!(fx >= 0 && fy >= 0 && fx < currentBuffers.width() && fy < currentBuffers.height()))
+                    continue;
+                const std::uint32_t id = currentBuffers.faceAt(int(fx), int(fy));
+                if (id == FrameBuffers::kNoFace) continue;
+                const FaceIndex hint(id);
+                if (hints.empty() || hints.back().face != hint) {
+                    if (std::size_t(id) >= current.num_faces() || current.is_removed(hint))
+                        throw InvalidInputError("The current mesh's face-id buffer names face " +
+                                                std::to_string(id) +
+                                                ", which the current mesh does not have.");
+                    hints.push_back({hint, {}, kInputFaceQuality});
                 }
-                cachedHint = hint;
+                hintOf[std::size_t(c)] = std::uint32_t(hints.size() - 1);
             }
-            float faceQ = kInputFaceQuality;
-            if (hasQuality) { // without qualities every face has kInputFaceQuality: no need to know which
-                FaceIndex closest = hint;
-                // Fast path: the sample lies on the face under its pixel (up to rounding), as almost always
-                // where the current mesh is the reference; any closer face is closer by less than that.
-                const Eigen::Vector3d q =
-                    closestPointOnTriangle(s.point, hintCorner[0], hintCorner[1], hintCorner[2]);
-                if (!((q - s.point).norm() <= kOnFaceFootprints * double(s.footprint)))
-                    closest = closestPointNear(current, s.point, hint, search).face;
-                faceQ = qualityMap[closest];
+            // Without qualities every face has kInputFaceQuality: no need to know which is closest.
+            if (hasQuality) {
+                for (HintFace& hf : hints) {
+                    const HalfedgeIndex h = current.halfedge(hf.face);
+                    for (const auto& [corner, v] :
+                         {std::pair{0, current.source(h)}, std::pair{1, current.target(h)},
+                          std::pair{2, current.target(current.next(h))}}) {
+                        const Point3& p = current.point(v);
+                        hf.corner[std::size_t(corner)] = {p.x(), p.y(), p.z()};
+                    }
+                    hf.quality = qualityMap[hf.face];
+                }
             }
-            if (std::isnan(faceQ)) faceQ = kInputFaceQuality;
-            if (double(s.quality) < (1.0 - options.margin) * double(faceQ)) continue;
-            s.admissible = s.valid = false;
-            ++dropped[std::size_t(block)];
+            for (int c = 0; c < grid.cols; ++c) {
+                if (hintOf[std::size_t(c)] == kNoHint) continue;
+                Sample& s = row[c];
+                const HintFace& hf = hints[hintOf[std::size_t(c)]];
+                float faceQ = kInputFaceQuality;
+                if (hasQuality) {
+                    // Fast path: the sample lies on the face under its pixel (up to rounding), as almost
+                    // always where the current mesh is the reference; any closer face is closer by less.
+                    const Eigen::Vector3d q =
+                        closestPointOnTriangle(s.point, hf.corner[0], hf.corner[1], hf.corner[2]);
+                    if ((q - s.point).norm() <= kOnFaceFootprints * double(s.footprint))
+                        faceQ = hf.quality;
+                    else
+                        faceQ = qualityMap[closestPointNear(current, s.point, hf.face, search).face];
+                }
+                if (std::isnan(faceQ)) faceQ = kInputFaceQuality;
+                if (double(s.quality) < (1.0 - options.margin) * double(faceQ)) continue;
+                s.admissible = s.valid = false;
+                ++dropped[std::size_t(block)];
+            }
         }
     });
     return std::accumulate(dropped.begin(), dropped.end(), std::size_t(0));
@@ -340,102 +331,166 @@ std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameB
 namespace {
 
 // The morphology works on one byte per sample (a Sample is ~90 bytes: every pass over the grid's
-// samples streams all of them through memory), in the buffers of a ScanWorkspace: valid, admissible, and
-// square and counts as scratch.
+// samples streams all of them through memory), in the buffers of a ScanWorkspace: valid, admissible and
+// original (valid as read, so that only the samples that changed are written back), and square and
+// counts as scratch.
 using Scratch = ScanWorkspace::Impl;
 
-// Calls body(begin, end) over blocks of the grid's samples (whole rows), one block per thread.
-template <class Body> void forSampleBlocks(const SampleGrid& grid, Body&& body) {
-    detail::parallelRows(grid.rows, detail::rowBlocks(grid.rows, 64), [&](int, int rowBegin, int rowEnd) {
-        body(grid.index(rowBegin, 0), grid.index(rowEnd, 0));
+// A block of whole rows [rowBegin, rowEnd) of a rows × cols byte grid, and a way to wait until every
+// block has reached the same point: the steps below run on all blocks at once (one thread each,
+// parallel.h), each step writing only its block's rows and reading other rows only after a sync().
+// Every result is the serial one.
+struct RowBlock {
+    int rows, cols, rowBegin, rowEnd;
+    const std::function<void()>& sync;
+    std::vector<int>& count; // scratch of cols entries, the block's own
+    std::size_t begin() const { return std::size_t(rowBegin) * std::size_t(cols); }
+    std::size_t end() const { return std::size_t(rowEnd) * std::size_t(cols); }
+};
+
+// Runs step(block) on row blocks of the grid, one thread each, and returns the sum of what they return.
+// Everything is allocated before the blocks start: a step must not throw (the others would wait for it).
+template <class Step> std::size_t inRowBlocks(int rows, int cols, Step&& step) {
+    const int blocks = detail::rowBlocks(rows, 64);
+    std::barrier barrier(blocks);
+    const std::function<void()> sync = [&barrier] { barrier.arrive_and_wait(); };
+    std::vector<std::size_t> sums(std::size_t(blocks), 0);
+    std::vector<std::vector<int>> counts(std::size_t(blocks),
+                                         std::vector<int>(std::size_t(std::max(cols, 0))));
+    detail::parallelRows(rows, blocks, [&](int b, int rowBegin, int rowEnd) {
+        sums[std::size_t(b)] = step(RowBlock{rows, cols, rowBegin, rowEnd, sync, counts[std::size_t(b)]});
     });
+    return std::accumulate(sums.begin(), sums.end(), std::size_t(0));
 }
 
-// Fills f.valid (and f.admissible when \p withAdmissible) from the grid's samples.
-void flagsOf(const SampleGrid& grid, Scratch& f, bool withAdmissible) {
-    f.valid.resize(grid.samples.size()); // every entry written below
-    if (withAdmissible) f.admissible.resize(grid.samples.size());
-    forSampleBlocks(grid, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) {
-            f.valid[i] = grid.samples[i].valid ? 1 : 0;
-            if (withAdmissible) f.admissible[i] = grid.samples[i].admissible ? 1 : 0;
+// out = pred(number of set entries of `in` in the window [c − radius, c + radius] of the same row),
+// entries outside the grid counting as unset, for the block's rows.
+template <class Pred>
+void rowWindows(const RowBlock& b, const std::vector<std::uint8_t>& in, int radius,
+                std::vector<std::uint8_t>& out, Pred pred) {
+    const int cols = b.cols;
+    for (int r = b.rowBegin; r < b.rowEnd; ++r) {
+        const std::uint8_t* row = in.data() + std::size_t(r) * std::size_t(cols);
+        std::uint8_t* o = out.data() + std::size_t(r) * std::size_t(cols);
+        int count = 0;
+        for (int i = 0; i < std::min(radius, cols); ++i)
+            count += row[i];
+        for (int i = 0; i < cols; ++i) {
+            if (i + radius < cols) count += row[i + radius];
+            if (i - radius - 1 >= 0) count -= row[i - radius - 1];
+            o[i] = pred(count) ? 1 : 0;
         }
-    });
+    }
 }
 
-void storeValid(SampleGrid& grid, const std::vector<std::uint8_t>& valid) {
-    forSampleBlocks(grid, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i)
-            grid.samples[i].valid = valid[i] != 0;
-    });
+// visit(index, count) for the block's entries, count = number of set entries of `in` in the window
+// [r − radius, r + radius] of the same column (outside the grid unset); row by row, one running count per
+// column, so memory is read in order.
+template <class Visit>
+void columnWindows(const RowBlock& b, const std::vector<std::uint8_t>& in, int radius, Visit visit) {
+    const int rows = b.rows, cols = b.cols;
+    std::vector<int>& count = b.count;
+    std::fill(count.begin(), count.end(), 0);
+    auto addRow = [&](int r, int sign) {
+        const std::uint8_t* row = in.data() + std::size_t(r) * std::size_t(cols);
+        for (int c = 0; c < cols; ++c)
+            count[std::size_t(c)] += sign * row[c];
+    };
+    // The window of the row before the block: rows [rowBegin − radius − 1, rowBegin + radius − 1].
+    for (int r = std::max(b.rowBegin - radius - 1, 0); r < std::min(b.rowBegin + radius, rows); ++r)
+        addRow(r, 1);
+    for (int i = b.rowBegin; i < b.rowEnd; ++i) {
+        if (i + radius < rows) addRow(i + radius, 1);
+        if (i - radius - 1 >= 0) addRow(i - radius - 1, -1);
+        const std::size_t base = std::size_t(i) * std::size_t(cols);
+        for (int c = 0; c < cols; ++c)
+            visit(base + std::size_t(c), count[std::size_t(c)]);
+    }
 }
 
-std::size_t clearAll(std::vector<std::uint8_t>& valid) {
-    std::size_t removed = 0;
-    for (std::uint8_t& v : valid)
-        removed += std::exchange(v, std::uint8_t(0));
-    return removed;
+// Reads valid (and admissible when \p withAdmissible) of the block's samples into f.valid, f.original
+// and f.admissible.
+void readFlags(const RowBlock& b, const SampleGrid& grid, Scratch& f, bool withAdmissible) {
+    for (std::size_t i = b.begin(); i < b.end(); ++i) {
+        const Sample& s = grid.samples[i];
+        f.valid[i] = f.original[i] = s.valid ? 1 : 0;
+        if (withAdmissible) f.admissible[i] = s.admissible ? 1 : 0;
+    }
 }
 
-std::size_t erodeFlags(std::vector<std::uint8_t>& valid, int rows, int cols, int radius, Scratch& scratch) {
-    if (radius == 0 || valid.empty()) return 0;
+// Writes f.valid back into the block's samples where it differs from what was read.
+void writeChangedFlags(const RowBlock& b, SampleGrid& grid, const Scratch& f) {
+    for (std::size_t i = b.begin(); i < b.end(); ++i)
+        if (f.valid[i] != f.original[i]) grid.samples[i].valid = f.valid[i] != 0;
+}
+
+void sizeScratch(Scratch& f, std::size_t n, bool withAdmissible) {
+    f.valid.resize(n); // every entry is written before it is read
+    f.original.resize(n);
+    f.square.resize(n);
+    if (withAdmissible) f.admissible.resize(n);
+}
+
+std::size_t erodeBlock(const RowBlock& b, std::vector<std::uint8_t>& valid, int radius, Scratch& scratch) {
+    if (radius == 0) return 0;
     const long long side = 2LL * radius + 1;
-    if (side > std::min(rows, cols)) return clearAll(valid); // no square fits in the grid
+    std::size_t removed = 0;
+    if (side > std::min(b.rows, b.cols)) { // no square fits in the grid
+        for (std::size_t i = b.begin(); i < b.end(); ++i)
+            removed += std::exchange(valid[i], std::uint8_t(0));
+        b.sync();
+        return removed;
+    }
     // Separable: a full square = full rows of full columns.
     std::vector<std::uint8_t>& rowsFull = scratch.square;
-    std::vector<std::uint16_t>& counts = scratch.counts;
-    rowsFull.resize(valid.size()); // every entry written below
-    windowCounts(valid, rows, cols, radius, false, counts);
-    for (std::size_t i = 0; i < counts.size(); ++i)
-        rowsFull[i] = (long long)counts[i] == side ? 1 : 0;
-    windowCounts(rowsFull, rows, cols, radius, true, counts);
-    std::size_t removed = 0;
-    for (std::size_t i = 0; i < counts.size(); ++i) {
-        if (valid[i] && (long long)counts[i] != side) {
-            valid[i] = 0;
-            ++removed;
-        }
-    }
+    rowWindows(b, valid, radius, rowsFull, [side](int n) { return n == side; });
+    b.sync();
+    columnWindows(b, rowsFull, radius, [&](std::size_t i, int n) {
+        if (valid[i] && n != side) valid[i] = 0, ++removed;
+    });
+    b.sync();
     return removed;
 }
 
-std::size_t dilateFlags(std::vector<std::uint8_t>& valid, const std::vector<std::uint8_t>& admissible,
-                        int rows, int cols, int radius, Scratch& scratch) {
-    if (radius == 0 || valid.empty()) return 0;
-    radius = std::min(radius, std::max(rows, cols)); // larger squares cover the grid all the same
+std::size_t dilateBlock(const RowBlock& b, std::vector<std::uint8_t>& valid,
+                        const std::vector<std::uint8_t>& admissible, int radius, Scratch& scratch) {
+    if (radius == 0) return 0;
+    radius = std::min(radius, std::max(b.rows, b.cols)); // larger squares cover the grid all the same
     std::vector<std::uint8_t>& rowsAny = scratch.square;
-    std::vector<std::uint16_t>& counts = scratch.counts;
-    rowsAny.resize(valid.size()); // every entry written below
-    windowCounts(valid, rows, cols, radius, false, counts);
-    for (std::size_t i = 0; i < counts.size(); ++i)
-        rowsAny[i] = counts[i] > 0 ? 1 : 0;
-    windowCounts(rowsAny, rows, cols, radius, true, counts);
+    rowWindows(b, valid, radius, rowsAny, [](int n) { return n > 0; });
+    b.sync();
     std::size_t added = 0;
-    for (std::size_t i = 0; i < counts.size(); ++i) {
-        if (!valid[i] && admissible[i] && counts[i] > 0) {
-            valid[i] = 1;
-            ++added;
-        }
-    }
+    columnWindows(b, rowsAny, radius, [&](std::size_t i, int n) {
+        if (!valid[i] && admissible[i] && n > 0) valid[i] = 1, ++added;
+    });
+    b.sync();
     return added;
 }
 
-std::size_t removeUntriangulatableFlags(std::vector<std::uint8_t>& valid, int rows, int cols,
+std::size_t removeUntriangulatableBlock(const RowBlock& b, std::vector<std::uint8_t>& valid,
                                         Scratch& scratch) {
-    if (rows < 2 || cols < 2) return clearAll(valid);
+    const int rows = b.rows, cols = b.cols;
+    std::size_t removed = 0;
+    if (rows < 2 || cols < 2) {
+        for (std::size_t i = b.begin(); i < b.end(); ++i)
+            removed += std::exchange(valid[i], std::uint8_t(0));
+        b.sync();
+        return removed;
+    }
     auto at = [&](int r, int c) { return valid[std::size_t(r) * std::size_t(cols) + std::size_t(c)]; };
-    // quadFull(r, c): the quad with top-left corner (r, c) has four valid corners.
+    // quadFull(r, c): the quad with top-left corner (r, c) has four valid corners (stored at sample (r, c)).
     const int qr = rows - 1, qc = cols - 1;
     std::vector<std::uint8_t>& quadFull = scratch.square;
-    quadFull.resize(std::size_t(qr) * std::size_t(qc)); // every entry written below
-    for (int r = 0; r < qr; ++r)
+    for (int r = b.rowBegin; r < std::min(b.rowEnd, qr); ++r)
         for (int c = 0; c < qc; ++c)
-            quadFull[std::size_t(r) * qc + c] = at(r, c) && at(r, c + 1) && at(r + 1, c) && at(r + 1, c + 1);
+            quadFull[std::size_t(r) * std::size_t(cols) + std::size_t(c)] =
+                at(r, c) && at(r, c + 1) && at(r + 1, c) && at(r + 1, c + 1);
+    b.sync();
     auto full = [&](int r, int c) {
-        return r >= 0 && c >= 0 && r < qr && c < qc && quadFull[std::size_t(r) * qc + c];
+        return r >= 0 && c >= 0 && r < qr && c < qc &&
+               quadFull[std::size_t(r) * std::size_t(cols) + std::size_t(c)];
     };
-    std::size_t removed = 0;
-    for (int r = 0; r < rows; ++r) {
+    for (int r = b.rowBegin; r < b.rowEnd; ++r) {
         for (int c = 0; c < cols; ++c) {
             std::uint8_t& v = valid[std::size_t(r) * std::size_t(cols) + std::size_t(c)];
             if (v && !full(r - 1, c - 1) && !full(r - 1, c) && !full(r, c - 1) && !full(r, c)) {
@@ -444,6 +499,7 @@ std::size_t removeUntriangulatableFlags(std::vector<std::uint8_t>& valid, int ro
             }
         }
     }
+    b.sync();
     return removed;
 }
 
@@ -453,29 +509,41 @@ std::size_t erode(SampleGrid& grid, int radius) {
     requireRadius(radius);
     requireGridShape(grid);
     Scratch f;
-    flagsOf(grid, f, false);
-    const std::size_t removed = erodeFlags(f.valid, grid.rows, grid.cols, radius, f);
-    if (removed) storeValid(grid, f.valid);
-    return removed;
+    sizeScratch(f, grid.samples.size(), false);
+    return inRowBlocks(grid.rows, grid.cols, [&](const RowBlock& b) {
+        readFlags(b, grid, f, false);
+        b.sync();
+        const std::size_t removed = erodeBlock(b, f.valid, radius, f);
+        writeChangedFlags(b, grid, f);
+        return removed;
+    });
 }
 
 std::size_t dilate(SampleGrid& grid, int radius) {
     requireRadius(radius);
     requireGridShape(grid);
     Scratch f;
-    flagsOf(grid, f, true);
-    const std::size_t added = dilateFlags(f.valid, f.admissible, grid.rows, grid.cols, radius, f);
-    if (added) storeValid(grid, f.valid);
-    return added;
+    sizeScratch(f, grid.samples.size(), true);
+    return inRowBlocks(grid.rows, grid.cols, [&](const RowBlock& b) {
+        readFlags(b, grid, f, true);
+        b.sync();
+        const std::size_t added = dilateBlock(b, f.valid, f.admissible, radius, f);
+        writeChangedFlags(b, grid, f);
+        return added;
+    });
 }
 
 std::size_t removeUntriangulatableSamples(SampleGrid& grid) {
     requireGridShape(grid);
     Scratch f;
-    flagsOf(grid, f, false);
-    const std::size_t removed = removeUntriangulatableFlags(f.valid, grid.rows, grid.cols, f);
-    if (removed) storeValid(grid, f.valid);
-    return removed;
+    sizeScratch(f, grid.samples.size(), false);
+    return inRowBlocks(grid.rows, grid.cols, [&](const RowBlock& b) {
+        readFlags(b, grid, f, false);
+        b.sync();
+        const std::size_t removed = removeUntriangulatableBlock(b, f.valid, f);
+        writeChangedFlags(b, grid, f);
+        return removed;
+    });
 }
 
 MorphologyReport applyMorphology(SampleGrid& grid, const MorphologyOptions& options) {
@@ -491,14 +559,23 @@ MorphologyReport applyMorphology(SampleGrid& grid, const MorphologyOptions& opti
                                 " is negative.");
     requireGridShape(grid);
     const int dilateRadius = options.dilateRadius < 0 ? options.radius : options.dilateRadius;
-    // One read and one write of the samples for all three steps.
+    // One read of the samples for all three steps, and one write of those that changed.
     Scratch& f = workspace.impl();
-    flagsOf(grid, f, true);
+    sizeScratch(f, grid.samples.size(), true);
+    std::array<std::atomic<std::size_t>, 3> changed{};
+    inRowBlocks(grid.rows, grid.cols, [&](const RowBlock& b) {
+        readFlags(b, grid, f, true);
+        b.sync();
+        changed[0] += erodeBlock(b, f.valid, options.radius, f);
+        changed[1] += dilateBlock(b, f.valid, f.admissible, dilateRadius, f);
+        changed[2] += removeUntriangulatableBlock(b, f.valid, f);
+        writeChangedFlags(b, grid, f);
+        return std::size_t(0);
+    });
     MorphologyReport report;
-    report.eroded = erodeFlags(f.valid, grid.rows, grid.cols, options.radius, f);
-    report.restored = dilateFlags(f.valid, f.admissible, grid.rows, grid.cols, dilateRadius, f);
-    report.untriangulatable = removeUntriangulatableFlags(f.valid, grid.rows, grid.cols, f);
-    if (report.eroded || report.restored || report.untriangulatable) storeValid(grid, f.valid);
+    report.eroded = changed[0];
+    report.restored = changed[1];
+    report.untriangulatable = changed[2];
     return report;
 }
 

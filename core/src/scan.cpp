@@ -77,7 +77,11 @@ float sampleQuality(double footprint, double samplingAngle, double qualityAngleL
 }
 
 float triangleQuality(const Sample& a, const Sample& b, const Sample& c) {
-    return float((double(a.quality) + double(b.quality) + double(c.quality)) / 3.0);
+    return triangleQuality(a.quality, b.quality, c.quality);
+}
+
+float triangleQuality(float qa, float qb, float qc) {
+    return float((double(qa) + double(qb) + double(qc)) / 3.0);
 }
 
 void setSampleOnSurface(Sample& sample, const Mesh& reference, const Camera& camera, FaceIndex face,
@@ -124,12 +128,33 @@ SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& r
     std::atomic<bool> stop{false};
     const int blocks = detail::rowBlocks(h, 16);
     detail::parallelRows(h, blocks, [&](int block, int rowBegin, int rowEnd) {
-        // Neighbouring pixels mostly show the same face: keep the last face's geometry.
-        FaceIndex cachedFace = Mesh::null_face();
-        FaceGeometry g;
+        // Row by row: first the faces the row's pixels show (one entry per run of pixels showing the same
+        // face, as neighbouring pixels mostly do), then those faces' checks and geometry — lookups in the
+        // reference mesh that do not depend on each other, so the processor overlaps their cache misses —
+        // then the samples.
+        std::vector<FaceIndex> faces;
+        std::vector<FaceGeometry> geometry;
+        std::vector<std::uint32_t> runOf(static_cast<std::size_t>(w));
         try {
             for (int r = rowBegin; r < rowEnd && !stop.load(std::memory_order_relaxed); ++r) {
                 if (block == 0) progress.report(double(r - rowBegin) / double(rowEnd - rowBegin), "Sampling");
+                faces.clear();
+                for (int c = 0; c < w; ++c) {
+                    const std::uint32_t id = referenceBuffers.faceAt(c, r);
+                    if (id == FrameBuffers::kNoFace) continue;
+                    if (faces.empty() || faces.back() != FaceIndex(id)) faces.push_back(FaceIndex(id));
+                    runOf[std::size_t(c)] = std::uint32_t(faces.size() - 1);
+                }
+                geometry.resize(faces.size());
+                for (std::size_t k = 0; k < faces.size(); ++k) {
+                    const FaceIndex f = faces[k];
+                    if (std::size_t(f.idx()) >= reference.num_faces() || reference.is_removed(f) ||
+                        reference.degree(f) != 3)
+                        throw InvalidInputError("The face-id buffer names face " + std::to_string(f.idx()) +
+                                                ", which is not a triangle of the reference mesh: the "
+                                                "buffers were not rendered from this mesh.");
+                    geometry[k] = faceGeometry(reference, f);
+                }
                 for (int c = 0; c < w; ++c) {
                     Sample& s = grid.at(r, c);
                     const std::uint32_t id = referenceBuffers.faceAt(c, r);
@@ -140,20 +165,12 @@ SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& r
                     }
                     s.screen = {c + 0.5, r + 0.5};
                     const FaceIndex f(id);
-                    if (f != cachedFace) { // checked once per run of pixels showing the same face
-                        if (std::size_t(id) >= reference.num_faces() || reference.is_removed(f) ||
-                            reference.degree(f) != 3)
-                            throw InvalidInputError("The face-id buffer names face " + std::to_string(id) +
-                                                    ", which is not a triangle of the reference mesh: the "
-                                                    "buffers were not rendered from this mesh.");
-                        g = faceGeometry(reference, f);
-                        cachedFace = f;
-                    }
-                    const Eigen::Vector3d unprojected =
-                        projector.unprojectPixelCentre(c, r, referenceBuffers.depthAt(c, r));
+                    const FaceGeometry& g = geometry[runOf[std::size_t(c)]];
+                    // The pixel centre at its depth, and the viewing ray through it (s.screen).
+                    const auto [unprojected, ray] =
+                        projector.unprojectPixelCentreWithRay(c, r, referenceBuffers.depthAt(c, r));
                     // Snap along the viewing ray onto the face's plane (removes depth quantisation).
                     Eigen::Vector3d point = unprojected;
-                    const Ray ray = projector.ray(s.screen.x(), s.screen.y());
                     const double denom = g.normal.dot(ray.direction);
                     if (g.normal.squaredNorm() > 0 && std::abs(denom) > 1e-12) {
                         const Eigen::Vector3d snapped =

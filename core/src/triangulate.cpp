@@ -65,14 +65,13 @@ std::uint8_t sampleFlags(const Sample& s, const Viewer& viewer, const JudgeLimit
     return f;
 }
 
-// The 3D tests of a candidate whose screen orientation is already known to be the grid's; \p flags are
-// the sampleFlags of the grid's samples.
-Verdict judge(const SampleGrid& grid, const std::uint8_t* flags, const Triangle& t, const Viewer& viewer,
+// The 3D tests of a candidate whose screen orientation is already known to be the grid's; \p corners are
+// the sampleFlags of its three samples, or-ed.
+Verdict judge(const SampleGrid& grid, std::uint8_t corners, const Triangle& t, const Viewer& viewer,
               const JudgeLimits& limits) {
     const Sample& a = grid.samples[t[0]];
     const Sample& b = grid.samples[t[1]];
     const Sample& c = grid.samples[t[2]];
-    const std::uint8_t corners = flags[t[0]] | flags[t[1]] | flags[t[2]];
     const Eigen::Vector3d centroid = (a.point + b.point + c.point) / 3.0;
     const Eigen::Vector3d toViewer = viewer.towards(centroid);
     const Eigen::Vector3d normal = (b.point - a.point).cross(c.point - a.point);
@@ -89,63 +88,116 @@ Verdict judge(const SampleGrid& grid, const std::uint8_t* flags, const Triangle&
 }
 
 // Removes triangles until every vertex has a single fan (the largest one is kept; ties keep the fan
-// with the lowest triangle index). Returns the number of pinched vertices found.
-std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, std::vector<bool>& alive,
-                                 std::size_t sampleCount, std::size_t& removedTriangles,
-                                 ScanWorkspace::Impl& w) {
-    // Triangles incident to each sample (compressed rows).
-    std::vector<std::uint32_t>& offset = w.offset;
-    offset.assign(sampleCount + 1, 0);
+// with the lowest triangle index), compacting \p triangles to the survivors in their order. Returns the
+// number of pinched vertices found. \p triangles are grid triangles in quad order (row-major quads, for
+// each quad first {i00, i10, i11} then {i00, i11, i01}, or both with their last two corners swapped when
+// \p mirrored), as the candidates are made.
+//
+// Vertex v = (r, c) lies in at most six grid triangles; in triangle order they are: quad (r−1, c−1) both
+// halves, quad (r−1, c) first half, quad (r, c−1) second half, quad (r, c) both halves. So one byte per
+// sample — which halves of the quad whose top-left corner it is exist and are still alive — gives each
+// vertex's fan in triangle order without an incidence list, and a triangle's rank in that order is
+// 2·(top-left sample) + half. The work list is the one an incidence-list version would make: first every
+// vertex in two or more triangles, in increasing order, taken from the back (here read lazily, downwards),
+// then the vertices of removed triangles pushed on top when not already waiting.
+std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, int rows, int cols, bool mirrored,
+                                 std::size_t& removedTriangles, ScanWorkspace::Impl& w) {
+    if (triangles.empty()) return 0;
+    constexpr std::uint8_t kExists[2] = {1, 2}, kAlive[2] = {4, 8};
+    const std::size_t sampleCount = std::size_t(rows) * std::size_t(cols);
+    const auto ucols = std::uint32_t(cols);
+    std::vector<std::uint8_t>& quad = w.quadHalves; // by top-left sample
+    quad.assign(sampleCount, 0);
+    auto halfOf = [&](const Triangle& t) { return (t[1] == t[0] + ucols || t[2] == t[0] + ucols) ? 0 : 1; };
     for (const Triangle& t : triangles)
-        for (std::uint32_t v : t)
-            ++offset[v + 1];
-    for (std::size_t i = 0; i < sampleCount; ++i)
-        offset[i + 1] += offset[i];
-    std::vector<std::uint32_t>& incident = w.incident;
-    incident.resize(offset.back()); // every entry is written below
-    {
-        std::vector<std::uint32_t>& fill = w.fill;
-        fill.assign(offset.begin(), offset.end() - 1);
-        for (std::uint32_t ti = 0; ti < triangles.size(); ++ti)
-            for (std::uint32_t v : triangles[ti])
-                incident[fill[v]++] = ti;
-    }
+        quad[t[0]] |= std::uint8_t(kExists[halfOf(t)] | kAlive[halfOf(t)]);
+    // The corners of half h of the quad at top-left sample q, in the triangle's vertex order.
+    auto corners = [&](std::uint32_t q, int h) -> Triangle {
+        Triangle t = h == 0 ? Triangle{q, q + ucols, q + ucols + 1} : Triangle{q, q + ucols + 1, q + 1};
+        if (mirrored) std::swap(t[1], t[2]);
+        return t;
+    };
+    struct Slot {
+        std::uint32_t quad;
+        int half;
+    };
+    // The (up to six) triangles around v = (r, c) that exist, alive or all, in triangle order.
+    auto fanAt = [&](std::uint32_t v, std::uint32_t r, std::uint32_t c, bool aliveOnly,
+                     std::array<Slot, 6>& out) {
+        std::size_t n = 0;
+        auto take = [&](std::uint32_t q, int h) {
+            if (quad[q] & (aliveOnly ? kAlive[h] : kExists[h])) out[n++] = {q, h};
+        };
+        if (r > 0 && c > 0) take(v - ucols - 1, 0), take(v - ucols - 1, 1);
+        if (r > 0) take(v - ucols, 0);
+        if (c > 0) take(v - 1, 1);
+        take(v, 0), take(v, 1);
+        return n;
+    };
+    auto fanOf = [&](std::uint32_t v, bool aliveOnly, std::array<Slot, 6>& out) {
+        return fanAt(v, v / ucols, v % ucols, aliveOnly, out);
+    };
+    auto initialCount = [&](std::uint32_t v) {
+        std::array<Slot, 6> all;
+        return fanOf(v, false, all);
+    };
+    std::vector<std::uint8_t>& pushed = w.pushed; // on the work list above the initial vertices
+    pushed.assign(sampleCount, 0);
     std::vector<std::uint32_t>& work = w.work;
     work.clear();
-    std::vector<bool>& queued = w.queued;
-    queued.assign(sampleCount, false);
-    for (std::uint32_t v = 0; v < sampleCount; ++v)
-        if (offset[v + 1] - offset[v] > 1) work.push_back(v), queued[v] = true;
+    // Initial vertices not yet taken: those ≤ next (and in two or more triangles); next = (nextRow, nextCol).
+    std::int64_t next = std::int64_t(sampleCount) - 1;
+    std::uint32_t nextRow = std::uint32_t(rows - 1), nextCol = std::uint32_t(cols - 1);
+    auto waiting = [&](std::uint32_t x) {
+        return pushed[x] || (std::int64_t(x) <= next && initialCount(x) > 1);
+    };
 
     std::size_t pinched = 0;
-    std::vector<std::uint32_t> fan, component;
-    while (!work.empty()) {
-        const std::uint32_t v = work.back();
-        work.pop_back();
-        queued[v] = false;
-        fan.clear();
-        for (std::uint32_t k = offset[v]; k < offset[v + 1]; ++k)
-            if (alive[incident[k]]) fan.push_back(incident[k]);
+    std::array<Slot, 6> fan;
+    std::array<Triangle, 6> tri;
+    std::array<std::uint32_t, 6> component;
+    for (;;) {
+        std::uint32_t v = 0;
+        if (!work.empty()) {
+            v = work.back();
+            work.pop_back();
+            pushed[v] = 0;
+        } else {
+            // Down to the next vertex that was initially in two or more triangles (row and column
+            // counted along, no division per sample).
+            bool found = false;
+            while (next >= 0 && !found) {
+                found = fanAt(std::uint32_t(next), nextRow, nextCol, false, fan) > 1;
+                v = std::uint32_t(next--);
+                if (nextCol > 0)
+                    --nextCol;
+                else
+                    nextCol = ucols - 1, --nextRow;
+            }
+            if (!found) break;
+        }
+        const std::size_t n = fanOf(v, true, fan);
         // A grid vertex lies in at most the six grid triangles around it, which form one closed fan:
         // all six alive means manifold (the common interior case, skipped without the search below).
-        if (fan.size() < 2 || fan.size() == 6) continue;
+        if (n < 2 || n == 6) continue;
+        for (std::size_t i = 0; i < n; ++i)
+            tri[i] = corners(fan[i].quad, fan[i].half);
         // Connected components of the triangles around v: two are adjacent when they share an edge at v,
         // i.e. a vertex other than v.
-        component.assign(fan.size(), std::uint32_t(-1));
+        component.fill(std::uint32_t(-1));
         std::uint32_t components = 0;
-        for (std::size_t s = 0; s < fan.size(); ++s) {
+        for (std::size_t s = 0; s < n; ++s) {
             if (component[s] != std::uint32_t(-1)) continue;
             component[s] = components;
             for (bool grown = true; grown;) {
                 grown = false;
-                for (std::size_t i = 0; i < fan.size(); ++i) {
+                for (std::size_t i = 0; i < n; ++i) {
                     if (component[i] != components) continue;
-                    for (std::size_t j = 0; j < fan.size(); ++j) {
+                    for (std::size_t j = 0; j < n; ++j) {
                         if (component[j] != std::uint32_t(-1)) continue;
                         bool shares = false;
-                        for (std::uint32_t x : triangles[fan[i]])
-                            if (x != v && std::find(triangles[fan[j]].begin(), triangles[fan[j]].end(), x) !=
-                                              triangles[fan[j]].end())
+                        for (std::uint32_t x : tri[i])
+                            if (x != v && std::find(tri[j].begin(), tri[j].end(), x) != tri[j].end())
                                 shares = true;
                         if (shares) component[j] = components, grown = true;
                     }
@@ -155,23 +207,28 @@ std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, std::vector<b
         }
         if (components < 2) continue;
         ++pinched;
-        std::vector<std::size_t> size(components, 0);
-        std::vector<std::uint32_t> lowest(components, std::uint32_t(-1));
-        for (std::size_t i = 0; i < fan.size(); ++i) {
+        // Per component: size and lowest rank (2·quad + half, in triangle order).
+        std::array<std::size_t, 6> size{};
+        std::array<std::uint64_t, 6> lowest;
+        lowest.fill(std::uint64_t(-1));
+        for (std::size_t i = 0; i < n; ++i) {
             ++size[component[i]];
-            lowest[component[i]] = std::min(lowest[component[i]], fan[i]);
+            lowest[component[i]] =
+                std::min(lowest[component[i]], 2 * std::uint64_t(fan[i].quad) + fan[i].half);
         }
         std::uint32_t keep = 0;
         for (std::uint32_t k = 1; k < components; ++k)
             if (size[k] > size[keep] || (size[k] == size[keep] && lowest[k] < lowest[keep])) keep = k;
-        for (std::size_t i = 0; i < fan.size(); ++i) {
+        for (std::size_t i = 0; i < n; ++i) {
             if (component[i] == keep) continue;
-            alive[fan[i]] = false;
+            quad[fan[i].quad] &= std::uint8_t(~kAlive[fan[i].half]);
             ++removedTriangles;
-            for (std::uint32_t x : triangles[fan[i]])
-                if (x != v && !queued[x]) work.push_back(x), queued[x] = true;
+            for (std::uint32_t x : tri[i])
+                if (x != v && !waiting(x)) work.push_back(x), pushed[x] = 1;
         }
     }
+    if (removedTriangles > 0)
+        std::erase_if(triangles, [&](const Triangle& t) { return !(quad[t[0]] & kAlive[halfOf(t)]); });
     return pinched;
 }
 
@@ -226,27 +283,27 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     patch.rows = grid.rows;
     patch.cols = grid.cols;
     patch.scanId = grid.scanId;
-    patch.vertexOfSample.assign(grid.samples.size(), Mesh::null_vertex());
     TriangulateReport& report = patch.report;
 
     const Viewer viewer(grid.camera);
     const double maxAngle = options.maxSamplingAngleDeg * std::numbers::pi / 180.0;
     const JudgeLimits limits{options.maxEdgeFootprints, maxAngle, std::cos(maxAngle)};
 
-    // Usable samples and their own tests (sampleFlags) as one byte each: every sample is a corner of up to
-    // four quads and six triangles.
+    // One pass over the quad rows, in blocks, one per thread (parallel.h), with the samples of a quad row
+    // in cache: their own tests (sampleFlags, one byte per sample of the two rows at hand: every sample is
+    // a corner of up to four quads and six triangles), the candidates — both triangles of every quad with
+    // four usable corners, split along (r,c)–(r+1,c+1), in the vertex order that is counter-clockwise on
+    // the screen for a regular grid — their exact screen orientation and their 3D tests (judge). Which
+    // orientation is the grid's is only known once every candidate is counted: a fishbone grid may be
+    // mirrored on the screen, its majority orientation is then the grid's and the vertex order is reversed
+    // so that the faces still face the camera (which reverses the exact orientation too). A candidate is
+    // judged in the one order in which it is not flipped: as made if it turns right (kept if the grid is
+    // not mirrored), reversed if it turns left (kept if the grid is mirrored). The blocks' kept candidates
+    // are concatenated in row order, so the result does not depend on the number of blocks.
+    // The samples' q go into a dense array for the faces' qualities at the end.
     const std::size_t sampleCount = grid.samples.size();
-    std::vector<std::uint8_t>& usableSample = w.sampleFlags;
-    usableSample.resize(sampleCount); // every entry is written below
-    detail::parallelRows(grid.rows, detail::rowBlocks(grid.rows, 64), [&](int, int rowBegin, int rowEnd) {
-        for (std::size_t i = grid.index(rowBegin, 0), e = grid.index(rowEnd, 0); i < e; ++i)
-            usableSample[i] = sampleFlags(grid.samples[i], viewer, limits);
-    });
-
-    // Candidates: both triangles of every quad with four usable corners, split along (r,c)–(r+1,c+1),
-    // in the vertex order that is counter-clockwise on the screen for a regular grid. Quad rows in
-    // blocks, one per thread (parallel.h); the blocks' candidates are concatenated in row order, so the
-    // result does not depend on the number of blocks.
+    std::vector<float>& sampleQuality = w.sampleQuality;
+    sampleQuality.resize(sampleCount); // every entry is written below
     const int quadRows = std::max(grid.rows - 1, 0);
     const int blocks = detail::rowBlocks(quadRows, 16);
     using Block = ScanWorkspace::Impl::Block;
@@ -254,23 +311,61 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     block.resize(static_cast<std::size_t>(blocks));
     for (Block& b : block) {
         b.candidates.clear();
-        b.orientation.clear();
-        b.quads = 0;
+        b.keptIf.clear();
+        b.quads = b.rightTurns = b.leftTurns = 0;
+        b.verdicts = {};
+        b.top.resize(std::size_t(grid.cols)); // every entry written before it is read
+        b.bottom.resize(std::size_t(grid.cols));
     }
-    detail::parallelRows(quadRows, blocks, [&](int b, int rowBegin, int rowEnd) {
+    constexpr std::uint8_t kKeptIfNotMirrored = 1, kKeptIfMirrored = 2;
+    detail::parallelRows(std::max(quadRows, 1), blocks, [&](int b, int rowBegin, int rowEnd) {
         Block& out = block[std::size_t(b)];
-        for (int r = rowBegin; r < rowEnd; ++r) {
-            const std::uint8_t* top = usableSample.data() + grid.index(r, 0);
-            const std::uint8_t* bottom = usableSample.data() + grid.index(r + 1, 0);
+        // This block's sample rows for the dense q: its quad rows' top rows, and the last row for the last.
+        const int qualityEnd = rowEnd == std::max(quadRows, 1) ? grid.rows : rowEnd;
+        auto flagRow = [&](int r, std::vector<std::uint8_t>& flags) {
+            const Sample* row = grid.samples.data() + grid.index(r, 0);
+            for (int c = 0; c < grid.cols; ++c)
+                flags[std::size_t(c)] = sampleFlags(row[c], viewer, limits);
+            if (r >= rowBegin && r < qualityEnd)
+                for (int c = 0; c < grid.cols; ++c)
+                    sampleQuality[grid.index(r, c)] = row[c].quality;
+        };
+        if (rowBegin < grid.rows) flagRow(rowBegin, out.bottom);
+        for (int r = rowBegin; r < rowEnd && r + 1 < grid.rows; ++r) {
+            std::swap(out.top, out.bottom);
+            flagRow(r + 1, out.bottom);
+            const std::uint8_t* top = out.top.data();
+            const std::uint8_t* bottom = out.bottom.data();
             for (int c = 0; c + 1 < grid.cols; ++c) {
                 if (!(top[c] & top[c + 1] & bottom[c] & bottom[c + 1] & kUsable)) continue;
                 const auto i00 = std::uint32_t(grid.index(r, c)), i01 = std::uint32_t(grid.index(r, c + 1)),
                            i10 = std::uint32_t(grid.index(r + 1, c)),
                            i11 = std::uint32_t(grid.index(r + 1, c + 1));
                 ++out.quads;
-                for (const Triangle& t : {Triangle{i00, i10, i11}, Triangle{i00, i11, i01}}) {
-                    out.candidates.push_back(t);
-                    out.orientation.push_back(screenOrientation(grid, t));
+                const std::uint8_t lower = top[c] | bottom[c] | bottom[c + 1],
+                                   upper = top[c] | bottom[c + 1] | top[c + 1];
+                for (const auto& [t, corners] :
+                     {std::pair{Triangle{i00, i10, i11}, lower}, std::pair{Triangle{i00, i11, i01}, upper}}) {
+                    const CGAL::Orientation o = screenOrientation(grid, t);
+                    out.rightTurns += (o == CGAL::RIGHT_TURN);
+                    out.leftTurns += (o == CGAL::LEFT_TURN);
+                    // [0]: the verdicts if the grid is not mirrored, [1]: if it is.
+                    if (o == CGAL::RIGHT_TURN) {
+                        const Verdict v = judge(grid, corners, t, viewer, limits);
+                        ++out.verdicts[0][std::size_t(v)];
+                        ++out.verdicts[1][std::size_t(Verdict::Flipped)];
+                        if (v == Verdict::Keep)
+                            out.candidates.push_back(t), out.keptIf.push_back(kKeptIfNotMirrored);
+                    } else if (o == CGAL::LEFT_TURN) {
+                        const Verdict v = judge(grid, corners, Triangle{t[0], t[2], t[1]}, viewer, limits);
+                        ++out.verdicts[0][std::size_t(Verdict::Flipped)];
+                        ++out.verdicts[1][std::size_t(v)];
+                        if (v == Verdict::Keep)
+                            out.candidates.push_back(t), out.keptIf.push_back(kKeptIfMirrored);
+                    } else {
+                        ++out.verdicts[0][std::size_t(Verdict::Flipped)];
+                        ++out.verdicts[1][std::size_t(Verdict::Flipped)];
+                    }
                 }
             }
         }
@@ -278,33 +373,11 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     std::size_t rightTurns = 0, leftTurns = 0;
     for (const Block& b : block) {
         report.quads += b.quads;
-        for (const CGAL::Orientation o : b.orientation) {
-            rightTurns += (o == CGAL::RIGHT_TURN);
-            leftTurns += (o == CGAL::LEFT_TURN);
-        }
+        rightTurns += b.rightTurns;
+        leftTurns += b.leftTurns;
     }
-    // A fishbone grid may be mirrored on the screen: its majority orientation is the grid's, and the
-    // vertex order is reversed so that the faces still face the camera (which reverses the exact
-    // orientation too: the grid's orientation is then RIGHT_TURN again).
     const bool mirrored = leftTurns > rightTurns;
-
-    // Judge each block's candidates in place (kept ones compacted to the front), then concatenate.
-    std::vector<std::array<std::size_t, 5>> verdicts(std::size_t(blocks), std::array<std::size_t, 5>{});
-    detail::parallelRows(blocks, blocks, [&](int b, int, int) {
-        Block& in = block[std::size_t(b)];
-        std::size_t kept = 0;
-        for (std::size_t k = 0; k < in.candidates.size(); ++k) {
-            Triangle t = in.candidates[k];
-            CGAL::Orientation o = in.orientation[k];
-            if (mirrored) std::swap(t[1], t[2]), o = CGAL::Orientation(-int(o));
-            const Verdict v = o != CGAL::RIGHT_TURN ? Verdict::Flipped
-                                                    : judge(grid, usableSample.data(), t, viewer, limits);
-            ++verdicts[std::size_t(b)][std::size_t(v)];
-            if (v == Verdict::Keep) in.candidates[kept++] = t;
-        }
-        in.candidates.resize(kept);
-        in.orientation.clear();
-    });
+    const std::uint8_t kept = mirrored ? kKeptIfMirrored : kKeptIfNotMirrored;
     std::vector<Triangle>& triangles = w.triangles;
     triangles.clear();
     {
@@ -313,21 +386,26 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
             total += b.candidates.size();
         triangles.reserve(total);
         for (Block& b : block) {
-            triangles.insert(triangles.end(), b.candidates.begin(), b.candidates.end());
+            for (std::size_t k = 0; k < b.candidates.size(); ++k) {
+                if (b.keptIf[k] != kept) continue;
+                Triangle t = b.candidates[k];
+                if (mirrored) std::swap(t[1], t[2]);
+                triangles.push_back(t);
+            }
             b.candidates.clear();
+            b.keptIf.clear();
         }
     }
-    for (const auto& v : verdicts) {
+    for (const Block& b : block) {
+        const auto& v = b.verdicts[mirrored ? 1 : 0];
         report.flipped += v[std::size_t(Verdict::Flipped)];
         report.backFacing += v[std::size_t(Verdict::BackFacing)];
         report.longEdges += v[std::size_t(Verdict::LongEdge)];
         report.grazing += v[std::size_t(Verdict::Grazing)];
     }
 
-    std::vector<bool>& alive = w.alive;
-    alive.assign(triangles.size(), true);
     report.nonManifoldVertices =
-        makeVerticesManifold(triangles, alive, grid.samples.size(), report.nonManifoldTriangles, w);
+        makeVerticesManifold(triangles, grid.rows, grid.cols, mirrored, report.nonManifoldTriangles, w);
 
     // The halfedge structure directly (Surface_mesh::add_face searches each new edge around its vertex,
     // and add_vertex / add_edge / add_face grow every property array one element at a time). Pass 1
@@ -346,7 +424,6 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     sampleOf.clear();
     std::size_t faceCount = 0;
     for (std::size_t k = 0; k < triangles.size(); ++k) {
-        if (!alive[k]) continue;
         ++faceCount;
         for (std::uint32_t i : triangles[k]) {
             if (vertexOf[i] != kNone) continue;
@@ -365,7 +442,6 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     };
     std::uint32_t edgeCount = 0;
     for (std::size_t k = 0; k < triangles.size(); ++k) {
-        if (!alive[k]) continue;
         const Triangle& t = triangles[k];
         for (std::size_t j = 0; j < 3; ++j) {
             std::uint32_t& slot = slotOf(t[j], t[(j + 1) % 3]);
@@ -374,70 +450,87 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
     }
 
     Mesh& mesh = patch.mesh;
-    // A recycled mesh is emptied and resized: its arrays keep their memory and get the default values a
-    // new mesh's would (Surface_mesh's property arrays fill new elements with their default).
+    // A recycled mesh (one with exactly our properties and nothing removed, ScanWorkspace::recycle) is
+    // resized without being emptied first: its arrays keep their memory and their old values, and every
+    // value of every element is written below — points, grid indices, vertex, halfedge (target, face,
+    // next, prev) and face connectivity, face qualities and scan ids — while its removed flags are all
+    // false already. Emptying it first would make resize write every array once more (as much as filling
+    // it). Any other mesh is replaced by a new one.
     if (!hasPatchPropertiesOnly(mesh)) mesh = Mesh();
-    mesh.resize(0, 0, 0);
     mesh.resize(Mesh::size_type(sampleOf.size()), Mesh::size_type(edgeCount), Mesh::size_type(faceCount));
     auto gridIndex = mesh.add_property_map<VertexIndex, GridIndex>(props::vertexGridIndex, GridIndex{}).first;
     auto quality = mesh.add_property_map<FaceIndex, float>(props::faceQuality, kInputFaceQuality).first;
     auto scanId = mesh.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1).first;
-    for (std::uint32_t v = 0; v < sampleOf.size(); ++v) {
-        const std::uint32_t i = sampleOf[v];
-        const Eigen::Vector3d& p = grid.samples[i].point;
-        const VertexIndex vi(v);
-        mesh.point(vi) = Point3(p.x(), p.y(), p.z());
-        gridIndex[vi] = {std::int32_t(i / std::size_t(grid.cols)), std::int32_t(i % std::size_t(grid.cols))};
-        patch.vertexOfSample[i] = vi;
-    }
+    // The vertices' points, grid indices and vertexOfSample (task 1) and the connectivity and face
+    // properties (task 0) write different arrays: two threads fill them at once where there are two.
+    auto fillVertices = [&] {
+        patch.vertexOfSample.assign(grid.samples.size(), Mesh::null_vertex());
+        for (std::uint32_t v = 0; v < sampleOf.size(); ++v) {
+            const std::uint32_t i = sampleOf[v];
+            const Eigen::Vector3d& p = grid.samples[i].point;
+            const VertexIndex vi(v);
+            mesh.point(vi) = Point3(p.x(), p.y(), p.z());
+            gridIndex[vi] = {std::int32_t(i / std::size_t(grid.cols)),
+                             std::int32_t(i % std::size_t(grid.cols))};
+            patch.vertexOfSample[i] = vi;
+        }
+    };
     // An edge's first halfedge (2e) runs the way the first face that used it traverses it; the second
     // face finds it already made and takes the opposite halfedge, which must run the other way round.
+    // edgeMade counts the faces of each edge: the opposite halfedge of an edge with one is a border.
     std::vector<std::uint8_t>& edgeMade = w.edgeMade;
     edgeMade.assign(edgeCount, 0);
-    std::uint32_t faceIndex = 0;
-    for (std::size_t k = 0; k < triangles.size(); ++k) {
-        if (!alive[k]) continue;
-        const Triangle& t = triangles[k];
-        const FaceIndex f(faceIndex++);
-        std::array<HalfedgeIndex, 3> h;
-        for (std::size_t j = 0; j < 3; ++j) {
-            const std::uint32_t from = t[j], to = t[(j + 1) % 3];
-            const std::uint32_t e = slotOf(from, to);
-            const HalfedgeIndex first(2 * e);
-            const VertexIndex toVertex(vertexOf[to]);
-            if (!edgeMade[e]) {
-                edgeMade[e] = 1;
-                mesh.set_target(first, toVertex);
-                mesh.set_target(mesh.opposite(first), VertexIndex(vertexOf[from]));
-                h[j] = first;
-            } else {
-                h[j] = mesh.opposite(first); // the other face's halfedge runs to → from
-                if (mesh.target(h[j]) != toVertex || mesh.face(h[j]) != Mesh::null_face()) throw fail(from);
+    auto fillFaces = [&] {
+        std::uint32_t faceIndex = 0;
+        for (std::size_t k = 0; k < triangles.size(); ++k) {
+            const Triangle& t = triangles[k];
+            const FaceIndex f(faceIndex++);
+            std::array<HalfedgeIndex, 3> h;
+            for (std::size_t j = 0; j < 3; ++j) {
+                const std::uint32_t from = t[j], to = t[(j + 1) % 3];
+                const std::uint32_t e = slotOf(from, to);
+                const HalfedgeIndex first(2 * e);
+                const VertexIndex toVertex(vertexOf[to]);
+                if (!edgeMade[e]) {
+                    edgeMade[e] = 1;
+                    mesh.set_target(first, toVertex);
+                    mesh.set_target(mesh.opposite(first), VertexIndex(vertexOf[from]));
+                    mesh.set_face(mesh.opposite(first), Mesh::null_face()); // until a second face takes it
+                    h[j] = first;
+                } else {
+                    h[j] = mesh.opposite(first); // the other face's halfedge runs to → from
+                    if (mesh.target(h[j]) != toVertex || mesh.face(h[j]) != Mesh::null_face())
+                        throw fail(from);
+                    edgeMade[e] = 2;
+                }
             }
+            mesh.set_halfedge(f, h[0]);
+            for (std::size_t j = 0; j < 3; ++j) {
+                mesh.set_face(h[j], f);
+                mesh.set_next(h[j], h[(j + 1) % 3]);
+                mesh.set_halfedge(mesh.target(h[j]), h[j]);
+            }
+            quality[f] = triangleQuality(sampleQuality[t[0]], sampleQuality[t[1]], sampleQuality[t[2]]);
+            scanId[f] = grid.scanId;
         }
-        mesh.set_halfedge(f, h[0]);
-        for (std::size_t j = 0; j < 3; ++j) {
-            mesh.set_face(h[j], f);
-            mesh.set_next(h[j], h[(j + 1) % 3]);
-            mesh.set_halfedge(mesh.target(h[j]), h[j]);
-        }
-        quality[f] = triangleQuality(grid.samples[t[0]], grid.samples[t[1]], grid.samples[t[2]]);
-        scanId[f] = grid.scanId;
-    }
+    };
+    detail::parallelRows(2, std::min(scanThreads(), 2), [&](int, int taskBegin, int taskEnd) {
+        for (int task = taskBegin; task < taskEnd; ++task)
+            task == 0 ? fillFaces() : fillVertices();
+    });
     // Border halfedges follow each other around the patch's boundary; a border vertex points to its
     // incoming one. Vertex-manifold: at most one border halfedge leaves each vertex.
-    std::vector<HalfedgeIndex> borderFrom(sampleOf.size());
-    std::vector<HalfedgeIndex> borders;
+    std::vector<HalfedgeIndex>& borderFrom = w.borderFrom;
+    borderFrom.assign(sampleOf.size(), HalfedgeIndex());
+    std::vector<HalfedgeIndex>& borders = w.borders;
+    borders.clear();
     for (const std::uint32_t e : edgeSlot) {
-        if (e == kNone) continue;
-        const HalfedgeIndex slot(2 * e);
-        for (const HalfedgeIndex b : {slot, mesh.opposite(slot)}) {
-            if (mesh.face(b) != Mesh::null_face()) continue;
-            HalfedgeIndex& out = borderFrom[mesh.source(b).idx()];
-            if (out != HalfedgeIndex()) throw fail(sampleOf[mesh.source(b).idx()]);
-            out = b;
-            borders.push_back(b);
-        }
+        if (e == kNone || edgeMade[e] != 1) continue; // the first halfedge (2e) has its face
+        const HalfedgeIndex b = mesh.opposite(HalfedgeIndex(2 * e));
+        HalfedgeIndex& out = borderFrom[mesh.source(b).idx()];
+        if (out != HalfedgeIndex()) throw fail(sampleOf[mesh.source(b).idx()]);
+        out = b;
+        borders.push_back(b);
     }
     for (const HalfedgeIndex b : borders) {
         const VertexIndex end = mesh.target(b);

@@ -219,3 +219,30 @@ TEST(CameraProjector, MatchesTheCameraMethods) {
         }
     }
 }
+
+// The regular scan unprojects every pixel centre with unprojectPixelCentreWithRay: it must give exactly
+// (bit for bit) unprojectPixelCentre and ray, or scans would change.
+TEST(CameraProjector, PixelCentreWithRayIsBitIdenticalToUnprojectAndRay) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> depth(0, 1);
+    for (bool parallel : {false, true}) {
+        for (const auto& [w, h] : {std::pair{640, 480}, std::pair{257, 1031}}) {
+            Camera c = makeCamera(parallel);
+            c.width = w;
+            c.height = h;
+            const fss::CameraProjector p(c);
+            std::size_t mismatches = 0;
+            for (int py = 0; py < h; py += 3) {
+                for (int px = 0; px < w; px += 2) {
+                    const double z = depth(rng); // a float depth, as the depth buffer holds
+                    const auto got = p.unprojectPixelCentreWithRay(px, py, z);
+                    const Eigen::Vector3d point = p.unprojectPixelCentre(px, py, z);
+                    const fss::Ray ray = p.ray(px + 0.5, py + 0.5);
+                    mismatches += !(got.point == point && got.ray.origin == ray.origin &&
+                                    got.ray.direction == ray.direction);
+                }
+            }
+            EXPECT_EQ(mismatches, 0u) << (parallel ? "parallel " : "perspective ") << w << "x" << h;
+        }
+    }
+}

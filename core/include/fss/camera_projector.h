@@ -36,6 +36,16 @@ public:
     }
     /// As Camera::ray.
     Ray ray(double sx, double sy) const;
+
+    /// A pixel centre unprojected at a depth, and the viewing ray through that centre.
+    struct PixelCentre {
+        Eigen::Vector3d point; ///< unprojectPixelCentre(px, py, depth)
+        Ray ray;               ///< ray(px + ½, py + ½)
+    };
+    /// unprojectPixelCentre(px, py, depth) and ray(px + ½, py + ½) at once, bit for bit the same values:
+    /// the three unprojections (at depth, and at 0 and 1 for the ray) share the matrix product's x and y
+    /// terms, which are computed once (the product sums its terms in column order, so they come first).
+    PixelCentre unprojectPixelCentreWithRay(int px, int py, double depth) const;
     /// As Camera::pixelFootprint.
     double pixelFootprint(const Eigen::Vector3d& p) const {
         if (parallel_) return parallelFootprint_;

@@ -51,6 +51,8 @@ float sampleQuality(double footprint, double samplingAngle, double qualityAngleL
 
 /// The quality of a triangle whose corners are the samples \p a, \p b, \p c: the mean of their q.
 float triangleQuality(const Sample& a, const Sample& b, const Sample& c);
+/// As above, from the corners' q alone.
+float triangleQuality(float qa, float qb, float qc);
 
 /// Fills \p sample as a sample of the reference surface at \p point on face \p face, seen by \p camera:
 /// point, face, unit face normal, sampling angle (between the reversed viewing ray towards \p point and

@@ -5,8 +5,6 @@
 #include "fss/scan_workspace.h"
 #include "fss/triangulate.h"
 
-#include <CGAL/enum.h>
-
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -20,23 +18,25 @@ struct ScanWorkspace::Impl {
     bool hasPatch = false;
 
     // Morphology (mask.cpp): one byte per sample.
-    std::vector<std::uint8_t> valid, admissible, square;
-    std::vector<std::uint16_t> counts;
+    std::vector<std::uint8_t> valid, admissible, original, square;
 
     // Triangulation (triangulate.cpp).
     using Triangle = std::array<std::uint32_t, 3>;
     struct Block {
-        std::vector<Triangle> candidates;
-        std::vector<CGAL::Orientation> orientation; // of each candidate, as listed
-        std::size_t quads = 0;
+        std::vector<Triangle> candidates; // kept by the 3D tests in one of the two orders
+        std::vector<std::uint8_t> keptIf; // of each candidate: kept if the grid is not mirrored, or if it is
+        std::vector<std::uint8_t> top, bottom; // sample flags of the two rows of the quad row at hand
+        std::size_t quads = 0, rightTurns = 0, leftTurns = 0;
+        std::array<std::array<std::size_t, 5>, 2> verdicts{}; // per verdict, if not mirrored / if mirrored
     };
-    std::vector<std::uint8_t> sampleFlags;
+    std::vector<float> sampleQuality;
     std::vector<Block> blocks;
     std::vector<Triangle> triangles;
-    std::vector<bool> alive, queued;
-    std::vector<std::uint32_t> offset, incident, fill, work;
+    std::vector<std::uint8_t> quadHalves, pushed;
+    std::vector<std::uint32_t> work;
     std::vector<std::uint32_t> vertexOf, sampleOf, edgeSlot;
     std::vector<std::uint8_t> edgeMade;
+    std::vector<Mesh::Halfedge_index> borderFrom, borders;
 };
 
 } // namespace fss
