@@ -13,6 +13,7 @@
 #include <numeric>
 #include <optional>
 #include <string>
+#include <utility>
 
 namespace fss {
 namespace {
@@ -413,20 +414,22 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
 
     progress.report(0.1, "render reference");
     auto t = Clock::now();
-    const FrameBuffers buffers = referenceRenderer.render(params.camera);
+    FrameBuffers referenceBuffers = referenceRenderer.render(params.camera);
     result.timings.renderReference = secondsSince(t);
-    if (buffers.coveredCount() == 0) throw InvalidInputError("The scan camera sees no part of the mesh.");
-    const int W = buffers.width(), H = buffers.height();
+    if (referenceBuffers.coveredCount() == 0)
+        throw InvalidInputError("The scan camera sees no part of the mesh.");
+    const int W = referenceBuffers.width(), H = referenceBuffers.height();
 
     const bool currentIsReference = (&current == &reference);
     if (!currentIsReference) {
         progress.report(0.2, "render current");
         t = Clock::now();
-        result.currentBuffers = currentRenderer.render(buffers.camera);
+        result.currentBuffers = currentRenderer.render(referenceBuffers.camera);
         result.timings.renderCurrent = secondsSince(t);
     } else {
-        result.currentBuffers = buffers;
+        result.currentBuffers = std::move(referenceBuffers); // one render serves both, without a copy
     }
+    const FrameBuffers& buffers = currentIsReference ? result.currentBuffers : referenceBuffers;
 
     // Direction fields: the backbone's (traced backbone) and the ribs' (automatic or traced key-ribs).
     progress.report(0.3, "direction field");
