@@ -109,8 +109,8 @@ struct FishboneParams {
     LocalSearchOptions raycast{};
 
     /// Tracing with LowAnisotropyPolicy::ContinueStraight; RK4 steps of half a pixel for the backbone and of
-    /// one pixel for the ribs (rib turns limited to 20° per step: the same 2.9-pixel radius of curvature as
-    /// 10° per half pixel). Sessions store these options, so older sessions replay with their own.
+    /// one pixel for the ribs (rib turns limited to 12° per step, which ends ribs at field seams about where
+    /// 10° per half pixel did). Sessions store these options, so older sessions replay with their own.
     static FishboneOptions defaultTracing();
 };
 
