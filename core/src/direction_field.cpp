@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <memory>
 #include <numbers>
@@ -250,7 +251,7 @@ struct LazyDirectionTiles {
     LazyDirectionTiles(const Mesh& mesh, const CurvatureField& curvature, const FrameBuffers& buffers,
                        bool max, int size)
         : source(mesh, curvature, buffers), useMax(max), tileSize(size),
-          tilesX((source.width() + size - 1) / size), tilesY((source.height() + size - 1) / size),
+          tileShift((size & (size - 1)) == 0 ? std::countr_zero(unsigned(size)) : -1), tilesX((source.width() + size - 1) / size), tilesY((source.height() + size - 1) / size),
           tiles(std::size_t(tilesX) * std::size_t(tilesY)) {}
     LazyDirectionTiles(const LazyDirectionTiles&) = delete;
     LazyDirectionTiles& operator=(const LazyDirectionTiles&) = delete;
@@ -259,18 +260,23 @@ struct LazyDirectionTiles {
             delete t.load(std::memory_order_acquire);
     }
 
-    // The tile holding pixel (x, y), computed on first use. \pre (x, y) inside the image.
-    const DirectionTile& tileOf(int x, int y) const {
-        std::atomic<const DirectionTile*>& slot =
-            tiles[std::size_t(y / tileSize) * std::size_t(tilesX) + std::size_t(x / tileSize)];
+    // The tile column (row) of pixel column x (row y): a shift for the usual power-of-two sizes.
+    int tileIndex(int x) const { return tileShift >= 0 ? x >> tileShift : x / tileSize; }
+
+    // Tile (tx, ty), computed on first use. \pre 0 ≤ tx < tilesX, 0 ≤ ty < tilesY.
+    const DirectionTile& tile(int tx, int ty) const {
+        std::atomic<const DirectionTile*>& slot = tiles[std::size_t(ty) * std::size_t(tilesX) + std::size_t(tx)];
         if (const DirectionTile* t = slot.load(std::memory_order_acquire)) return *t;
-        auto made = std::make_unique<const DirectionTile>(compute(x / tileSize * tileSize, y / tileSize * tileSize));
+        auto made = std::make_unique<const DirectionTile>(compute(tx * tileSize, ty * tileSize));
         const DirectionTile* expected = nullptr;
         if (slot.compare_exchange_strong(expected, made.get(), std::memory_order_acq_rel,
                                          std::memory_order_acquire))
             return *made.release();
         return *expected; // another thread published the same tile first
     }
+
+    // The tile holding pixel (x, y), computed on first use. \pre (x, y) inside the image.
+    const DirectionTile& tileOf(int x, int y) const { return tile(tileIndex(x), tileIndex(y)); }
 
     std::size_t computedPixels() const {
         std::size_t n = 0;
@@ -281,7 +287,9 @@ struct LazyDirectionTiles {
 
     FieldSource source;
     bool useMax;
-    int tileSize, tilesX, tilesY;
+    int tileSize;
+    int tileShift; // log2(tileSize) when it is a power of two, else -1
+    int tilesX, tilesY;
 
 private:
     DirectionTile compute(int x0, int y0) const {
@@ -310,30 +318,50 @@ private:
 
 namespace {
 
+// One of the four pixels around a sample position, as DirectionField::sample reads it.
+struct NeighbourPixel {
+    const Eigen::Vector2d* direction = nullptr; // null: outside the image
+    float anisotropy = 0;
+    bool valid = false;
+};
+
+// The 2×2 pixels (x0 + i, y0 + j), i, j ∈ {0, 1}, at index i + 2j.
+using PixelQuad = std::array<NeighbourPixel, 4>;
+
 // Pixel access for DirectionField::sample: the stored arrays.
 struct StoredPixels {
     const DirectionField& f;
-    struct Ref {
-        const Eigen::Vector2d& direction;
-        float anisotropy;
-        bool valid;
-    };
-    Ref at(int x, int y) const {
-        const std::size_t k = f.index(x, y);
-        return {f.direction[k], f.anisotropy[k], f.valid[k] != 0};
+    void quad(int x0, int y0, PixelQuad& q) const {
+        for (int k = 0; k < 4; ++k) {
+            const int x = x0 + (k & 1), y = y0 + (k >> 1);
+            if (!f.inside(x, y)) continue;
+            const std::size_t i = f.index(x, y);
+            q[std::size_t(k)] = {&f.direction[i], f.anisotropy[i], f.valid[i] != 0};
+        }
     }
 };
 
-// Pixel access for DirectionField::sample: the tiles of a lazy field (the last tile is remembered; the
-// four neighbours of a sample usually share one).
+// Pixel access for DirectionField::sample: the tiles of a lazy field (one tile lookup when the four pixels
+// share a tile, as they mostly do).
 struct TiledPixels {
     const detail::LazyDirectionTiles& tiles;
-    mutable const DirectionTile* last = nullptr;
-    using Ref = const DirectionPixel&;
-    Ref at(int x, int y) const {
-        if (!last || x < last->x0 || y < last->y0 || x >= last->x0 + last->w || y >= last->y0 + last->h)
-            last = &tiles.tileOf(x, y);
-        return last->at(x, y);
+    int width, height;
+    static NeighbourPixel of(const DirectionPixel& px) { return {&px.direction, px.anisotropy, px.valid}; }
+    void quad(int x0, int y0, PixelQuad& q) const {
+        if (x0 >= 0 && y0 >= 0 && x0 + 1 < width && y0 + 1 < height) {
+            const int tx = tiles.tileIndex(x0), ty = tiles.tileIndex(y0);
+            if (tiles.tileIndex(x0 + 1) == tx && tiles.tileIndex(y0 + 1) == ty) {
+                const DirectionTile& t = tiles.tile(tx, ty);
+                const DirectionPixel* row0 = &t.at(x0, y0);
+                const DirectionPixel* row1 = row0 + t.w;
+                q = {of(row0[0]), of(row0[1]), of(row1[0]), of(row1[1])};
+                return;
+            }
+        }
+        for (int k = 0; k < 4; ++k) {
+            const int x = x0 + (k & 1), y = y0 + (k >> 1);
+            if (x >= 0 && y >= 0 && x < width && y < height) q[std::size_t(k)] = of(tiles.tileOf(x, y).at(x, y));
+        }
     }
 };
 
@@ -345,10 +373,15 @@ std::optional<DirectionSample> bilinearSample(const Pixels& pixels, int width, i
     if (!(pos.x() >= 0 && pos.y() >= 0 && pos.x() <= width && pos.y() <= height)) return std::nullopt;
     // The pixel containing pos decides coverage (so background stops are pixel-exact).
     const int cx = std::min(int(pos.x()), width - 1), cy = std::min(int(pos.y()), height - 1);
-    if (cx < 0 || cy < 0 || !pixels.at(cx, cy).valid) return std::nullopt;
-    // Bilinear weights between the four nearest pixel centres.
+    if (cx < 0 || cy < 0) return std::nullopt;
+    // Bilinear weights between the four nearest pixel centres (x0 + i, y0 + j). The containing pixel is one
+    // of them: x0 ≤ cx ≤ x0 + 1 (pos − ½ rounds to within [pos − 1, pos]), likewise in y.
     const double gx = pos.x() - 0.5, gy = pos.y() - 0.5;
     const int x0 = int(std::floor(gx)), y0 = int(std::floor(gy));
+    PixelQuad quad;
+    pixels.quad(x0, y0, quad);
+    const NeighbourPixel& containing = quad[std::size_t((cx - x0) + 2 * (cy - y0))];
+    if (!containing.valid) return std::nullopt;
     const double fx = gx - x0, fy = gy - y0;
     // The unit reference is needed only where a low-anisotropy neighbour is bent towards it.
     std::optional<Eigen::Vector2d> unitReference;
@@ -358,35 +391,31 @@ std::optional<DirectionSample> bilinearSample(const Pixels& pixels, int width, i
     };
     Eigen::Vector2d dir = Eigen::Vector2d::Zero();
     double aniso = 0, weight = 0;
-    for (int j = 0; j < 2; ++j)
-        for (int i = 0; i < 2; ++i) {
-            const int x = x0 + i, y = y0 + j;
-            if (x < 0 || y < 0 || x >= width || y >= height) continue;
-            typename Pixels::Ref px = pixels.at(x, y);
-            if (!px.valid) continue;
-            const double w = (i ? fx : 1 - fx) * (j ? fy : 1 - fy);
-            if (w <= 0) continue;
-            const double a = double(px.anisotropy);
-            // Line field: flip to agree with the reference (a multiplication by ±1, exact, without a branch
-            // that a line field's arbitrary signs would mispredict).
-            Eigen::Vector2d d = (1.0 - 2.0 * double(px.direction.dot(reference) < 0)) * px.direction;
-            if (straightBelow > 0 && a < 2 * straightBelow) {
-                const double f = std::clamp((a - straightBelow) / straightBelow, 0.0, 1.0);
-                d = f * d + (1 - f) * unitRef();
-            }
-            // Well-defined directions dominate ill-defined ones; the floor keeps an all-isotropic
-            // neighbourhood (a plane, anisotropy 0) a plain bilinear average.
-            dir += (w * std::max(a, kMinDirectionWeight)) * d;
-            aniso += w * a;
-            weight += w;
+    for (int k = 0; k < 4; ++k) {
+        const NeighbourPixel& px = quad[std::size_t(k)];
+        if (!px.valid) continue; // invalid or outside the image
+        const double w = ((k & 1) ? fx : 1 - fx) * ((k & 2) ? fy : 1 - fy);
+        if (w <= 0) continue;
+        const double a = double(px.anisotropy);
+        // Line field: flip to agree with the reference (a multiplication by ±1, exact, without a branch
+        // that a line field's arbitrary signs would mispredict).
+        Eigen::Vector2d d = (1.0 - 2.0 * double(px.direction->dot(reference) < 0)) * *px.direction;
+        if (straightBelow > 0 && a < 2 * straightBelow) {
+            const double f = std::clamp((a - straightBelow) / straightBelow, 0.0, 1.0);
+            d = f * d + (1 - f) * unitRef();
         }
+        // Well-defined directions dominate ill-defined ones; the floor keeps an all-isotropic
+        // neighbourhood (a plane, anisotropy 0) a plain bilinear average.
+        dir += (w * std::max(a, kMinDirectionWeight)) * d;
+        aniso += w * a;
+        weight += w;
+    }
     if (weight <= 0) {
         // pos sits exactly on the containing pixel's far edge with zero weight everywhere else.
-        typename Pixels::Ref px = pixels.at(cx, cy);
-        if (straightBelow > 0 && double(px.anisotropy) < straightBelow)
-            return DirectionSample{unitRef(), double(px.anisotropy)};
-        const Eigen::Vector2d& d = px.direction;
-        return DirectionSample{d.dot(reference) < 0 ? Eigen::Vector2d(-d) : d, double(px.anisotropy)};
+        if (straightBelow > 0 && double(containing.anisotropy) < straightBelow)
+            return DirectionSample{unitRef(), double(containing.anisotropy)};
+        const Eigen::Vector2d& d = *containing.direction;
+        return DirectionSample{d.dot(reference) < 0 ? Eigen::Vector2d(-d) : d, double(containing.anisotropy)};
     }
     const double len = dir.norm();
     if (!(len > 1e-12)) return std::nullopt;
@@ -435,7 +464,7 @@ std::size_t DirectionField::computedPixels() const {
 std::optional<DirectionSample> DirectionField::sample(const Eigen::Vector2d& pos,
                                                       const Eigen::Vector2d& reference,
                                                       double straightBelow) const {
-    if (lazy_) return bilinearSample(TiledPixels{*lazy_}, width, height, pos, reference, straightBelow);
+    if (lazy_) return bilinearSample(TiledPixels{*lazy_, width, height}, width, height, pos, reference, straightBelow);
     return bilinearSample(StoredPixels{*this}, width, height, pos, reference, straightBelow);
 }
 

@@ -59,25 +59,36 @@ double distanceToPolyline(const Polyline2& line, const Eigen::Vector2d& p) {
 
 } // namespace
 
+// The streamline default (quarter-pixel steps) and the fishbone ribs' tracing (whole-pixel steps, 12° turns:
+// FishboneParams::defaultTracing) must both hold 0.1 px over 200 px.
+struct StepCase {
+    const char* name;
+    double step, maxTurnDeg;
+};
+constexpr StepCase kStepCases[] = {{"default step", 0.25, 10.0}, {"rib step 1 px", 1.0, 12.0}};
+
 TEST(Streamline, ConcentricCirclesStayOnTheirCircle) {
     const DirectionField f = makeField(512, 512, circleTangent);
-    for (double radius : {40.0, 100.0, 200.0}) {
-        StreamlineOptions o;
-        o.maxLength = 200;
-        const Eigen::Vector2d seed = kCentre + Eigen::Vector2d(radius, 0.3);
-        const fss::Streamline line = fss::traceStreamline(f, seed, o);
-        EXPECT_EQ(line.forwardStop, StreamlineStop::MaxLength);
-        EXPECT_EQ(line.backwardStop, StreamlineStop::MaxLength);
-        EXPECT_NEAR(fss::polylineLength(line.forward()), 200.0, 1e-9);
-        EXPECT_NEAR(fss::polylineLength(line.backward()), 200.0, 1e-9);
-        const double r0 = (seed - kCentre).norm();
-        double worst = 0;
-        for (const Eigen::Vector2d& p : line.points)
-            worst = std::max(worst, std::abs((p - kCentre).norm() - r0));
-        std::printf("[ circle r=%.0f ] %zu points over 2 x 200 px, worst radial deviation %.2e px\n", radius,
-                    line.points.size(), worst);
-        EXPECT_LT(worst, 0.1);
-    }
+    for (const StepCase& c : kStepCases)
+        for (double radius : {40.0, 100.0, 200.0}) {
+            StreamlineOptions o;
+            o.step = c.step;
+            o.maxTurnDeg = c.maxTurnDeg;
+            o.maxLength = 200;
+            const Eigen::Vector2d seed = kCentre + Eigen::Vector2d(radius, 0.3);
+            const fss::Streamline line = fss::traceStreamline(f, seed, o);
+            EXPECT_EQ(line.forwardStop, StreamlineStop::MaxLength);
+            EXPECT_EQ(line.backwardStop, StreamlineStop::MaxLength);
+            EXPECT_NEAR(fss::polylineLength(line.forward()), 200.0, 1e-9);
+            EXPECT_NEAR(fss::polylineLength(line.backward()), 200.0, 1e-9);
+            const double r0 = (seed - kCentre).norm();
+            double worst = 0;
+            for (const Eigen::Vector2d& p : line.points)
+                worst = std::max(worst, std::abs((p - kCentre).norm() - r0));
+            std::printf("[ circle r=%.0f, %s ] %zu points over 2 x 200 px, worst radial deviation %.2e px\n",
+                        radius, c.name, line.points.size(), worst);
+            EXPECT_LT(worst, 0.1);
+        }
 }
 
 TEST(Streamline, ClosedCircleStopsAtTheSeed) {
@@ -110,18 +121,23 @@ TEST(Streamline, SineFieldFollowsItsIntegralCurves) {
     auto dir = [&](const Eigen::Vector2d& p) { return Eigen::Vector2d(1, A / L * std::cos(p.x() / L)); };
     const DirectionField f = makeField(300, 200, dir, 5);
     const Eigen::Vector2d seed(40.0, 100.0);
-    StreamlineOptions o;
-    o.maxLength = 400; // more than 200 px in x
-    const fss::StreamlineHalf half = fss::traceStreamlineHalf(f, seed, {1, 0}, o);
-    const double C = seed.y() - A * std::sin(seed.x() / L);
-    double worst = 0, xmax = 0;
-    for (const Eigen::Vector2d& p : half.points) {
-        worst = std::max(worst, std::abs(p.y() - (A * std::sin(p.x() / L) + C)));
-        xmax = std::max(xmax, p.x());
+    for (const StepCase& c : kStepCases) {
+        StreamlineOptions o;
+        o.step = c.step;
+        o.maxTurnDeg = c.maxTurnDeg;
+        o.maxLength = 400; // more than 200 px in x
+        const fss::StreamlineHalf half = fss::traceStreamlineHalf(f, seed, {1, 0}, o);
+        const double C = seed.y() - A * std::sin(seed.x() / L);
+        double worst = 0, xmax = 0;
+        for (const Eigen::Vector2d& p : half.points) {
+            worst = std::max(worst, std::abs(p.y() - (A * std::sin(p.x() / L) + C)));
+            xmax = std::max(xmax, p.x());
+        }
+        std::printf("[ sine field, %s ] x from %.1f to %.1f, worst deviation %.2e px\n", c.name, seed.x(), xmax,
+                    worst);
+        EXPECT_GE(xmax - seed.x(), 200.0);
+        EXPECT_LT(worst, 0.1);
     }
-    std::printf("[ sine field ] x from %.1f to %.1f, worst deviation %.2e px\n", seed.x(), xmax, worst);
-    EXPECT_GE(xmax - seed.x(), 200.0);
-    EXPECT_LT(worst, 0.1);
 }
 
 TEST(Streamline, StopsAtBackgroundBorderRegionAnisotropyAndTurns) {

@@ -108,8 +108,9 @@ struct FishboneParams {
     /// Local search of the hinted ray casts.
     LocalSearchOptions raycast{};
 
-    /// Tracing with LowAnisotropyPolicy::ContinueStraight and half-pixel RK4 steps for the backbone and the
-    /// ribs.
+    /// Tracing with LowAnisotropyPolicy::ContinueStraight; RK4 steps of half a pixel for the backbone and of
+    /// one pixel for the ribs (rib turns limited to 12° per step, which ends ribs at field seams about where
+    /// 10° per half pixel did). Sessions store these options, so older sessions replay with their own.
     static FishboneOptions defaultTracing();
 };
 
