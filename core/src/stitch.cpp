@@ -2365,10 +2365,37 @@ private:
             flipPass(loc, plan);
         }
         valencePass(loc, plan);
-        // -- last smoothing: the vertices added outside the patch whose smallest angle around is still small
-        // search their plane for a better place (no flips after it, so the valences stay).
+        // -- last smoothing: the free vertices near the seam whose smallest angle around is still small search
+        // for a better place (smoothOutside with search; no flips after it, so the valences stay).
         for (int pass = 0; pass < 2; ++pass)
             if (smoothOutside(loc, true) == 0) break;
+    }
+
+    // The smallest angle of the faces (v, p, q) of `ring` (faces `faces`) with v moved from p0 to p1, or -1
+    // where one of them would turn over in the view (or, unseen, against its plane) or degenerate, a patch
+    // face would turn its normal more than maxNormalChangeDeg, or (with `floors`) a face would fall below
+    // its floor. uv: p1 in the view.
+    double ringScore(const Local& loc, const std::vector<std::pair<VertexIndex, VertexIndex>>& ring,
+                     const std::vector<FaceIndex>& faces, const Vec3& p0, const Vec3& p1, bool floors,
+                     Point2& uv) const {
+        const Mesh& S = loc.star.S;
+        double w;
+        if (!V_.project(p1, uv, w)) return -1.0;
+        double m = std::numbers::pi;
+        for (std::size_t i = 0; i < ring.size(); ++i) {
+            const auto [p, q] = ring[i];
+            if (!oriented(loc, faces[i], uv, loc.uv[p], loc.uv[q], p1, pt(S, p), pt(S, q)) ||
+                CGAL::collinear(toPoint(p1), S.point(p), S.point(q)))
+                return -1.0;
+            if (loc.patchSide[faces[i]] &&
+                angleBetween(normalOf(p0, pt(S, p), pt(S, q)), normalOf(p1, pt(S, p), pt(S, q))) >
+                    O_.maxNormalChangeDeg * kDeg)
+                return -1.0;
+            const double after = minAngle(p1, pt(S, p), pt(S, q));
+            if (floors && after < loc.minAllowed[faces[i]]) return -1.0;
+            m = std::min(m, after);
+        }
+        return m;
     }
 
     // A seam vertex on a mesh edge (a crossing, a snapped patch vertex) slides along that edge towards the
@@ -2400,26 +2427,7 @@ private:
         for (const auto& [p, q] : ring)
             oldMin = std::min(oldMin, minAngle(p0, pt(S, p), pt(S, q)));
         // The smallest angle around v moved to U + t (W - U), or -1 where a check fails.
-        auto score = [&](double t, Point2& uv) {
-            const Vec3 p1 = U + t * (W - U);
-            double w;
-            if (!V_.project(p1, uv, w)) return -1.0;
-            double newMin = std::numbers::pi;
-            for (std::size_t i = 0; i < ring.size(); ++i) {
-                const auto [p, q] = ring[i];
-                if (!oriented(loc, faces[i], uv, loc.uv[p], loc.uv[q], p1, pt(S, p), pt(S, q)) ||
-                    CGAL::collinear(toPoint(p1), S.point(p), S.point(q)))
-                    return -1.0;
-                if (loc.patchSide[faces[i]] &&
-                    angleBetween(normalOf(p0, pt(S, p), pt(S, q)), normalOf(p1, pt(S, p), pt(S, q))) >
-                        O_.maxNormalChangeDeg * kDeg)
-                    return -1.0;
-                const double after = minAngle(p1, pt(S, p), pt(S, q));
-                if (after < loc.minAllowed[faces[i]]) return -1.0;
-                newMin = std::min(newMin, after);
-            }
-            return newMin;
-        };
+        auto score = [&](double t, Point2& uv) { return ringScore(loc, ring, faces, p0, U + t * (W - U), true, uv); };
         double bestMin = oldMin, bestT = -1;
         Point2 bestUv;
         auto consider = [&](double t) {
@@ -2538,22 +2546,7 @@ private:
             // The smallest angle around v moved to p1, or -1 where a face would turn over in the view (or,
             // unseen, against its plane) or degenerate.
             auto score = [&](const Vec3& p1, Point2& uv) {
-                double w;
-                if (offSurface(p1) || !V_.project(p1, uv, w)) return -1.0;
-                double m = std::numbers::pi;
-                for (std::size_t i = 0; i < ring.size(); ++i) {
-                    const auto [p, q] = ring[i];
-                    if (!oriented(loc, ringFaces[i], uv, loc.uv[p], loc.uv[q], p1, pt(S, p), pt(S, q)) ||
-                        CGAL::collinear(toPoint(p1), S.point(p), S.point(q)))
-                        return -1.0;
-                    if (loc.patchSide[ringFaces[i]] &&
-                        angleBetween(normalOf(p0, pt(S, p), pt(S, q)), normalOf(p1, pt(S, p), pt(S, q))) > maxTurn)
-                        return -1.0;
-                    const double after = minAngle(p1, pt(S, p), pt(S, q));
-                    if (withPatch && after < loc.minAllowed[ringFaces[i]]) return -1.0;
-                    m = std::min(m, after);
-                }
-                return m;
+                return offSurface(p1) ? -1.0 : ringScore(loc, ring, ringFaces, p0, p1, withPatch, uv);
             };
             double oldMin = std::numbers::pi, nearest = std::numeric_limits<double>::infinity();
             for (const auto& [p, q] : ring) {
