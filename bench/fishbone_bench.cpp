@@ -5,7 +5,8 @@
 //  * regular:  scanPatch with the same camera at the resolution whose covered-pixel count equals the
 //    fishbone's sample count (calibrated once before timing: covered ∝ resolution²).
 // Both scans run alternately in the same loop; counters: fishbone_ms, regular_ms, ratio =
-// fishbone_ms / regular_ms, the two sample counts, and the stage times of the fishbone scan. The direction
+// fishbone_ms / regular_ms (wall clock: the target), cpu_ratio (the same with the process's CPU time, all
+// threads: steadier than the wall clock when the machine is shared), the two sample counts, and the stage times of the fishbone scan. The direction
 // fields are lazy (computed per tile while tracing, so their cost is in f_trace_ms); f_dir_pixels counts the
 // pixels they computed. Curvature and
 // the AABB tree are per-reference precomputations (cached in FishboneCache, as the Session keeps them):
@@ -22,6 +23,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <ctime>
 #include <memory>
 #include <string>
 
@@ -30,6 +32,14 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+// CPU time of the whole process (all threads, llvmpipe's included) in milliseconds: a load-independent
+// companion of the wall-clock ratio when other work shares the machine.
+double processCpuMs() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return 1e3 * double(t.tv_sec) + 1e-6 * double(t.tv_nsec);
 }
 
 struct Scene {
@@ -91,16 +101,21 @@ void BM_FishboneVsRegular(benchmark::State& state) {
         std::max(8, int(std::lround(512.0 * std::sqrt(double(fishSamples) / double(full.counts.covered)))));
     regParams.camera.width = regParams.camera.height = res;
 
+    double fishCpu = 0, regCpu = 0;
     double fishMs = 0, regMs = 0, dirMs = 0, traceMs = 0, castMs = 0, renderMs = 0, maskMs = 0, triMs = 0;
     std::size_t regSamples = 0, dirPixels = 0;
     for (auto _ : state) {
+        double c = processCpuMs();
         t = Clock::now();
         const fss::FishboneScanResult f =
             fss::scanFishbonePatch(scene.mesh, renderer, scene.mesh, renderer, fishParams, fb, cache);
         fishMs += msSince(t);
+        fishCpu += processCpuMs() - c;
+        c = processCpuMs();
         t = Clock::now();
         const fss::ScanResult r = fss::scanPatch(scene.mesh, renderer, scene.mesh, renderer, regParams);
         regMs += msSince(t);
+        regCpu += processCpuMs() - c;
         regSamples = r.counts.covered;
         dirPixels = f.counts.directionPixels;
         renderMs += f.timings.renderReference * 1e3;
@@ -116,6 +131,7 @@ void BM_FishboneVsRegular(benchmark::State& state) {
     state.counters["fishbone_ms"] = fishMs / n;
     state.counters["regular_ms"] = regMs / n;
     state.counters["ratio"] = fishMs / regMs;
+    state.counters["cpu_ratio"] = fishCpu / regCpu;
     state.counters["fish_samples"] = double(fishSamples);
     state.counters["reg_samples"] = double(regSamples);
     state.counters["reg_res"] = res;

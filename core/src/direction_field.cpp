@@ -20,7 +20,7 @@ Eigen::Vector3d toEigen(const Point3& p) {
     return {p.x(), p.y(), p.z()};
 }
 
-// Camera::project / ray with the matrices computed once (Camera rebuilds them on every call), same
+// Camera::unproject / ray with the matrices computed once (Camera rebuilds them on every call), same
 // conventions as camera.h.
 class Projector {
 public:
@@ -29,10 +29,6 @@ public:
           footprintPerDepth_(2.0 * std::tan(0.5 * c.viewAngleDeg * std::numbers::pi / 180.0) / c.height),
           viewDirection_(c.viewDirection()) {}
 
-    Eigen::Vector2d project(const Eigen::Vector3d& world) const {
-        const Eigen::Vector4d clip = vp_ * world.homogeneous();
-        return {(clip.x() / clip.w() + 1.0) * 0.5 * c_.width, (1.0 - clip.y() / clip.w()) * 0.5 * c_.height};
-    }
     Eigen::Vector3d unproject(double sx, double sy, double depth) const {
         const Eigen::Vector4d ndc(2.0 * sx / c_.width - 1.0, 1.0 - 2.0 * sy / c_.height, 2.0 * depth - 1.0,
                                   1.0);
@@ -43,6 +39,8 @@ public:
         const Eigen::Vector3d a = unproject(sx, sy, 0.0), b = unproject(sx, sy, 1.0);
         return {c_.parallel ? a : c_.eye, (b - a).normalized()};
     }
+    const Eigen::Matrix4d& viewProjection() const { return vp_; }
+    const Eigen::Matrix4d& inverse() const { return inverse_; }
     double pixelFootprint(const Eigen::Vector3d& p) const {
         if (c_.parallel) return 2.0 * c_.parallelScale / c_.height;
         return std::abs((p - c_.eye).dot(viewDirection_)) * footprintPerDepth_;
@@ -79,23 +77,37 @@ bool storePixel(Eigen::Vector2d& direction, float& anisotropy, const Eigen::Vect
     return true;
 }
 
-// The face a pixel shows: its vertices, corner positions and (unnormalised) normal. Neighbouring pixels
-// mostly show the same face, so the last one is kept (PixelFrame::face).
+// What the pixels of one face share (computed once per face, FaceCache): its corners, normal n, the
+// barycentric dual vectors gᵢ = n × (edge opposite corner i) / |n|² (so wᵢ = (p − qᵢ)·gᵢ with qᵢ the
+// next corner), and per corner the vertex normal, the anisotropy (0 where the curvature is undefined)
+// and, per principal direction, the vertex direction flipped to agree with the face's first defined one
+// (line field; zero where undefined).
 struct FaceGeometry {
     std::uint32_t id = FrameBuffers::kNoFace;
-    std::array<VertexIndex, 3> v;
-    Eigen::Vector3d a, b, c, n;
+    std::array<Eigen::Vector3d, 3> corner, g, normal;
+    std::array<std::array<Eigen::Vector3d, 3>, 2> dir; // [useMax][corner]
+    std::array<double, 3> aniso{};
+    Eigen::Vector3d n;
     double n2 = 0;
 };
 
+// The last faces seen, direct-mapped by id: neighbouring pixels, and the rows of a tile, mostly show the
+// faces just seen.
+struct FaceCache {
+    static constexpr std::size_t kSlots = 64;
+    std::array<FaceGeometry, kSlots> slots;
+};
+
 // What the per-pixel computation of both principal directions shares: the face, the barycentric
-// coordinates, the surface point, the interpolated normal and vertex anisotropy.
+// coordinates, the surface point, its clip coordinates, the interpolated normal and vertex anisotropy.
 struct PixelFrame {
-    FaceGeometry face;
+    FaceCache cache;
+    const FaceGeometry* face = nullptr;
     std::array<double, 3> w;
     Eigen::Vector3d p, N;
+    Eigen::Vector4d clip; // VP·(p, 1)
     double aniso = 0;
-    double eps = 0; // 10⁻³ pixel footprints at p
+    double footprint = 0; // pixel footprint at p (world units)
 };
 
 // The inputs of a direction field with their checks, and the per-pixel computation (header, steps 1–6).
@@ -103,111 +115,135 @@ class FieldSource {
 public:
     FieldSource(const Mesh& mesh, const CurvatureField& curvature, const FrameBuffers& buffers)
         : mesh_(mesh), curvature_(curvature), buffers_(buffers), projector_((validate(), buffers.camera)),
-          faceSlots_(mesh.number_of_faces() + mesh.number_of_removed_faces()) {}
+          faceSlots_(mesh.number_of_faces() + mesh.number_of_removed_faces()) {
+        // Perspective: the homogeneous far point of pixel (nx, ny) in NDC, H = M⁻¹·(nx, ny, 1, 1), is affine
+        // in (nx, ny), and so is H.xyz − eye·H.w, a (non-unit) direction of the ray from the eye.
+        const Camera& c = buffers.camera;
+        const Eigen::Matrix4d& inv = projector_.inverse();
+        auto dir = [&](const Eigen::Vector4d& h) { return Eigen::Vector3d(h.head<3>() - c.eye * h.w()); };
+        rayX_ = dir(inv.col(0)) * (2.0 / c.width);
+        rayY_ = dir(inv.col(1)) * (-2.0 / c.height);
+        ray0_ = dir(inv.col(2) + inv.col(3) - inv.col(0) + inv.col(1));
+    }
 
     int width() const { return buffers_.camera.width; }
     int height() const { return buffers_.camera.height; }
 
     // Steps 1–3 and the shared part of 4: false where the pixel can have no direction (background,
-    // degenerate face, barycentric coordinates all clamped away). \p fr keeps the last face between
-    // calls. \throw InvalidInputError for a face id that is no triangle of the mesh.
+    // degenerate face, barycentric coordinates all clamped away). \p fr caches faces between calls.
+    // \throw InvalidInputError for a face id that is no triangle of the mesh.
     bool frame(int x, int y, PixelFrame& fr) const {
         const std::uint32_t id = buffers_.faceAt(x, y);
         if (id == FrameBuffers::kNoFace) return false;
-        if (id != fr.face.id) fr.face = faceGeometry(id, x, y);
-        const FaceGeometry& face = fr.face;
-        const std::array<VertexIndex, 3>& v = face.v;
-        const Eigen::Vector3d &a = face.a, &b = face.b, &c = face.c, &n = face.n;
-        const double n2 = face.n2;
-        if (!(n2 > 0)) return false; // degenerate face: no plane, no direction
+        if (!fr.face || fr.face->id != id) {
+            FaceGeometry& slot = fr.cache.slots[id % FaceCache::kSlots];
+            if (slot.id != id) fillFace(slot, id, x, y);
+            fr.face = &slot;
+        }
+        const FaceGeometry& face = *fr.face;
+        const Eigen::Vector3d &a = face.corner[0], &n = face.n;
+        if (!(face.n2 > 0)) return false; // degenerate face: no plane, no direction
 
         // 3D point under the pixel centre: ray ∩ face plane (double), depth buffer as fallback.
-        const Ray ray = projector_.ray(x + 0.5, y + 0.5);
+        Ray ray;
+        if (buffers_.camera.parallel) {
+            ray = projector_.ray(x + 0.5, y + 0.5);
+        } else {
+            ray.origin = buffers_.camera.eye;
+            ray.direction = ray0_ + (x + 0.5) * rayX_ + (y + 0.5) * rayY_;
+        }
         const double denom = n.dot(ray.direction);
         Eigen::Vector3d p;
-        if (std::abs(denom) > 1e-12 * std::sqrt(n2))
+        if (std::abs(denom) > 1e-12 * std::sqrt(face.n2) * ray.direction.norm())
             p = ray.origin + (n.dot(a - ray.origin) / denom) * ray.direction;
         else
             p = projector_.unproject(x + 0.5, y + 0.5, double(buffers_.depthAt(x, y)));
 
         // Barycentric coordinates, clamped to the triangle (the pixel centre may lie a hair outside).
         std::array<double, 3>& w = fr.w;
-        w = {n.dot((b - p).cross(c - p)) / n2, n.dot((c - p).cross(a - p)) / n2,
-             n.dot((a - p).cross(b - p)) / n2};
         double sum = 0;
-        for (double& wi : w)
-            sum += (wi = std::max(0.0, wi));
+        for (std::size_t k = 0; k < 3; ++k)
+            sum += (w[k] = std::max(0.0, (p - face.corner[(k + 1) % 3]).dot(face.g[k])));
         if (!(sum > 0)) return false;
         for (double& wi : w)
             wi /= sum;
-        fr.p = w[0] * a + w[1] * b + w[2] * c;
+        fr.p = w[0] * a + w[1] * face.corner[1] + w[2] * face.corner[2];
+        fr.clip = projector_.viewProjection() * fr.p.homogeneous();
 
         // Into the tangent plane of the interpolated vertex normal (the smooth surface's plane at p). The
         // face plane would tilt D by up to half the dihedral angle of the faceting, which the
         // foreshortening near silhouettes turns into screen errors of degrees.
-        Eigen::Vector3d N = Eigen::Vector3d::Zero();
-        double aniso = 0;
-        for (int k = 0; k < 3; ++k) {
-            N += w[std::size_t(k)] * curvature_.normal[v[std::size_t(k)].idx()];
-            if (curvature_.isDefined(v[std::size_t(k)]))
-                aniso += w[std::size_t(k)] * curvature_.anisotropy[v[std::size_t(k)].idx()];
-        }
+        Eigen::Vector3d N = w[0] * face.normal[0] + w[1] * face.normal[1] + w[2] * face.normal[2];
         if (!(N.norm() > 1e-9)) N = n;
-        N.normalize();
-        fr.N = N;
-        fr.aniso = aniso;
-        fr.eps = 1e-3 * projector_.pixelFootprint(fr.p);
+        fr.N = N.normalized();
+        fr.aniso = w[0] * face.aniso[0] + w[1] * face.aniso[1] + w[2] * face.aniso[2];
+        fr.footprint = projector_.pixelFootprint(fr.p);
         return true;
     }
 
     // Steps 4–6 for one principal direction: false where it has no screen direction; else the unnormalised
     // screen direction and the anisotropy to store.
     bool direction(const PixelFrame& fr, bool useMax, Eigen::Vector2d& screen, double& anisotropy) const {
-        // Line field: align every vertex direction with the first defined one, then blend.
-        Eigen::Vector3d D = Eigen::Vector3d::Zero();
-        const Eigen::Vector3d* first = nullptr;
-        for (int k = 0; k < 3; ++k) {
-            const VertexIndex vk = fr.face.v[std::size_t(k)];
-            if (!curvature_.isDefined(vk)) continue;
-            // By magnitude: Max is the direction of the principal curvature of larger |k| (across a crease,
-            // convex or concave), Min the other.
-            const std::size_t vi = vk.idx();
-            const bool swapped = std::abs(curvature_.k2[vi]) > std::abs(curvature_.k1[vi]);
-            const Eigen::Vector3d& d = curvature_.direction(vk, useMax != swapped);
-            if (!first) first = &d;
-            D += (d.dot(*first) < 0 ? -fr.w[std::size_t(k)] : fr.w[std::size_t(k)]) * d;
-        }
+        const std::array<Eigen::Vector3d, 3>& d = fr.face->dir[useMax ? 1 : 0];
+        Eigen::Vector3d D = fr.w[0] * d[0] + fr.w[1] * d[1] + fr.w[2] * d[2];
         D -= D.dot(fr.N) * fr.N;
         const double coherence = D.norm();
         if (!(coherence > 1e-9)) return false;
         const Eigen::Vector3d unit = D / coherence;
-        screen = projector_.project(fr.p + fr.eps * unit) - projector_.project(fr.p - fr.eps * unit);
-        // A direction along the viewing ray projects to (almost) nothing: no screen direction.
-        if (!(screen.norm() > 1e-6 * 2e-3)) return false;
+        // The derivative of the projection at p along D̂ (pixels per world unit): the clip coordinates
+        // of p + t·D̂ are clip + t·VP·(D̂, 0).
+        const Eigen::Vector4d cu = projector_.viewProjection() * Eigen::Vector4d(unit.x(), unit.y(), unit.z(), 0.0);
+        const Eigen::Vector4d& c = fr.clip;
+        const double w2 = c.w() * c.w();
+        screen = {0.5 * width() * (cu.x() * c.w() - c.x() * cu.w()) / w2,
+                  -0.5 * height() * (cu.y() * c.w() - c.y() * cu.w()) / w2};
+        // A direction along the viewing ray projects to (almost) nothing: no screen direction (less than
+        // 10⁻⁶ pixels per pixel footprint).
+        if (!(screen.norm() * fr.footprint > 1e-6)) return false;
         anisotropy = fr.aniso * std::min(1.0, coherence);
         return true;
     }
 
 private:
-    FaceGeometry faceGeometry(std::uint32_t id, int x, int y) const {
+    void fillFace(FaceGeometry& g, std::uint32_t id, int x, int y) const {
         const FaceIndex f(id);
         if (std::size_t(id) >= faceSlots_ || mesh_.is_removed(f))
             throw InvalidInputError("The face id " + std::to_string(id) + " at pixel " + pixelName(x, y) +
                                     " is not a face of the mesh.");
-        FaceGeometry g;
+        std::array<VertexIndex, 3> v;
         int nv = 0;
         for (VertexIndex u : CGAL::vertices_around_face(mesh_.halfedge(f), mesh_)) {
             if (nv == 3) throw InvalidInputError("Face " + std::to_string(id) + " is not a triangle.");
-            g.v[std::size_t(nv++)] = u;
+            v[std::size_t(nv++)] = u;
         }
         if (nv != 3) throw InvalidInputError("Face " + std::to_string(id) + " is not a triangle.");
-        g.a = toEigen(mesh_.point(g.v[0]));
-        g.b = toEigen(mesh_.point(g.v[1]));
-        g.c = toEigen(mesh_.point(g.v[2]));
-        g.n = (g.b - g.a).cross(g.c - g.a);
+        for (std::size_t k = 0; k < 3; ++k)
+            g.corner[k] = toEigen(mesh_.point(v[k]));
+        g.n = (g.corner[1] - g.corner[0]).cross(g.corner[2] - g.corner[0]);
         g.n2 = g.n.squaredNorm();
+        for (std::size_t k = 0; k < 3; ++k)
+            g.g[k] = g.n2 > 0 ? Eigen::Vector3d(g.n.cross(g.corner[(k + 2) % 3] - g.corner[(k + 1) % 3]) / g.n2)
+                              : Eigen::Vector3d::Zero();
+        for (int useMax = 0; useMax < 2; ++useMax) {
+            const Eigen::Vector3d* first = nullptr;
+            for (std::size_t k = 0; k < 3; ++k) {
+                Eigen::Vector3d& out = g.dir[std::size_t(useMax)][k];
+                out.setZero();
+                if (!curvature_.isDefined(v[k])) continue;
+                // By magnitude: Max is the direction of the principal curvature of larger |k| (across a
+                // crease, convex or concave), Min the other.
+                const std::size_t vi = v[k].idx();
+                const bool swapped = std::abs(curvature_.k2[vi]) > std::abs(curvature_.k1[vi]);
+                const Eigen::Vector3d& d = curvature_.direction(v[k], (useMax != 0) != swapped);
+                out = first && d.dot(*first) < 0 ? Eigen::Vector3d(-d) : d;
+                if (!first) first = &d;
+            }
+        }
+        for (std::size_t k = 0; k < 3; ++k) {
+            g.normal[k] = curvature_.normal[v[k].idx()];
+            g.aniso[k] = curvature_.isDefined(v[k]) ? curvature_.anisotropy[v[k].idx()] : 0.0;
+        }
         g.id = id;
-        return g;
     }
 
     void validate() const {
@@ -230,6 +266,7 @@ private:
     const FrameBuffers& buffers_;
     Projector projector_;
     std::size_t faceSlots_;
+    Eigen::Vector3d ray0_, rayX_, rayY_; // perspective ray direction at pixel (sx, sy): ray0 + sx·rayX + sy·rayY
 };
 
 // One computed tile of a lazy field: the pixels [x0, x0 + w) × [y0, y0 + h), row-major.
@@ -299,7 +336,7 @@ private:
         t.w = std::min(tileSize, source.width() - x0);
         t.h = std::min(tileSize, source.height() - y0);
         t.pixels.resize(std::size_t(t.w) * std::size_t(t.h));
-        PixelFrame fr;
+        PixelFrame& fr = threadFrame();
         Eigen::Vector2d screen;
         double aniso = 0;
         for (int y = y0; y < y0 + t.h; ++y)
@@ -310,6 +347,26 @@ private:
                 }
         return t;
     }
+
+    // The calling thread's pixel frame for this field: the tiles one thread computes one after another
+    // are mostly neighbours along its streamlines, so its face cache carries over between them.
+    PixelFrame& threadFrame() const {
+        thread_local struct {
+            std::uint64_t owner = 0;
+            std::unique_ptr<PixelFrame> frame;
+        } local;
+        if (local.owner != serial || !local.frame) {
+            local.frame = std::make_unique<PixelFrame>();
+            local.owner = serial;
+        }
+        return *local.frame;
+    }
+
+    static std::uint64_t nextSerial() {
+        static std::atomic<std::uint64_t> counter{0};
+        return ++counter;
+    }
+    const std::uint64_t serial = nextSerial(); // identifies this field in the threads' frames
 
     mutable std::vector<std::atomic<const DirectionTile*>> tiles;
 };

@@ -138,11 +138,12 @@ struct DirectionFieldOptions {
 ///     D = Σ wᵢ·sᵢ·dᵢ (undefined vertices contribute 0) and projected into the tangent plane of the
 ///     interpolated vertex normal Σ wᵢ·nᵢ (not f's plane: the faceting would tilt D and foreshortening
 ///     near silhouettes magnifies that to degrees on the screen);
-///  5. the screen direction: project p ± ε·D̂ (ε = 10⁻³ pixel footprints) and normalise the difference;
+///  5. the screen direction: the derivative of the projection at p along D̂ (exact, from the clip
+///     coordinates), normalised;
 ///  6. anisotropy = (Σ wᵢ·aᵢ) · |D| (vertex anisotropies interpolated, times the coherence |D| ≤ 1 of the
 ///     three directions, which drops near singularities where they disagree).
 /// Invalid (background) pixels: no face, or no direction (all vertices undefined, directions cancelling,
-/// or the direction along the viewing ray).
+/// or the direction along the viewing ray: less than 10⁻⁶ pixels per pixel footprint on the screen).
 /// \param mesh       the reference mesh the buffers were rendered from
 /// \param curvature  estimateCurvature(mesh)
 /// \param buffers    ID buffer (and camera) of a render of \p mesh
