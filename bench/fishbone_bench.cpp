@@ -1,7 +1,10 @@
 // Issue 5, deliverable 7: a fishbone scan costs at most 2x a regular scan with the same number of samples.
 //
 // Per mesh (fandisk, 13k faces; a 100k-face torus), one GPU renderer (head-less) for both scans:
-//  * fishbone: scanFishbonePatch at 512² with h = 2 pixels (automatic mode, seed on a curved region);
+//  * fishbone: scanFishbonePatch with h = 2 pixels at 512² and with h = 1 pixel at 256² (the same view: the
+//    same surface region and about the same number of samples; automatic mode, seed on a curved region).
+//    At h = 1 the fishbone renders one pixel per sample, as the regular scan does; at h = 2 it renders
+//    four, so its render and per-pixel direction field cost more per sample;
 //  * regular:  scanPatch with the same camera at the resolution whose covered-pixel count equals the
 //    fishbone's sample count (calibrated once before timing: covered ∝ resolution²).
 // Both scans run alternately in the same loop; counters: fishbone_ms, regular_ms, ratio =
@@ -55,15 +58,16 @@ Eigen::AlignedBox3d bbox(const fss::Mesh& m) {
     return b;
 }
 
-Scene makeScene(int which) {
+Scene makeScene(int which, int resolution) {
     Scene s;
+    const int R = resolution;
     if (which == 0) {
         s.mesh = fss::readMesh(std::string(FSS_BENCH_MESH_DIR) + "/fandisk.off");
-        s.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(s.mesh), 512, 512);
-        s.seed = {0.4 * 512, 0.55 * 512}; // on fandisk's curved middle feature (as the CLI test)
+        s.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(s.mesh), R, R);
+        s.seed = {0.4 * R, 0.55 * R}; // on fandisk's curved middle feature (as the CLI test)
     } else {
         s.mesh = fss::shapes::torus(250, 200, 1.0, 0.35);
-        s.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(s.mesh), 512, 512);
+        s.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(s.mesh), R, R);
         const Eigen::Vector3d p =
             1.35 * Eigen::Vector3d(1, 1, 0).normalized(); // outer equator, facing the eye
         const Eigen::Vector3d q = s.camera.project(p);
@@ -73,7 +77,8 @@ Scene makeScene(int which) {
 }
 
 void BM_FishboneVsRegular(benchmark::State& state) {
-    const Scene scene = makeScene(int(state.range(0)));
+    const int h = int(state.range(1)), resolution = 256 * h;
+    const Scene scene = makeScene(int(state.range(0)), resolution);
     fss::render::GpuMeshRenderer renderer;
     renderer.setMesh(scene.mesh);
     fss::FishboneCache cache;
@@ -88,7 +93,7 @@ void BM_FishboneVsRegular(benchmark::State& state) {
     fishParams.camera = scene.camera;
     fss::FishboneParams fb;
     fb.seed = scene.seed;
-    fb.spacing = 2.0;
+    fb.spacing = double(h);
     const fss::FishboneScanResult probe =
         fss::scanFishbonePatch(scene.mesh, renderer, scene.mesh, renderer, fishParams, fb, cache);
     const std::size_t fishSamples = probe.counts.covered;
@@ -98,7 +103,7 @@ void BM_FishboneVsRegular(benchmark::State& state) {
     regParams.camera = scene.camera;
     const fss::ScanResult full = fss::scanPatch(scene.mesh, renderer, scene.mesh, renderer, regParams);
     const int res =
-        std::max(8, int(std::lround(512.0 * std::sqrt(double(fishSamples) / double(full.counts.covered)))));
+        std::max(8, int(std::lround(resolution * std::sqrt(double(fishSamples) / double(full.counts.covered)))));
     regParams.camera.width = regParams.camera.height = res;
 
     double fishCpu = 0, regCpu = 0;
@@ -145,7 +150,8 @@ void BM_FishboneVsRegular(benchmark::State& state) {
     state.counters["curvature_ms"] = curvatureMs;
     state.counters["aabb_ms"] = aabbMs;
     state.counters["threads"] = fss::scanThreads();
-    state.SetLabel(state.range(0) == 0 ? "fandisk" : "torus 100k");
+    state.SetLabel(std::string(state.range(0) == 0 ? "fandisk" : "torus 100k") + ", h = " + std::to_string(h) +
+                   " px at " + std::to_string(resolution) + "²");
 }
 
 } // namespace
@@ -156,6 +162,13 @@ const bool threadsFromEnvironment = [] {
     return true;
 }();
 
-BENCHMARK(BM_FishboneVsRegular)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(10);
+BENCHMARK(BM_FishboneVsRegular)
+    ->ArgNames({"mesh", "h"})
+    ->Args({0, 2})
+    ->Args({0, 1})
+    ->Args({1, 2})
+    ->Args({1, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(10);
 
 BENCHMARK_MAIN();
