@@ -77,6 +77,46 @@ std::optional<Eigen::Vector3d> hitOnFace(const Mesh& mesh, FaceIndex f, const Ra
     return ray.origin + t * ray.direction;
 }
 
+/// Walks over the mesh from face \p start towards the ray (a visibility walk in the ray's barycentric
+/// coordinates): in each face the ray's intersection with the face's plane has barycentric coordinates;
+/// when one is negative the walk crosses the edge opposite the most negative one. Returns the face the
+/// ray hits and the hit point, or nothing when the walk reaches a border, a face seen from its other side
+/// (a silhouette: the visible sheet ends there), a face the ray runs parallel to, or \p maxSteps faces.
+/// On meshes whose faces are smaller than a pixel the face under the rib vertex's pixel is often a
+/// neighbour of the hit face: the walk reaches it in a few steps, where a ring search tests dozens.
+std::optional<std::pair<FaceIndex, Eigen::Vector3d>> walkToHit(const Mesh& mesh, FaceIndex start, const Ray& ray,
+                                                              int maxSteps) {
+    FaceIndex f = start;
+    double startSign = 0;
+    for (int step = 0; step <= maxSteps; ++step) {
+        const HalfedgeIndex h0 = mesh.halfedge(f), h1 = mesh.next(h0), h2 = mesh.next(h1);
+        auto P = [&](VertexIndex v) {
+            const Point3& p = mesh.point(v);
+            return Eigen::Vector3d(p.x(), p.y(), p.z());
+        };
+        const Eigen::Vector3d a = P(mesh.source(h0)), b = P(mesh.target(h0)), c = P(mesh.target(h1));
+        const Eigen::Vector3d e1 = b - a, e2 = c - a, pv = ray.direction.cross(e2);
+        const double det = e1.dot(pv);
+        if (!(std::abs(det) >= 1e-14 * e1.norm() * e2.norm())) return std::nullopt;
+        if (step == 0) startSign = det;
+        if ((det > 0) != (startSign > 0)) return std::nullopt;
+        const Eigen::Vector3d tv = ray.origin - a, qv = tv.cross(e1);
+        const double u = tv.dot(pv) / det, v = ray.direction.dot(qv) / det, w = 1.0 - u - v; // of b, c, a
+        constexpr double eps = 1e-12;
+        if (u >= -eps && v >= -eps && w >= -eps) {
+            const double t = e2.dot(qv) / det;
+            if (t < 0) return std::nullopt;
+            return std::make_pair(f, Eigen::Vector3d(ray.origin + t * ray.direction));
+        }
+        // The edge opposite the most negative coordinate: a's is b→c (h1), b's is c→a (h2), c's is a→b (h0).
+        const HalfedgeIndex exit = (w <= u && w <= v) ? h1 : (u <= v ? h2 : h0);
+        const FaceIndex next = mesh.face(mesh.opposite(exit));
+        if (next == Mesh::null_face()) return std::nullopt;
+        f = next;
+    }
+    return std::nullopt;
+}
+
 /// A sharp edge of the reference as seen from the scan camera (screen positions of its end points).
 struct CreaseSegment {
     Eigen::Vector2d a, b;
@@ -288,6 +328,9 @@ FishboneOptions FishboneParams::defaultTracing() {
 
 // ---- Ray casting ----------------------------------------------------------------------------------------
 
+// Faces a hinted ray cast walks over the surface before it tries the neighbouring pixels' faces.
+constexpr int kMaxWalkSteps = 24;
+
 SampleGrid rayCastFishbone(const FishboneGrid& fishbone, const FrameBuffers& referenceBuffers,
                            const Mesh& reference, const RayCaster& caster, const ScanOptions& options,
                            const LocalSearchOptions& search, std::size_t* hintHits) {
@@ -326,8 +369,13 @@ SampleGrid rayCastFishbone(const FishboneGrid& fishbone, const FrameBuffers& ref
                         setSampleOnSurface(s, reference, projector, hint, *q, options);
                         continue;
                     }
-                    // The faces under the 8 neighbouring pixels (the vertex is near its pixel's border, or
-                    // the faces are smaller than a pixel): nearest hit among them.
+                    // Walk over the surface from the hint face towards the ray (faces smaller than a pixel).
+                    if (const auto walked = walkToHit(reference, hint, ray, kMaxWalkSteps)) {
+                        setSampleOnSurface(s, reference, projector, walked->first, walked->second, options);
+                        continue;
+                    }
+                    // The faces under the 8 neighbouring pixels (the walk met a border or a silhouette):
+                    // nearest hit among them.
                     std::optional<Eigen::Vector3d> best;
                     FaceIndex bestFace;
                     for (int dy = -1; dy <= 1; ++dy)

@@ -393,3 +393,51 @@ TEST(FishboneScan, TracedAndDrawnBackbonesRemoveTheAliasingOnASkewTriangulation)
     EXPECT_GE(run.grid.meanAngleDeg, 2 * run.drawn.meanAngleDeg);
     EXPECT_LT(run.drawn.hausdorff, 0.5 * run.grid.hausdorff);
 }
+
+// The hinted ray cast on a mesh whose faces are smaller than a pixel (a 100k-face torus at 128²): the face
+// under a rib vertex's pixel is mostly not the face its ray hits, so the cast walks over the surface from
+// it. Every rib vertex, at random sub-pixel positions, must land where the AABB tree's first intersection
+// of the same ray lies (the visible surface), and miss exactly where that misses.
+TEST(FishboneScan, HintedRayCastOnFacesSmallerThanAPixelMatchesTheAabbTree) {
+    const Mesh torus = fss::shapes::torus(250, 200, 1.0, 0.35);
+    const fss::Camera camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(torus), 128, 128);
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(torus);
+    const fss::FrameBuffers buffers = renderer.render(camera);
+    const fss::RayCaster caster(torus);
+
+    fss::FishboneGrid grid;
+    grid.rows = 120;
+    grid.cols = 120;
+    grid.spacing = 1.0;
+    grid.screen.resize(std::size_t(grid.rows) * std::size_t(grid.cols));
+    grid.present.assign(grid.screen.size(), 1);
+    std::uint64_t state = 12345;
+    auto uniform = [&state] { // deterministic LCG in [0, 1)
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return double(state >> 11) * 0x1.0p-53;
+    };
+    for (int r = 0; r < grid.rows; ++r)
+        for (int c = 0; c < grid.cols; ++c)
+            grid.screen[grid.index(r, c)] = {4.0 + c + uniform(), 4.0 + r + uniform()};
+
+    std::size_t hintHits = 0;
+    const fss::SampleGrid samples = fss::rayCastFishbone(grid, buffers, torus, caster, {}, {}, &hintHits);
+    std::size_t hits = 0;
+    double worst = 0;
+    for (int r = 0; r < grid.rows; ++r)
+        for (int c = 0; c < grid.cols; ++c) {
+            const Vector2d p = grid.at(r, c);
+            const fss::SurfacePoint truth = caster.intersect(camera.ray(p.x(), p.y()));
+            const fss::Sample& s = samples.at(r, c);
+            ASSERT_EQ(s.hit, bool(truth)) << "rib vertex " << point(p);
+            if (!truth) continue;
+            ++hits;
+            worst = std::max(worst, (s.point - truth.point).norm());
+        }
+    EXPECT_GT(hits, std::size_t(grid.rows * grid.cols) / 5); // the torus covers about a quarter of the window
+    EXPECT_LT(worst, 1e-9); // the same point on the visible surface
+    std::printf("hinted ray cast on the 100k-face torus at 128²: %zu hits, %zu on the pixel's face, worst distance %.2e\n", hits, hintHits, worst);
+    // The pixel's own face is hit by fewer than 2/3 of the rays: most of the rest needed the walk.
+    EXPECT_LT(hintHits, 2 * hits / 3);
+}
