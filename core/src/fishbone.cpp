@@ -55,17 +55,15 @@ Closest closestOnPolyline(const Polyline2& line, const Eigen::Vector2d& p) {
     return best;
 }
 
-// A rib half traced from p0 along the rib field, or just {p0} when the field is undefined there.
-Polyline2 traceRibHalf(const DirectionField& field, const Eigen::Vector2d& p0, const Eigen::Vector2d& side,
-                       const FishboneOptions& options) {
+// Whether a rib half can be traced from p0 (else it is just {p0}): the rib field is defined there.
+bool ribHalfTraceable(const DirectionField& field, const Eigen::Vector2d& p0, const Eigen::Vector2d& side,
+                      const FishboneOptions& options) {
     const StreamlineOptions& o = options.ribTracing;
     const bool inImage = p0.x() >= 0 && p0.y() >= 0 && p0.x() <= field.width && p0.y() <= field.height;
     const std::optional<DirectionSample> s = inImage ? field.sample(p0, side) : std::nullopt;
     const bool undefined =
         s && s->anisotropy < o.minAnisotropy && o.lowAnisotropy == LowAnisotropyPolicy::Stop;
-    if (!s || undefined || (o.insideRegion && !o.insideRegion(p0))) return {p0};
-    const StreamlineHalf half = traceStreamlineHalf(field, p0, side, o);
-    return resampleAtSpacing(half.points, options.spacing);
+    return s && !undefined && (!o.insideRegion || o.insideRegion(p0));
 }
 
 // Splits a dense polyline at its point nearest to p0 into two halves starting at p0.
@@ -245,9 +243,20 @@ Rib traceRib(const DirectionField& ribField, const Backbone& backbone, std::size
                                 " does not exist (the backbone has " +
                                 std::to_string(backbone.samples.size()) + " samples).");
     const Eigen::Vector2d p0 = backbone.samples[row], n = backbone.normal(row);
-    Rib rib;
-    rib.positive = traceRibHalf(ribField, p0, n, options);
-    rib.negative = traceRibHalf(ribField, p0, -n, options);
+    const bool positive = ribHalfTraceable(ribField, p0, n, options);
+    const bool negative = ribHalfTraceable(ribField, p0, -n, options);
+    Rib rib{{p0}, {p0}};
+    if (positive && negative) { // the common case: both halves in lockstep (traceTwoHalves)
+        const auto [pos, neg] = traceTwoHalves(ribField, {p0, n}, {p0, -n}, options.ribTracing);
+        rib.positive = resampleAtSpacing(pos.points, options.spacing);
+        rib.negative = resampleAtSpacing(neg.points, options.spacing);
+    } else if (positive) {
+        rib.positive = resampleAtSpacing(traceStreamlineHalf(ribField, p0, n, options.ribTracing).points,
+                                         options.spacing);
+    } else if (negative) {
+        rib.negative = resampleAtSpacing(traceStreamlineHalf(ribField, p0, -n, options.ribTracing).points,
+                                         options.spacing);
+    }
     return rib;
 }
 

@@ -82,84 +82,94 @@ Polyline2 Streamline::backward() const {
     return out;
 }
 
-StreamlineHalf traceStreamlineHalf(const DirectionField& field, const Eigen::Vector2d& seed,
-                                   const Eigen::Vector2d& initialDirection,
-                                   const StreamlineOptions& options) {
-    validate(options);
-    if (!seed.allFinite() || !initialDirection.allFinite() || initialDirection.isZero())
-        throw InvalidInputError("A streamline needs a finite seed and a non-zero initial direction.");
-    const Tracer tracer(field, options);
-    const Evaluation start = tracer.evaluate(seed, initialDirection);
-    if (!start.direction)
-        throw InvalidInputError("The streamline seed " + pointName(seed) +
-                                " lies where the direction field is undefined (background, image border, "
-                                "outside the region or too low anisotropy).");
+namespace {
 
-    const double cosMaxTurn = std::cos(options.maxTurnDeg * std::numbers::pi / 180.0);
-    StreamlineHalf half;
-    half.points.push_back(seed);
-    Eigen::Vector2d p = seed, previous = *start.direction;
-    double step = options.step;
-    std::size_t steps = 0;
-    // The field at p aligned with `previous`: the last accepted step's end evaluation is exactly the next
-    // step's first (same position, same reference), so each step costs four field samples, not five.
-    std::optional<Evaluation> atP;
-    for (;;) {
-        if (steps >= options.maxSteps) {
-            half.stop = StreamlineStop::StepLimit;
-            break;
-        }
-        const double remaining = options.maxLength - half.length;
-        if (remaining <= 0) {
-            half.stop = StreamlineStop::MaxLength;
-            break;
-        }
-        const bool last = remaining <= step;
-        const double h = last ? remaining : step;
+// One half being traced, one attempted RK4 step at a time, the step split into its stages (begin: the
+// first evaluation when not reused; the three further stages; end: the evaluation at the step's end, the
+// stop tests, accept or retry). Tracing two halves stage by stage in lockstep (traceTwoHalves) puts their
+// independent field evaluations next to each other, so the processor overlaps their chains of dependent
+// loads, square roots and divisions; each half's result is exactly the same as traced alone.
+class HalfTracer {
+public:
+    HalfTracer(const DirectionField& field, const Eigen::Vector2d& seed, const Eigen::Vector2d& initialDirection,
+               const StreamlineOptions& options)
+        : tracer_(field, options), o_(options), seed_(seed),
+          cosMaxTurn_(std::cos(options.maxTurnDeg * std::numbers::pi / 180.0)), step_(options.step) {
+        validate(options);
+        if (!seed.allFinite() || !initialDirection.allFinite() || initialDirection.isZero())
+            throw InvalidInputError("A streamline needs a finite seed and a non-zero initial direction.");
+        const Evaluation start = tracer_.evaluate(seed, initialDirection);
+        if (!start.direction)
+            throw InvalidInputError("The streamline seed " + pointName(seed) +
+                                    " lies where the direction field is undefined (background, image border, "
+                                    "outside the region or too low anisotropy).");
+        startDirection_ = previous_ = *start.direction;
+        half_.points.push_back(seed);
+        p_ = seed;
+    }
 
-        // One RK4 step; every evaluation aligned with the previous step's direction.
+    bool done() const { return done_; }
+
+    // Starts an attempted step: the stop tests before it, its length and the field at p.
+    void begin() {
+        if (done_) return;
+        if (steps_ >= o_.maxSteps) return finish(StreamlineStop::StepLimit);
+        remaining_ = o_.maxLength - half_.length;
+        if (remaining_ <= 0) return finish(StreamlineStop::MaxLength);
+        last_ = remaining_ <= step_;
+        h_ = last_ ? remaining_ : step_;
+        if (!atP_) atP_ = tracer_.evaluate(p_, previous_);
+    }
+    // The RK4 stages, every evaluation aligned with the previous step's direction.
+    void stage2() {
+        if (done_) return;
+        k2_ = atP_->direction ? tracer_.evaluate(p_ + 0.5 * h_ * *atP_->direction, previous_) : *atP_;
+    }
+    void stage3() {
+        if (done_) return;
+        k3_ = k2_.direction ? tracer_.evaluate(p_ + 0.5 * h_ * *k2_.direction, previous_) : k2_;
+    }
+    void stage4() {
+        if (done_) return;
+        k4_ = k3_.direction ? tracer_.evaluate(p_ + h_ * *k3_.direction, previous_) : k3_;
+    }
+    // Ends the attempted step: accepted (the half grows by one point) or retried with half the step.
+    void end() {
+        if (done_) return;
         std::optional<StreamlineStop> failure;
         Eigen::Vector2d delta = Eigen::Vector2d::Zero();
-        {
-            if (!atP) atP = tracer.evaluate(p, previous);
-            const Evaluation& k1 = *atP;
-            const Evaluation k2 = k1.direction ? tracer.evaluate(p + 0.5 * h * *k1.direction, previous) : k1;
-            const Evaluation k3 = k2.direction ? tracer.evaluate(p + 0.5 * h * *k2.direction, previous) : k2;
-            const Evaluation k4 = k3.direction ? tracer.evaluate(p + h * *k3.direction, previous) : k3;
-            if (!k4.direction) {
-                failure = k4.reason;
-            } else {
-                delta =
-                    (h / 6.0) * (*k1.direction + 2.0 * *k2.direction + 2.0 * *k3.direction + *k4.direction);
-                if (!(delta.norm() > 0)) failure = StreamlineStop::SharpTurn;
-            }
+        if (!k4_.direction) {
+            failure = k4_.reason;
+        } else {
+            delta = (h_ / 6.0) *
+                    (*atP_->direction + 2.0 * *k2_.direction + 2.0 * *k3_.direction + *k4_.direction);
+            if (!(delta.norm() > 0)) failure = StreamlineStop::SharpTurn;
         }
-        if (!failure && last) delta *= remaining / delta.norm(); // end exactly at maxLength
-        Eigen::Vector2d q = p + delta;
+        if (!failure && last_) delta *= remaining_ / delta.norm(); // end exactly at maxLength
+        Eigen::Vector2d q = p_ + delta;
         std::optional<Evaluation> atQ;
         if (!failure) {
             // Aligned with the new heading: if the step is accepted this is the next step's k1.
-            atQ = tracer.evaluate(q, delta);
+            atQ = tracer_.evaluate(q, delta);
             if (!atQ->direction)
                 failure = atQ->reason;
-            else if (delta.normalized().dot(previous) < cosMaxTurn)
+            else if (delta.normalized().dot(previous_) < cosMaxTurn_)
                 failure = StreamlineStop::SharpTurn;
         }
         if (failure) {
-            if (h > options.minStep) {
-                step = std::max(options.minStep, 0.5 * h);
-                continue;
+            if (h_ > o_.minStep) {
+                step_ = std::max(o_.minStep, 0.5 * h_);
+                return;
             }
-            half.stop = *failure;
-            break;
+            return finish(*failure);
         }
 
         // Accept the step, moved onto the attracting curve when there is one nearby.
-        if (options.attractor && !last) {
-            if (const std::optional<Eigen::Vector2d> a = options.attractor(q, delta.normalized());
-                a && a->allFinite() && (*a - p).norm() > 1e-9) {
-                const Eigen::Vector2d moved = *a - p;
-                if (Evaluation e = tracer.evaluate(*a, moved); e.direction && moved.dot(previous) > 0) {
+        if (o_.attractor && !last_) {
+            if (const std::optional<Eigen::Vector2d> a = o_.attractor(q, delta.normalized());
+                a && a->allFinite() && (*a - p_).norm() > 1e-9) {
+                const Eigen::Vector2d moved = *a - p_;
+                if (Evaluation e = tracer_.evaluate(*a, moved); e.direction && moved.dot(previous_) > 0) {
                     q = *a;
                     delta = moved;
                     atQ = std::move(e);
@@ -167,28 +177,82 @@ StreamlineHalf traceStreamlineHalf(const DirectionField& field, const Eigen::Vec
             }
         }
         const double len = delta.norm();
-        half.points.push_back(q);
-        half.length += len;
-        previous = delta / len;
-        ++steps;
-        if (last) {
-            half.length = options.maxLength;
-            half.stop = StreamlineStop::MaxLength;
-            break;
+        half_.points.push_back(q);
+        half_.length += len;
+        previous_ = delta / len;
+        ++steps_;
+        if (last_) {
+            half_.length = o_.maxLength;
+            return finish(StreamlineStop::MaxLength);
         }
         // Closed integral curve: the step passed the seed again, heading the way it started.
-        if (half.length > 8.0 * options.step) {
-            const double t = std::clamp((seed - p).dot(delta) / (len * len), 0.0, 1.0);
-            if ((p + t * delta - seed).norm() < 0.5 * options.step && previous.dot(*start.direction) > 0) {
-                half.stop = StreamlineStop::Closed;
-                break;
-            }
+        if (half_.length > 8.0 * o_.step) {
+            const double t = std::clamp((seed_ - p_).dot(delta) / (len * len), 0.0, 1.0);
+            if ((p_ + t * delta - seed_).norm() < 0.5 * o_.step && previous_.dot(startDirection_) > 0)
+                return finish(StreamlineStop::Closed);
         }
-        p = q;
-        atP = std::move(atQ);
-        step = std::min(options.step, 2.0 * step);
+        p_ = q;
+        atP_ = std::move(atQ);
+        step_ = std::min(o_.step, 2.0 * step_);
     }
-    return half;
+
+    StreamlineHalf take() { return std::move(half_); }
+
+private:
+    void finish(StreamlineStop reason) {
+        half_.stop = reason;
+        done_ = true;
+    }
+
+    Tracer tracer_;
+    const StreamlineOptions& o_;
+    Eigen::Vector2d seed_, startDirection_, p_, previous_;
+    double cosMaxTurn_, step_;
+    double remaining_ = 0, h_ = 0; // of the attempted step
+    bool last_ = false;            // the attempted step ends at maxLength
+    std::size_t steps_ = 0;
+    // The field at p aligned with `previous`: the last accepted step's end evaluation is exactly the next
+    // step's first (same position, same reference), so each step costs four field samples, not five.
+    std::optional<Evaluation> atP_;
+    Evaluation k2_, k3_, k4_;
+    StreamlineHalf half_;
+    bool done_ = false;
+};
+
+} // namespace
+
+StreamlineHalf traceStreamlineHalf(const DirectionField& field, const Eigen::Vector2d& seed,
+                                   const Eigen::Vector2d& initialDirection,
+                                   const StreamlineOptions& options) {
+    HalfTracer t(field, seed, initialDirection, options);
+    while (!t.done()) {
+        t.begin();
+        t.stage2();
+        t.stage3();
+        t.stage4();
+        t.end();
+    }
+    return t.take();
+}
+
+std::pair<StreamlineHalf, StreamlineHalf> traceTwoHalves(const DirectionField& field, const HalfStart& first,
+                                                         const HalfStart& second,
+                                                         const StreamlineOptions& options) {
+    HalfTracer a(field, first.seed, first.initialDirection, options);
+    HalfTracer b(field, second.seed, second.initialDirection, options);
+    while (!a.done() || !b.done()) {
+        a.begin();
+        b.begin();
+        a.stage2();
+        b.stage2();
+        a.stage3();
+        b.stage3();
+        a.stage4();
+        b.stage4();
+        a.end();
+        b.end();
+    }
+    return {a.take(), b.take()};
 }
 
 Streamline traceStreamline(const DirectionField& field, const Eigen::Vector2d& seed,
