@@ -328,3 +328,36 @@ TEST(Streamline, AttractorKeepsTheLineOnAnAttractingCurve) {
     EXPECT_NEAR(crossing.points.back().y(), 70.0, 1e-9);
     EXPECT_NEAR(crossing.points.back().x(), 100.0, 1e-9);
 }
+
+// Two halves traced in lockstep are exactly the halves traced one after the other, whatever stops them:
+// on the circle field, two seeds with different lengths and stops (image border, closed circle, max length,
+// background of a cut-out).
+TEST(Streamline, TwoHalvesInLockstepEqualTwoSingleHalves) {
+    DirectionField f = makeField(512, 512, circleTangent, 3);
+    for (int y = 300; y < 340; ++y) // a hole the circles through it stop at
+        for (int x = 100; x < 140; ++x)
+            f.setPixel(x, y, Eigen::Vector2d::Zero(), 0.0);
+    fss::StreamlineOptions o;
+    o.step = 1.0;
+    o.maxTurnDeg = 12.0;
+    const std::pair<fss::HalfStart, fss::HalfStart> cases[] = {
+        {{{256.0, 50.0}, {1, 0}}, {{256.0, 50.0}, {-1, 0}}},   // radius 206: passes the hole
+        {{{300.0, 255.0}, {0, 1}}, {{20.0, 260.0}, {0, -1}}},  // radius 44 (closes), radius 236 (border)
+        {{{256.0, 150.0}, {-1, 0}}, {{256.0, 200.0}, {1, 0}}}, // different radii, both closed circles
+    };
+    for (double maxLength : {std::numeric_limits<double>::infinity(), 150.0})
+        for (const auto& [a, b] : cases) {
+            o.maxLength = maxLength;
+            const auto [la, lb] = fss::traceTwoHalves(f, a, b, o);
+            const fss::StreamlineHalf sa = fss::traceStreamlineHalf(f, a.seed, a.initialDirection, o);
+            const fss::StreamlineHalf sb = fss::traceStreamlineHalf(f, b.seed, b.initialDirection, o);
+            for (const auto& [lock, single] : {std::pair{&la, &sa}, std::pair{&lb, &sb}}) {
+                EXPECT_EQ(lock->stop, single->stop);
+                EXPECT_EQ(lock->length, single->length);
+                ASSERT_EQ(lock->points.size(), single->points.size());
+                EXPECT_GT(lock->points.size(), 20u);
+                for (std::size_t i = 0; i < lock->points.size(); ++i)
+                    ASSERT_EQ(lock->points[i], single->points[i]) << "point " << i;
+            }
+        }
+}
