@@ -12,13 +12,13 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <iomanip>
 #include <limits>
 #include <numbers>
 #include <numeric>
-#include <random>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -275,35 +275,60 @@ std::vector<FaceIndex> nonDegenerateFaces(const Mesh& m) {
     return faces;
 }
 
-/// Points on a surface for the distance measurement: its vertices, plus about \p count area-uniform
-/// random points (stratified: each face gets its expected share, the fraction decided at random).
+/// Points on a surface for the distance measurement. `fixed`: its vertices, edge midpoints and face
+/// centroids (where the distance between two nearby surfaces peaks when they are triangulated
+/// differently: across a face, along an edge). `random`: about \p count area-uniform random points
+/// (stratified: each face gets its expected share, the fraction decided at random). Each face draws its
+/// random points from a generator seeded by its own corner coordinates (in sorted order), so the points
+/// depend only on the geometry: the same surface gives the same figures whatever the order of its faces
+/// and vertices (a mesh in memory with removed elements and the file it was written to agree).
 struct SurfaceSamples {
-    std::vector<Point3> vertices;
+    std::vector<Point3> fixed;
     std::vector<Point3> random;
 };
 
+/// splitmix64: a small, well-mixing generator for the per-face seeds and draws.
+std::uint64_t splitmix64(std::uint64_t& state) {
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31);
+}
+
+Point3 mix(const Point3& a, const Point3& b, const Point3& c, double wa, double wb, double wc) {
+    return {wa * a.x() + wb * b.x() + wc * c.x(), wa * a.y() + wb * b.y() + wc * c.y(),
+            wa * a.z() + wb * b.z() + wc * c.z()};
+}
+
 SurfaceSamples sampleSurface(const Mesh& m, double totalArea, std::size_t count, std::uint64_t seed) {
     SurfaceSamples s;
-    s.vertices.reserve(m.number_of_vertices());
+    s.fixed.reserve(m.number_of_vertices() + m.number_of_edges() + m.number_of_faces());
     for (VertexIndex v : m.vertices())
-        s.vertices.push_back(m.point(v));
+        s.fixed.push_back(m.point(v));
+    for (EdgeIndex e : m.edges())
+        s.fixed.push_back(CGAL::midpoint(m.point(m.vertex(e, 0)), m.point(m.vertex(e, 1))));
+    for (FaceIndex f : m.faces()) {
+        const auto [a, b, c] = corners(m, f);
+        s.fixed.push_back(CGAL::centroid(a, b, c));
+    }
     if (!(totalArea > 0) || count == 0) return s;
 
-    std::mt19937_64 rng(seed);
-    std::uniform_real_distribution<double> uniform(0.0, 1.0);
     s.random.reserve(count + m.number_of_faces());
     const double perArea = double(count) / totalArea;
     for (FaceIndex f : m.faces()) {
         const double expected = triangleArea(m, f) * perArea;
+        std::array<Point3, 3> p = corners(m, f);
+        std::sort(p.begin(), p.end()); // lexicographic: the face's points do not depend on its rotation
+        std::uint64_t state = seed;
+        for (const Point3& q : p)
+            for (int i = 0; i < 3; ++i)
+                state ^= splitmix64(state) + std::bit_cast<std::uint64_t>(q[i]);
+        auto uniform = [&state] { return double(splitmix64(state) >> 11) * 0x1.0p-53; };
         std::size_t k = std::size_t(expected);
-        if (uniform(rng) < expected - double(k)) ++k;
-        if (k == 0) continue;
-        const auto [a, b, c] = corners(m, f);
+        if (uniform() < expected - double(k)) ++k;
         for (std::size_t i = 0; i < k; ++i) {
-            const double r = std::sqrt(uniform(rng)), t = uniform(rng);
-            const double wa = 1 - r, wb = r * (1 - t), wc = r * t;
-            s.random.emplace_back(wa * a.x() + wb * b.x() + wc * c.x(), wa * a.y() + wb * b.y() + wc * c.y(),
-                                  wa * a.z() + wb * b.z() + wc * c.z());
+            const double r = std::sqrt(uniform()), t = uniform();
+            s.random.push_back(mix(p[0], p[1], p[2], 1 - r, r * (1 - t), r * t));
         }
     }
     return s;
@@ -315,13 +340,13 @@ struct OneSidedDistance {
 };
 
 /// Distances from the samples to the surface in \p tree: the maximum over all samples and the RMS over
-/// the random (area-uniform) samples, or over the vertices when there are none.
+/// the random (area-uniform) samples, or over the fixed points when there are none.
 OneSidedDistance measureDistance(const SurfaceSamples& samples, const FaceTree& tree,
                                  const Progress& progress, std::string_view stage, double begin, double end) {
     OneSidedDistance d;
-    const std::size_t total = samples.vertices.size() + samples.random.size();
+    const std::size_t total = samples.fixed.size() + samples.random.size();
     std::size_t done = 0;
-    double maxSq = 0, sumSqVertices = 0, sumSqRandom = 0;
+    double maxSq = 0, sumSqFixed = 0, sumSqRandom = 0;
     auto query = [&](const Point3& p) {
         const double sq = tree.squared_distance(p);
         maxSq = std::max(maxSq, sq);
@@ -329,15 +354,15 @@ OneSidedDistance measureDistance(const SurfaceSamples& samples, const FaceTree& 
             progress.report(begin + (end - begin) * double(done) / double(total), stage);
         return sq;
     };
-    for (const Point3& p : samples.vertices)
-        sumSqVertices += query(p);
+    for (const Point3& p : samples.fixed)
+        sumSqFixed += query(p);
     for (const Point3& p : samples.random)
         sumSqRandom += query(p);
     d.max = std::sqrt(maxSq);
     if (!samples.random.empty())
         d.rms = std::sqrt(sumSqRandom / double(samples.random.size()));
-    else if (!samples.vertices.empty())
-        d.rms = std::sqrt(sumSqVertices / double(samples.vertices.size()));
+    else if (!samples.fixed.empty())
+        d.rms = std::sqrt(sumSqFixed / double(samples.fixed.size()));
     progress.report(end, stage);
     return d;
 }

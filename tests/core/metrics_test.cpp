@@ -699,3 +699,37 @@ INSTANTIATE_TEST_SUITE_P(CgalData, MetricsOnSampleMesh,
                              std::replace(name.begin(), name.end(), '-', '_');
                              return name;
                          });
+
+// The distances depend only on the geometry: the same surfaces with their vertices and faces in another
+// order (and each face starting at another corner) give exactly the same Hausdorff distances (the RMS to
+// rounding), so a mesh measured in
+// memory and the file written from it agree.
+TEST(Metrics, DistancesDoNotDependOnTheOrderOfVerticesAndFaces) {
+    auto permuted = [](const Mesh& m) {
+        std::vector<fss::VertexIndex> order(m.vertices().begin(), m.vertices().end());
+        std::reverse(order.begin(), order.end());
+        std::rotate(order.begin(), order.begin() + std::ptrdiff_t(order.size() / 3), order.end());
+        Mesh out;
+        std::map<fss::VertexIndex, fss::VertexIndex> to;
+        for (fss::VertexIndex v : order)
+            to[v] = out.add_vertex(m.point(v));
+        std::vector<fss::FaceIndex> faces(m.faces().begin(), m.faces().end());
+        std::reverse(faces.begin(), faces.end());
+        std::size_t k = 0;
+        for (fss::FaceIndex f : faces) {
+            std::vector<fss::VertexIndex> c;
+            for (fss::VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m))
+                c.push_back(to[v]);
+            std::rotate(c.begin(), c.begin() + std::ptrdiff_t(k++ % 3), c.end());
+            EXPECT_NE(out.add_face(c), Mesh::null_face());
+        }
+        return out;
+    };
+    const Mesh a = fss::shapes::uvSphere(24, 12), b = fss::shapes::icosphere(3);
+    const Metrics x = withReference(a, b), y = withReference(permuted(a), permuted(b));
+    ASSERT_TRUE(x.hausdorffToRef && y.hausdorffToRef && x.hausdorffFromRef && y.hausdorffFromRef);
+    EXPECT_GT(*x.hausdorffToRef, 0.0);
+    EXPECT_EQ(*x.hausdorffToRef, *y.hausdorffToRef);
+    EXPECT_EQ(*x.hausdorffFromRef, *y.hausdorffFromRef);
+    EXPECT_NEAR(*x.rmsToRef, *y.rmsToRef, 1e-12 * *x.rmsToRef); // the same points, summed in another order
+}

@@ -71,16 +71,19 @@ struct Metrics {
     double area = 0;                ///< area
 
     /// Distances to the reference (MetricsOptions::reference), absolute and relative to its bbox diagonal.
-    /// Each one-sided Hausdorff distance is the maximum, over the vertices and uniformly random points
-    /// (fixed seed) of one surface, of the exact distance to the other surface (CGAL AABB tree): a lower
-    /// bound of the true value that converges with the sample density. The distances *to* the reference
-    /// are null when this mesh has no vertex, those *from* it when this mesh has no non-degenerate face.
+    /// Each one-sided Hausdorff distance is the maximum, over the vertices, edge midpoints, face centroids
+    /// and area-uniform random points of one surface, of the exact distance to the other surface (CGAL
+    /// AABB tree): a lower bound of the true value that converges with the sample density. Each face's
+    /// random points are drawn from its own corner coordinates, so the distances depend only on the
+    /// geometry (the RMS up to rounding), not on the order of faces and vertices: a mesh in memory and
+    /// the file written from it agree. The distances *to* the reference are null when this mesh has no
+    /// vertex, those *from* it when this mesh has no non-degenerate face.
     std::optional<double> hausdorffToRef;      ///< hausdorff_to_ref: max over this mesh of distance to ref
     std::optional<double> hausdorffFromRef;    ///< hausdorff_from_ref: max over ref of distance to this mesh
     std::optional<double> hausdorffToRefRel;   ///< hausdorff_to_ref_rel
     std::optional<double> hausdorffFromRefRel; ///< hausdorff_from_ref_rel
     /// rms_to_ref: root mean square distance to ref over area-uniform random points of this mesh (over its
-    /// vertices when it has no area).
+    /// vertices, edge midpoints and face centroids when it has no area).
     std::optional<double> rmsToRef;
 };
 
