@@ -99,16 +99,25 @@ TEST(CliAuto, FandiskIsCoveredClosedManifoldAndFreeOfSelfIntersections) {
     EXPECT_NEAR(double(m.vertices), 6475.0, 0.15 * 6475.0);
     // Issue #7: minimum angle ≥ 10°.
     EXPECT_GE(m.minAngleDeg, 10.0);
+    // The seam relaxation (auto_remesh.h, step 6) ran and was kept: fraction of valence-6 interior vertices
+    // measured 0.772 (0.658 without it; CGAL's isotropic remeshing 0.773; the criterion, 0.90, below).
+    EXPECT_GT(r.report.at("seam_flips").get<int>(), 0);
+    EXPECT_GT(r.report.at("seam_collapses").get<int>(), 0);
+    EXPECT_FALSE(r.report.at("seam_relax_discarded").get<bool>());
+    EXPECT_GE(m.fracValence6Interior, 0.76);
 }
 
 // Issue #7's regularity and distance criteria on fandisk. NOT MET YET, measured on this branch
 // (`fss-remesh auto fandisk.off -o out.ply --json`, GPU renderer; bench_auto gives the same figures):
-// fraction of valence-6 interior vertices 0.699 (criterion ≥ 0.90; CGAL's isotropic remeshing: 0.773),
-// Hausdorff distance to / from the input 0.00870 / 0.00890 of the bbox diagonal (criterion: ≤ CGAL's
-// 0.00135 / 0.00135). With one region per view the 8 initial patches alone reach 0.77 valence 6 at 0.88
-// coverage; the stitch trims them at many seams and the follow-up scans that fill those gaps are small and
-// irregular. The pixel grids also cut the sharp edges that CGAL keeps as constraints (--fishbone auto keeps them on a cube, see core_auto_remesh_test, but not yet
-// on fandisk).
+// fraction of valence-6 interior vertices 0.772 (criterion ≥ 0.90; CGAL's isotropic remeshing: 0.773; 0.658
+// before the seam relaxation), Hausdorff distance to / from the input 0.00857 / 0.00990 of the bbox diagonal
+// (criterion: ≤ CGAL's 0.00135 / 0.00135). With one region per view the 8 initial patches alone reach 0.77
+// valence 6 at 0.88 coverage; the stitch trims them at many seams and the follow-up scans that fill those
+// gaps are small and irregular; the seam relaxation's flips and collapses stop at pairs of valence-5 and -7
+// vertices and at feature lines (whose vertices it does not move). The pixel grids also cut the sharp edges
+// that CGAL keeps as constraints: the largest distances are there and at vertices that the stitches' seam
+// collapses left off the surface at creases (--fishbone auto keeps the edges on a cube, see
+// core_auto_remesh_test, but not yet on fandisk).
 TEST(CliAuto, DISABLED_FandiskMeetsIssue7RegularityAndDistanceCriteria) {
     const AutoRun& r = fandiskRun();
     ASSERT_FALSE(r.report.is_null());
