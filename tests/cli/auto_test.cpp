@@ -42,32 +42,36 @@ struct AutoRun {
     double scannedArea = 0, totalArea = 0;
 };
 
-// Runs `auto` once on fandisk (shared by the tests below) and measures the result independently.
+// Runs `auto` on one of CGAL's sample meshes and measures the result independently.
+AutoRun runAuto(const std::string& name) {
+    AutoRun r;
+    const std::string input = meshPath(name + ".off").string();
+    const auto out = tmpPath("cli_auto/" + name + "_auto.ply");
+    const auto p = remesh({"auto", input, "-o", out.string(), "--json", "--no-metrics"});
+    EXPECT_EQ(p.exitCode, 0) << p.err;
+    if (p.exitCode != 0) return r;
+    r.report = nlohmann::json::parse(p.out);
+    r.mesh = fss::readMesh(out);
+    const fss::Mesh reference = fss::readMesh(input);
+    fss::MetricsOptions mo;
+    mo.reference = &reference;
+    r.metrics = fss::computeMetrics(r.mesh, mo);
+    const auto ids = r.mesh.property_map<fss::FaceIndex, std::int32_t>(fss::props::faceScanId);
+    EXPECT_TRUE(ids.second) << "the PLY output keeps the scan id of every face";
+    for (fss::FaceIndex f : r.mesh.faces()) {
+        const auto h = r.mesh.halfedge(f);
+        const double a =
+            std::sqrt(CGAL::squared_area(r.mesh.point(r.mesh.source(h)), r.mesh.point(r.mesh.target(h)),
+                                         r.mesh.point(r.mesh.target(r.mesh.next(h)))));
+        r.totalArea += a;
+        if (ids.second && ids.first[f] >= 0) r.scannedArea += a;
+    }
+    return r;
+}
+
+// Runs `auto` once on fandisk (shared by the tests below).
 const AutoRun& fandiskRun() {
-    static const AutoRun run = [] {
-        AutoRun r;
-        const auto out = tmpPath("cli_auto/fandisk_auto.ply");
-        const auto p = remesh({"auto", kFandisk, "-o", out.string(), "--json", "--no-metrics"});
-        EXPECT_EQ(p.exitCode, 0) << p.err;
-        if (p.exitCode != 0) return r;
-        r.report = nlohmann::json::parse(p.out);
-        r.mesh = fss::readMesh(out);
-        const fss::Mesh input = fss::readMesh(kFandisk);
-        fss::MetricsOptions mo;
-        mo.reference = &input;
-        r.metrics = fss::computeMetrics(r.mesh, mo);
-        const auto ids = r.mesh.property_map<fss::FaceIndex, std::int32_t>(fss::props::faceScanId);
-        EXPECT_TRUE(ids.second) << "the PLY output keeps the scan id of every face";
-        for (fss::FaceIndex f : r.mesh.faces()) {
-            const auto h = r.mesh.halfedge(f);
-            const double a =
-                std::sqrt(CGAL::squared_area(r.mesh.point(r.mesh.source(h)), r.mesh.point(r.mesh.target(h)),
-                                             r.mesh.point(r.mesh.target(r.mesh.next(h)))));
-            r.totalArea += a;
-            if (ids.second && ids.first[f] >= 0) r.scannedArea += a;
-        }
-        return r;
-    }();
+    static const AutoRun run = runAuto("fandisk");
     return run;
 }
 
@@ -105,6 +109,34 @@ TEST(CliAuto, FandiskIsCoveredClosedManifoldAndFreeOfSelfIntersections) {
     EXPECT_GT(r.report.at("seam_collapses").get<int>(), 0);
     EXPECT_FALSE(r.report.at("seam_relax_discarded").get<bool>());
     EXPECT_GE(m.fracValence6Interior, 0.76);
+}
+
+// Other closed CGAL sample meshes, curved and mechanical: the result stays valid and the seam relaxation
+// raises the fraction of valence-6 interior vertices. Measured (GPU renderer) with / without the relaxation:
+// elephant 0.605 / 0.439, couplingdown 0.662 / 0.575, rotor_small 0.662 / 0.447. Their coverage is still far
+// below the issue's 95 % (0.63, 0.38, 0.45): at ~30–60 pixel views most patch pieces are refused by the
+// stitch because the input mesh under their boundary folds over itself in the scan's view.
+TEST(CliAuto, OtherClosedMeshesStayValidAndGainValenceSixFromTheSeamRelaxation) {
+    struct Case {
+        const char* name;
+        double minValence6;
+    };
+    for (const Case& c : {Case{"elephant", 0.58}, Case{"couplingdown", 0.64}, Case{"rotor_small", 0.64}}) {
+        SCOPED_TRACE(c.name);
+        const AutoRun r = runAuto(c.name);
+        ASSERT_FALSE(r.report.is_null());
+        const fss::Metrics& m = r.metrics;
+        EXPECT_TRUE(m.closed);
+        EXPECT_EQ(m.boundaryEdges, 0u);
+        EXPECT_EQ(m.nonManifoldVertices, 0u);
+        EXPECT_EQ(m.components, 1u);
+        EXPECT_EQ(m.degenerateFaces, 0u);
+        EXPECT_EQ(m.selfIntersections, std::optional<std::size_t>(0));
+        EXPECT_NEAR(r.scannedArea / r.totalArea, r.report.at("coverage").get<double>(), 1e-6);
+        EXPECT_GT(r.report.at("seam_flips").get<int>(), 0);
+        EXPECT_FALSE(r.report.at("seam_relax_discarded").get<bool>());
+        EXPECT_GE(m.fracValence6Interior, c.minValence6);
+    }
 }
 
 // Issue #7's regularity and distance criteria on fandisk. NOT MET YET, measured on this branch
