@@ -243,8 +243,8 @@ TEST(AutoRemesh, SeamRelaxationRaisesValenceSixOnTheSphere) {
 
 // Invariants on random cases: shapes, vertex counts and relaxation options drawn at random (fixed seed); the
 // relaxed result is valid (closed, manifold, no self-intersections; an open cylinder keeps its borders),
-// never has a smaller angle than the
-// unrelaxed one or the relaxation's angle floor allows, has no more vertices and more of valence 6.
+// never has a smaller angle than the unrelaxed one or the relaxation's angle floor allows, has no more
+// vertices and more of valence 6.
 TEST(AutoRemesh, SeamRelaxationKeepsTheMeshValidOnRandomCases) {
     std::mt19937 rng(7);
     const std::vector<fss::Mesh> shapes = {fss::shapes::torus(48, 16, 1.0, 0.35),
