@@ -76,7 +76,7 @@ private:
     const SeamRelaxOptions& o_;
     const double floor_, maxTurn_, feature_;
     RayCaster caster_{ref_};
-    std::vector<char> zone_, fixed_, featureEdge_;
+    std::vector<char> zone_, fixed_, fixedEdge_, touchesInput_;
 
     Vec faceNormal(FaceIndex f) const {
         const HalfedgeIndex h = m_.halfedge(f);
@@ -85,19 +85,27 @@ private:
 
     void markFeaturesAndZone() {
         const std::size_t nv = m_.number_of_vertices() + m_.number_of_removed_vertices();
-        featureEdge_.assign(m_.number_of_edges() + m_.number_of_removed_edges(), 0);
+        fixedEdge_.assign(m_.number_of_edges() + m_.number_of_removed_edges(), 0);
         fixed_.assign(nv, 0);
         zone_.assign(nv, 0);
+        touchesInput_.assign(nv, 0);
+        const auto [ids, haveIds] = m_.property_map<FaceIndex, std::int32_t>(props::faceScanId);
+        auto isInput = [&](FaceIndex f) { return f != Mesh::null_face() && (!haveIds || ids[f] < 0); };
+        // Border and feature edges, and the edges between a face left from the input and a scanned one (so
+        // that the scanned area, the coverage, stays as it is), are fixed: never flipped or collapsed, their
+        // vertices never smoothed.
         for (EdgeIndex e : m_.edges()) {
             const HalfedgeIndex h = m_.halfedge(e);
+            const VertexIndex a = m_.source(h), b = m_.target(h);
             const bool border = m_.is_border(e);
-            if (border ||
+            const bool input1 = isInput(m_.face(h)), input2 = isInput(m_.face(m_.opposite(h)));
+            if (input1 || input2) touchesInput_[a.idx()] = touchesInput_[b.idx()] = 1;
+            if (border || input1 != input2 ||
                 angleBetween(faceNormal(m_.face(h)), faceNormal(m_.face(m_.opposite(h)))) > feature_) {
-                featureEdge_[e.idx()] = 1;
-                fixed_[m_.source(h).idx()] = fixed_[m_.target(h).idx()] = 1;
+                fixedEdge_[e.idx()] = 1;
+                fixed_[a.idx()] = fixed_[b.idx()] = 1;
             }
         }
-        const auto [ids, haveIds] = m_.property_map<FaceIndex, std::int32_t>(props::faceScanId);
         for (VertexIndex v : m_.vertices()) {
             bool seed = m_.degree(v) != 6;
             std::int32_t first = -2;
@@ -129,7 +137,7 @@ private:
         std::size_t flips = 0;
         const double tolerance = 0.05 * o_.edgeLength;
         for (EdgeIndex e : m_.edges()) {
-            if (m_.is_removed(e) || featureEdge_[e.idx()]) continue;
+            if (m_.is_removed(e) || fixedEdge_[e.idx()]) continue;
             const HalfedgeIndex h = m_.halfedge(e), o = m_.opposite(h);
             const VertexIndex a = m_.source(h), b = m_.target(h);
             const VertexIndex c = m_.target(m_.next(h)), d = m_.target(m_.next(o));
@@ -171,7 +179,7 @@ private:
         std::size_t collapses = 0;
         const double maxLength = 4.0 / 3.0 * o_.edgeLength;
         for (EdgeIndex e : m_.edges()) {
-            if (m_.is_removed(e) || featureEdge_[e.idx()]) continue;
+            if (m_.is_removed(e) || fixedEdge_[e.idx()]) continue;
             const HalfedgeIndex h = m_.halfedge(e), o = m_.opposite(h);
             const VertexIndex a = m_.source(h), b = m_.target(h);
             const VertexIndex c = m_.target(m_.next(h)), d = m_.target(m_.next(o));
@@ -218,15 +226,16 @@ private:
             // The collapse keeps one edge of each pair (a, c), (b, c) and (a, d), (b, d): it keeps their
             // flags.
             auto featureOf = [&](VertexIndex u, VertexIndex w) {
-                return char(featureEdge_[m_.edge(CGAL::halfedge(u, w, m_).first).idx()]);
+                return char(fixedEdge_[m_.edge(CGAL::halfedge(u, w, m_).first).idx()]);
             };
             const char fc = featureOf(a, c) | featureOf(b, c), fd = featureOf(a, d) | featureOf(b, d);
             const char fixedKept = fixed_[a.idx()] | fixed_[b.idx()];
             const VertexIndex kept = CGAL::Euler::collapse_edge(e, m_);
             m_.point(kept) = Point3(q.x(), q.y(), q.z());
             fixed_[kept.idx()] = fixedKept;
-            featureEdge_[m_.edge(CGAL::halfedge(kept, c, m_).first).idx()] = fc;
-            featureEdge_[m_.edge(CGAL::halfedge(kept, d, m_).first).idx()] = fd;
+            touchesInput_[kept.idx()] = touchesInput_[a.idx()] | touchesInput_[b.idx()];
+            fixedEdge_[m_.edge(CGAL::halfedge(kept, c, m_).first).idx()] = fc;
+            fixedEdge_[m_.edge(CGAL::halfedge(kept, d, m_).first).idx()] = fd;
             ++collapses;
         }
         return collapses;
@@ -239,14 +248,14 @@ private:
 
     /// Moves the zone's vertices that lie off the reference surface (by more than a tenth of the edge
     /// length: the stitches' collapses on creases leave a few) onto their closest reference point, feature
-    /// vertices included, where no face of their star degenerates, turns over (normal change above 60°) or
-    /// gets an angle below the floor.
+    /// vertices included (not those of input faces), where no face of their star degenerates, turns over
+    /// (normal change above 60°) or gets an angle below the floor.
     std::size_t projectOffSurface() {
         std::size_t moves = 0;
         const double tolerance = 0.1 * o_.edgeLength;
         const double maxTurn = std::numbers::pi / 3.0;
         for (VertexIndex v : m_.vertices()) {
-            if (!zone_[v.idx()] || m_.is_border(v)) continue;
+            if (!zone_[v.idx()] || touchesInput_[v.idx()] || m_.is_border(v)) continue;
             const Vec p = pos(m_, v);
             const SurfacePoint sp = caster_.closestPoint(p);
             if (!sp || sp.distance <= tolerance) continue;

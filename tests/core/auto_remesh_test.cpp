@@ -214,9 +214,9 @@ void expectValid(const fss::Metrics& m) {
 
 // The seam relaxation (auto_remesh.h, step 6) against the same run without it: the irregular vertices sit on
 // the seams; flips, collapses and smoothing there raise the fraction of valence-6 vertices, keep the mesh
-// valid, the smallest angle and the distance to the input. Measured (CPU renderer): valence 6 0.796 without,
-// 0.876 with the relaxation; smallest angle 20.2° → 26.6°; 2583 → 2518 vertices; Hausdorff distance to the
-// sphere 0.0030 → 0.0024 (L = 0.075).
+// valid, the coverage, the smallest angle and the distance to the input. Measured (CPU renderer): valence 6
+// 0.796 without, 0.876 with the relaxation; smallest angle 20.2° → 26.6°; 2583 → 2518 vertices; Hausdorff
+// distance to the sphere 0.0030 → 0.0024 (L = 0.075).
 TEST(AutoRemesh, SeamRelaxationRaisesValenceSixOnTheSphere) {
     const fss::Mesh sphere = fss::shapes::icosphere(4, 1.0);
     fss::AutoOptions o;
@@ -234,8 +234,8 @@ TEST(AutoRemesh, SeamRelaxationRaisesValenceSixOnTheSphere) {
     EXPECT_GE(after.fracValence6Interior, before.fracValence6Interior + 0.06);
     EXPECT_GE(after.fracValence6Interior, 0.85);
     EXPECT_GE(after.minAngleDeg, std::min(before.minAngleDeg, 20.0) - 1e-9);
-    EXPECT_LE(after.vertices, before.vertices); // collapses only
-    EXPECT_NEAR(relaxed.coverage, plain.coverage, 0.01);
+    EXPECT_LE(after.vertices, before.vertices);         // collapses only
+    EXPECT_GE(relaxed.coverage, plain.coverage - 1e-3); // no operation mixes input and scanned faces
     // Moved vertices are projected back onto the input: still far below the edge length from it.
     ASSERT_TRUE(after.hausdorffToRef && before.hausdorffToRef);
     EXPECT_LT(*after.hausdorffToRef, 0.05 * relaxed.edgeLength);
@@ -244,7 +244,7 @@ TEST(AutoRemesh, SeamRelaxationRaisesValenceSixOnTheSphere) {
 // Invariants on random cases: shapes, vertex counts and relaxation options drawn at random (fixed seed); the
 // relaxed result is valid (closed, manifold, no self-intersections; an open cylinder keeps its borders),
 // never has a smaller angle than the unrelaxed one or the relaxation's angle floor allows, has no more
-// vertices and more of valence 6.
+// vertices, the same coverage and more vertices of valence 6.
 TEST(AutoRemesh, SeamRelaxationKeepsTheMeshValidOnRandomCases) {
     std::mt19937 rng(7);
     const std::vector<fss::Mesh> shapes = {fss::shapes::torus(48, 16, 1.0, 0.35),
@@ -274,11 +274,12 @@ TEST(AutoRemesh, SeamRelaxationKeepsTheMeshValidOnRandomCases) {
         }
         EXPECT_GE(after.minAngleDeg, std::min(before.minAngleDeg, o.seamRelaxMinAngleDeg) - 1e-9);
         EXPECT_LE(after.vertices, before.vertices);
+        EXPECT_GE(relaxed.coverage, plain.coverage - 1e-3);
         if (!o.seamRelaxCollapses) {
             EXPECT_EQ(relaxed.seamCollapses, 0u);
         }
-        // Measured: 0.390 → 0.527 (torus), 0.677 → 0.747 (cylinder), 0.706 → 0.820 (sphere), 0.596 → 0.620
-        // (cube), 0.673 → 0.744 (open cylinder).
+        // Measured: 0.390 → 0.524 (torus), 0.677 → 0.747 (cylinder), 0.706 → 0.819 (sphere), 0.596 → 0.614
+        // (cube), 0.673 → 0.737 (open cylinder).
         EXPECT_GT(after.fracValence6Interior, before.fracValence6Interior + 0.01);
     }
 }

@@ -37,7 +37,8 @@
 ///     bring the four vertices' valences closer to 6, edge collapses that do the same (the merged vertex on
 ///     the reference), and tangential smoothing of the zone's vertices projected back onto the reference
 ///     (closest point). Feature edges (featureAngleDeg) are never flipped or collapsed and their vertices
-///     stay where they are (unless off the reference); no flip, collapse or move makes an angle below
+///     stay where they are (unless off the reference); edges between an input face and a scanned one stay (no
+///     operation mixes the two, so the coverage stays); no flip, collapse or move makes an angle below
 ///     seamRelaxMinAngleDeg (or the smallest one already there) or turns a face's normal by more than the
 ///     stitch's maxNormalChangeDeg; a flip keeps its new edge as close to the reference as the old one. A
 ///     relaxed mesh that would intersect itself is discarded as a whole. Closedness and manifoldness are

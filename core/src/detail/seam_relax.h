@@ -22,9 +22,12 @@ struct SeamRelaxOptions {
     double minAngleDeg = 20.0;
     /// Largest angle between a new face's normal and the normal of the faces it replaces (degrees).
     double maxNormalChangeDeg = 20.0;
-    /// Edges whose two faces' normals differ by more than this (degrees) are feature edges: never flipped or
-    /// collapsed; their vertices move only when they lie off the reference (more than a tenth of
-    /// edgeLength: onto their closest reference point) and may absorb a neighbour off the feature lines.
+    /// Edges whose two faces' normals differ by more than this (degrees) are feature edges. Feature edges,
+    /// border edges and the edges between a face left from the input (props::faceScanId < 0) and a scanned
+    /// face are fixed: never flipped or collapsed; their vertices are not smoothed (a vertex off the
+    /// reference by more than a tenth of edgeLength goes onto its closest reference point unless it is on
+    /// an input face) and may absorb a free neighbour by a collapse. Every operation changes faces of one
+    /// kind only (input or scanned), so the scanned area (the coverage) stays as it is.
     double featureAngleDeg = 35.0;
     /// The zone: vertices with a valence ≠ 6, on faces of different scans or on faces left from the input
     /// (props::faceScanId < 0), grown by this many vertex rings. Only edges with all four vertices in the
