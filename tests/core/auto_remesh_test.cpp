@@ -1,10 +1,13 @@
 // fss::autoRemesh on analytic shapes with the CPU renderer (no GL needed): the edge length from a vertex
 // count, coverage of a cube and a sphere, validity of the result (closed, manifold, no self-intersections),
-// the vertex count it aims at, the distance to the input, and clear errors for bad options.
+// the vertex count it aims at, the distance to the input, the seam relaxation (valence 6, invariants on
+// random cases), and clear errors for bad options.
 #include "fss/auto_remesh.h"
 #include "fss/error.h"
 #include "fss/metrics.h"
 #include "fss/shapes.h"
+
+#include "expect_valid_mesh.h"
 
 #include <gtest/gtest.h>
 
@@ -201,15 +204,6 @@ fss::Metrics metricsAgainst(const fss::Mesh& mesh, const fss::Mesh& reference) {
     return fss::computeMetrics(mesh, mo);
 }
 
-void expectValid(const fss::Metrics& m) {
-    EXPECT_TRUE(m.closed);
-    EXPECT_EQ(m.boundaryEdges, 0u);
-    EXPECT_EQ(m.nonManifoldVertices, 0u);
-    EXPECT_EQ(m.components, 1u);
-    EXPECT_EQ(m.degenerateFaces, 0u);
-    EXPECT_EQ(m.selfIntersections, std::optional<std::size_t>(0));
-}
-
 } // namespace
 
 // The seam relaxation (auto_remesh.h, step 6) against the same run without it: the irregular vertices sit on
@@ -230,7 +224,7 @@ TEST(AutoRemesh, SeamRelaxationRaisesValenceSixOnTheSphere) {
     EXPECT_FALSE(relaxed.seamRelaxDiscarded);
     const fss::Metrics before = metricsAgainst(plain.mesh, sphere);
     const fss::Metrics after = metricsAgainst(relaxed.mesh, sphere);
-    expectValid(after);
+    fss::test::expectClosedValidMesh(after);
     EXPECT_GE(after.fracValence6Interior, before.fracValence6Interior + 0.06);
     EXPECT_GE(after.fracValence6Interior, 0.85);
     EXPECT_GE(after.minAngleDeg, std::min(before.minAngleDeg, 20.0) - 1e-9);
@@ -265,7 +259,7 @@ TEST(AutoRemesh, SeamRelaxationKeepsTheMeshValidOnRandomCases) {
         const fss::Metrics before = metricsAgainst(plain.mesh, shape);
         const fss::Metrics after = metricsAgainst(relaxed.mesh, shape);
         if (trial < 4) {
-            expectValid(after);
+            fss::test::expectClosedValidMesh(after);
         } else { // the open cylinder: its two borders stay as they were
             EXPECT_EQ(after.boundaryEdges, before.boundaryEdges);
             EXPECT_EQ(after.boundaryLoops, 2u);
