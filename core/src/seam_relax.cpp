@@ -130,7 +130,11 @@ private:
         }
     }
 
-    static int deviation(int degree) { return (degree - 6) * (degree - 6); }
+    /// Cost of a valence: an irregular vertex (valence ≠ 6) costs more than the squared deviations from 6 of
+    /// the four vertices an operation changes can add up to in practice, so flips and collapses first lower
+    /// the number of irregular vertices, then the squared deviation (which alone would trade a 4 and an 8
+    /// for a 5 and a 7 but also a 9 for an 8, a 7 and a 7).
+    static int deviation(int degree) { return (degree != 6) * 64 + (degree - 6) * (degree - 6); }
 
     /// One pass of valence-improving flips over the zone's edges.
     std::size_t flipSweep() {
@@ -223,6 +227,21 @@ private:
             }
             if (!ok || newMin < std::min(oldMin, floor_) || longestAfter > std::max(maxLength, longestBefore))
                 continue;
+            // The new faces stay as close to the reference as the old ones (or within a tolerance): their
+            // centroids, against the largest gap of the old faces' centroids.
+            double oldGap = 0, newGap = 0;
+            for (VertexIndex v : {a, b}) {
+                const Vec p = pos(m_, v);
+                for (HalfedgeIndex g : CGAL::halfedges_around_target(m_.halfedge(v), m_)) {
+                    const HalfedgeIndex n1 = m_.next(g);
+                    const Vec s = pos(m_, m_.target(n1)), t = pos(m_, m_.target(m_.next(n1)));
+                    oldGap = std::max(oldGap, caster_.closestPoint((p + s + t) / 3.0).distance);
+                    const FaceIndex f = m_.face(g);
+                    if (f != m_.face(h) && f != m_.face(o))
+                        newGap = std::max(newGap, caster_.closestPoint((q + s + t) / 3.0).distance);
+                }
+            }
+            if (newGap > std::max(oldGap, 0.05 * o_.edgeLength)) continue;
             // The collapse keeps one edge of each pair (a, c), (b, c) and (a, d), (b, d): it keeps their
             // flags.
             auto featureOf = [&](VertexIndex u, VertexIndex w) {
@@ -277,6 +296,21 @@ private:
         return moves;
     }
 
+    /// Whether the faces \p star (corners q, r after the moving vertex) stay as close to the reference with
+    /// the vertex at \p to as at \p from, or within a twentieth of the edge length: their centroids' largest
+    /// distance to the reference.
+    template <class Star> bool staysNearReference(const Vec& from, const Vec& to, const Star& star) const {
+        const double tolerance = 0.05 * o_.edgeLength;
+        double newGap = 0;
+        for (const auto& k : star)
+            newGap = std::max(newGap, caster_.closestPoint((to + k.q + k.r) / 3.0).distance);
+        if (newGap <= tolerance) return true;
+        double oldGap = 0;
+        for (const auto& k : star)
+            oldGap = std::max(oldGap, caster_.closestPoint((from + k.q + k.r) / 3.0).distance);
+        return newGap <= oldGap;
+    }
+
     /// One pass of tangential smoothing of the zone's free vertices, projected onto the reference.
     std::size_t smoothSweep() {
         std::size_t moves = 0;
@@ -323,6 +357,7 @@ private:
                 }
             }
             if (!ok || newMin < std::min(oldMin, floor_)) continue;
+            if (!staysNearReference(p, q, star)) continue;
             m_.point(v) = Point3(q.x(), q.y(), q.z());
             ++moves;
         }

@@ -100,16 +100,16 @@ TEST(CliAuto, FandiskIsCoveredClosedManifoldAndFreeOfSelfIntersections) {
     // Issue #7: minimum angle ≥ 10°.
     EXPECT_GE(m.minAngleDeg, 10.0);
     // The seam relaxation (auto_remesh.h, step 6) ran and was kept: fraction of valence-6 interior vertices
-    // measured 0.761 (0.658 without it; CGAL's isotropic remeshing 0.773; the criterion, 0.90, below).
+    // measured 0.791 (0.658 without it; CGAL's isotropic remeshing 0.773; the criterion, 0.90, below).
     EXPECT_GT(r.report.at("seam_flips").get<int>(), 0);
     EXPECT_GT(r.report.at("seam_collapses").get<int>(), 0);
     EXPECT_FALSE(r.report.at("seam_relax_discarded").get<bool>());
-    EXPECT_GE(m.fracValence6Interior, 0.75);
+    EXPECT_GE(m.fracValence6Interior, 0.78);
 }
 
 // Other closed CGAL sample meshes, curved and mechanical: the result stays valid and the seam relaxation
 // raises the fraction of valence-6 interior vertices. Measured (GPU renderer) with / without the relaxation:
-// elephant 0.567 / 0.439, couplingdown 0.628 / 0.575, rotor_small 0.633 / 0.447. Their coverage is still far
+// elephant 0.617 / 0.439, couplingdown 0.673 / 0.575, rotor_small 0.679 / 0.447. Their coverage is still far
 // below the issue's 95 % (0.63, 0.38, 0.45): at ~30–60 pixel views most patch pieces are refused by the
 // stitch because the input mesh under their boundary folds over itself in the scan's view.
 TEST(CliAuto, OtherClosedMeshesStayValidAndGainValenceSixFromTheSeamRelaxation) {
@@ -117,7 +117,7 @@ TEST(CliAuto, OtherClosedMeshesStayValidAndGainValenceSixFromTheSeamRelaxation) 
         const char* name;
         double minValence6;
     };
-    for (const Case& c : {Case{"elephant", 0.55}, Case{"couplingdown", 0.61}, Case{"rotor_small", 0.61}}) {
+    for (const Case& c : {Case{"elephant", 0.60}, Case{"couplingdown", 0.65}, Case{"rotor_small", 0.65}}) {
         SCOPED_TRACE(c.name);
         const AutoRun r = runAuto(c.name);
         ASSERT_FALSE(r.report.is_null());
@@ -132,15 +132,15 @@ TEST(CliAuto, OtherClosedMeshesStayValidAndGainValenceSixFromTheSeamRelaxation) 
 
 // Issue #7's regularity and distance criteria on fandisk. NOT MET YET, measured on this branch
 // (`fss-remesh auto fandisk.off -o out.ply --json`, GPU renderer; bench_auto gives the same figures):
-// fraction of valence-6 interior vertices 0.761 (criterion ≥ 0.90; CGAL's isotropic remeshing: 0.773; 0.658
-// before the seam relaxation), Hausdorff distance to / from the input 0.00790 / 0.00990 of the bbox diagonal
+// fraction of valence-6 interior vertices 0.791 (criterion ≥ 0.90; CGAL's isotropic remeshing: 0.773; 0.658
+// before the seam relaxation), Hausdorff distance to / from the input 0.00787 / 0.00990 of the bbox diagonal
 // (criterion: ≤ CGAL's 0.00135 / 0.00135). With one region per view the 8 initial patches alone reach 0.77
 // valence 6 at 0.88 coverage; the stitch trims them at many seams and the follow-up scans that fill those
 // gaps are small and irregular; the seam relaxation's flips and collapses stop at pairs of valence-5 and -7
 // vertices and at feature lines (whose vertices it does not move). The pixel grids also cut the sharp edges
-// that CGAL keeps as constraints: the largest distances are there and at vertices that the stitches' seam
-// collapses left off the surface at creases (--fishbone auto keeps the edges on a cube, see
-// core_auto_remesh_test, but not yet on fandisk).
+// that CGAL keeps as constraints: the largest distances are on faces across those edges (moving the few
+// vertices that the stitches' seam collapses left off the surface at creases does not lower them;
+// --fishbone auto keeps the edges on a cube, see core_auto_remesh_test, but not yet on fandisk).
 TEST(CliAuto, DISABLED_FandiskMeetsIssue7RegularityAndDistanceCriteria) {
     const AutoRun& r = fandiskRun();
     ASSERT_FALSE(r.report.is_null());

@@ -34,14 +34,15 @@
 ///     optimising the seam, the last step improves that zone only (vertices with a valence ≠ 6, on faces of
 ///     two scans or of the input, and one ring around them): zone vertices left off the reference by the
 ///     stitches' collapses go back onto it where their faces allow; then, a few rounds of edge flips that
-///     bring the four vertices' valences closer to 6, edge collapses that do the same (the merged vertex on
-///     the reference), and tangential smoothing of the zone's vertices projected back onto the reference
-///     (closest point). Feature edges (featureAngleDeg) are never flipped or collapsed and their vertices
-///     stay where they are (unless off the reference); edges between an input face and a scanned one stay (no
-///     operation mixes the two, so the coverage stays); no flip, collapse or move makes an angle below
-///     seamRelaxMinAngleDeg (or the smallest one already there) or turns a face's normal by more than the
-///     stitch's maxNormalChangeDeg; a flip keeps its new edge as close to the reference as the old one. A
-///     relaxed mesh that would intersect itself is discarded as a whole. Closedness and manifoldness are
+///     lower the number of irregular vertices among the four they change (or keep it and bring the
+///     valences closer to 6), edge collapses that do the same (the merged vertex on the reference), and
+///     tangential smoothing of the zone's vertices projected back onto the reference (closest point).
+///     Feature edges (featureAngleDeg) are never flipped or collapsed and their vertices stay where they
+///     are (unless off the reference); edges between an input face and a scanned one stay (no operation
+///     mixes the two, so the coverage stays); no flip, collapse or move makes an angle below
+///     seamRelaxMinAngleDeg (or the smallest one already there), turns a face's normal by more than the
+///     stitch's maxNormalChangeDeg, or takes faces farther from the reference than they were (beyond L/20).
+///     A relaxed mesh that would intersect itself is discarded as a whole. Closedness and manifoldness are
 ///     kept; only collapses lower the vertex count (towards the target: the seams have more vertices than a
 ///     regular grid).
 ///
@@ -124,8 +125,8 @@ struct AutoOptions {
     /// No flip or move of the seam relaxation makes an angle smaller than the smaller of this and the
     /// smallest angle of the faces it changes (degrees, in [0, 60)).
     double seamRelaxMinAngleDeg = 20.0;
-    /// The seam relaxation also collapses edges between two zone vertices off the feature lines where that
-    /// brings the valences closer to 6 (the vertex count drops a little).
+    /// The seam relaxation also collapses zone edges where that lowers the number of irregular vertices
+    /// (the vertex count drops a little).
     bool seamRelaxCollapses = true;
     /// Options of every stitch. Faces with a smallest angle under 10° are refused (trimmed and retried).
     StitchOptions stitch = defaultStitch();

@@ -15,7 +15,9 @@ namespace fss::detail {
 struct SeamRelaxOptions {
     /// Rounds of (flips, smoothing). 0 = nothing.
     int rounds = 4;
-    /// Target edge length of the mesh (world units): tolerances of the distance checks scale with it.
+    /// Target edge length of the mesh (world units). A flip, collapse or move must keep the faces it makes
+    /// as close to the reference as the ones it replaces, or within edgeLength / 20 (new edge midpoint for
+    /// a flip, face centroids for collapses and moves).
     double edgeLength = 1.0;
     /// A flip or a move may not create an angle smaller than the smaller of this and the smallest angle
     /// of the faces it replaces (degrees).
@@ -33,8 +35,9 @@ struct SeamRelaxOptions {
     /// (props::faceScanId < 0), grown by this many vertex rings. Only edges with all four vertices in the
     /// zone are flipped and only zone vertices move: the scan grids' regular interiors stay untouched.
     int zoneRings = 1;
-    /// Also collapse zone edges between two vertices off the feature lines where that brings the valences
-    /// closer to 6 (lowers the vertex count a little).
+    /// Also collapse zone edges (not between two fixed vertices) where that brings the valences closer to 6
+    /// (lowers the vertex count a little). Flips and collapses are taken where they lower the number of
+    /// vertices of valence ≠ 6 among the four they change, or keep it and lower the squared deviation.
     bool collapses = true;
     /// Smoothing step as a fraction of the way to the centroid of the neighbours, in (0, 1].
     double smoothingStep = 0.5;
