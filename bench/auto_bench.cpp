@@ -4,7 +4,8 @@
 // feature angle as FSS and passed as edge_is_constrained_map, 3 iterations. Each remesher runs once per
 // mesh (Iterations(1)); the quality of both results is measured with fss::computeMetrics against the input
 // (fraction of valence-6 interior vertices, minimum angle, Hausdorff distance both ways relative to the
-// bbox diagonal) and printed side by side after the benchmarks, with the time ratio FSS / CGAL.
+// bbox diagonal) and printed side by side after the benchmarks, with the time ratio FSS / CGAL, followed by
+// where FSS's irregular vertices are (next to input faces, on feature edges, on seams, inside a patch).
 //
 //   ./build/bin/bench_auto                       # the four default meshes, GPU renderer when available
 //   FSS_AUTO_BENCH_MESHES=fandisk,eight ./build/bin/bench_auto
@@ -23,9 +24,11 @@
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -35,11 +38,51 @@ namespace {
 namespace PMP = CGAL::Polygon_mesh_processing;
 using Clock = std::chrono::steady_clock;
 
+/// Where the irregular (valence ≠ 6) vertices of a result are, by the first class that fits: next to a face
+/// left from the input, on a feature edge (dihedral angle above the feature angle), on a seam (faces of
+/// different scans), or inside one scan's patch.
+struct Irregular {
+    enum Class { Input, Feature, Seam, Patch, Count };
+    std::size_t vertices[Count] = {};
+    std::size_t irregular[Count] = {};
+};
+
+Irregular irregularVertices(const fss::Mesh& m, double featureAngleDeg) {
+    Irregular out;
+    const auto [ids, haveIds] = m.property_map<fss::FaceIndex, std::int32_t>(fss::props::faceScanId);
+    const double cosFeature = std::cos(featureAngleDeg * std::numbers::pi / 180.0);
+    auto normal = [&](fss::FaceIndex f) {
+        const auto h = m.halfedge(f);
+        return CGAL::unit_normal(m.point(m.source(h)), m.point(m.target(h)), m.point(m.target(m.next(h))));
+    };
+    for (fss::VertexIndex v : m.vertices()) {
+        bool input = false, feature = false, seam = false;
+        std::int32_t first = -2;
+        for (fss::HalfedgeIndex h : CGAL::halfedges_around_target(v, m)) {
+            const fss::FaceIndex f = m.face(h), g = m.face(m.opposite(h));
+            if (f == fss::Mesh::null_face() || g == fss::Mesh::null_face()) continue;
+            const std::int32_t id = haveIds ? ids[f] : -1;
+            input = input || id < 0;
+            seam = seam || (first != -2 && id != first);
+            first = id;
+            feature = feature || normal(f) * normal(g) < cosFeature;
+        }
+        const Irregular::Class c = input     ? Irregular::Input
+                                   : feature ? Irregular::Feature
+                                   : seam    ? Irregular::Seam
+                                             : Irregular::Patch;
+        ++out.vertices[c];
+        if (m.degree(v) != 6) ++out.irregular[c];
+    }
+    return out;
+}
+
 struct Row {
     double seconds = 0;
     fss::Metrics metrics;
     double coverage = -1; // FSS only
     int scans = 0;
+    Irregular irregular; // FSS only
 };
 
 struct MeshResults {
@@ -112,6 +155,7 @@ void BM_FssAuto(benchmark::State& state, std::string name) {
         r.fss.metrics = measure(res.mesh, ref);
         r.fss.coverage = res.coverage;
         r.fss.scans = res.scansStitched;
+        r.fss.irregular = irregularVertices(res.mesh, o.featureAngleDeg);
         r.haveFss = true;
         state.ResumeTiming();
     }
@@ -173,6 +217,16 @@ void printTable() {
                         who == 0 ? r.fss.seconds / r.cgal.seconds : 1.0, m.closed ? "yes" : "no",
                         m.selfIntersections.value_or(0));
         }
+    }
+    std::printf("\nFSS: irregular (valence != 6) / all vertices by where they are (first class that fits)\n");
+    std::printf("%-14s %15s %15s %15s %15s\n", "mesh", "input_faces", "feature_edge", "seam", "patch_inside");
+    for (const std::string& name : meshOrder) {
+        const MeshResults& r = results()[name];
+        if (!r.haveFss) continue;
+        std::printf("%-14s", name.c_str());
+        for (int c = 0; c < Irregular::Count; ++c)
+            std::printf(" %7zu/%-7zu", r.fss.irregular.irregular[c], r.fss.irregular.vertices[c]);
+        std::printf("\n");
     }
     std::fflush(stdout);
 }

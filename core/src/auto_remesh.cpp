@@ -1,5 +1,7 @@
 #include "fss/auto_remesh.h"
 
+#include "detail/seam_relax.h"
+
 #include "fss/error.h"
 #include "fss/fishbone_scan.h"
 #include "fss/mask.h"
@@ -551,6 +553,10 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
     if (options.regionFillPasses < 0) throw InvalidInputError("The region fill passes must not be negative.");
     if (!(options.partitionSmoothing >= 0) || !(options.minRegionArea >= 0))
         throw InvalidInputError("The partition smoothing and the smallest region area must not be negative.");
+    if (options.seamRelaxRounds < 0 ||
+        !(options.seamRelaxMinAngleDeg >= 0 && options.seamRelaxMinAngleDeg < 60))
+        throw InvalidInputError("The seam relaxation rounds must not be negative and its smallest angle must "
+                                "be in [0, 60) degrees.");
     if (options.maxViews < 1) throw InvalidInputError("The view budget must be at least one view.");
     if (!(options.footprintRatio > 0.1 && options.footprintRatio <= 4))
         throw InvalidInputError("The footprint ratio must be in (0.1, 4].");
@@ -891,8 +897,25 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
         result.sliverFlips = flipSlivers(current, options.flipSliversBelowDeg, 20.0, 8);
         result.stitchSeconds += secondsSince(t);
     }
-    progress.report(1.0, "done");
     current.collect_garbage();
+    if (options.seamRelaxRounds > 0) {
+        progress.report(0.99, "relax");
+        auto t = Clock::now();
+        detail::SeamRelaxOptions ro;
+        ro.rounds = options.seamRelaxRounds;
+        ro.edgeLength = L;
+        ro.minAngleDeg = options.seamRelaxMinAngleDeg;
+        ro.maxNormalChangeDeg = options.stitch.maxNormalChangeDeg;
+        ro.featureAngleDeg = options.featureAngleDeg;
+        ro.collapses = options.seamRelaxCollapses;
+        const detail::SeamRelaxReport rr = detail::relaxSeams(current, reference, ro);
+        result.seamFlips = rr.flips;
+        result.seamCollapses = rr.collapses;
+        result.seamMoves = rr.moves;
+        result.seamRelaxDiscarded = rr.reverted;
+        result.stitchSeconds += secondsSince(t);
+    }
+    progress.report(1.0, "done");
     const Coverage c = measureCoverage(current);
     result.coverage = c.fraction();
     result.inputFacesLeft = c.inputFaces;

@@ -143,6 +143,10 @@ int runAuto(const std::vector<std::string>& args) {
         j["input_area_left"] = result.inputAreaLeft;
         j["feature_chains"] = result.featureChains;
         j["sliver_flips"] = result.sliverFlips;
+        j["seam_flips"] = result.seamFlips;
+        j["seam_collapses"] = result.seamCollapses;
+        j["seam_moves"] = result.seamMoves;
+        j["seam_relax_discarded"] = result.seamRelaxDiscarded;
         j["scans_stitched"] = result.scansStitched;
         j["scans_skipped"] = result.scansSkipped;
         nlohmann::json steps = nlohmann::json::array();

@@ -4,6 +4,7 @@
 //
 // The criteria of issue #7 that FSS does not meet yet are kept, unchanged, in the DISABLED_ test below (run
 // it with --gtest_also_run_disabled_tests); the numbers measured are in its comment.
+#include "expect_valid_mesh.h"
 #include "run_process.h"
 #include "test_data.h"
 
@@ -42,32 +43,36 @@ struct AutoRun {
     double scannedArea = 0, totalArea = 0;
 };
 
-// Runs `auto` once on fandisk (shared by the tests below) and measures the result independently.
+// Runs `auto` on one of CGAL's sample meshes and measures the result independently.
+AutoRun runAuto(const std::string& name) {
+    AutoRun r;
+    const std::string input = meshPath(name + ".off").string();
+    const auto out = tmpPath("cli_auto/" + name + "_auto.ply");
+    const auto p = remesh({"auto", input, "-o", out.string(), "--json", "--no-metrics"});
+    EXPECT_EQ(p.exitCode, 0) << p.err;
+    if (p.exitCode != 0) return r;
+    r.report = nlohmann::json::parse(p.out);
+    r.mesh = fss::readMesh(out);
+    const fss::Mesh reference = fss::readMesh(input);
+    fss::MetricsOptions mo;
+    mo.reference = &reference;
+    r.metrics = fss::computeMetrics(r.mesh, mo);
+    const auto ids = r.mesh.property_map<fss::FaceIndex, std::int32_t>(fss::props::faceScanId);
+    EXPECT_TRUE(ids.second) << "the PLY output keeps the scan id of every face";
+    for (fss::FaceIndex f : r.mesh.faces()) {
+        const auto h = r.mesh.halfedge(f);
+        const double a =
+            std::sqrt(CGAL::squared_area(r.mesh.point(r.mesh.source(h)), r.mesh.point(r.mesh.target(h)),
+                                         r.mesh.point(r.mesh.target(r.mesh.next(h)))));
+        r.totalArea += a;
+        if (ids.second && ids.first[f] >= 0) r.scannedArea += a;
+    }
+    return r;
+}
+
+// Runs `auto` once on fandisk (shared by the tests below).
 const AutoRun& fandiskRun() {
-    static const AutoRun run = [] {
-        AutoRun r;
-        const auto out = tmpPath("cli_auto/fandisk_auto.ply");
-        const auto p = remesh({"auto", kFandisk, "-o", out.string(), "--json", "--no-metrics"});
-        EXPECT_EQ(p.exitCode, 0) << p.err;
-        if (p.exitCode != 0) return r;
-        r.report = nlohmann::json::parse(p.out);
-        r.mesh = fss::readMesh(out);
-        const fss::Mesh input = fss::readMesh(kFandisk);
-        fss::MetricsOptions mo;
-        mo.reference = &input;
-        r.metrics = fss::computeMetrics(r.mesh, mo);
-        const auto ids = r.mesh.property_map<fss::FaceIndex, std::int32_t>(fss::props::faceScanId);
-        EXPECT_TRUE(ids.second) << "the PLY output keeps the scan id of every face";
-        for (fss::FaceIndex f : r.mesh.faces()) {
-            const auto h = r.mesh.halfedge(f);
-            const double a =
-                std::sqrt(CGAL::squared_area(r.mesh.point(r.mesh.source(h)), r.mesh.point(r.mesh.target(h)),
-                                             r.mesh.point(r.mesh.target(r.mesh.next(h)))));
-            r.totalArea += a;
-            if (ids.second && ids.first[f] >= 0) r.scannedArea += a;
-        }
-        return r;
-    }();
+    static const AutoRun run = runAuto("fandisk");
     return run;
 }
 
@@ -89,26 +94,53 @@ TEST(CliAuto, FandiskIsCoveredClosedManifoldAndFreeOfSelfIntersections) {
     EXPECT_GT(r.report.at("scans_stitched").get<int>(), 5);
     // Valid: closed, manifold, no degenerate faces, no self-intersections (CGAL PMP).
     const fss::Metrics& m = r.metrics;
-    EXPECT_TRUE(m.closed);
-    EXPECT_EQ(m.boundaryEdges, 0u);
-    EXPECT_EQ(m.nonManifoldVertices, 0u);
-    EXPECT_EQ(m.components, 1u);
-    EXPECT_EQ(m.degenerateFaces, 0u);
-    EXPECT_EQ(m.selfIntersections, std::optional<std::size_t>(0));
+    fss::test::expectClosedValidMesh(m);
     // About the input's vertex count.
     EXPECT_NEAR(double(m.vertices), 6475.0, 0.15 * 6475.0);
     // Issue #7: minimum angle ≥ 10°.
     EXPECT_GE(m.minAngleDeg, 10.0);
+    // The seam relaxation (auto_remesh.h, step 6) ran and was kept: fraction of valence-6 interior vertices
+    // measured 0.791 (0.658 without it; CGAL's isotropic remeshing 0.773; the criterion, 0.90, below).
+    EXPECT_GT(r.report.at("seam_flips").get<int>(), 0);
+    EXPECT_GT(r.report.at("seam_collapses").get<int>(), 0);
+    EXPECT_FALSE(r.report.at("seam_relax_discarded").get<bool>());
+    EXPECT_GE(m.fracValence6Interior, 0.78);
+}
+
+// Other closed CGAL sample meshes, curved and mechanical: the result stays valid and the seam relaxation
+// raises the fraction of valence-6 interior vertices. Measured (GPU renderer) with / without the relaxation:
+// elephant 0.617 / 0.439, couplingdown 0.673 / 0.575, rotor_small 0.679 / 0.447. Their coverage is still far
+// below the issue's 95 % (0.63, 0.38, 0.45): at ~30–60 pixel views most patch pieces are refused by the
+// stitch because the input mesh under their boundary folds over itself in the scan's view.
+TEST(CliAuto, OtherClosedMeshesStayValidAndGainValenceSixFromTheSeamRelaxation) {
+    struct Case {
+        const char* name;
+        double minValence6;
+    };
+    for (const Case& c : {Case{"elephant", 0.60}, Case{"couplingdown", 0.65}, Case{"rotor_small", 0.65}}) {
+        SCOPED_TRACE(c.name);
+        const AutoRun r = runAuto(c.name);
+        ASSERT_FALSE(r.report.is_null());
+        const fss::Metrics& m = r.metrics;
+        fss::test::expectClosedValidMesh(m);
+        EXPECT_NEAR(r.scannedArea / r.totalArea, r.report.at("coverage").get<double>(), 1e-6);
+        EXPECT_GT(r.report.at("seam_flips").get<int>(), 0);
+        EXPECT_FALSE(r.report.at("seam_relax_discarded").get<bool>());
+        EXPECT_GE(m.fracValence6Interior, c.minValence6);
+    }
 }
 
 // Issue #7's regularity and distance criteria on fandisk. NOT MET YET, measured on this branch
 // (`fss-remesh auto fandisk.off -o out.ply --json`, GPU renderer; bench_auto gives the same figures):
-// fraction of valence-6 interior vertices 0.699 (criterion ≥ 0.90; CGAL's isotropic remeshing: 0.773),
-// Hausdorff distance to / from the input 0.00870 / 0.00890 of the bbox diagonal (criterion: ≤ CGAL's
-// 0.00135 / 0.00135). With one region per view the 8 initial patches alone reach 0.77 valence 6 at 0.88
-// coverage; the stitch trims them at many seams and the follow-up scans that fill those gaps are small and
-// irregular. The pixel grids also cut the sharp edges that CGAL keeps as constraints (--fishbone auto keeps them on a cube, see core_auto_remesh_test, but not yet
-// on fandisk).
+// fraction of valence-6 interior vertices 0.791 (criterion ≥ 0.90; CGAL's isotropic remeshing: 0.773; 0.658
+// before the seam relaxation), Hausdorff distance to / from the input 0.00787 / 0.00990 of the bbox diagonal
+// (criterion: ≤ CGAL's 0.00135 / 0.00135). With one region per view the 8 initial patches alone reach 0.77
+// valence 6 at 0.88 coverage; the stitch trims them at many seams and the follow-up scans that fill those
+// gaps are small and irregular; the seam relaxation's flips and collapses stop at pairs of valence-5 and -7
+// vertices and at feature lines (whose vertices it does not move). The pixel grids also cut the sharp edges
+// that CGAL keeps as constraints: the largest distances are on faces across those edges (moving the few
+// vertices that the stitches' seam collapses left off the surface at creases does not lower them;
+// --fishbone auto keeps the edges on a cube, see core_auto_remesh_test, but not yet on fandisk).
 TEST(CliAuto, DISABLED_FandiskMeetsIssue7RegularityAndDistanceCriteria) {
     const AutoRun& r = fandiskRun();
     ASSERT_FALSE(r.report.is_null());

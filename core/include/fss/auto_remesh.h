@@ -29,6 +29,23 @@
 ///     hand-drawn backbone is the chain projected into a view that sees both sides of the edge, inside a
 ///     band-shaped lasso around it, so that samples lie on the feature line itself.
 ///
+///  6. **Seam relaxation.** The scan grids' interiors are regular; the irregular vertices sit on the seams
+///     between patches and on the faces left from the input. Like the paper's zippering, which ends by
+///     optimising the seam, the last step improves that zone only (vertices with a valence ≠ 6, on faces of
+///     two scans or of the input, and one ring around them): zone vertices left off the reference by the
+///     stitches' collapses go back onto it where their faces allow; then, a few rounds of edge flips that
+///     lower the number of irregular vertices among the four they change (or keep it and bring the
+///     valences closer to 6), edge collapses that do the same (the merged vertex on the reference), and
+///     tangential smoothing of the zone's vertices projected back onto the reference (closest point).
+///     Feature edges (featureAngleDeg) are never flipped or collapsed and their vertices stay where they
+///     are (unless off the reference); edges between an input face and a scanned one stay (no operation
+///     mixes the two, so the coverage stays); no flip, collapse or move makes an angle below
+///     seamRelaxMinAngleDeg (or the smallest one already there), turns a face's normal by more than the
+///     stitch's maxNormalChangeDeg, or takes faces farther from the reference than they were (beyond L/20).
+///     A relaxed mesh that would intersect itself is discarded as a whole. Closedness and manifoldness are
+///     kept; only collapses lower the vertex count (towards the target: the seams have more vertices than a
+///     regular grid).
+///
 /// Every stitch has the strong guarantee: a scan or stitch that fails is skipped (and reported), the mesh
 /// is never left invalid.
 
@@ -102,6 +119,15 @@ struct AutoOptions {
     /// raises the smallest angle of faces whose smallest angle is below this (degrees; 0 = no flips): seams
     /// leave such slivers when the stitch's angle floor is low.
     double flipSliversBelowDeg = 20.0;
+    /// Rounds of seam relaxation after the last scan (file comment, step 6; 0 = none): each round flips the
+    /// zone's edges to better valences, then smooths the zone's vertices once.
+    int seamRelaxRounds = 4;
+    /// No flip or move of the seam relaxation makes an angle smaller than the smaller of this and the
+    /// smallest angle of the faces it changes (degrees, in [0, 60)).
+    double seamRelaxMinAngleDeg = 20.0;
+    /// The seam relaxation also collapses zone edges where that lowers the number of irregular vertices
+    /// (the vertex count drops a little).
+    bool seamRelaxCollapses = true;
     /// Options of every stitch. Faces with a smallest angle under 10° are refused (trimmed and retried).
     StitchOptions stitch = defaultStitch();
     /// Quality-mask margin (mask.h QualityMaskOptions::margin) of the regular scans.
@@ -147,10 +173,15 @@ struct AutoResult {
     int scansSkipped = 0;           ///< steps with stitched == false
     std::size_t featureChains = 0;  ///< feature chains found (fishbone only)
     std::size_t sliverFlips = 0;    ///< edges flipped after the last scan (AutoOptions::flipSliversBelowDeg)
-    double seconds = 0;             ///< total wall time
-    double planSeconds = 0;         ///< of which: view planning and coverage bookkeeping
-    double scanSeconds = 0;         ///< of which: rendering, masks, triangulation
-    double stitchSeconds = 0;       ///< of which: stitching
+    std::size_t seamFlips = 0;      ///< edges flipped by the seam relaxation (AutoOptions::seamRelaxRounds)
+    std::size_t seamCollapses = 0;  ///< edges collapsed by the seam relaxation
+    std::size_t seamMoves = 0;      ///< vertex moves of the seam relaxation
+    /// True when the seam relaxation was discarded because its result intersected itself.
+    bool seamRelaxDiscarded = false;
+    double seconds = 0;       ///< total wall time
+    double planSeconds = 0;   ///< of which: view planning and coverage bookkeeping
+    double scanSeconds = 0;   ///< of which: rendering, masks, triangulation
+    double stitchSeconds = 0; ///< of which: stitching and the seam relaxation
 };
 
 /// The edge length a regular triangulation with \p vertices vertices of a surface of area \p area has:
@@ -160,7 +191,9 @@ double edgeLengthForVertexCount(double area, std::size_t vertices);
 /// Remeshes the whole visible surface of \p reference (see the file comment).
 /// \param reference  a valid, consistently oriented, edge-manifold triangle mesh (closed or not).
 /// \param options    see AutoOptions.
-/// \param progress   fractions in [0, 1] with stages "plan", "scan i/n", "follow-up", "fishbone"; may cancel.
+/// \param progress   fractions in [0, 1] with stages "plan", "scan i/n", "follow-up", "fishbone", "relax";
+/// may
+///                   cancel.
 /// \return the remeshed mesh and a report; the mesh is valid after every step (strong guarantee of each
 ///         stitch), closed when the reference is.
 /// \throw InvalidInputError when the reference is empty, not a triangle mesh, has no area, or an option is

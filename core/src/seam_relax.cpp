@@ -1,0 +1,384 @@
+#include "detail/seam_relax.h"
+
+#include "fss/raycast.h"
+
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/boost/graph/Euler_operations.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+namespace fss::detail {
+namespace {
+
+namespace PMP = CGAL::Polygon_mesh_processing;
+using Vec = Eigen::Vector3d;
+
+Vec pos(const Mesh& m, VertexIndex v) {
+    const Point3& p = m.point(v);
+    return {p.x(), p.y(), p.z()};
+}
+
+/// Smallest corner angle of triangle (a, b, c), radians (0 for a degenerate one).
+double minAngle(const Vec& a, const Vec& b, const Vec& c) {
+    auto corner = [](const Vec& p, const Vec& q, const Vec& r) {
+        const Vec u = q - p, v = r - p;
+        return std::atan2(u.cross(v).norm(), u.dot(v));
+    };
+    return std::min({corner(a, b, c), corner(b, c, a), corner(c, a, b)});
+}
+
+/// Unit normal of triangle (a, b, c); zero when degenerate.
+Vec unitNormal(const Vec& a, const Vec& b, const Vec& c) {
+    const Vec n = (b - a).cross(c - a);
+    const double len = n.norm();
+    return len > 0 ? Vec(n / len) : Vec(0, 0, 0);
+}
+
+double angleBetween(const Vec& u, const Vec& v) {
+    return std::atan2(u.cross(v).norm(), u.dot(v));
+}
+
+class Relaxer {
+public:
+    Relaxer(Mesh& mesh, const Mesh& reference, const SeamRelaxOptions& o)
+        : m_(mesh), ref_(reference), o_(o), floor_(o.minAngleDeg * std::numbers::pi / 180.0),
+          maxTurn_(o.maxNormalChangeDeg * std::numbers::pi / 180.0),
+          feature_(o.featureAngleDeg * std::numbers::pi / 180.0) {}
+
+    SeamRelaxReport run() {
+        SeamRelaxReport report;
+        markFeaturesAndZone();
+        report.zoneVertices = std::size_t(std::count(zone_.begin(), zone_.end(), 1));
+        report.projected = projectOffSurface();
+        for (int round = 0; round < o_.rounds; ++round) {
+            std::size_t flips = 0;
+            for (int sweep = 0; sweep < 4; ++sweep) {
+                const std::size_t f = flipSweep();
+                flips += f;
+                if (f == 0) break;
+            }
+            const std::size_t collapses = o_.collapses ? collapseSweep() : 0;
+            const std::size_t moves = smoothSweep();
+            report.collapses += collapses;
+            report.flips += flips;
+            report.moves += moves;
+            if (flips == 0 && collapses == 0 && moves == 0) break;
+        }
+        return report;
+    }
+
+private:
+    Mesh& m_;
+    const Mesh& ref_;
+    const SeamRelaxOptions& o_;
+    const double floor_, maxTurn_, feature_;
+    RayCaster caster_{ref_};
+    std::vector<char> zone_, fixed_, fixedEdge_, touchesInput_;
+
+    Vec faceNormal(FaceIndex f) const {
+        const HalfedgeIndex h = m_.halfedge(f);
+        return unitNormal(pos(m_, m_.source(h)), pos(m_, m_.target(h)), pos(m_, m_.target(m_.next(h))));
+    }
+
+    void markFeaturesAndZone() {
+        const std::size_t nv = m_.number_of_vertices() + m_.number_of_removed_vertices();
+        fixedEdge_.assign(m_.number_of_edges() + m_.number_of_removed_edges(), 0);
+        fixed_.assign(nv, 0);
+        zone_.assign(nv, 0);
+        touchesInput_.assign(nv, 0);
+        const auto [ids, haveIds] = m_.property_map<FaceIndex, std::int32_t>(props::faceScanId);
+        auto isInput = [&](FaceIndex f) { return f != Mesh::null_face() && (!haveIds || ids[f] < 0); };
+        // Border and feature edges, and the edges between a face left from the input and a scanned one (so
+        // that the scanned area, the coverage, stays as it is), are fixed: never flipped or collapsed, their
+        // vertices never smoothed.
+        for (EdgeIndex e : m_.edges()) {
+            const HalfedgeIndex h = m_.halfedge(e);
+            const VertexIndex a = m_.source(h), b = m_.target(h);
+            const bool border = m_.is_border(e);
+            const bool input1 = isInput(m_.face(h)), input2 = isInput(m_.face(m_.opposite(h)));
+            if (input1 || input2) touchesInput_[a.idx()] = touchesInput_[b.idx()] = 1;
+            if (border || input1 != input2 ||
+                angleBetween(faceNormal(m_.face(h)), faceNormal(m_.face(m_.opposite(h)))) > feature_) {
+                fixedEdge_[e.idx()] = 1;
+                fixed_[a.idx()] = fixed_[b.idx()] = 1;
+            }
+        }
+        for (VertexIndex v : m_.vertices()) {
+            bool seed = m_.degree(v) != 6;
+            std::int32_t first = -2;
+            for (FaceIndex f : CGAL::faces_around_target(m_.halfedge(v), m_)) {
+                if (f == Mesh::null_face()) {
+                    seed = true;
+                    continue;
+                }
+                const std::int32_t id = haveIds ? ids[f] : -1;
+                if (id < 0 || (first != -2 && id != first)) seed = true;
+                first = id;
+            }
+            zone_[v.idx()] = seed;
+        }
+        for (int ring = 0; ring < o_.zoneRings; ++ring) {
+            std::vector<char> grown(zone_);
+            for (VertexIndex v : m_.vertices())
+                if (zone_[v.idx()])
+                    for (VertexIndex w : CGAL::vertices_around_target(m_.halfedge(v), m_))
+                        grown[w.idx()] = 1;
+            zone_.swap(grown);
+        }
+    }
+
+    /// Cost of a valence: an irregular vertex (valence ≠ 6) costs more than the squared deviations from 6 of
+    /// the four vertices an operation changes can add up to in practice, so flips and collapses first lower
+    /// the number of irregular vertices, then the squared deviation (which alone would trade a 4 and an 8
+    /// for a 5 and a 7 but also a 9 for an 8, a 7 and a 7).
+    static int deviation(int degree) { return (degree != 6) * 64 + (degree - 6) * (degree - 6); }
+
+    /// One pass of valence-improving flips over the zone's edges.
+    std::size_t flipSweep() {
+        std::size_t flips = 0;
+        const double tolerance = 0.05 * o_.edgeLength;
+        for (EdgeIndex e : m_.edges()) {
+            if (m_.is_removed(e) || fixedEdge_[e.idx()]) continue;
+            const HalfedgeIndex h = m_.halfedge(e), o = m_.opposite(h);
+            const VertexIndex a = m_.source(h), b = m_.target(h);
+            const VertexIndex c = m_.target(m_.next(h)), d = m_.target(m_.next(o));
+            if (c == d || !zone_[a.idx()] || !zone_[b.idx()] || !zone_[c.idx()] || !zone_[d.idx()]) continue;
+            const int da = int(m_.degree(a)), db = int(m_.degree(b));
+            const int dc = int(m_.degree(c)), dd = int(m_.degree(d));
+            if (da <= 3 || db <= 3) continue;
+            const int before = deviation(da) + deviation(db) + deviation(dc) + deviation(dd);
+            const int after = deviation(da - 1) + deviation(db - 1) + deviation(dc + 1) + deviation(dd + 1);
+            if (after >= before) continue;
+            if (CGAL::halfedge(c, d, m_).second) continue;
+            const Vec pa = pos(m_, a), pb = pos(m_, b), pc = pos(m_, c), pd = pos(m_, d);
+            // Faces (a, b, c), (b, a, d) become (a, d, c), (d, b, c).
+            const double oldMin = std::min(minAngle(pa, pb, pc), minAngle(pb, pa, pd));
+            const double newMin = std::min(minAngle(pa, pd, pc), minAngle(pd, pb, pc));
+            if (newMin < std::min(oldMin, floor_)) continue;
+            const Vec n1 = unitNormal(pa, pb, pc), n2 = unitNormal(pb, pa, pd);
+            const Vec m1 = unitNormal(pa, pd, pc), m2 = unitNormal(pd, pb, pc);
+            if (n1.isZero() || n2.isZero() || m1.isZero() || m2.isZero()) continue;
+            const Vec mean = (n1 + n2).normalized();
+            if (angleBetween(m1, mean) > maxTurn_ || angleBetween(m2, mean) > maxTurn_ ||
+                angleBetween(m1, m2) > feature_)
+                continue;
+            // The new edge stays as close to the reference surface as the old one (or within a tolerance).
+            const double oldGap = caster_.closestPoint(0.5 * (pa + pb)).distance;
+            const double newGap = caster_.closestPoint(0.5 * (pc + pd)).distance;
+            if (newGap > std::max(oldGap, tolerance)) continue;
+            CGAL::Euler::flip_edge(h, m_);
+            ++flips;
+        }
+        return flips;
+    }
+
+    /// One pass of valence-improving edge collapses over the zone's edges between two free vertices: the
+    /// kept vertex gets both valences minus four, the two opposite vertices lose one each (two valence-5
+    /// vertices next to two valence-7 ones become four valence-6 vertices). The merged vertex sits at the
+    /// reference point closest to the edge's midpoint.
+    std::size_t collapseSweep() {
+        std::size_t collapses = 0;
+        const double maxLength = 4.0 / 3.0 * o_.edgeLength;
+        for (EdgeIndex e : m_.edges()) {
+            if (m_.is_removed(e) || fixedEdge_[e.idx()]) continue;
+            const HalfedgeIndex h = m_.halfedge(e), o = m_.opposite(h);
+            const VertexIndex a = m_.source(h), b = m_.target(h);
+            const VertexIndex c = m_.target(m_.next(h)), d = m_.target(m_.next(o));
+            // A vertex on a feature line may absorb a free neighbour (and stays where it is); two never
+            // merge.
+            if (c == d || (fixed_[a.idx()] && fixed_[b.idx()])) continue;
+            if (!zone_[a.idx()] || !zone_[b.idx()] || !zone_[c.idx()] || !zone_[d.idx()]) continue;
+            const int da = int(m_.degree(a)), db = int(m_.degree(b));
+            const int dc = int(m_.degree(c)), dd = int(m_.degree(d));
+            if (dc <= 3 || dd <= 3) continue;
+            const int before = deviation(da) + deviation(db) + deviation(dc) + deviation(dd);
+            const int after = deviation(da + db - 4) + deviation(dc - 1) + deviation(dd - 1);
+            if (after >= before) continue;
+            if (!CGAL::Euler::does_satisfy_link_condition(e, m_)) continue;
+            Vec q;
+            if (fixed_[a.idx()] || fixed_[b.idx()]) {
+                q = pos(m_, fixed_[a.idx()] ? a : b);
+            } else {
+                const SurfacePoint sp = caster_.closestPoint(0.5 * (pos(m_, a) + pos(m_, b)));
+                if (!sp) continue;
+                q = sp.point;
+            }
+            // The faces around a and b but the two of e, with a or b at q.
+            double oldMin = std::min(faceMinAngle(m_.face(h)), faceMinAngle(m_.face(o)));
+            double newMin = std::numbers::pi, longestBefore = 0, longestAfter = 0;
+            bool ok = true;
+            for (VertexIndex v : {a, b}) {
+                const Vec p = pos(m_, v);
+                for (HalfedgeIndex g : CGAL::halfedges_around_target(m_.halfedge(v), m_)) {
+                    const FaceIndex f = m_.face(g);
+                    if (f == m_.face(h) || f == m_.face(o)) continue;
+                    const HalfedgeIndex n1 = m_.next(g);
+                    const Vec s = pos(m_, m_.target(n1)), t = pos(m_, m_.target(m_.next(n1)));
+                    oldMin = std::min(oldMin, minAngle(p, s, t));
+                    newMin = std::min(newMin, minAngle(q, s, t));
+                    longestBefore = std::max({longestBefore, (s - p).norm(), (t - p).norm()});
+                    longestAfter = std::max({longestAfter, (s - q).norm(), (t - q).norm()});
+                    const Vec n0 = unitNormal(p, s, t), n = unitNormal(q, s, t);
+                    if (n0.isZero() || n.isZero() || angleBetween(n, n0) > maxTurn_) ok = false;
+                }
+            }
+            if (!ok || newMin < std::min(oldMin, floor_) || longestAfter > std::max(maxLength, longestBefore))
+                continue;
+            // The new faces stay as close to the reference as the old ones (or within a tolerance): their
+            // centroids, against the largest gap of the old faces' centroids.
+            double oldGap = 0, newGap = 0;
+            for (VertexIndex v : {a, b}) {
+                const Vec p = pos(m_, v);
+                for (HalfedgeIndex g : CGAL::halfedges_around_target(m_.halfedge(v), m_)) {
+                    const HalfedgeIndex n1 = m_.next(g);
+                    const Vec s = pos(m_, m_.target(n1)), t = pos(m_, m_.target(m_.next(n1)));
+                    oldGap = std::max(oldGap, caster_.closestPoint((p + s + t) / 3.0).distance);
+                    const FaceIndex f = m_.face(g);
+                    if (f != m_.face(h) && f != m_.face(o))
+                        newGap = std::max(newGap, caster_.closestPoint((q + s + t) / 3.0).distance);
+                }
+            }
+            if (newGap > std::max(oldGap, 0.05 * o_.edgeLength)) continue;
+            // The collapse keeps one edge of each pair (a, c), (b, c) and (a, d), (b, d): it keeps their
+            // flags.
+            auto featureOf = [&](VertexIndex u, VertexIndex w) {
+                return char(fixedEdge_[m_.edge(CGAL::halfedge(u, w, m_).first).idx()]);
+            };
+            const char fc = featureOf(a, c) | featureOf(b, c), fd = featureOf(a, d) | featureOf(b, d);
+            const char fixedKept = fixed_[a.idx()] | fixed_[b.idx()];
+            const VertexIndex kept = CGAL::Euler::collapse_edge(e, m_);
+            m_.point(kept) = Point3(q.x(), q.y(), q.z());
+            fixed_[kept.idx()] = fixedKept;
+            touchesInput_[kept.idx()] = touchesInput_[a.idx()] | touchesInput_[b.idx()];
+            fixedEdge_[m_.edge(CGAL::halfedge(kept, c, m_).first).idx()] = fc;
+            fixedEdge_[m_.edge(CGAL::halfedge(kept, d, m_).first).idx()] = fd;
+            ++collapses;
+        }
+        return collapses;
+    }
+
+    double faceMinAngle(FaceIndex f) const {
+        const HalfedgeIndex h = m_.halfedge(f);
+        return minAngle(pos(m_, m_.source(h)), pos(m_, m_.target(h)), pos(m_, m_.target(m_.next(h))));
+    }
+
+    /// Moves the zone's vertices that lie off the reference surface (by more than a tenth of the edge
+    /// length: the stitches' collapses on creases leave a few) onto their closest reference point, feature
+    /// vertices included (not those of input faces), where no face of their star degenerates, turns over
+    /// (normal change above 60°) or gets an angle below the floor.
+    std::size_t projectOffSurface() {
+        std::size_t moves = 0;
+        const double tolerance = 0.1 * o_.edgeLength;
+        const double maxTurn = std::numbers::pi / 3.0;
+        for (VertexIndex v : m_.vertices()) {
+            if (!zone_[v.idx()] || touchesInput_[v.idx()] || m_.is_border(v)) continue;
+            const Vec p = pos(m_, v);
+            const SurfacePoint sp = caster_.closestPoint(p);
+            if (!sp || sp.distance <= tolerance) continue;
+            const Vec q = sp.point;
+            double oldMin = std::numbers::pi, newMin = std::numbers::pi;
+            bool ok = true;
+            for (HalfedgeIndex h : CGAL::halfedges_around_target(m_.halfedge(v), m_)) {
+                const HalfedgeIndex n1 = m_.next(h);
+                const Vec s = pos(m_, m_.target(n1)), t = pos(m_, m_.target(m_.next(n1)));
+                oldMin = std::min(oldMin, minAngle(p, s, t));
+                newMin = std::min(newMin, minAngle(q, s, t));
+                const Vec n0 = unitNormal(p, s, t), n = unitNormal(q, s, t);
+                if (n0.isZero() || n.isZero() || angleBetween(n, n0) > maxTurn) ok = false;
+            }
+            if (!ok || newMin < std::min(oldMin, floor_)) continue;
+            m_.point(v) = Point3(q.x(), q.y(), q.z());
+            ++moves;
+        }
+        return moves;
+    }
+
+    /// Whether the faces \p star (corners q, r after the moving vertex) stay as close to the reference with
+    /// the vertex at \p to as at \p from, or within a twentieth of the edge length: their centroids' largest
+    /// distance to the reference.
+    template <class Star> bool staysNearReference(const Vec& from, const Vec& to, const Star& star) const {
+        const double tolerance = 0.05 * o_.edgeLength;
+        double newGap = 0;
+        for (const auto& k : star)
+            newGap = std::max(newGap, caster_.closestPoint((to + k.q + k.r) / 3.0).distance);
+        if (newGap <= tolerance) return true;
+        double oldGap = 0;
+        for (const auto& k : star)
+            oldGap = std::max(oldGap, caster_.closestPoint((from + k.q + k.r) / 3.0).distance);
+        return newGap <= oldGap;
+    }
+
+    /// One pass of tangential smoothing of the zone's free vertices, projected onto the reference.
+    std::size_t smoothSweep() {
+        std::size_t moves = 0;
+        for (VertexIndex v : m_.vertices()) {
+            if (m_.is_removed(v) || !zone_[v.idx()] || fixed_[v.idx()]) continue;
+            const Vec p = pos(m_, v);
+            Vec centroid(0, 0, 0), normal(0, 0, 0);
+            int n = 0;
+            for (VertexIndex w : CGAL::vertices_around_target(m_.halfedge(v), m_))
+                centroid += pos(m_, w), ++n;
+            struct Corner {
+                FaceIndex face;
+                Vec q, r; // the face's other two vertices, in order after v
+                Vec normal;
+            };
+            std::vector<Corner> star;
+            for (HalfedgeIndex h : CGAL::halfedges_around_target(m_.halfedge(v), m_)) {
+                const FaceIndex f = m_.face(h);
+                const HalfedgeIndex n1 = m_.next(h);
+                Corner k{f, pos(m_, m_.target(n1)), pos(m_, m_.target(m_.next(n1))), Vec(0, 0, 0)};
+                const Vec raw = (k.q - p).cross(k.r - p);
+                k.normal = unitNormal(p, k.q, k.r);
+                normal += raw;
+                star.push_back(k);
+            }
+            if (n < 3 || normal.isZero()) continue;
+            normal.normalize();
+            centroid /= double(n);
+            Vec t = centroid - p;
+            t -= t.dot(normal) * normal;
+            const SurfacePoint sp = caster_.closestPoint(p + o_.smoothingStep * t);
+            if (!sp) continue;
+            const Vec q = sp.point;
+            if ((q - p).norm() <= 1e-9 * o_.edgeLength) continue;
+            double oldMin = std::numbers::pi, newMin = std::numbers::pi;
+            bool ok = true;
+            for (const Corner& k : star) {
+                oldMin = std::min(oldMin, minAngle(p, k.q, k.r));
+                newMin = std::min(newMin, minAngle(q, k.q, k.r));
+                const Vec nn = unitNormal(q, k.q, k.r);
+                if (nn.isZero() || k.normal.isZero() || angleBetween(nn, k.normal) > maxTurn_) {
+                    ok = false;
+                    break;
+                }
+            }
+            if (!ok || newMin < std::min(oldMin, floor_)) continue;
+            if (!staysNearReference(p, q, star)) continue;
+            m_.point(v) = Point3(q.x(), q.y(), q.z());
+            ++moves;
+        }
+        return moves;
+    }
+};
+
+} // namespace
+
+SeamRelaxReport relaxSeams(Mesh& mesh, const Mesh& reference, const SeamRelaxOptions& options) {
+    if (options.rounds <= 0 || mesh.is_empty()) return {};
+    const Mesh before = mesh;
+    SeamRelaxReport report = Relaxer(mesh, reference, options).run();
+    mesh.collect_garbage();
+    if ((report.flips > 0 || report.collapses > 0 || report.moves > 0 || report.projected > 0) &&
+        PMP::does_self_intersect(mesh) && !PMP::does_self_intersect(before)) {
+        mesh = before;
+        report.flips = report.collapses = report.moves = report.projected = 0;
+        report.reverted = true;
+    }
+    return report;
+}
+
+} // namespace fss::detail
