@@ -234,30 +234,43 @@ Backbone drawnBackbone(const Polyline2& points, const FishboneOptions& options) 
     return b;
 }
 
-Rib traceRib(const DirectionField& ribField, const Backbone& backbone, std::size_t row,
-             const FishboneOptions& options) {
+std::vector<Rib> traceRibs(const DirectionField& ribField, const Backbone& backbone, std::size_t first,
+                           std::size_t count, const FishboneOptions& options) {
     requireSpacing(options.spacing);
     requireBackbone(backbone);
-    if (row >= backbone.samples.size())
+    if (first + count > backbone.samples.size() || first + count < first)
+        throw InvalidInputError("The ribs' backbone samples " + std::to_string(first) + " to " +
+                                std::to_string(first + count) + " do not exist (the backbone has " +
+                                std::to_string(backbone.samples.size()) + " samples).");
+    // Every half whose start is defined, all traced in lockstep (traceHalvesInLockstep), then resampled.
+    std::vector<Rib> ribs(count);
+    std::vector<HalfStart> starts;
+    std::vector<Polyline2*> targets;
+    for (std::size_t i = 0; i < count; ++i) {
+        const Eigen::Vector2d p0 = backbone.samples[first + i], n = backbone.normal(first + i);
+        ribs[i] = Rib{{p0}, {p0}};
+        for (const bool positive : {true, false}) {
+            const Eigen::Vector2d side = positive ? n : Eigen::Vector2d(-n);
+            if (!ribHalfTraceable(ribField, p0, side, options)) continue;
+            starts.push_back({p0, side});
+            targets.push_back(positive ? &ribs[i].positive : &ribs[i].negative);
+        }
+    }
+    const std::vector<StreamlineHalf> halves = traceHalvesInLockstep(ribField, starts, options.ribTracing);
+    for (std::size_t k = 0; k < halves.size(); ++k)
+        *targets[k] = resampleAtSpacing(halves[k].points, options.spacing);
+    return ribs;
+}
+
+Rib traceRib(const DirectionField& ribField, const Backbone& backbone, std::size_t row,
+             const FishboneOptions& options) {
+    if (row >= backbone.samples.size()) {
+        requireBackbone(backbone);
         throw InvalidInputError("The rib's backbone sample " + std::to_string(row) +
                                 " does not exist (the backbone has " +
                                 std::to_string(backbone.samples.size()) + " samples).");
-    const Eigen::Vector2d p0 = backbone.samples[row], n = backbone.normal(row);
-    const bool positive = ribHalfTraceable(ribField, p0, n, options);
-    const bool negative = ribHalfTraceable(ribField, p0, -n, options);
-    Rib rib{{p0}, {p0}};
-    if (positive && negative) { // the common case: both halves in lockstep (traceTwoHalves)
-        const auto [pos, neg] = traceTwoHalves(ribField, {p0, n}, {p0, -n}, options.ribTracing);
-        rib.positive = resampleAtSpacing(pos.points, options.spacing);
-        rib.negative = resampleAtSpacing(neg.points, options.spacing);
-    } else if (positive) {
-        rib.positive = resampleAtSpacing(traceStreamlineHalf(ribField, p0, n, options.ribTracing).points,
-                                         options.spacing);
-    } else if (negative) {
-        rib.negative = resampleAtSpacing(traceStreamlineHalf(ribField, p0, -n, options.ribTracing).points,
-                                         options.spacing);
     }
-    return rib;
+    return traceRibs(ribField, backbone, row, 1, options).front();
 }
 
 KeyRib drawnKeyRib(const Backbone& backbone, const Polyline2& points, const FishboneOptions& options) {
@@ -325,6 +338,22 @@ FishboneGrid assembleFishboneGrid(const Backbone& backbone, const std::vector<Ri
     return g;
 }
 
+std::vector<Rib> traceAllRibs(const DirectionField& ribField, const Backbone& backbone,
+                              const FishboneOptions& options) {
+    requireBackbone(backbone);
+    // Independent streamlines: groups of kRibsInLockstep neighbouring ribs (their halves traced in
+    // lockstep) on the scan threads, each group into its own slots (parallel.h).
+    constexpr std::size_t kRibsInLockstep = 2;
+    const std::size_t n = backbone.samples.size(), groups = (n + kRibsInLockstep - 1) / kRibsInLockstep;
+    std::vector<Rib> ribs(n);
+    detail::parallelItems(groups, 2, [&](std::size_t g) {
+        const std::size_t first = g * kRibsInLockstep, count = std::min(kRibsInLockstep, n - first);
+        std::vector<Rib> traced = traceRibs(ribField, backbone, first, count, options);
+        std::move(traced.begin(), traced.end(), ribs.begin() + std::ptrdiff_t(first));
+    });
+    return ribs;
+}
+
 FishboneGrid automaticFishbone(const DirectionField& backboneField, const DirectionField& ribField,
                                const Eigen::Vector2d& seed, const FishboneOptions& options) {
     if (backboneField.width != ribField.width || backboneField.height != ribField.height)
@@ -332,9 +361,7 @@ FishboneGrid automaticFishbone(const DirectionField& backboneField, const Direct
     const Backbone backbone = traceBackbone(backboneField, seed, options);
     requireBackbone(backbone);
     // The ribs are independent streamlines: traced on several threads, each into its own slot (parallel.h).
-    std::vector<Rib> ribs(backbone.samples.size());
-    detail::parallelItems(ribs.size(), 4,
-                          [&](std::size_t r) { ribs[r] = traceRib(ribField, backbone, r, options); });
+    const std::vector<Rib> ribs = traceAllRibs(ribField, backbone, options);
     return assembleFishboneGrid(backbone, ribs, options.spacing, ribField.width, ribField.height);
 }
 

@@ -535,12 +535,9 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
         throw InvalidInputError("The fishbone backbone has fewer than two samples; pick a point on a longer "
                                 "feature or reduce h.");
     if (!keyRibMode) {
-        // The ribs are independent streamlines: traced on the scan threads, each into its own slot
-        // (parallel.h; the grid is the same for any thread count).
-        std::vector<Rib> ribs(backbone.samples.size());
-        detail::parallelItems(ribs.size(), 4,
-                              [&](std::size_t r) { ribs[r] = traceRib(ribField, backbone, r, options); });
-        result.fishbone = assembleFishboneGrid(backbone, ribs, h, W, H);
+        // The ribs are independent streamlines, traced on the scan threads (the grid is the same for any
+        // thread count).
+        result.fishbone = assembleFishboneGrid(backbone, traceAllRibs(ribField, backbone, options), h, W, H);
     } else {
         std::vector<KeyRib> keys;
         std::vector<std::uint8_t> used(backbone.samples.size(), 0);

@@ -235,24 +235,28 @@ StreamlineHalf traceStreamlineHalf(const DirectionField& field, const Eigen::Vec
     return t.take();
 }
 
-std::pair<StreamlineHalf, StreamlineHalf> traceTwoHalves(const DirectionField& field, const HalfStart& first,
-                                                         const HalfStart& second,
-                                                         const StreamlineOptions& options) {
-    HalfTracer a(field, first.seed, first.initialDirection, options);
-    HalfTracer b(field, second.seed, second.initialDirection, options);
-    while (!a.done() || !b.done()) {
-        a.begin();
-        b.begin();
-        a.stage2();
-        b.stage2();
-        a.stage3();
-        b.stage3();
-        a.stage4();
-        b.stage4();
-        a.end();
-        b.end();
+std::vector<StreamlineHalf> traceHalvesInLockstep(const DirectionField& field, const std::vector<HalfStart>& starts,
+                                                  const StreamlineOptions& options) {
+    std::vector<HalfTracer> tracers;
+    tracers.reserve(starts.size());
+    for (const HalfStart& s : starts)
+        tracers.emplace_back(field, s.seed, s.initialDirection, options);
+    auto all = [&](void (HalfTracer::*stage)()) {
+        for (HalfTracer& t : tracers)
+            (t.*stage)();
+    };
+    while (std::any_of(tracers.begin(), tracers.end(), [](const HalfTracer& t) { return !t.done(); })) {
+        all(&HalfTracer::begin);
+        all(&HalfTracer::stage2);
+        all(&HalfTracer::stage3);
+        all(&HalfTracer::stage4);
+        all(&HalfTracer::end);
     }
-    return {a.take(), b.take()};
+    std::vector<StreamlineHalf> out;
+    out.reserve(tracers.size());
+    for (HalfTracer& t : tracers)
+        out.push_back(t.take());
+    return out;
 }
 
 Streamline traceStreamline(const DirectionField& field, const Eigen::Vector2d& seed,

@@ -348,7 +348,9 @@ TEST(Streamline, TwoHalvesInLockstepEqualTwoSingleHalves) {
     for (double maxLength : {std::numeric_limits<double>::infinity(), 150.0})
         for (const auto& [a, b] : cases) {
             o.maxLength = maxLength;
-            const auto [la, lb] = fss::traceTwoHalves(f, a, b, o);
+            const std::vector<fss::StreamlineHalf> lockstep = fss::traceHalvesInLockstep(f, {a, b}, o);
+            ASSERT_EQ(lockstep.size(), 2u);
+            const fss::StreamlineHalf &la = lockstep[0], &lb = lockstep[1];
             const fss::StreamlineHalf sa = fss::traceStreamlineHalf(f, a.seed, a.initialDirection, o);
             const fss::StreamlineHalf sb = fss::traceStreamlineHalf(f, b.seed, b.initialDirection, o);
             for (const auto& [lock, single] : {std::pair{&la, &sa}, std::pair{&lb, &sb}}) {

@@ -143,6 +143,17 @@ Backbone traceBackbone(const DirectionField& backboneField, const Eigen::Vector2
 /// \pre at least two distinct finite points; spacing > 0. \throw InvalidInputError otherwise.
 Backbone drawnBackbone(const Polyline2& points, const FishboneOptions& options = {});
 
+/// The ribs through backbone samples first … first + count − 1, each exactly traceRib's: their halves are
+/// traced in lockstep on the calling thread (traceHalvesInLockstep), which is faster than one by one.
+/// \pre first + count ≤ backbone.samples.size(), backbone has ≥ 2 samples. \throw InvalidInputError otherwise.
+std::vector<Rib> traceRibs(const DirectionField& ribField, const Backbone& backbone, std::size_t first,
+                           std::size_t count, const FishboneOptions& options = {});
+
+/// Every rib of \p backbone (the automatic mode), in backbone order: traceRibs on groups of neighbouring
+/// backbone samples, the groups on the scan threads (parallel.h); the same ribs for any thread count.
+std::vector<Rib> traceAllRibs(const DirectionField& ribField, const Backbone& backbone,
+                              const FishboneOptions& options = {});
+
 /// Traces the rib through backbone sample \p row on \p ribField, both ways, each half sampled every h
 /// from the backbone sample; a half whose start is undefined (background) is just the sample.
 /// \pre row < backbone.samples.size(), backbone has ≥ 2 samples. \throw InvalidInputError otherwise.

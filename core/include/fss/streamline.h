@@ -19,7 +19,6 @@
 #include <functional>
 #include <limits>
 #include <optional>
-#include <utility>
 #include <vector>
 
 namespace fss {
@@ -109,20 +108,19 @@ StreamlineHalf traceStreamlineHalf(const DirectionField& field, const Eigen::Vec
                                    const Eigen::Vector2d& initialDirection,
                                    const StreamlineOptions& options = {});
 
-/// Where one half of a streamline starts (traceTwoHalves).
+/// Where one half of a streamline starts (traceHalvesInLockstep).
 struct HalfStart {
     Eigen::Vector2d seed;
     Eigen::Vector2d initialDirection;
 };
 
-/// Traces two halves on the calling thread in lockstep, one RK4 stage of each after the other: each result
-/// is exactly traceStreamlineHalf's for its start, in less time than tracing them one after the other,
-/// because the two halves' independent field evaluations overlap in the processor (the two halves of a
-/// rib, for instance).
-/// \pre and \throw as traceStreamlineHalf, for both starts (checked before any tracing).
-std::pair<StreamlineHalf, StreamlineHalf> traceTwoHalves(const DirectionField& field, const HalfStart& first,
-                                                         const HalfStart& second,
-                                                         const StreamlineOptions& options = {});
+/// Traces several halves on the calling thread in lockstep, one RK4 stage of each after the other: each
+/// result is exactly traceStreamlineHalf's for its start (in the order of \p starts), in less time than
+/// tracing them one after the other, because the halves' independent field evaluations overlap in the
+/// processor (the two halves of two neighbouring ribs, for instance).
+/// \pre and \throw as traceStreamlineHalf, for every start (checked before any tracing).
+std::vector<StreamlineHalf> traceHalvesInLockstep(const DirectionField& field, const std::vector<HalfStart>& starts,
+                                                  const StreamlineOptions& options = {});
 
 /// Traces a streamline both ways from \p seed (DESIGN.md §1: the backbone through the picked point, the
 /// ribs through the backbone samples). "Forward" is the field direction at the seed aligned with
