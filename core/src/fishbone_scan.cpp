@@ -54,29 +54,6 @@ struct RayFactory {
     }
 };
 
-/// The ray's hit on face \p f (Möller–Trumbore, inclusive edges with a tiny tolerance), if any. The fast
-/// path of the hinted ray cast: a rib vertex lies in the pixel whose centre shows \p f, so most rays hit
-/// it; the rest go to RayCaster::intersect (local search, AABB fallback).
-std::optional<Eigen::Vector3d> hitOnFace(const Mesh& mesh, FaceIndex f, const Ray& ray) {
-    const HalfedgeIndex h = mesh.halfedge(f);
-    auto P = [&](VertexIndex v) {
-        const Point3& p = mesh.point(v);
-        return Eigen::Vector3d(p.x(), p.y(), p.z());
-    };
-    const Eigen::Vector3d a = P(mesh.source(h)), b = P(mesh.target(h)), c = P(mesh.target(mesh.next(h)));
-    const Eigen::Vector3d e1 = b - a, e2 = c - a, pv = ray.direction.cross(e2);
-    const double det = e1.dot(pv);
-    if (std::abs(det) < 1e-14 * e1.norm() * e2.norm())
-        return std::nullopt; // ray in the plane: let the caster decide
-    const Eigen::Vector3d tv = ray.origin - a;
-    const double u = tv.dot(pv) / det;
-    const Eigen::Vector3d qv = tv.cross(e1);
-    const double v = ray.direction.dot(qv) / det, t = e2.dot(qv) / det;
-    constexpr double eps = 1e-12;
-    if (u < -eps || v < -eps || u + v > 1 + eps || t < 0) return std::nullopt;
-    return ray.origin + t * ray.direction;
-}
-
 /// Walks over the mesh from face \p start towards the ray (a visibility walk in the ray's barycentric
 /// coordinates): in each face the ray's intersection with the face's plane has barycentric coordinates;
 /// when one is negative the walk crosses the edge opposite the most negative one. Returns the face the
@@ -115,6 +92,13 @@ std::optional<std::pair<FaceIndex, Eigen::Vector3d>> walkToHit(const Mesh& mesh,
         f = next;
     }
     return std::nullopt;
+}
+
+/// The ray's hit on face \p f alone (the walk's test of one face: Möller–Trumbore, inclusive edges with a
+/// tiny tolerance), if any.
+std::optional<Eigen::Vector3d> hitOnFace(const Mesh& mesh, FaceIndex f, const Ray& ray) {
+    const auto hit = walkToHit(mesh, f, ray, 0);
+    return hit ? std::optional<Eigen::Vector3d>(hit->second) : std::nullopt;
 }
 
 /// A sharp edge of the reference as seen from the scan camera (screen positions of its end points).
@@ -364,13 +348,11 @@ SampleGrid rayCastFishbone(const FishboneGrid& fishbone, const FrameBuffers& ref
                     (id != FrameBuffers::kNoFace && id < faceCount) ? FaceIndex(id) : Mesh::null_face();
                 const Ray ray = rays(p.x(), p.y());
                 if (hint != Mesh::null_face() && !search.verifyUnoccluded) {
-                    if (const std::optional<Eigen::Vector3d> q = hitOnFace(reference, hint, ray)) {
-                        ++local;
-                        setSampleOnSurface(s, reference, projector, hint, *q, options);
-                        continue;
-                    }
-                    // Walk over the surface from the hint face towards the ray (faces smaller than a pixel).
+                    // Most rays hit the hint face (a rib vertex lies in the pixel whose centre shows it); the
+                    // walk tests it first, then moves over the surface towards the ray (faces smaller than a
+                    // pixel).
                     if (const auto walked = walkToHit(reference, hint, ray, kMaxWalkSteps)) {
+                        if (walked->first == hint) ++local;
                         setSampleOnSurface(s, reference, projector, walked->first, walked->second, options);
                         continue;
                     }
