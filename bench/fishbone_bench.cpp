@@ -3,8 +3,9 @@
 // Per mesh (fandisk, 13k faces; a 100k-face torus), one GPU renderer (head-less) for both scans:
 //  * fishbone: scanFishbonePatch with h = 2 pixels at 512² and with h = 1 pixel at 256² (the same view: the
 //    same surface region and about the same number of samples; automatic mode, seed on a curved region).
-//    At h = 1 the fishbone renders one pixel per sample, as the regular scan does; at h = 2 it renders
-//    four, so its render and per-pixel direction field cost more per sample;
+//    At h = 1 the fishbone renders one pixel per sample, as the regular scan does. At h = 2 it samples by
+//    default (FishboneParams::samplingFactor, argument k = 0) on the 256² image, one pixel per sample too;
+//    with k = 1 it renders and computes its direction fields on all 512² pixels, four per sample;
 //  * regular:  scanPatch with the same camera at the resolution whose covered-pixel count equals the
 //    fishbone's sample count (calibrated once before timing: covered ∝ resolution²).
 // Both scans run alternately in the same loop; counters: fishbone_ms, regular_ms, ratio =
@@ -94,6 +95,7 @@ void BM_FishboneVsRegular(benchmark::State& state) {
     fss::FishboneParams fb;
     fb.seed = scene.seed;
     fb.spacing = double(h);
+    fb.samplingFactor = int(state.range(2));
     const fss::FishboneScanResult probe =
         fss::scanFishbonePatch(scene.mesh, renderer, scene.mesh, renderer, fishParams, fb, cache);
     const std::size_t fishSamples = probe.counts.covered;
@@ -150,8 +152,10 @@ void BM_FishboneVsRegular(benchmark::State& state) {
     state.counters["curvature_ms"] = curvatureMs;
     state.counters["aabb_ms"] = aabbMs;
     state.counters["threads"] = fss::scanThreads();
+    state.counters["k"] = probe.samplingFactor;
     state.SetLabel(std::string(state.range(0) == 0 ? "fandisk" : "torus 100k") + ", h = " + std::to_string(h) +
-                   " px at " + std::to_string(resolution) + "²");
+                   " px at " + std::to_string(resolution) + "², sampling image " +
+                   std::to_string(probe.grid.camera.width) + "²");
 }
 
 } // namespace
@@ -163,11 +167,13 @@ const bool threadsFromEnvironment = [] {
 }();
 
 BENCHMARK(BM_FishboneVsRegular)
-    ->ArgNames({"mesh", "h"})
-    ->Args({0, 2})
-    ->Args({0, 1})
-    ->Args({1, 2})
-    ->Args({1, 1})
+    ->ArgNames({"mesh", "h", "k"})
+    ->Args({0, 2, 0})
+    ->Args({0, 2, 1})
+    ->Args({0, 1, 0})
+    ->Args({1, 2, 0})
+    ->Args({1, 2, 1})
+    ->Args({1, 1, 0})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(10);
 

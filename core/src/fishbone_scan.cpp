@@ -391,43 +391,19 @@ SampleGrid rayCastFishbone(const FishboneGrid& fishbone, const FrameBuffers& ref
 
 // ---- The scan -------------------------------------------------------------------------------------------
 
-FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& referenceRenderer,
-                                     const Mesh& current, MeshRenderer& currentRenderer,
-                                     const ScanParams& params, const FishboneParams& fb, FishboneCache& cache,
-                                     const Progress& progress) {
-    const auto start = Clock::now();
-    params.camera.validate();
-    if (params.erodeRadius < 0 || params.dilateRadius < 0)
-        throw InvalidInputError("The erosion and dilation radii must not be negative.");
-    if (params.lasso) validateLasso(*params.lasso);
+namespace {
+
+// The scan on its sampling image: \p params and \p fb are already scaled to it (and validated); \p k is
+// the sampling factor, only for the positions in error messages (which the user gave in scan pixels).
+FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& referenceRenderer,
+                                       const Mesh& current, MeshRenderer& currentRenderer,
+                                       const ScanParams& params, const FishboneParams& fb, FishboneCache& cache,
+                                       const Progress& progress, int k, Clock::time_point start) {
+    auto shown = [k](const Eigen::Vector2d& p) { return point(double(k) * p); };
     const double h = fb.spacing;
-    const double maxH = std::min(params.camera.width, params.camera.height) / 4.0;
-    if (!std::isfinite(h) || h < 0.5 || h > maxH)
-        throw InvalidInputError("The fishbone spacing h = " + fmt(h) + " pixels is outside [0.5, " +
-                                fmt(maxH) + "] for a " + std::to_string(params.camera.width) + "x" +
-                                std::to_string(params.camera.height) + " scan.");
     const bool drawnBackbone = !fb.drawnBackbone.empty();
-    if (!drawnBackbone && !fb.seed)
-        throw InvalidInputError("A fishbone scan needs a seed point or a drawn backbone.");
-    if (drawnBackbone && fb.drawnBackbone.size() < 2)
-        throw InvalidInputError("A drawn backbone needs at least two points.");
     const std::size_t keyRibCount = fb.keyRibs.size() + fb.drawnKeyRibs.size();
     const bool keyRibMode = keyRibCount > 0;
-    if (keyRibMode && keyRibCount < 2)
-        throw InvalidInputError("Key-rib mode needs at least two key-ribs to blend between, " +
-                                std::to_string(keyRibCount) + " given.");
-    auto insideImage = [&](const Eigen::Vector2d& p) {
-        return std::isfinite(p.x()) && std::isfinite(p.y()) && p.x() >= 0 && p.y() >= 0 &&
-               p.x() < params.camera.width && p.y() < params.camera.height;
-    };
-    if (!std::isfinite(fb.creaseAngleDeg) || fb.creaseAngleDeg < 0 || fb.creaseAngleDeg >= 180 ||
-        !std::isfinite(fb.creaseSnapRadius) || !(fb.creaseSnapRadius > 0))
-        throw InvalidInputError("The crease angle must lie in [0, 180) degrees and the crease snap radius "
-                                "must be positive.");
-    if (fb.seed && !drawnBackbone && !insideImage(*fb.seed))
-        throw InvalidInputError("The fishbone seed " + point(*fb.seed) + " lies outside the " +
-                                std::to_string(params.camera.width) + "x" +
-                                std::to_string(params.camera.height) + " scan image.");
 
     FishboneScanResult result;
     FishboneOptions options = fb.tracing;
@@ -478,7 +454,7 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
     if (tracedBackbone) {
         const int sx = int(std::floor(fb.seed->x())), sy = int(std::floor(fb.seed->y()));
         if (!buffers.covered(sx, sy))
-            throw InvalidInputError("The fishbone seed " + point(*fb.seed) +
+            throw InvalidInputError("The fishbone seed " + shown(*fb.seed) +
                                     " lies on the background; pick a point on the surface.");
     }
     // Lazy fields: a tile of pixels is computed when the backbone or a rib first comes near it, so the cost
@@ -497,7 +473,7 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
     } else {
         const std::optional<DirectionSample> at = backboneField.sample(*fb.seed, Eigen::Vector2d(1, 0));
         if (!at || at->anisotropy < fb.minSeedAnisotropy)
-            throw InvalidInputError("The fishbone seed " + point(*fb.seed) +
+            throw InvalidInputError("The fishbone seed " + shown(*fb.seed) +
                                     " lies on a flat or isotropic region where no principal direction is "
                                     "defined; pick a point on a curved feature.");
         const CreaseIndex creases(
@@ -533,9 +509,9 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
             const std::size_t row = backbone.nearestSample(p);
             const double d = (backbone.samples[row] - p).norm();
             if (d > 2 * h)
-                throw InvalidInputError("The key-rib point " + point(p) + " lies " + fmt(d) +
-                                        " pixels from the backbone, farther than 2h = " + fmt(2 * h) + ".");
-            claim(row, point(p));
+                throw InvalidInputError("The key-rib point " + shown(p) + " lies " + fmt(k * d) +
+                                        " pixels from the backbone, farther than 2h = " + fmt(2 * k * h) + ".");
+            claim(row, shown(p));
             keys.push_back(KeyRib{row, traceRib(ribField, backbone, row, options)});
         }
         for (const Polyline2& drawn : fb.drawnKeyRibs) {
@@ -555,6 +531,12 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
     t = Clock::now();
     result.grid = rayCastFishbone(result.fishbone, buffers, reference, caster, params.scan, fb.raycast,
                                   &result.counts.onHintFace);
+    // Sampling quality as on the scan image (its pixel footprint, 1/k of the sampling image's), so that the
+    // quality mask ranks a fishbone patch the same whatever k is. The footprints stay the sampling camera's
+    // (the triangulation's edge limits are in them).
+    if (k > 1)
+        for (Sample& s : result.grid.samples)
+            if (s.hit) s.quality /= float(k);
     result.timings.rayCasting = secondsSince(t);
     result.counts.covered = result.grid.hitCount();
     result.counts.frontFacing = result.grid.admissibleCount();
@@ -591,6 +573,127 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
             "erosion or reduce h.");
     }
     result.timings.total = secondsSince(start);
+    return result;
+}
+
+} // namespace
+
+int fishboneSamplingFactor(const Camera& scan, const FishboneParams& fb) {
+    const int W = scan.width, H = scan.height;
+    const double h = fb.spacing;
+    if (fb.samplingFactor < 0)
+        throw InvalidInputError("The fishbone sampling factor " + std::to_string(fb.samplingFactor) +
+                                " is negative (0 chooses it automatically).");
+    if (fb.samplingFactor > 0) {
+        const int k = fb.samplingFactor;
+        if (W % k != 0 || H % k != 0)
+            throw InvalidInputError("The fishbone sampling factor " + std::to_string(k) + " does not divide the " +
+                                    std::to_string(W) + "x" + std::to_string(H) + " scan image.");
+        if (!(double(k) <= h))
+            throw InvalidInputError("The fishbone sampling factor " + std::to_string(k) +
+                                    " exceeds the spacing h = " + fmt(h) +
+                                    " pixels (the sampling image needs at least one pixel per sample).");
+        return k;
+    }
+    if (!(h >= 2) || W <= 0 || H <= 0) return 1;
+    for (int k = int(std::min({std::floor(h), double(W), double(H)})); k > 1; --k)
+        if (W % k == 0 && H % k == 0) return k;
+    return 1;
+}
+
+Camera fishboneSamplingCamera(const Camera& scan, const FishboneParams& fb) {
+    const int k = fishboneSamplingFactor(scan, fb);
+    Camera c = scan;
+    c.width /= k;
+    c.height /= k;
+    return c;
+}
+
+FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& referenceRenderer,
+                                     const Mesh& current, MeshRenderer& currentRenderer,
+                                     const ScanParams& params, const FishboneParams& fb, FishboneCache& cache,
+                                     const Progress& progress) {
+    const auto start = Clock::now();
+    params.camera.validate();
+    if (params.erodeRadius < 0 || params.dilateRadius < 0)
+        throw InvalidInputError("The erosion and dilation radii must not be negative.");
+    if (params.lasso) validateLasso(*params.lasso);
+    const double h = fb.spacing;
+    const double maxH = std::min(params.camera.width, params.camera.height) / 4.0;
+    if (!std::isfinite(h) || h < 0.5 || h > maxH)
+        throw InvalidInputError("The fishbone spacing h = " + fmt(h) + " pixels is outside [0.5, " +
+                                fmt(maxH) + "] for a " + std::to_string(params.camera.width) + "x" +
+                                std::to_string(params.camera.height) + " scan.");
+    const bool drawnBackbone = !fb.drawnBackbone.empty();
+    if (!drawnBackbone && !fb.seed)
+        throw InvalidInputError("A fishbone scan needs a seed point or a drawn backbone.");
+    if (drawnBackbone && fb.drawnBackbone.size() < 2)
+        throw InvalidInputError("A drawn backbone needs at least two points.");
+    const std::size_t keyRibCount = fb.keyRibs.size() + fb.drawnKeyRibs.size();
+    const bool keyRibMode = keyRibCount > 0;
+    if (keyRibMode && keyRibCount < 2)
+        throw InvalidInputError("Key-rib mode needs at least two key-ribs to blend between, " +
+                                std::to_string(keyRibCount) + " given.");
+    auto insideImage = [&](const Eigen::Vector2d& p) {
+        return std::isfinite(p.x()) && std::isfinite(p.y()) && p.x() >= 0 && p.y() >= 0 &&
+               p.x() < params.camera.width && p.y() < params.camera.height;
+    };
+    if (!std::isfinite(fb.creaseAngleDeg) || fb.creaseAngleDeg < 0 || fb.creaseAngleDeg >= 180 ||
+        !std::isfinite(fb.creaseSnapRadius) || !(fb.creaseSnapRadius > 0))
+        throw InvalidInputError("The crease angle must lie in [0, 180) degrees and the crease snap radius "
+                                "must be positive.");
+    if (fb.seed && !drawnBackbone && !insideImage(*fb.seed))
+        throw InvalidInputError("The fishbone seed " + point(*fb.seed) + " lies outside the " +
+                                std::to_string(params.camera.width) + "x" +
+                                std::to_string(params.camera.height) + " scan image.");
+
+    const int k = fishboneSamplingFactor(params.camera, fb);
+    FishboneScanResult result;
+    if (k == 1) {
+        result = scanOnSamplingImage(reference, referenceRenderer, current, currentRenderer, params, fb, cache,
+                                     progress, 1, start);
+    } else {
+        // Everything the user gave in pixels of the scan image, in pixels of the sampling image.
+        const double s = 1.0 / k;
+        ScanParams sp = params;
+        sp.camera = fishboneSamplingCamera(params.camera, fb);
+        if (sp.lasso)
+            for (Eigen::Vector2d& q : sp.lasso->points)
+                q *= s;
+        FishboneParams f = fb;
+        if (f.seed) *f.seed *= s;
+        f.spacing *= s;
+        for (Eigen::Vector2d& q : f.keyRibs)
+            q *= s;
+        for (Polyline2& c : f.drawnKeyRibs)
+            for (Eigen::Vector2d& q : c)
+                q *= s;
+        for (Eigen::Vector2d& q : f.drawnBackbone)
+            q *= s;
+        f.creaseSnapRadius *= s;
+        // The same streamlines in scan pixels: steps (and so the turn limit per step) and lengths scaled.
+        for (StreamlineOptions* o : {&f.tracing.backboneTracing, &f.tracing.ribTracing}) {
+            o->step *= s;
+            o->minStep *= s;
+            o->maxLength *= s;
+            if (o->insideRegion)
+                o->insideRegion = [inside = o->insideRegion, k](const Eigen::Vector2d& q) { return inside(k * q); };
+            if (o->attractor)
+                o->attractor = [attract = o->attractor, k, s](const Eigen::Vector2d& q, const Eigen::Vector2d& d)
+                    -> std::optional<Eigen::Vector2d> {
+                    if (const std::optional<Eigen::Vector2d> a = attract(k * q, d)) return s * *a;
+                    return std::nullopt;
+                };
+        }
+        result = scanOnSamplingImage(reference, referenceRenderer, current, currentRenderer, sp, f, cache, progress,
+                                     k, start);
+        // The traced grid back in pixels of the scan image (the widget draws it over the view).
+        for (Eigen::Vector2d& q : result.fishbone.screen)
+            q *= double(k);
+        result.fishbone.spacing *= double(k);
+        result.timings.total = secondsSince(start);
+    }
+    result.samplingFactor = k;
     progress.report(1.0, "done");
     return result;
 }

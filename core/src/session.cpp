@@ -151,8 +151,10 @@ const StitchReport& Session::accept(const Progress& progress) {
         progress.report(0.85 * fraction, stage);
         return true;
     });
-    StitchReport report =
-        stitchPatch(next, p.patch.mesh, p.step.params.camera, options, p.currentBuffers.faceId, stitchProgress);
+    // A fishbone scan samples (and rendered the current mesh) with its sampling camera.
+    const Camera camera = p.step.fishbone ? fishboneSamplingCamera(p.step.params.camera, *p.step.fishbone)
+                                          : p.step.params.camera;
+    StitchReport report = stitchPatch(next, p.patch.mesh, camera, options, p.currentBuffers.faceId, stitchProgress);
     if (next.has_garbage()) next.collect_garbage();
     progress.report(0.9, "record");
     HistoryItem item{p.step, std::move(report), detail::MeshDelta::between(d.current, next)};

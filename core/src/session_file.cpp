@@ -112,6 +112,7 @@ struct Writer {
         j["crease"] = {{"angle_deg", number(p.creaseAngleDeg, f + ".crease.angle_deg")},
                        {"snap_radius", number(p.creaseSnapRadius, f + ".crease.snap_radius")}};
         j["raycast"] = {{"rings", p.raycast.rings}, {"verify_unoccluded", p.raycast.verifyUnoccluded}};
+        j["sampling_factor"] = p.samplingFactor;
         return j;
     }
 
@@ -361,7 +362,7 @@ StreamlineOptions readStreamline(const Node& n) {
 
 FishboneParams readFishbone(const Node& n) {
     n.onlyKeys({"seed", "direction", "h", "key_ribs", "drawn_key_ribs", "drawn_backbone", "tracing",
-                "min_seed_anisotropy", "crease", "raycast"});
+                "min_seed_anisotropy", "crease", "raycast", "sampling_factor"});
     FishboneParams p;
     const Node seed = n.at("seed");
     if (!seed.isNull()) p.seed = seed.vec2();
@@ -395,6 +396,10 @@ FishboneParams readFishbone(const Node& n) {
     r.onlyKeys({"rings", "verify_unoccluded"});
     p.raycast.rings = int(r.at("rings").integer(0, kIntMax, "an integer of at least 0"));
     p.raycast.verifyUnoccluded = r.at("verify_unoccluded").boolean();
+    // Optional: files written before the sampling image sampled at the scan resolution (k = 1).
+    p.samplingFactor = n.has("sampling_factor")
+                           ? int(n.at("sampling_factor").integer(0, 64, "an integer from 0 (automatic) to 64"))
+                           : 1;
     return p;
 }
 

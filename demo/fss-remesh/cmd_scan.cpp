@@ -1,6 +1,6 @@
 // fss-remesh scan MESH -o OUT [--into CURRENT] [--view V | --camera ...] [--parallel] [--resolution W[xH]] [--zoom F]
 //                  [--lasso "x,y;x,y;..."] [--erode N] [--dilate N] [--json] ...
-//                  [--fishbone "seed=X,Y[;dir=min|max][;h=PIXELS][;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...]"]
+//                  [--fishbone "seed=X,Y[;dir=min|max][;h=PIXELS][;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...][;sampling=K]"]
 #include "args.h"
 #include "commands.h"
 #include "stitch_json.h"
@@ -110,7 +110,8 @@ std::vector<Eigen::Vector2d> parsePointList(const std::string& key, const std::s
     return points;
 }
 
-// "seed=X,Y[;dir=min|max][;h=PIXELS][;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...]", points normalised.
+// "seed=X,Y[;dir=min|max][;h=PIXELS][;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...][;sampling=K]", points
+// normalised.
 FishboneParams parseFishbone(const std::string& text, int w, int h) {
     FishboneParams fb;
     bool haveSeed = false;
@@ -139,8 +140,15 @@ FishboneParams parseFishbone(const std::string& text, int w, int h) {
                 fb.keyRibs = parsePointList(key, value, w, h);
             } else if (key == "backbone") {
                 fb.drawnBackbone = parsePointList(key, value, w, h);
+            } else if (key == "sampling") {
+                const double k = parseDouble("--fishbone sampling", value);
+                if (!(k >= 0 && k <= 64) || k != std::floor(k))
+                    throw UsageError("The --fishbone sampling factor '" + value +
+                                     "' is not an integer from 0 (automatic) to 64.");
+                fb.samplingFactor = int(k);
             } else {
-                throw UsageError("The --fishbone key '" + key + "' is not one of seed, dir, h, keyribs, backbone.");
+                throw UsageError("The --fishbone key '" + key +
+                                 "' is not one of seed, dir, h, keyribs, backbone, sampling.");
             }
         }
         if (semi == std::string::npos) break;
@@ -175,7 +183,8 @@ std::unique_ptr<MeshRenderer> makeRenderer(const std::string& kind, std::string&
 // What either kind of scan produced, with its part of the JSON report and of the text summary.
 struct ScanRun {
     Patch patch;
-    FrameBuffers currentBuffers; // the current mesh from the scan camera (for the stitch)
+    FrameBuffers currentBuffers; // the current mesh from the sampling camera (for the stitch)
+    Camera samplingCamera;       // the scan camera, or a fishbone's sampling camera (for the stitch)
     nlohmann::json json;         // everything but input / output / renderer
     std::string summary;         // "fishbone-scanned ... in 0.1 s"
 };
@@ -194,6 +203,7 @@ ScanRun fishboneScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& 
     j["resolution"] = {params.camera.width, params.camera.height};
     j["fishbone"] = {{"direction", fishbone.direction == PrincipalDirection::Min ? "min" : "max"},
                      {"h_pixels", fishbone.spacing},
+                     {"sampling_factor", result.samplingFactor},
                      {"key_ribs", fishbone.keyRibs.size()},
                      {"drawn_backbone", !fishbone.drawnBackbone.empty()}};
     j["counts"] = {{"rows", c.rows},
@@ -220,6 +230,7 @@ ScanRun fishboneScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& 
     run.summary = text.str();
     run.patch = std::move(result.patch);
     run.currentBuffers = std::move(result.currentBuffers);
+    run.samplingCamera = fishboneSamplingCamera(params.camera, fishbone);
     return run;
 }
 
@@ -256,6 +267,7 @@ ScanRun regularScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& c
     run.summary = text.str();
     run.patch = std::move(result.patch);
     run.currentBuffers = std::move(result.currentBuffers);
+    run.samplingCamera = params.camera;
     return run;
 }
 
@@ -331,12 +343,14 @@ int runScan(const std::vector<std::string>& args) {
              "bottom-right). Self-intersecting polygons use the non-zero winding rule.", &lassoText, &haveLasso);
     p.option("--fishbone", "SPEC",
              "Feature-sensitive (fishbone) grid instead of the pixel grid: \"seed=X,Y[;dir=min|max][;h=PIXELS]"
-             "[;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...]\". seed: a point on a curved feature; the backbone is "
+             "[;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...][;sampling=K]\". seed: a point on a curved feature; the backbone is "
              "traced through it along the min (default) or max curvature direction, ribs along the other; h: "
              "sample spacing in pixels (default 4); keyribs: ribs only at the backbone samples nearest these points "
              "(at least two), blended in between; backbone: a hand-drawn backbone through these points instead of "
-             "the seed. Points in normalised image coordinates as for --lasso. --max-edge-footprints is "
-             "multiplied by h.", &fishboneText, &haveFishbone);
+             "the seed; sampling: the fishbone renders and traces on the image at 1/K of the resolution (default 0: "
+             "K = the largest integer <= h dividing both sides, about one pixel per sample as a regular scan; 1 "
+             "= full resolution, finer direction fields at up to h^2 times the render cost). Points in "
+             "normalised image coordinates as for --lasso. --max-edge-footprints is multiplied by h/K.", &fishboneText, &haveFishbone);
     p.option("--erode", "N", "Erosion radius in samples (default 1; 0 = none).", &erodeText);
     p.option("--dilate", "N", "Dilation radius after the erosion (default 1); never re-admits rejected samples.",
              &dilateText);
@@ -436,7 +450,7 @@ int runScan(const std::vector<std::string>& args) {
         StitchOptions stitchOptions;
         stitchOptions.collectGarbage = true;
         const StitchReport report =
-            stitchPatch(result, run.patch.mesh, params.camera, stitchOptions, run.currentBuffers.faceId);
+            stitchPatch(result, run.patch.mesh, run.samplingCamera, stitchOptions, run.currentBuffers.faceId);
         writeMesh(result, outPath, WriteOptions{.binary = false});
         j["into"] = intoPath;
         j["scan_id"] = params.scan.scanId;

@@ -71,6 +71,10 @@ TEST(CliFishbone, MalformedSpecsFailWithOneSentence) {
     expectCleanFailure(scan("seed=0.4,0.55;keyribs=0.4,0.5"), "at least two points");
     expectCleanFailure(scan("backbone=0.4,0.5"), "at least two points");
     expectCleanFailure(scan("seed=0.02,0.02"), "lies on the background");
-    expectCleanFailure(scan("seed=0.5,0.5"), "flat or isotropic region");
+    expectCleanFailure(scan("seed=0.5,0.5;sampling=1"), "flat or isotropic region");
+    expectCleanFailure(scan("seed=0.4,0.55;sampling=x"), "of --fishbone sampling is not a finite number");
+    expectCleanFailure(scan("seed=0.4,0.55;sampling=2.5"), "is not an integer from 0 (automatic) to 64");
+    expectCleanFailure(scan("seed=0.4,0.55;h=4;sampling=3"), "sampling factor 3 does not divide the 256x256");
+    expectCleanFailure(scan("seed=0.4,0.55;h=2;sampling=4"), "sampling factor 4 exceeds the spacing h = 2");
     expectCleanFailure(scan("seed=0.4,0.55;keyribs=0.4,0.45|0.4,0.65"), "pixels from the backbone, farther than 2h");
 }

@@ -338,6 +338,45 @@ TEST(FishboneFandisk, DrawnFishboneRemovesTheAliasingOfACurvedCrease) {
     EXPECT_GE(g.meanAngleDeg, 2 * ta.meanAngleDeg);
     EXPECT_LT(ta.hausdorff, g.hausdorff);
 
+    // The same traced fishbone at twice the resolution and h = 2 pixels (the same spacing on the surface):
+    // by default (FishboneParams::samplingFactor) it samples on the 200² image, k = 2, i.e. it renders and
+    // computes its direction fields at one pixel per sample like the pixel grid; with k = 1 it would render
+    // four. Both keep the crease and the aliasing gain.
+    fss::ScanParams params2 = params;
+    params2.camera.width = params2.camera.height = 400;
+    for (auto& p : params2.lasso->points)
+        p *= 2.0;
+    fss::FishboneParams traced2 = traced;
+    traced2.spacing = 2.0;
+    traced2.seed = 2.0 * clicked[4];
+    const fss::FishboneScanResult half = fss::scanFishbonePatch(m, renderer, m, renderer, params2, traced2, cache);
+    traced2.samplingFactor = 1;
+    const fss::FishboneScanResult full = fss::scanFishbonePatch(m, renderer, m, renderer, params2, traced2, cache);
+    EXPECT_EQ(half.samplingFactor, 2);
+    EXPECT_EQ(half.grid.camera.width, 200);
+    EXPECT_EQ(full.samplingFactor, 1);
+    EXPECT_EQ(half.fishbone.spacing, 2.0); // the grid is reported in pixels of the 400² scan image
+    const PatchError th = measure(half.patch, reference, line, inner, hWorld);
+    const PatchError tk = measure(full.patch, reference, line, inner, hWorld);
+    print("traced, 400², h = 2, k = 2", th, half.patch);
+    print("traced, 400², h = 2, k = 1", tk, full.patch);
+    const Drift halfDrift = driftOf(half), fullDrift = driftOf(full);
+    std::printf("[ aliasing, fandisk ] 400², h = 2: backbone off the crease by at most %.3f h (k = 2), %.3f h "
+                "(k = 1); covers %.1f %% / %.1f %%; rib vertices %zu / %zu\n",
+                halfDrift.worst, fullDrift.worst, 100 * halfDrift.coverage, 100 * fullDrift.coverage,
+                half.counts.ribVertices, full.counts.ribVertices);
+    for (const fss::FishboneScanResult* r : {&half, &full}) {
+        const Drift d = driftOf(*r);
+        EXPECT_GT(d.samples, 100u);
+        EXPECT_LT(d.worst, 0.5);
+        EXPECT_GT(d.coverage, 0.99);
+    }
+    for (const PatchError* e : {&th, &tk}) {
+        EXPECT_GT(e->faces, 500u);
+        EXPECT_GE(g.meanAngleDeg, 2 * e->meanAngleDeg);
+        EXPECT_LT(e->hausdorff, g.hausdorff);
+    }
+
     // The picture (docs/fishbone_vs_grid_fandisk.png is a copy): both patches from a closer camera aimed at
     // the crease, side by side (pixel grid left, fishbone right).
     fss::Camera view = camera;

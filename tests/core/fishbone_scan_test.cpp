@@ -203,7 +203,12 @@ TEST(FishboneScan, AutomaticScanOfTheCreasedRingIsAManifoldPatch) {
     EXPECT_GT(r.counts.rows, 30);
     EXPECT_GT(r.counts.cols, 10);
     EXPECT_GT(r.counts.covered, r.counts.ribVertices * 9 / 10);
-    EXPECT_GT(r.counts.onHintFace, r.counts.covered / 4); // faces are about a pixel wide
+    // h = 3 on the 160² image: the sampling image is 80² (k = 2, the largest divisor of 160 up to 3), whose
+    // pixels are about two faces wide, so about every fifth rib vertex lands on the face under its pixel
+    // (at k = 1 every fourth: below).
+    EXPECT_EQ(r.samplingFactor, 2);
+    EXPECT_EQ(r.grid.camera.width, 80);
+    EXPECT_GT(r.counts.onHintFace, r.counts.covered / 8);
     EXPECT_GT(r.patch.mesh.number_of_faces(), 500u);
     EXPECT_TRUE(CGAL::is_valid_polygon_mesh(r.patch.mesh));
     EXPECT_GT(r.timings.curvature, 0.0);
@@ -217,6 +222,27 @@ TEST(FishboneScan, AutomaticScanOfTheCreasedRingIsAManifoldPatch) {
         fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
     EXPECT_EQ(again.timings.curvature, 0.0);
     EXPECT_EQ(again.patch.mesh.number_of_faces(), r.patch.mesh.number_of_faces());
+    // The same fishbone on the full 160² image (k = 1): the faces are about a pixel wide.
+    fss::FishboneParams fine = fb;
+    fine.samplingFactor = 1;
+    const fss::FishboneScanResult f =
+        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fine, cache);
+    EXPECT_EQ(f.samplingFactor, 1);
+    EXPECT_EQ(f.grid.camera.width, 160);
+    EXPECT_GT(f.counts.onHintFace, f.counts.covered / 4);
+    EXPECT_GT(f.patch.mesh.number_of_faces(), 500u);
+    // Both grids have the same spacing on the scan image: about as many samples.
+    EXPECT_NEAR(double(r.counts.covered), double(f.counts.covered), 0.15 * double(f.counts.covered));
+    // Quality as on the scan image whatever k is (footprints of the sampling camera, k times larger).
+    for (const fss::FishboneScanResult* s : {&r, &f})
+        for (const fss::Sample& x : s->grid.samples)
+            if (x.hit) {
+                const double k = s->samplingFactor;
+                ASSERT_NEAR(x.quality, x.footprint / k / std::max(std::cos(double(x.samplingAngle)),
+                                                                   std::cos(fss::ScanOptions{}.qualityAngleLimitDeg *
+                                                                            std::numbers::pi / 180)),
+                            1e-5 * x.quality);
+            }
 
     // Key-rib mode: two traced key-ribs on the backbone, blended in between.
     fss::FishboneParams keys = fb;
@@ -242,11 +268,15 @@ TEST(FishboneScan, BadFishbonesGiveOneSentence) {
     };
     fss::FishboneParams fb;
     EXPECT_EQ(scan(fb), "A fishbone scan needs a seed point or a drawn backbone.");
-    const fss::FrameBuffers buffers = renderer.render(scene.camera);
+    // A background pixel of the sampling image (the default h = 4 samples the 160² scan on 40²), as a
+    // point of the scan image.
+    const fss::Camera sampling = fss::fishboneSamplingCamera(scene.camera, fb);
+    ASSERT_EQ(sampling.width, 40);
+    const fss::FrameBuffers buffers = renderer.render(sampling);
     Vector2d background(-1, -1);
-    for (int y = 0; y < 160 && background.x() < 0; ++y)
-        for (int x = 0; x < 160 && background.x() < 0; ++x)
-            if (!buffers.covered(x, y)) background = Vector2d(x + 0.5, y + 0.5);
+    for (int y = 0; y < 40 && background.x() < 0; ++y)
+        for (int x = 0; x < 40 && background.x() < 0; ++x)
+            if (!buffers.covered(x, y)) background = 4.0 * Vector2d(x + 0.5, y + 0.5);
     ASSERT_GE(background.x(), 0);
     fb.seed = background;
     EXPECT_EQ(scan(fb), "The fishbone seed " + point(background) +
@@ -257,6 +287,14 @@ TEST(FishboneScan, BadFishbonesGiveOneSentence) {
     fb.spacing = 100;
     EXPECT_EQ(scan(fb), "The fishbone spacing h = 100 pixels is outside [0.5, 40] for a 160x160 scan.");
     fb.spacing = 3;
+    fb.samplingFactor = -1;
+    EXPECT_EQ(scan(fb), "The fishbone sampling factor -1 is negative (0 chooses it automatically).");
+    fb.samplingFactor = 3;
+    EXPECT_EQ(scan(fb), "The fishbone sampling factor 3 does not divide the 160x160 scan image.");
+    fb.samplingFactor = 4;
+    EXPECT_EQ(scan(fb), "The fishbone sampling factor 4 exceeds the spacing h = 3 pixels (the sampling image "
+                        "needs at least one pixel per sample).");
+    fb.samplingFactor = 0;
     fb.keyRibs = {*fb.seed};
     EXPECT_EQ(scan(fb), "Key-rib mode needs at least two key-ribs to blend between, 1 given.");
     fb.keyRibs = {*fb.seed, *fb.seed + Vector2d(0.5, 0)};

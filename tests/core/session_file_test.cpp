@@ -107,6 +107,9 @@ void expectSame(const fss::ScanStep& a, const fss::ScanStep& b) {
         EXPECT_TRUE(sameBits(fa.minSeedAnisotropy, fb.minSeedAnisotropy));
         EXPECT_EQ(fa.raycast.rings, fb.raycast.rings);
         EXPECT_EQ(fa.raycast.verifyUnoccluded, fb.raycast.verifyUnoccluded);
+        EXPECT_TRUE(sameBits(fa.creaseAngleDeg, fb.creaseAngleDeg));
+        EXPECT_TRUE(sameBits(fa.creaseSnapRadius, fb.creaseSnapRadius));
+        EXPECT_EQ(fa.samplingFactor, fb.samplingFactor);
     }
     const fss::StitchOptions &sa = a.stitch, &sb = b.stitch;
     EXPECT_EQ(sa.seamRings, sb.seamRings);
@@ -201,6 +204,9 @@ fss::ScanStep fishboneStep() {
     fb.minSeedAnisotropy = 0.15;
     fb.raycast.rings = 3;
     fb.raycast.verifyUnoccluded = true;
+    fb.creaseAngleDeg = 42.5;
+    fb.creaseSnapRadius = 0.75;
+    fb.samplingFactor = 3;
     s.fishbone = fb;
     return s;
 }
@@ -395,6 +401,28 @@ TEST_F(BadSessionFile, MissingFields) {
     EXPECT_EQ(load(j), ": events[1].step.fishbone is missing.");
 }
 
+// Files written before the sampling image existed sampled fishbones at the scan resolution: without the
+// field they load with k = 1 and so replay as recorded; a file that has it keeps its value (0 = automatic).
+TEST_F(BadSessionFile, FishboneSamplingFactorIsOptionalAndOneWhenAbsent) {
+    auto samplingFactorOf = [&](const Json& j) {
+        const auto path = fss::test::tmpPath("sampling_" + name_ + ".session.json");
+        {
+            std::ofstream out(path, std::ios::binary | std::ios::trunc);
+            out << j.dump(2);
+        }
+        const fss::SessionFile f = fss::loadSessionFile(path);
+        return f.events.at(1).step.fishbone.value().samplingFactor;
+    };
+    Json j = good_;
+    ASSERT_TRUE(j["events"][1]["step"]["fishbone"].contains("sampling_factor"));
+    EXPECT_EQ(samplingFactorOf(j), 3);
+    j["events"][1]["step"]["fishbone"]["sampling_factor"] = 0;
+    EXPECT_EQ(samplingFactorOf(j), 0);
+    j["events"][1]["step"]["fishbone"].erase("sampling_factor");
+    EXPECT_EQ(samplingFactorOf(j), 1);
+    EXPECT_EQ(fss::FishboneParams{}.samplingFactor, 0); // new scans choose it
+}
+
 TEST_F(BadSessionFile, WrongTypesAndValues) {
     const std::pair<std::function<void(Json&)>, std::string> cases[] = {
         {[](Json& j) { j["events"][0]["step"]["camera"]["width"] = "321"; },
@@ -445,6 +473,8 @@ TEST_F(BadSessionFile, WrongTypesAndValues) {
         {[](Json& j) { j["events"][1]["step"]["fishbone"]["tracing"]["backbone"]["low_anisotropy"] = true; },
          ": events[1].step.fishbone.tracing.backbone.low_anisotropy must be one of \"stop\", "
          "\"continue_straight\"."},
+        {[](Json& j) { j["events"][1]["step"]["fishbone"]["sampling_factor"] = 65; },
+         ": events[1].step.fishbone.sampling_factor must be an integer from 0 (automatic) to 64."},
         {[](Json& j) { j["events"][1]["step"]["stitch"]["seam_rings"] = 1.5; },
          ": events[1].step.stitch.seam_rings must be an integer of at least 0."},
         {[](Json& j) { j["events"][0]["step"]["camera"]["eyes"] = 1; },

@@ -88,9 +88,10 @@ struct FishboneParams {
     std::vector<Eigen::Vector2d> keyRibs;         ///< key-rib mode: traced key-ribs at these points (≥ 2)
     std::vector<Polyline2> drawnKeyRibs;          ///< key-rib mode: hand-drawn key-ribs (splines)
     Polyline2 drawnBackbone;                      ///< hand-drawn backbone (≥ 2 points) instead of seed
-    /// Tracing options (its spacing is replaced by `spacing`). The default continues straight across
-    /// isotropic regions, which CAD meshes' flat faces need. An unbounded (infinite) maxLength becomes the
-    /// image diagonal for the backbone (each way) and half of it for each rib half.
+    /// Tracing options (its spacing is replaced by `spacing`), lengths in pixels of the scan image as
+    /// everything here. The default continues straight across isotropic regions, which CAD meshes' flat
+    /// faces need. An unbounded (infinite) maxLength becomes the image diagonal for the backbone (each way)
+    /// and half of it for each rib half.
     FishboneOptions tracing = defaultTracing();
     /// A traced backbone needs the seed's interpolated anisotropy to reach this (else the principal
     /// directions are undefined there: flat or umbilic region).
@@ -107,6 +108,21 @@ struct FishboneParams {
     double creaseSnapRadius = 1.5;
     /// Local search of the hinted ray casts.
     LocalSearchOptions raycast{};
+    /// The sampling image's resolution divisor k (fishboneSamplingFactor): the reference (and the current
+    /// mesh, for the quality mask and the stitch) are rendered at (W/k) × (H/k), the scan camera's frustum
+    /// at 1/k of its resolution, and the fishbone is traced there (the same streamline steps, spacing and
+    /// lengths in pixels of the scan image, h/k and so on in its pixels). A regular scan renders one pixel
+    /// per sample; with k = ⌊h⌋ a fishbone renders about one per sample too, instead of h² (issue 5: at
+    /// most twice the cost of a regular scan of as many samples). The samples themselves are exact either
+    /// way (rays from the eye onto the reference), and their quality (Sample::quality) is that of the scan
+    /// image's pixel footprint whatever k is, so the quality mask ranks the patch the same; the direction
+    /// field is sampled k times more coarsely (bilinear between its pixels), which costs some alignment:
+    /// on fandisk's curved crease at 400², h = 2 px, the mean normal error near the crease is 1.5° with
+    /// k = 2 and 0.6° with k = 1 (the pixel grid's: 8.5°; tests/core/fishbone_fandisk_test.cpp).
+    /// 0 (the default) = automatic: the largest integer k ≤ h that divides both W and H; k ≥ 1 requests
+    /// that divisor (it must divide W and H and be at most h). Session files written before this option
+    /// replay with k = 1 (the scan resolution), as they were recorded.
+    int samplingFactor = 0;
 
     /// Tracing with LowAnisotropyPolicy::ContinueStraight; RK4 steps of half a pixel for the backbone and of
     /// one pixel for the ribs (rib turns limited to 12° per step, which ends ribs at field seams about where
@@ -143,12 +159,14 @@ struct FishboneCounts {
 };
 
 /// The result of a fishbone scan: the screen grid, the SampleGrid with its masks, the patch, and the
-/// current mesh's buffers from the scan camera (for the stitcher).
+/// current mesh's buffers from the sampling camera (for the stitcher: stitch with
+/// fishboneSamplingCamera(params.camera, fishbone) and currentBuffers.faceId).
 struct FishboneScanResult {
-    FishboneGrid fishbone;
-    SampleGrid grid;
+    FishboneGrid fishbone;       ///< the traced grid, in pixels of the scan image (camera.width × height)
+    SampleGrid grid;             ///< the samples; grid.camera is the sampling camera (fitted clipping range)
     Patch patch;
-    FrameBuffers currentBuffers;
+    FrameBuffers currentBuffers; ///< the current mesh from the sampling camera
+    int samplingFactor = 1;      ///< k actually used (FishboneParams::samplingFactor)
     FishboneCounts counts;
     FishboneTimings timings;
 };
@@ -166,10 +184,26 @@ SampleGrid rayCastFishbone(const FishboneGrid& fishbone, const FrameBuffers& ref
                            const Mesh& reference, const RayCaster& caster, const ScanOptions& options = {},
                            const LocalSearchOptions& search = {}, std::size_t* hintHits = nullptr);
 
+/// The sampling image's divisor k for a fishbone scan with \p fishbone on the scan camera \p scan
+/// (FishboneParams::samplingFactor): the explicit factor when one is given, else the largest integer
+/// k ≤ h dividing both width and height (1 when h < 2).
+/// \throw InvalidInputError when an explicit factor does not divide the scan's width and height, exceeds h,
+///        or is negative.
+int fishboneSamplingFactor(const Camera& scan, const FishboneParams& fishbone);
+
+/// The camera a fishbone scan samples with: \p scan at (width/k) × (height/k), k =
+/// fishboneSamplingFactor(scan, fishbone), with the same frustum (so screen point p of the scan image is
+/// p/k of the sampling image); \p scan itself when k = 1. The stitcher takes this camera with
+/// FishboneScanResult::currentBuffers. \throw as fishboneSamplingFactor.
+Camera fishboneSamplingCamera(const Camera& scan, const FishboneParams& fishbone);
+
 /// Runs one fishbone scan (see the file comment); parallel to scanPatch, with the same renderer contract
 /// (\p referenceRenderer holds \p reference, \p currentRenderer \p current; pass the same renderer and
 /// `current == reference` for the first scan, which skips the quality mask). Triangulation accepts edges
-/// up to `params.triangulate.maxEdgeFootprints · h` footprints (grid edges are h pixels long).
+/// up to `params.triangulate.maxEdgeFootprints · h/k` footprints of the sampling camera (grid edges are h
+/// pixels of the scan image long, h/k of the sampling image). All positions in \p params and \p fishbone
+/// (seed, key-ribs, drawn curves, lasso) are in pixels of the scan image; the scan itself runs on the
+/// sampling image (FishboneParams::samplingFactor, fishboneSamplingCamera).
 /// \throw InvalidInputError with one sentence when: the camera, lasso or radii are invalid (as scanPatch);
 ///        h is not in [0.5, min(W, H)/4]; neither a seed nor a drawn backbone is given; the seed lies
 ///        outside the image, on the background, or on a flat / isotropic region; fewer than two key-ribs
