@@ -456,6 +456,24 @@ private slots:
         if (qEnvironmentVariableIsSet("FSS_TEST_SCREENSHOTS"))
             w->grab().save(QStringLiteral("/tmp/fishbone_widget.png"));
 
+        // The sampling image: by default about one pixel per sample (h = 3 → the largest divisor of both
+        // sides up to 3); "Fine direction field" rescans on the full image.
+        {
+            const fss::ScanPreview& coarse = *w->session()->preview();
+            const fss::Camera& scanCamera = coarse.step.params.camera;
+            QCOMPARE(coarse.step.fishbone->samplingFactor, 0);
+            const int k = fss::fishboneSamplingFactor(scanCamera, *coarse.step.fishbone);
+            QVERIFY(k >= 2);
+            QCOMPARE(coarse.grid.camera.width, scanCamera.width / k);
+            w->scanPanel()->setFishboneFineField(true);
+            QVERIFY(waitIdle(*w));
+            const fss::ScanPreview& fine = *w->session()->preview();
+            QCOMPARE(fine.step.fishbone->samplingFactor, 1);
+            QCOMPARE(fine.grid.camera.width, scanCamera.width);
+            QVERIFY(tool->hasGridPreview());
+            QVERIFY(fine.patch.mesh.number_of_faces() > 100);
+        }
+
         // Accept: the fishbone patch is stitched in.
         const fss::Mesh before = w->mesh();
         const fss::Mesh patch = w->session()->preview()->patch.mesh;

@@ -725,6 +725,7 @@ void RemeshWidget::runFishbone() {
         const QSize size(step.params.camera.width, step.params.camera.height);
         step.fishbone = tool->params(size, d_->scanPanel->fishboneSpacing());
         if (!step.fishbone) return;
+        step.fishbone->samplingFactor = d_->scanPanel->fishboneSamplingFactor();
         const ScanPreview& preview = session.scan(step);
         ++d_->nextScanId;
         tool->setGrid(preview.fishbone ? &*preview.fishbone : nullptr, size);

@@ -59,6 +59,11 @@ ScanPanel::ScanPanel(QWidget* parent) : QWidget(parent) {
     spacing_->setSuffix(tr(" px"));
     spacing_->setToolTip(tr("Spacing of the fishbone grid in scan pixels"));
     form->addRow(tr("Fishbone spacing"), spacing_);
+    fineField_ = new QCheckBox(tr("Fine direction field"), this);
+    fineField_->setToolTip(tr("Trace fishbones on every pixel of the scan image: better alignment with "
+                              "features, up to spacing² times the render cost (otherwise about one pixel "
+                              "per sample, like a regular scan)"));
+    form->addRow(QString(), fineField_);
 
     auto changed = [this] {
         refreshEdgeLength();
@@ -72,6 +77,7 @@ ScanPanel::ScanPanel(QWidget* parent) : QWidget(parent) {
     connect(margin_, &QDoubleSpinBox::valueChanged, this, changed);
     connect(force_, &QCheckBox::toggled, this, changed);
     connect(spacing_, &QDoubleSpinBox::valueChanged, this, changed);
+    connect(fineField_, &QCheckBox::toggled, this, changed);
     refreshEdgeLength();
 }
 
@@ -124,6 +130,12 @@ double ScanPanel::fishboneSpacing() const {
 }
 void ScanPanel::setFishboneSpacing(double pixels) {
     spacing_->setValue(pixels);
+}
+bool ScanPanel::fishboneFineField() const {
+    return fineField_->isChecked();
+}
+void ScanPanel::setFishboneFineField(bool fine) {
+    fineField_->setChecked(fine);
 }
 
 QSize ScanPanel::scanSize(QSizeF viewSize) const {

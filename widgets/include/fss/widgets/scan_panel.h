@@ -54,6 +54,13 @@ public:
     /// Fishbone grid spacing h in scan-image pixels (FishboneParams::spacing), [0.5, 32]; default 2.
     double fishboneSpacing() const;
     void setFishboneSpacing(double pixels);
+    /// Fishbones traced on the full scan image (FishboneParams::samplingFactor = 1: finer direction fields,
+    /// better feature alignment, up to h² times the render cost) instead of the sampling image of about one
+    /// pixel per sample (samplingFactor = 0, automatic). Default false.
+    bool fishboneFineField() const;
+    void setFishboneFineField(bool fine);
+    /// The FishboneParams::samplingFactor these settings ask for: 1 with the fine field, else 0.
+    int fishboneSamplingFactor() const { return fishboneFineField() ? 1 : 0; }
 
     /// The scan image size for a view image of \p viewSize (any unit): the longer side is resolution(),
     /// the other keeps the aspect (at least 1).
@@ -87,6 +94,7 @@ private:
     QDoubleSpinBox* margin_ = nullptr;
     QCheckBox* force_ = nullptr;
     QDoubleSpinBox* spacing_ = nullptr;
+    QCheckBox* fineField_ = nullptr;
     QLabel* edgeLabel_ = nullptr;
     std::optional<Camera> viewCamera_;
     Eigen::Vector3d at_{0, 0, 0};
