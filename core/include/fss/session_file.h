@@ -33,7 +33,8 @@
 ///                          "backbone": STREAMLINE, "ribs": STREAMLINE },
 ///             "min_seed_anisotropy": 0.1,
 ///             "crease": { "angle_deg": 30, "snap_radius": 1.5 },  (optional; missing: these defaults)
-///             "raycast": { "rings": 2, "verify_unoccluded": false } },
+///             "raycast": { "rings": 2, "verify_unoccluded": false },
+///             "sampling_factor": 0 },       (0 = automatic, 1..64; optional: missing = 1, the scan resolution)
 ///         "stitch": { "seam_rings": 2, "optimise_seam": true, "collapse_edge_ratio": 0.4, "seam_grading": 1,
 ///                     "min_angle_floor_deg": 1, "max_view_angle_deg": 85, "max_normal_change_deg": 20,
 ///                     "max_gap_ratio": 0.25, "max_trim_rounds": 16, "min_component_faces": 8,
