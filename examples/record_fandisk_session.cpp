@@ -34,6 +34,9 @@ fss::ScanStep fishboneStep(const fss::Mesh& mesh, fss::StandardView view, int re
     step.fishbone->seed = seed;
     step.fishbone->direction = fss::PrincipalDirection::Min; // backbone along the cylinder's axis
     step.fishbone->spacing = h;
+    // Traced on every pixel of the scan image (the finest alignment with the features; the automatic
+    // sampling image would trace on 1/⌊h⌋ of the resolution, as fast as a regular scan).
+    step.fishbone->samplingFactor = 1;
     return step;
 }
 
