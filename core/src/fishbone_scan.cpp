@@ -614,10 +614,7 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
                                      const ScanParams& params, const FishboneParams& fb, FishboneCache& cache,
                                      const Progress& progress) {
     const auto start = Clock::now();
-    params.camera.validate();
-    if (params.erodeRadius < 0 || params.dilateRadius < 0)
-        throw InvalidInputError("The erosion and dilation radii must not be negative.");
-    if (params.lasso) validateLasso(*params.lasso);
+    validateScanParams(params);
     const double h = fb.spacing;
     const double maxH = std::min(params.camera.width, params.camera.height) / 4.0;
     if (!std::isfinite(h) || h < 0.5 || h > maxH)

@@ -93,6 +93,11 @@ struct ScanResult {
     ScanTimings timings;
 };
 
+/// Checks the parts of \p params every scan needs before it renders: the camera (Camera::validate), the
+/// erosion and dilation radii (not negative) and the lasso (validateLasso), when there is one.
+/// \throw InvalidInputError with one sentence naming the problem.
+void validateScanParams(const ScanParams& params);
+
 /// Runs one scan. \p referenceRenderer must hold \p reference (setMesh) and \p currentRenderer
 /// \p current; when \p current is the reference itself (same object, the first scan) pass the same
 /// renderer: the current mesh is then not rendered again and the quality mask is skipped (input faces
