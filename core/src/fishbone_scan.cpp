@@ -667,11 +667,11 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
                 q *= s;
         for (Eigen::Vector2d& q : f.drawnBackbone)
             q *= s;
+        // The tracing steps are pixels of the sampling image (the direction field's own resolution), as for
+        // any scan of that size; lengths and the crease snap radius are the user's, in scan pixels (a
+        // radius of 1.5 sampling pixels pulls a backbone on fandisk at 128² onto neighbouring creases).
         f.creaseSnapRadius *= s;
-        // The same streamlines in scan pixels: steps (and so the turn limit per step) and lengths scaled.
         for (StreamlineOptions* o : {&f.tracing.backboneTracing, &f.tracing.ribTracing}) {
-            o->step *= s;
-            o->minStep *= s;
             o->maxLength *= s;
             if (o->insideRegion)
                 o->insideRegion = [inside = o->insideRegion, k](const Eigen::Vector2d& q) { return inside(k * q); };

@@ -340,8 +340,8 @@ TEST(FishboneFandisk, DrawnFishboneRemovesTheAliasingOfACurvedCrease) {
 
     // The same traced fishbone at twice the resolution and h = 2 pixels (the same spacing on the surface):
     // by default (FishboneParams::samplingFactor) it samples on the 200² image, k = 2, i.e. it renders and
-    // computes its direction fields at one pixel per sample like the pixel grid; with k = 1 it would render
-    // four. Both keep the crease and the aliasing gain.
+    // computes its direction fields at one pixel per sample like the pixel grid; with k = 1 it renders four
+    // and its direction fields are twice as fine. Both keep the crease and the aliasing gain.
     fss::ScanParams params2 = params;
     params2.camera.width = params2.camera.height = 400;
     for (auto& p : params2.lasso->points)
@@ -349,6 +349,7 @@ TEST(FishboneFandisk, DrawnFishboneRemovesTheAliasingOfACurvedCrease) {
     fss::FishboneParams traced2 = traced;
     traced2.spacing = 2.0;
     traced2.seed = 2.0 * clicked[4];
+    traced2.creaseSnapRadius = 2.0 * traced.creaseSnapRadius; // scan pixels: the same radius on the surface
     const fss::FishboneScanResult half = fss::scanFishbonePatch(m, renderer, m, renderer, params2, traced2, cache);
     traced2.samplingFactor = 1;
     const fss::FishboneScanResult full = fss::scanFishbonePatch(m, renderer, m, renderer, params2, traced2, cache);
@@ -356,6 +357,16 @@ TEST(FishboneFandisk, DrawnFishboneRemovesTheAliasingOfACurvedCrease) {
     EXPECT_EQ(half.grid.camera.width, 200);
     EXPECT_EQ(full.samplingFactor, 1);
     EXPECT_EQ(half.fishbone.spacing, 2.0); // the grid is reported in pixels of the 400² scan image
+    // With k = 2 the 400² scan at h = 2 is the 200² scan at h = 1 (the traced one above), sample for sample.
+    ASSERT_EQ(half.patch.mesh.number_of_vertices(), tracedAll.patch.mesh.number_of_vertices());
+    ASSERT_EQ(half.patch.mesh.number_of_faces(), tracedAll.patch.mesh.number_of_faces());
+    for (auto v : half.patch.mesh.vertices())
+        ASSERT_EQ(pt(half.patch.mesh, v), pt(tracedAll.patch.mesh, v));
+    for (int r = 0; r < half.fishbone.rows; ++r)
+        for (int c = 0; c < half.fishbone.cols; ++c)
+            if (half.fishbone.isPresent(r, c)) {
+                ASSERT_EQ(half.fishbone.at(r, c), 2.0 * tracedAll.fishbone.at(r, c));
+            }
     const PatchError th = measure(half.patch, reference, line, inner, hWorld);
     const PatchError tk = measure(full.patch, reference, line, inner, hWorld);
     print("traced, 400², h = 2, k = 2", th, half.patch);

@@ -88,10 +88,11 @@ struct FishboneParams {
     std::vector<Eigen::Vector2d> keyRibs;         ///< key-rib mode: traced key-ribs at these points (≥ 2)
     std::vector<Polyline2> drawnKeyRibs;          ///< key-rib mode: hand-drawn key-ribs (splines)
     Polyline2 drawnBackbone;                      ///< hand-drawn backbone (≥ 2 points) instead of seed
-    /// Tracing options (its spacing is replaced by `spacing`), lengths in pixels of the scan image as
-    /// everything here. The default continues straight across isotropic regions, which CAD meshes' flat
-    /// faces need. An unbounded (infinite) maxLength becomes the image diagonal for the backbone (each way)
-    /// and half of it for each rib half.
+    /// Tracing options (its spacing is replaced by `spacing`): steps in pixels of the sampling image (the
+    /// direction field's, see samplingFactor), a finite maxLength in pixels of the scan image. The default
+    /// continues straight across isotropic regions, which CAD meshes' flat faces need. An unbounded
+    /// (infinite) maxLength becomes the image diagonal for the backbone (each way) and half of it for each
+    /// rib half.
     FishboneOptions tracing = defaultTracing();
     /// A traced backbone needs the seed's interpolated anisotropy to reach this (else the principal
     /// directions are undefined there: flat or umbilic region).
@@ -104,21 +105,22 @@ struct FishboneParams {
     /// curved crease the min direction of the curved side is across the crease, one triangle away), so
     /// the crease is no attracting streamline of the field and small errors grow. 0 turns it off.
     double creaseAngleDeg = 30.0;
-    /// See creaseAngleDeg; pixels (> 0).
+    /// See creaseAngleDeg; pixels of the scan image (> 0).
     double creaseSnapRadius = 1.5;
     /// Local search of the hinted ray casts.
     LocalSearchOptions raycast{};
     /// The sampling image's resolution divisor k (fishboneSamplingFactor): the reference (and the current
     /// mesh, for the quality mask and the stitch) are rendered at (W/k) × (H/k), the scan camera's frustum
-    /// at 1/k of its resolution, and the fishbone is traced there (the same streamline steps, spacing and
-    /// lengths in pixels of the scan image, h/k and so on in its pixels). A regular scan renders one pixel
-    /// per sample; with k = ⌊h⌋ a fishbone renders about one per sample too, instead of h² (issue 5: at
-    /// most twice the cost of a regular scan of as many samples). The samples themselves are exact either
-    /// way (rays from the eye onto the reference), and their quality (Sample::quality) is that of the scan
-    /// image's pixel footprint whatever k is, so the quality mask ranks the patch the same; the direction
-    /// field is sampled k times more coarsely (bilinear between its pixels), which costs some alignment:
-    /// on fandisk's curved crease at 400², h = 2 px, the mean normal error near the crease is 1.5° with
-    /// k = 2 and 0.6° with k = 1 (the pixel grid's: 8.5°; tests/core/fishbone_fandisk_test.cpp).
+    /// at 1/k of its resolution, and the fishbone is traced there: the scan with spacing h on W × H is the
+    /// scan with spacing h/k on (W/k) × (H/k) — seed, key-ribs, drawn curves, lasso, maxLength and the
+    /// crease snap radius divided by k, the tracing steps as they are (pixels of the direction field). A
+    /// regular scan renders one pixel per sample; with k = ⌊h⌋ a fishbone renders about one per sample
+    /// too, instead of h² (issue 5: at most twice the cost of a regular scan of as many samples). The
+    /// samples themselves are exact either way (rays from the eye onto the reference), and their quality
+    /// (Sample::quality) is that of the scan image's pixel footprint whatever k is, so the quality mask
+    /// ranks the patch the same; the direction field is k times coarser, which costs some alignment: on
+    /// fandisk's curved crease at 400², h = 2 px, the mean normal error near the crease is 1.0° with k = 2
+    /// and 0.6° with k = 1 (the pixel grid's: 8.5°; tests/core/fishbone_fandisk_test.cpp).
     /// 0 (the default) = automatic: the largest integer k ≤ h that divides both W and H; k ≥ 1 requests
     /// that divisor (it must divide W and H and be at most h). Session files written before this option
     /// replay with k = 1 (the scan resolution), as they were recorded.
