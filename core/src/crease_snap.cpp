@@ -223,9 +223,10 @@ private:
     /// Whether the triangles \p after may replace \p before: no degenerate face, no normal turned by 90° or
     /// more (each face against its own old normal when \p sameCount, else against the old faces' mean
     /// normal), no angle below the floor (or the smallest old angle), a largest distance to the reference
-    /// that does not grow and an integrated squared distance that falls below \p gain times the old one.
-    bool better(const std::vector<Tri>& before, const std::vector<Tri>& after, bool sameCount,
-                double gain) const {
+    /// that does not grow and an integrated squared distance that falls below \p gain times the old one;
+    /// never when the old faces are within \p minOldError of the reference already.
+    bool better(const std::vector<Tri>& before, const std::vector<Tri>& after, bool sameCount, double gain,
+                double minOldError = 0) const {
         Vec mean(0, 0, 0);
         double oldMin = std::numbers::pi, newMin = std::numbers::pi;
         for (const Tri& t : before) {
@@ -247,6 +248,7 @@ private:
             oldErr.max = std::max(oldErr.max, e.max);
             oldErr.integral += e.integral;
         }
+        if (oldErr.max < minOldError) return false;
         for (const Tri& t : after) {
             const Error e = error(t);
             newErr.max = std::max(newErr.max, e.max);
@@ -387,7 +389,8 @@ private:
             if (!creases_.closest(0.25 * (pa + pb + pc + pd), q, dist) || dist > L_) continue;
             if (CGAL::halfedge(c, d, m_).second) continue;
             // Faces (a, b, c), (b, a, d) become (a, d, c), (d, b, c).
-            if (!better({{pa, pb, pc}, {pb, pa, pd}}, {{pa, pd, pc}, {pd, pb, pc}}, false, 0.8)) continue;
+            if (!better({{pa, pb, pc}, {pb, pa, pd}}, {{pa, pd, pc}, {pd, pb, pc}}, false, 0.8, 0.02 * L_))
+                continue;
             const FaceIndex f = m_.face(h), g = m_.face(o);
             const std::int32_t idF = haveIds ? ids[f] : -1, idG = haveIds ? ids[g] : -1;
             const float qualityF = haveQuality ? quality[f] : 0.f, qualityG = haveQuality ? quality[g] : 0.f;
