@@ -259,6 +259,7 @@ private:
 
     /// Moves vertices near a crease onto their closest crease point, nearest first; a vertex next to one
     /// already on a crease within the snap radius of that point stays (two vertices there make a short edge).
+    /// Vertices farther from the crease but off the reference go onto their closest reference point.
     std::size_t snapSweep() {
         struct Candidate {
             double distance;

@@ -132,7 +132,7 @@ TEST(CliAuto, OtherClosedMeshesStayValidAndGainValenceSixFromTheSeamRelaxation) 
 
 // Issue #7's regularity and distance criteria on fandisk. NOT MET YET, measured on this branch
 // (bench_auto, GPU renderer; `fss-remesh auto fandisk.off -o out.ply --json` runs the same autoRemesh):
-// fraction of valence-6 interior vertices 0.790 (criterion ≥ 0.90; CGAL's isotropic remeshing: 0.773; 0.658
+// fraction of valence-6 interior vertices 0.795 (criterion ≥ 0.90; CGAL's isotropic remeshing: 0.773; 0.658
 // before the seam relaxation), Hausdorff distance to / from the input 0.00687 / 0.00530 of the bbox diagonal
 // (criterion: ≤ CGAL's 0.00135 / 0.00135). With one region per view the 8 initial patches alone reach 0.77
 // valence 6 at 0.88 coverage; the stitch trims them at many seams and the follow-up scans that fill those
@@ -141,7 +141,7 @@ TEST(CliAuto, OtherClosedMeshesStayValidAndGainValenceSixFromTheSeamRelaxation) 
 // that CGAL keeps as constraints: the largest distances were on faces across those edges (all of the top 1 %
 // of the distance samples within two edge lengths of a crease). The crease recovery (auto_remesh.h, step 7)
 // moves vertices onto the creases, splits and flips edges there: 0.00942 / 0.00975 → 0.00687 / 0.00530
-// (bench_auto; valence 6 0.791 → 0.790); what is left is still at the creases (vertices too far from them
+// (bench_auto; valence 6 0.791 → 0.795); what is left is still at the creases (vertices too far from them
 // to move, or whose move would fold a face).
 TEST(CliAuto, DISABLED_FandiskMeetsIssue7RegularityAndDistanceCriteria) {
     const AutoRun& r = fandiskRun();

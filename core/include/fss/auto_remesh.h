@@ -47,16 +47,17 @@
 ///     lower the vertex count (towards the target: the seams have more vertices than a regular grid).
 ///  7. **Crease recovery.** The views' regions meet at the sharp creases of the reference, so the seams run
 ///     along them, and neither pixel grid has vertices on them: the faces there bevel the creases off by up
-///     to half an edge length, where the largest distances to and from the reference were. Scanned vertices
+///     to half an edge length, where the largest distances to and from the reference were. Vertices
 ///     within L/2 of a crease (reference edges above featureAngleDeg) move onto it, edges that still pass a
 ///     crease at a bevel are split at the crease, and edges are flipped to the diagonal that follows it; each
 ///     operation only where it does not raise the largest distance of the faces it changes to the reference
 ///     and lowers their integrated squared distance, makes no angle below the stitch's minAngleFloorDeg (or
-///     the smallest already there) and turns no face over; a round that would make the mesh intersect
-///     itself is undone. Vertices near a crease but off the reference by more than L/10 (left inside a bevel
-///     by the stitches) go onto their closest reference point under the same conditions. No edge between a
-///     face left from the input and a scanned one is flipped. The seams are then relaxed once more (step 6),
-///     with the vertices put on a crease kept where they are.
+///     the smallest already there), turns no face over and makes the faces around it intersect no other
+///     (else it is undone at once; a round that still makes the mesh intersect itself is undone as well).
+///     Vertices near a crease but off the reference by more than L/10 (left inside a bevel by the stitches)
+///     go onto their closest reference point under the same conditions. No edge between a face left from the
+///     input and a scanned one is flipped. The seams are then relaxed once more (step 6), with the vertices
+///     put on a crease kept where they are.
 ///
 /// Every stitch has the strong guarantee: a scan or stitch that fails is skipped (and reported), the mesh
 /// is never left invalid.

@@ -47,16 +47,19 @@ struct CreaseSnapReport {
 /// Brings the faces of \p mesh near the creases of \p reference onto them (see the file comment). Border
 /// vertices never move; no edge between a face left from the input (props::faceScanId < 0) and a scanned
 /// face is flipped, so the scanned area changes only as much as a vertex moved onto a crease or a split
-/// shifts it. Every moved or new vertex lies on a crease of the reference (so on its surface).
+/// shifts it. Every moved or new vertex lies on a crease of the reference, or (a vertex near a crease that
+/// was off the reference by more than edgeLength / 10) at its closest reference point.
 /// Each operation must not raise the largest distance to the reference of the faces it changes and must
-/// lower their integrated squared distance (both sampled at centroids, edge midpoints and three inner points;
-/// a flip by a fifth at least, so that flips follow creases rather than noise), keep every new face's normal
-/// within 90° of the faces it replaces, create no angle below the floor (CreaseSnapOptions::minAngleDeg), and
-/// keep the mesh a valid edge-manifold triangle mesh (flips: no existing edge, valence ≥ 3). An operation
-/// after which the faces within two vertex rings of it intersect each other is undone at once; a round whose
+/// lower their integrated squared distance (both sampled at centroids, edge midpoints and three inner
+/// points; a flip by a fifth at least, and only where its two faces are farther than edgeLength / 50 from
+/// the reference, so that flips follow creases rather than noise), keep every new face's normal within 90°
+/// of the faces it replaces, create no angle below the floor (CreaseSnapOptions::minAngleDeg), and keep the
+/// mesh a valid edge-manifold triangle mesh (flips: no existing edge, valence ≥ 3). An operation after
+/// which the faces within two vertex rings of it intersect each other is undone at once; a round whose
 /// result still intersects itself (while the mesh before did not) is undone as a whole. New faces keep the
-/// scan id and quality of the face they split. \p mesh is garbage collected on return. \pre \p mesh is a
-/// valid triangle mesh; \p reference is a triangle mesh (the surface \p mesh approximates).
+/// scan id and quality of the face they split. The vertices put on a crease get the property
+/// kOnCreaseProperty (true). \p mesh is garbage collected on return.
+/// \pre \p mesh is a valid triangle mesh; \p reference is a triangle mesh (the surface \p mesh approximates).
 CreaseSnapReport snapToCreases(Mesh& mesh, const Mesh& reference, const CreaseSnapOptions& options);
 
 } // namespace fss::detail
