@@ -1,5 +1,6 @@
 #include "fss/auto_remesh.h"
 
+#include "detail/crease_snap.h"
 #include "detail/seam_relax.h"
 
 #include "fss/error.h"
@@ -898,8 +899,10 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
         result.stitchSeconds += secondsSince(t);
     }
     current.collect_garbage();
-    if (options.seamRelaxRounds > 0) {
-        progress.report(0.99, "relax");
+    // The seams are relaxed, the creases recovered where the scans bevelled them, and the seams relaxed
+    // again around the crease vertices (which the relaxation now keeps as feature vertices).
+    auto relax = [&] {
+        if (options.seamRelaxRounds <= 0) return;
         auto t = Clock::now();
         detail::SeamRelaxOptions ro;
         ro.rounds = options.seamRelaxRounds;
@@ -909,11 +912,29 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
         ro.featureAngleDeg = options.featureAngleDeg;
         ro.collapses = options.seamRelaxCollapses;
         const detail::SeamRelaxReport rr = detail::relaxSeams(current, reference, ro);
-        result.seamFlips = rr.flips;
-        result.seamCollapses = rr.collapses;
-        result.seamMoves = rr.moves;
-        result.seamRelaxDiscarded = rr.reverted;
+        result.seamFlips += rr.flips;
+        result.seamCollapses += rr.collapses;
+        result.seamMoves += rr.moves;
+        result.seamRelaxDiscarded = result.seamRelaxDiscarded || rr.reverted;
         result.stitchSeconds += secondsSince(t);
+    };
+    progress.report(0.99, "relax");
+    relax();
+    if (options.creaseSnapRounds > 0) {
+        auto t = Clock::now();
+        detail::CreaseSnapOptions co;
+        co.edgeLength = L;
+        co.creaseAngleDeg = options.featureAngleDeg;
+        co.minAngleDeg = options.stitch.minAngleFloorDeg;
+        co.rounds = options.creaseSnapRounds;
+        const detail::CreaseSnapReport cr = detail::snapToCreases(current, reference, co);
+        result.creaseSnaps = cr.snaps;
+        result.creaseSplits = cr.splits;
+        result.creaseFlips = cr.flips;
+        result.stitchSeconds += secondsSince(t);
+        if (cr.snaps + cr.splits + cr.flips > 0) relax();
+        if (auto [onCrease, have] = current.property_map<VertexIndex, bool>(detail::kOnCreaseProperty); have)
+            current.remove_property_map(onCrease);
     }
     progress.report(1.0, "done");
     const Coverage c = measureCoverage(current);

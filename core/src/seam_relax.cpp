@@ -1,5 +1,8 @@
 #include "detail/seam_relax.h"
 
+#include "detail/crease_snap.h"
+#include "detail/triangle_geometry.h"
+
 #include "fss/raycast.h"
 
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
@@ -16,31 +19,6 @@ namespace {
 namespace PMP = CGAL::Polygon_mesh_processing;
 using Vec = Eigen::Vector3d;
 
-Vec pos(const Mesh& m, VertexIndex v) {
-    const Point3& p = m.point(v);
-    return {p.x(), p.y(), p.z()};
-}
-
-/// Smallest corner angle of triangle (a, b, c), radians (0 for a degenerate one).
-double minAngle(const Vec& a, const Vec& b, const Vec& c) {
-    auto corner = [](const Vec& p, const Vec& q, const Vec& r) {
-        const Vec u = q - p, v = r - p;
-        return std::atan2(u.cross(v).norm(), u.dot(v));
-    };
-    return std::min({corner(a, b, c), corner(b, c, a), corner(c, a, b)});
-}
-
-/// Unit normal of triangle (a, b, c); zero when degenerate.
-Vec unitNormal(const Vec& a, const Vec& b, const Vec& c) {
-    const Vec n = (b - a).cross(c - a);
-    const double len = n.norm();
-    return len > 0 ? Vec(n / len) : Vec(0, 0, 0);
-}
-
-double angleBetween(const Vec& u, const Vec& v) {
-    return std::atan2(u.cross(v).norm(), u.dot(v));
-}
-
 class Relaxer {
 public:
     Relaxer(Mesh& mesh, const Mesh& reference, const SeamRelaxOptions& o)
@@ -48,23 +26,42 @@ public:
           maxTurn_(o.maxNormalChangeDeg * std::numbers::pi / 180.0),
           feature_(o.featureAngleDeg * std::numbers::pi / 180.0) {}
 
-    SeamRelaxReport run() {
+    /// The relaxation; with \p checkStages, a stage (the projection, a round's flips, its collapses or its
+    /// smoothing) after which the mesh intersects itself is undone, and that kind of stage is not run again.
+    SeamRelaxReport run(bool checkStages) {
         SeamRelaxReport report;
         markFeaturesAndZone();
         report.zoneVertices = std::size_t(std::count(zone_.begin(), zone_.end(), 1));
-        report.projected = projectOffSurface();
+        Mesh before;
+        if (checkStages) before = m_;
+        // Ends one stage: false when it was undone.
+        auto keep = [&](std::size_t count, std::size_t& total) {
+            if (count == 0) return true;
+            if (checkStages) {
+                if (PMP::does_self_intersect(m_)) {
+                    m_ = before;
+                    report.reverted = true;
+                    return false;
+                }
+                before = m_;
+            }
+            total += count;
+            return true;
+        };
+        keep(projectOffSurface(), report.projected);
+        bool flipping = true, collapsing = o_.collapses, smoothing = true;
         for (int round = 0; round < o_.rounds; ++round) {
-            std::size_t flips = 0;
-            for (int sweep = 0; sweep < 4; ++sweep) {
+            std::size_t flips = 0, collapses = 0, moves = 0;
+            for (int sweep = 0; flipping && sweep < 4; ++sweep) {
                 const std::size_t f = flipSweep();
                 flips += f;
                 if (f == 0) break;
             }
-            const std::size_t collapses = o_.collapses ? collapseSweep() : 0;
-            const std::size_t moves = smoothSweep();
-            report.collapses += collapses;
-            report.flips += flips;
-            report.moves += moves;
+            flipping = keep(flips, report.flips) && flipping;
+            if (collapsing) collapses = collapseSweep();
+            collapsing = keep(collapses, report.collapses) && collapsing;
+            if (smoothing) moves = smoothSweep();
+            smoothing = keep(moves, report.moves) && smoothing;
             if (flips == 0 && collapses == 0 && moves == 0) break;
         }
         return report;
@@ -106,6 +103,10 @@ private:
                 fixed_[a.idx()] = fixed_[b.idx()] = 1;
             }
         }
+        // Vertices the crease recovery put on a crease of the reference stay there.
+        if (const auto [onCrease, have] = m_.property_map<VertexIndex, bool>(kOnCreaseProperty); have)
+            for (VertexIndex v : m_.vertices())
+                if (onCrease[v]) fixed_[v.idx()] = 1;
         for (VertexIndex v : m_.vertices()) {
             bool seed = m_.degree(v) != 6;
             std::int32_t first = -2;
@@ -369,15 +370,9 @@ private:
 
 SeamRelaxReport relaxSeams(Mesh& mesh, const Mesh& reference, const SeamRelaxOptions& options) {
     if (options.rounds <= 0 || mesh.is_empty()) return {};
-    const Mesh before = mesh;
-    SeamRelaxReport report = Relaxer(mesh, reference, options).run();
+    const bool intersectedBefore = PMP::does_self_intersect(mesh);
+    SeamRelaxReport report = Relaxer(mesh, reference, options).run(!intersectedBefore);
     mesh.collect_garbage();
-    if ((report.flips > 0 || report.collapses > 0 || report.moves > 0 || report.projected > 0) &&
-        PMP::does_self_intersect(mesh) && !PMP::does_self_intersect(before)) {
-        mesh = before;
-        report.flips = report.collapses = report.moves = report.projected = 0;
-        report.reverted = true;
-    }
     return report;
 }
 

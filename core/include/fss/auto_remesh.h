@@ -42,9 +42,22 @@
 ///     mixes the two, so the coverage stays); no flip, collapse or move makes an angle below
 ///     seamRelaxMinAngleDeg (or the smallest one already there), turns a face's normal by more than the
 ///     stitch's maxNormalChangeDeg, or takes faces farther from the reference than they were (beyond L/20).
-///     A relaxed mesh that would intersect itself is discarded as a whole. Closedness and manifoldness are
-///     kept; only collapses lower the vertex count (towards the target: the seams have more vertices than a
-///     regular grid).
+///     A stage of the relaxation (a round's flips, collapses or smoothing) after which the mesh would
+///     intersect itself is undone and not run again. Closedness and manifoldness are kept; only collapses
+///     lower the vertex count (towards the target: the seams have more vertices than a regular grid).
+///  7. **Crease recovery.** The views' regions meet at the sharp creases of the reference, so the seams run
+///     along them, and neither pixel grid has vertices on them: the faces there bevel the creases off by up
+///     to half an edge length, where the largest distances to and from the reference were. Vertices
+///     within L/2 of a crease (reference edges above featureAngleDeg) move onto it, edges that still pass a
+///     crease at a bevel are split at the crease, and edges are flipped to the diagonal that follows it; each
+///     operation only where it does not raise the largest distance of the faces it changes to the reference
+///     and lowers their integrated squared distance, makes no angle below the stitch's minAngleFloorDeg (or
+///     the smallest already there), turns no face over and makes the faces around it intersect no other
+///     (else it is undone at once; a round that still makes the mesh intersect itself is undone as well).
+///     Vertices near a crease but off the reference by more than L/10 (left inside a bevel by the stitches)
+///     go onto their closest reference point under the same conditions. No edge between a face left from the
+///     input and a scanned one is flipped. The seams are then relaxed once more (step 6), with the vertices
+///     put on a crease kept where they are.
 ///
 /// Every stitch has the strong guarantee: a scan or stitch that fails is skipped (and reported), the mesh
 /// is never left invalid.
@@ -128,6 +141,9 @@ struct AutoOptions {
     /// The seam relaxation also collapses zone edges where that lowers the number of irregular vertices
     /// (the vertex count drops a little).
     bool seamRelaxCollapses = true;
+    /// Rounds of crease recovery after the seam relaxation (file comment, step 7; 0 = none): each round
+    /// snaps vertices onto the creases, splits edges at them, then flips edges to follow them.
+    int creaseSnapRounds = 3;
     /// Options of every stitch. Faces with a smallest angle under 10° are refused (trimmed and retried).
     StitchOptions stitch = defaultStitch();
     /// Quality-mask margin (mask.h QualityMaskOptions::margin) of the regular scans.
@@ -173,10 +189,15 @@ struct AutoResult {
     int scansSkipped = 0;           ///< steps with stitched == false
     std::size_t featureChains = 0;  ///< feature chains found (fishbone only)
     std::size_t sliverFlips = 0;    ///< edges flipped after the last scan (AutoOptions::flipSliversBelowDeg)
-    std::size_t seamFlips = 0;      ///< edges flipped by the seam relaxation (AutoOptions::seamRelaxRounds)
-    std::size_t seamCollapses = 0;  ///< edges collapsed by the seam relaxation
-    std::size_t seamMoves = 0;      ///< vertex moves of the seam relaxation
-    /// True when the seam relaxation was discarded because its result intersected itself.
+    /// Edges flipped by the seam relaxation (AutoOptions::seamRelaxRounds; both passes, before and after
+    /// the crease recovery).
+    std::size_t seamFlips = 0;
+    std::size_t seamCollapses = 0; ///< edges collapsed by the seam relaxation (both passes)
+    std::size_t seamMoves = 0;     ///< vertex moves of the seam relaxation (both passes)
+    std::size_t creaseSnaps = 0;   ///< vertices moved onto a crease of the reference
+    std::size_t creaseSplits = 0;  ///< edges split at a crease of the reference
+    std::size_t creaseFlips = 0;   ///< edges flipped to follow a crease
+    /// True when a stage of the seam relaxation was undone because its result intersected itself.
     bool seamRelaxDiscarded = false;
     double seconds = 0;       ///< total wall time
     double planSeconds = 0;   ///< of which: view planning and coverage bookkeeping

@@ -29,7 +29,8 @@ struct SeamRelaxOptions {
     /// face are fixed: never flipped or collapsed; their vertices are not smoothed (a vertex off the
     /// reference by more than a tenth of edgeLength goes onto its closest reference point unless it is on
     /// an input face) and may absorb a free neighbour by a collapse. Every operation changes faces of one
-    /// kind only (input or scanned), so the scanned area (the coverage) stays as it is.
+    /// kind only (input or scanned), so the scanned area (the coverage) stays as it is. Vertices with the
+    /// property kOnCreaseProperty (crease_snap.h) are fixed as well: they lie on a crease of the reference.
     double featureAngleDeg = 35.0;
     /// The zone: vertices with a valence ≠ 6, on faces of different scans or on faces left from the input
     /// (props::faceScanId < 0), grown by this many vertex rings. Only edges with all four vertices in the
@@ -50,8 +51,9 @@ struct SeamRelaxReport {
     std::size_t projected = 0;    ///< zone vertices off the reference moved onto it (before the rounds)
     std::size_t collapses = 0;    ///< edges collapsed
     std::size_t moves = 0;        ///< vertex moves accepted (a vertex counts once per smoothing sweep)
-    /// True when the relaxed mesh intersected itself while the mesh before did not: the mesh was restored
-    /// as it was before relaxSeams (all counts but zoneVertices are then 0).
+    /// True when a stage (the projection, or a round's flips, collapses or smoothing) left the mesh
+    /// intersecting itself while the mesh before relaxSeams did not: that stage was undone (the counts are
+    /// those of the stages kept) and that kind of stage was not run again.
     bool reverted = false;
 };
 
@@ -59,8 +61,8 @@ struct SeamRelaxReport {
 /// edge flips and vertex moves projected onto \p reference (closest point). Every flip keeps the mesh a
 /// valid, oriented, edge-manifold triangle mesh (no flip creates an existing edge or a vertex of valence
 /// < 3; collapses satisfy the link condition); border edges and their vertices are never touched. \p mesh
-/// is garbage collected on return. A result with new
-/// self-intersections is discarded as a whole (strong guarantee).
+/// is garbage collected on return. A stage that creates self-intersections is undone and not run again
+/// (the other stages go on).
 /// \pre \p mesh is a valid triangle mesh; \p reference is a triangle mesh (the surface \p mesh approximates).
 SeamRelaxReport relaxSeams(Mesh& mesh, const Mesh& reference, const SeamRelaxOptions& options);
 
