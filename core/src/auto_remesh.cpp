@@ -667,6 +667,10 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
                     screenLength += (line[i] - line[i - 1]).norm();
                 fb.spacing = screenLength / std::max(1.0, std::round(screenLength / h));
                 fb.spacing = std::clamp(fb.spacing, 0.75 * h, 1.5 * h);
+                // Ribs traced on every pixel: the finest alignment with the feature (with the automatic
+                // sampling image fandisk's auto run keeps 1 % less of its area and 1 % fewer valence-6
+                // vertices; these scans are few, so their render cost hardly counts).
+                fb.samplingFactor = 1;
                 step.camera = params.camera;
                 auto ts = Clock::now();
                 FishboneScanResult scan = scanFishbonePatch(reference, *referenceRenderer, current,
