@@ -147,6 +147,9 @@ int runAuto(const std::vector<std::string>& args) {
         j["seam_collapses"] = result.seamCollapses;
         j["seam_moves"] = result.seamMoves;
         j["seam_relax_discarded"] = result.seamRelaxDiscarded;
+        j["crease_snaps"] = result.creaseSnaps;
+        j["crease_splits"] = result.creaseSplits;
+        j["crease_flips"] = result.creaseFlips;
         j["scans_stitched"] = result.scansStitched;
         j["scans_skipped"] = result.scansSkipped;
         nlohmann::json steps = nlohmann::json::array();

@@ -105,6 +105,10 @@ TEST(CliAuto, FandiskIsCoveredClosedManifoldAndFreeOfSelfIntersections) {
     EXPECT_GT(r.report.at("seam_collapses").get<int>(), 0);
     EXPECT_FALSE(r.report.at("seam_relax_discarded").get<bool>());
     EXPECT_GE(m.fracValence6Interior, 0.78);
+    // The crease recovery (auto_remesh.h) moved vertices onto fandisk's sharp edges.
+    EXPECT_GT(r.report.at("crease_snaps").get<int>(), 0);
+    EXPECT_TRUE(r.report.at("crease_splits").is_number_unsigned());
+    EXPECT_TRUE(r.report.at("crease_flips").is_number_unsigned());
 }
 
 // Other closed CGAL sample meshes, curved and mechanical: the result stays valid and the seam relaxation
