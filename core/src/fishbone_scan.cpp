@@ -653,7 +653,8 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
         // Everything the user gave in pixels of the scan image, in pixels of the sampling image.
         const double s = 1.0 / k;
         ScanParams sp = params;
-        sp.camera = fishboneSamplingCamera(params.camera, fb);
+        sp.camera.width /= k; // fishboneSamplingCamera, with the k already chosen
+        sp.camera.height /= k;
         if (sp.lasso)
             for (Eigen::Vector2d& q : sp.lasso->points)
                 q *= s;
