@@ -935,8 +935,10 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
         result.creaseSnaps = cr.snaps;
         result.creaseSplits = cr.splits;
         result.creaseFlips = cr.flips;
+        result.creaseRemovals = cr.removals;
+        result.creaseRepairs = cr.repairs;
         result.stitchSeconds += secondsSince(t);
-        if (cr.snaps + cr.splits + cr.flips > 0) relax();
+        if (cr.snaps + cr.splits + cr.flips + cr.removals + cr.repairs > 0) relax();
         if (auto [onCrease, have] = current.property_map<VertexIndex, bool>(detail::kOnCreaseProperty); have)
             current.remove_property_map(onCrease);
     }

@@ -8,6 +8,7 @@
 #include <CGAL/boost/graph/Euler_operations.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -61,6 +62,7 @@ class CreaseIndex {
 public:
     CreaseIndex(const Mesh& reference, double creaseAngle, double cell) : cell_(cell) {
         const double cosCrease = std::cos(creaseAngle);
+        std::vector<int> degree(reference.number_of_vertices() + reference.number_of_removed_vertices(), 0);
         for (EdgeIndex e : reference.edges()) {
             if (reference.is_border(e)) continue;
             const HalfedgeIndex h = reference.halfedge(e), o = reference.opposite(h);
@@ -68,6 +70,8 @@ public:
             const Vec n1 = unitNormal(a, b, pos(reference, reference.target(reference.next(h))));
             const Vec n2 = unitNormal(b, a, pos(reference, reference.target(reference.next(o))));
             if (n1.isZero() || n2.isZero() || n1.dot(n2) >= cosCrease) continue;
+            ++degree[reference.source(h).idx()];
+            ++degree[reference.target(h).idx()];
             const int id = int(segments_.size());
             segments_.push_back({a, b});
             const Vec lo = a.cwiseMin(b).array() - cell, hi = a.cwiseMax(b).array() + cell;
@@ -77,7 +81,12 @@ public:
                     for (std::int64_t z = k0.z; z <= k1.z; ++z)
                         cells_[hash({x, y, z})].push_back(id);
         }
+        for (VertexIndex v : reference.vertices())
+            if (degree[v.idx()] != 0 && degree[v.idx()] != 2) corners_.push_back(pos(reference, v));
     }
+    /// The corners of the creases: reference vertices where a crease ends or branches (one crease edge,
+    /// or three and more).
+    const std::vector<Vec>& corners() const { return corners_; }
     std::size_t size() const { return segments_.size(); }
     /// The crease segments that may lie within one cell of \p p (and possibly a few more).
     const std::vector<int>& near(const Vec& p) const {
@@ -119,6 +128,7 @@ private:
     std::vector<Segment> segments_;
     std::unordered_map<std::uint64_t, std::vector<int>> cells_;
     std::vector<int> empty_;
+    std::vector<Vec> corners_;
 };
 
 struct Tri {
@@ -128,9 +138,9 @@ struct Tri {
 class CreaseSnapper {
 public:
     CreaseSnapper(Mesh& mesh, const Mesh& reference, const CreaseSnapOptions& o)
-        : m_(mesh), o_(o), L_(o.edgeLength), floor_(o.minAngleDeg * std::numbers::pi / 180.0),
-          caster_(reference), creases_(reference, o.creaseAngleDeg * std::numbers::pi / 180.0, o.edgeLength) {
-    }
+        : m_(mesh), ref_(reference), o_(o), L_(o.edgeLength),
+          floor_(o.minAngleDeg * std::numbers::pi / 180.0), caster_(reference),
+          creases_(reference, o.creaseAngleDeg * std::numbers::pi / 180.0, o.edgeLength) {}
 
     std::size_t creaseEdges() const { return creases_.size(); }
 
@@ -148,9 +158,15 @@ public:
     /// One round: snaps, splits, flips; adds their counts to \p r.
     void round(CreaseSnapReport& r) {
         markFrozen();
+        r.snaps += cornerSweep();
         r.snaps += snapSweep();
+        r.removals += removeSweep();
+        markFrozen();
+        r.repairs += repairSweep();
         markFrozen();
         r.splits += splitSweep();
+        markFrozen();
+        r.splits += errorSplitSweep();
         markFrozen();
         for (int sweep = 0; sweep < 4; ++sweep) {
             const std::size_t f = flipSweep();
@@ -161,6 +177,7 @@ public:
 
 private:
     Mesh& m_;
+    const Mesh& ref_;
     const CreaseSnapOptions& o_;
     const double L_, floor_;
     RayCaster caster_;
@@ -238,7 +255,7 @@ private:
             const Vec n = unitNormal(t.a, t.b, t.c);
             if (n.isZero()) return false;
             const Vec ref = sameCount ? unitNormal(before[i].a, before[i].b, before[i].c) : mean;
-            if (n.dot(ref) <= 0) return false;
+            if (n.dot(ref) <= 0 && !liesOnReference(t, n)) return false;
             newMin = std::min(newMin, minAngle(t.a, t.b, t.c));
         }
         if (newMin < std::min(oldMin, floor_)) return false;
@@ -255,6 +272,357 @@ private:
             newErr.integral += e.integral;
         }
         return newErr.max <= oldErr.max + 1e-6 * L_ && newErr.integral < gain * oldErr.integral;
+    }
+
+    /// Whether the triangle \p t (unit normal \p n) lies on the reference: its centroid within a tenth of an
+    /// edge length of the reference, on a reference face whose normal is within 60° of \p n. Such a face
+    /// replaces faces that fold over (a bevel whose two faces overlap), whose normals say nothing of the
+    /// surface's side.
+    bool liesOnReference(const Tri& t, const Vec& n) const {
+        const SurfacePoint sp = caster_.closestPoint((t.a + t.b + t.c) / 3.0);
+        if (!sp || sp.distance > 0.1 * L_) return false;
+        const HalfedgeIndex h = ref_.halfedge(sp.face);
+        const Vec rn = unitNormal(pos(ref_, ref_.source(h)), pos(ref_, ref_.target(h)),
+                                  pos(ref_, ref_.target(ref_.next(h))));
+        return rn.dot(n) > 0.5;
+    }
+
+    /// Moves, for each corner of the creases (crease_snap.h), the nearest vertex within twice the snap
+    /// radius onto it (else the next nearest, up to three), where that brings its faces closer to the
+    /// reference: the snap sweep alone puts a vertex on one of the creases there, not at their meeting point.
+    std::size_t cornerSweep() {
+        std::size_t snaps = 0;
+        const double radius = 2 * o_.snapRadius * L_;
+        for (const Vec& corner : creases_.corners()) {
+            std::vector<std::pair<double, VertexIndex>> near;
+            bool taken = false;
+            for (VertexIndex v : m_.vertices()) {
+                const double d = (pos(m_, v) - corner).norm();
+                if (d < 1e-9 * L_)
+                    taken = true;
+                else if (d < radius && !frozen_[v.idx()])
+                    near.emplace_back(d, v);
+            }
+            if (taken) continue;
+            std::sort(near.begin(), near.end());
+            if (near.size() > 3) near.resize(3);
+            for (const auto& [d, v] : near)
+                if (moveVertex(v, corner)) {
+                    onCrease_[v.idx()] = 1;
+                    ++snaps;
+                    break;
+                }
+        }
+        return snaps;
+    }
+
+    /// Moves \p v to \p target where its faces come closer to the reference (better, with the same number of
+    /// faces) and the faces around it intersect no other; false (and \p v where it was) otherwise.
+    bool moveVertex(VertexIndex v, const Vec& target) {
+        const Vec p = pos(m_, v);
+        std::vector<Tri> before, after;
+        for (HalfedgeIndex h : CGAL::halfedges_around_target(m_.halfedge(v), m_)) {
+            const HalfedgeIndex n1 = m_.next(h);
+            const Vec q = pos(m_, m_.target(n1)), r = pos(m_, m_.target(m_.next(n1)));
+            before.push_back({p, q, r});
+            after.push_back({target, q, r});
+        }
+        if (!better(before, after, true, 0.99)) return false;
+        m_.point(v) = Point3(target.x(), target.y(), target.z());
+        if (intersectsAround({v})) {
+            m_.point(v) = Point3(p.x(), p.y(), p.z());
+            return false;
+        }
+        return true;
+    }
+
+    /// Removes vertices of valence 3 whose three faces lie farther from the reference than the one face
+    /// that replaces them (better): the stitches leave a few inside the bevel of a crease, off the reference,
+    /// where no snap can move them. The three faces must all be scanned or all be left from the input.
+    std::size_t removeSweep() {
+        const auto [ids, haveIds] = m_.property_map<FaceIndex, std::int32_t>(props::faceScanId);
+        const auto [quality, haveQuality] = m_.property_map<FaceIndex, float>(props::faceQuality);
+        std::vector<VertexIndex> candidates;
+        for (VertexIndex v : m_.vertices())
+            if (!frozen_[v.idx()] && m_.degree(v) == 3) candidates.push_back(v);
+        std::size_t removals = 0;
+        for (VertexIndex v : candidates) {
+            if (m_.is_removed(v) || m_.degree(v) != 3) continue;
+            std::vector<Tri> before;
+            std::vector<VertexIndex> ring;
+            std::vector<FaceIndex> faces;
+            bool mixed = false, tooSmall = false;
+            for (HalfedgeIndex h : CGAL::halfedges_around_target(m_.halfedge(v), m_)) {
+                const HalfedgeIndex n1 = m_.next(h);
+                before.push_back({pos(m_, v), pos(m_, m_.target(n1)), pos(m_, m_.target(m_.next(n1)))});
+                ring.push_back(m_.source(h));
+                faces.push_back(m_.face(h));
+                mixed = mixed || isInput(faces.front()) != isInput(faces.back());
+                tooSmall = tooSmall || m_.degree(m_.source(h)) <= 3;
+            }
+            if (mixed || tooSmall) continue;
+            // The ring (v's neighbours around it, in order) becomes one face with v's faces' orientation.
+            const Tri merged{pos(m_, ring[2]), pos(m_, ring[1]), pos(m_, ring[0])};
+            if (!better(before, {merged}, false, 0.99, 0.02 * L_)) continue;
+            std::int32_t oldIds[3] = {-1, -1, -1};
+            float oldQuality[3] = {0.f, 0.f, 0.f};
+            for (std::size_t i = 0; i < 3; ++i) {
+                if (haveIds) oldIds[i] = ids[faces[i]];
+                if (haveQuality) oldQuality[i] = quality[faces[i]];
+            }
+            const Point3 old = m_.point(v);
+            const HalfedgeIndex hv = m_.halfedge(v);
+            const HalfedgeIndex border = CGAL::Euler::remove_center_vertex(hv, m_);
+            const FaceIndex f = m_.face(border);
+            if (haveIds) ids[f] = oldIds[0];
+            if (haveQuality) quality[f] = oldQuality[0];
+            if (intersectsAround({ring[0], ring[1], ring[2]})) { // undo: the vertex back in the face
+                const HalfedgeIndex hn = CGAL::Euler::add_center_vertex(border, m_);
+                m_.point(m_.target(hn)) = old;
+                // Each new face has the halfedge (ring[i] → v) of the old face faces[i].
+                for (HalfedgeIndex h : CGAL::halfedges_around_target(hn, m_)) {
+                    const std::size_t i =
+                        std::size_t(std::find(ring.begin(), ring.end(), m_.source(h)) - ring.begin());
+                    if (haveIds) ids[m_.face(h)] = oldIds[i];
+                    if (haveQuality) quality[m_.face(h)] = oldQuality[i];
+                }
+                continue;
+            }
+            ++removals;
+        }
+        return removals;
+    }
+
+    /// The reference's unit normal at the point closest to \p p (zero when there is none).
+    Vec referenceNormal(const Vec& p) const {
+        const SurfacePoint sp = caster_.closestPoint(p);
+        if (!sp) return Vec::Zero();
+        const HalfedgeIndex h = ref_.halfedge(sp.face);
+        return unitNormal(pos(ref_, ref_.source(h)), pos(ref_, ref_.target(h)),
+                          pos(ref_, ref_.target(ref_.next(h))));
+    }
+
+    /// Whether \p t faces away from the reference: its normal against the reference's normal at the point
+    /// closest to its centroid (a degenerate triangle counts as turned over).
+    bool turnedOver(const Tri& t) const {
+        const Vec n = unitNormal(t.a, t.b, t.c);
+        return n.isZero() || n.dot(referenceNormal((t.a + t.b + t.c) / 3.0)) < 0;
+    }
+
+    /// The smallest angle and the largest distance to the reference of the faces an operation replaces.
+    struct Before {
+        double minAngle = std::numbers::pi, maxError = 0;
+    };
+    Before measure(const std::vector<Tri>& before) const {
+        Before b;
+        for (const Tri& t : before) {
+            b.minAngle = std::min(b.minAngle, minAngle(t.a, t.b, t.c));
+            b.maxError = std::max(b.maxError, error(t).max);
+        }
+        return b;
+    }
+
+    /// Whether \p after may replace faces measured as \p before, among which a face turned over or far from
+    /// the reference: none of \p after is turned over, no angle below the floor (or the smallest angle
+    /// before), and a largest distance to the reference at most \p gain times the one before.
+    bool repairs(const Before& before, const std::vector<Tri>& after, double gain) const {
+        for (const Tri& t : after)
+            if (minAngle(t.a, t.b, t.c) < std::min(before.minAngle, floor_)) return false;
+        for (const Tri& t : after)
+            if (turnedOver(t)) return false;
+        const double limit = gain * before.maxError + 1e-6 * L_;
+        for (const Tri& t : after)
+            if (error(t).max > limit) return false;
+        return true;
+    }
+
+    /// Repairs the faces turned over against the reference (folds the stitches and the seam relaxation leave
+    /// at a crease, where two faces overlap) and the faces still farther from it than errorSplitDistance edge
+    /// lengths: for each, the first of these that leaves no face there turned over and (for a far face)
+    /// lowers the largest distance to the reference by a fifth (repairs) is taken: a flip of one of its
+    /// edges, else a move of one of its corners onto the crease within an edge length of it, else a
+    /// collapse of one of its edges to one end, to the crease point within an edge length of its midpoint,
+    /// or to the reference point closest to its midpoint. Vertices put on a crease stay there; no edge
+    /// between a face left from the input and a scanned one changes; an operation after which the faces
+    /// around it intersect others is undone.
+    std::size_t repairSweep() {
+        // Turned over: the gain 1 (no farther from the reference); far from it (only faces near a crease,
+        // where the scans leave such faces): the gain 0.8.
+        auto bad = [&](FaceIndex f) {
+            const Tri t = triangle(f);
+            if (turnedOver(t)) return 1.0;
+            Vec q;
+            double d;
+            if (!creases_.closest((t.a + t.b + t.c) / 3.0, q, d) || d > 1.5 * L_) return 0.0;
+            return error(t).max > o_.errorSplitDistance * L_ ? 0.8 : 0.0;
+        };
+        std::vector<FaceIndex> folded;
+        for (FaceIndex f : m_.faces())
+            if (bad(f) > 0) folded.push_back(f);
+        std::size_t repaired = 0;
+        for (FaceIndex f : folded) {
+            if (m_.is_removed(f)) continue;
+            const double gain = bad(f);
+            if (gain == 0) continue;
+            // The three edges, taken before any of them changes the face.
+            const HalfedgeIndex h0 = m_.halfedge(f);
+            const std::array<HalfedgeIndex, 3> edges = {h0, m_.next(h0), m_.prev(h0)};
+            bool done = false;
+            for (std::size_t i = 0; i < 3 && !done; ++i)
+                done = tryFlip(edges[i], gain);
+            for (std::size_t i = 0; i < 3 && !done; ++i)
+                done = tryMoveToCrease(m_.target(edges[i]), gain);
+            for (std::size_t i = 0; i < 3 && !done; ++i)
+                done = tryCollapse(edges[i], gain);
+            repaired += done;
+        }
+        return repaired;
+    }
+
+    Tri triangle(FaceIndex f) const {
+        const HalfedgeIndex h = m_.halfedge(f);
+        return {pos(m_, m_.source(h)), pos(m_, m_.target(h)), pos(m_, m_.target(m_.next(h)))};
+    }
+
+    /// Whether the faces on the two sides of \p h are both scanned or both left from the input.
+    bool sameKind(HalfedgeIndex h) const { return isInput(m_.face(h)) == isInput(m_.face(m_.opposite(h))); }
+
+    bool tryFlip(HalfedgeIndex h, double gain) {
+        const HalfedgeIndex o = m_.opposite(h);
+        if (m_.is_border(m_.edge(h)) || !sameKind(h)) return false;
+        const VertexIndex a = m_.source(h), b = m_.target(h);
+        const VertexIndex c = m_.target(m_.next(h)), d = m_.target(m_.next(o));
+        if (c == d || m_.degree(a) <= 3 || m_.degree(b) <= 3 || CGAL::halfedge(c, d, m_).second) return false;
+        const Vec pa = pos(m_, a), pb = pos(m_, b), pc = pos(m_, c), pd = pos(m_, d);
+        if (!repairs(measure({{pa, pb, pc}, {pb, pa, pd}}), {{pa, pd, pc}, {pd, pb, pc}}, gain)) return false;
+        return applyOrUndo([&] { CGAL::Euler::flip_edge(h, m_); }, {a, b, c, d});
+    }
+
+    /// Moves \p v onto its closest crease point when that is within one edge length, then flips the edge
+    /// opposite \p v in each of its faces that the move flattened into a cap (an angle above 160° at \p v,
+    /// between two vertices on the crease): the move with those flips must repair (repairs) the faces
+    /// around \p v and the caps' neighbours, else the mesh is restored.
+    bool tryMoveToCrease(VertexIndex v, double gain) {
+        if (frozen_[v.idx()] || onCrease_[v.idx()]) return false;
+        Vec q;
+        double dist;
+        if (!creases_.closest(pos(m_, v), q, dist) || dist > L_) return false;
+        for (VertexIndex w : CGAL::vertices_around_target(m_.halfedge(v), m_))
+            if (onCrease_[w.idx()] && (pos(m_, w) - q).norm() < o_.snapRadius * L_) return false; // crowded
+        const Vec p = pos(m_, v);
+        std::vector<Tri> before, moved;
+        std::vector<HalfedgeIndex> caps; // the edges opposite v in the faces with an angle above 160° at q
+        for (HalfedgeIndex h : CGAL::halfedges_around_target(m_.halfedge(v), m_)) {
+            const HalfedgeIndex opposite = m_.prev(h); // from target(next(h)) to source(h)
+            const Vec x = pos(m_, m_.source(opposite)), y = pos(m_, m_.target(opposite));
+            before.push_back({p, x, y});
+            moved.push_back({q, x, y});
+            if (angleBetween(x - q, y - q) > 160.0 * std::numbers::pi / 180.0) caps.push_back(opposite);
+        }
+        if (caps.empty()) { // the move alone
+            if (!repairs(measure(before), moved, gain)) return false;
+            m_.point(v) = Point3(q.x(), q.y(), q.z());
+            if (intersectsAround({v})) {
+                m_.point(v) = Point3(p.x(), p.y(), p.z());
+                return false;
+            }
+            onCrease_[v.idx()] = 1;
+            return true;
+        }
+        const Mesh saved = m_;
+        auto restore = [&] {
+            m_ = saved;
+            return false;
+        };
+        m_.point(v) = Point3(q.x(), q.y(), q.z());
+        for (HalfedgeIndex c : caps) {
+            const HalfedgeIndex o = m_.opposite(c);
+            if (m_.is_border(o) || !sameKind(c)) return restore();
+            const VertexIndex x = m_.source(c), y = m_.target(c), w = m_.target(m_.next(o));
+            if (w == v || m_.degree(x) <= 3 || m_.degree(y) <= 3 || CGAL::halfedge(v, w, m_).second)
+                return restore();
+            before.push_back(triangle(m_.face(o)));
+            CGAL::Euler::flip_edge(c, m_);
+        }
+        std::vector<Tri> after;
+        for (FaceIndex f : CGAL::faces_around_target(m_.halfedge(v), m_))
+            after.push_back(triangle(f));
+        if (!repairs(measure(before), after, gain) || intersectsAround({v})) return restore();
+        onCrease_[v.idx()] = 1;
+        return true;
+    }
+
+    bool tryCollapse(HalfedgeIndex h, double gain) {
+        const HalfedgeIndex o = m_.opposite(h);
+        const EdgeIndex e = m_.edge(h);
+        if (m_.is_border(e) || !sameKind(h)) return false;
+        const VertexIndex a = m_.source(h), b = m_.target(h);
+        const VertexIndex c = m_.target(m_.next(h)), d = m_.target(m_.next(o));
+        if (frozen_[a.idx()] || frozen_[b.idx()] || (onCrease_[a.idx()] && onCrease_[b.idx()])) return false;
+        if (m_.degree(c) <= 3 || m_.degree(d) <= 3 || !CGAL::Euler::does_satisfy_link_condition(e, m_))
+            return false;
+        const Vec pa = pos(m_, a), pb = pos(m_, b);
+        // Where the merged vertex goes, and whether that is on a crease.
+        std::vector<std::pair<Vec, bool>> targets;
+        if (onCrease_[a.idx()])
+            targets = {{pa, true}};
+        else if (onCrease_[b.idx()])
+            targets = {{pb, true}};
+        else {
+            targets = {{pa, false}, {pb, false}};
+            Vec q;
+            double dist;
+            const Vec mid = 0.5 * (pa + pb);
+            if (creases_.closest(mid, q, dist) && dist < L_) targets.emplace_back(q, true);
+            if (const SurfacePoint sp = caster_.closestPoint(mid)) targets.emplace_back(sp.point, false);
+        }
+        std::vector<Tri> before;
+        std::vector<std::array<VertexIndex, 3>> ring; // the faces that stay, by their corners
+        for (VertexIndex v : {a, b})
+            for (FaceIndex g : CGAL::faces_around_target(m_.halfedge(v), m_)) {
+                if (g == m_.face(h) || g == m_.face(o)) continue;
+                if (isInput(g) != isInput(m_.face(h)))
+                    return false; // a border of the scanned area would move
+                const HalfedgeIndex k = m_.halfedge(g);
+                ring.push_back({m_.source(k), m_.target(k), m_.target(m_.next(k))});
+                before.push_back(triangle(g));
+            }
+        for (FaceIndex g : {m_.face(h), m_.face(o)})
+            before.push_back(triangle(g));
+        const Before measured = measure(before);
+        for (const auto& [t, marked] : targets) {
+            std::vector<Tri> after;
+            for (const auto& r : ring) {
+                Vec corner[3];
+                for (int i = 0; i < 3; ++i)
+                    corner[i] =
+                        r[std::size_t(i)] == a || r[std::size_t(i)] == b ? t : pos(m_, r[std::size_t(i)]);
+                after.push_back({corner[0], corner[1], corner[2]});
+            }
+            if (!repairs(measured, after, gain)) continue;
+            if (applyOrUndo(
+                    [&] {
+                        const VertexIndex kept = CGAL::Euler::collapse_edge(e, m_);
+                        m_.point(kept) = Point3(t.x(), t.y(), t.z());
+                        onCrease_[kept.idx()] = marked;
+                    },
+                    {c, d}))
+                return true;
+        }
+        return false;
+    }
+
+    /// Runs \p op; undoes it (the whole mesh and the vertex marks restored) when the faces within two rings
+    /// of \p around then intersect others. True when it stays.
+    template <typename Op> bool applyOrUndo(Op op, std::initializer_list<VertexIndex> around) {
+        const Mesh saved = m_;
+        const std::vector<char> frozen = frozen_, onCrease = onCrease_;
+        op();
+        if (!intersectsAround(around)) return true;
+        m_ = saved;
+        frozen_ = frozen;
+        onCrease_ = onCrease;
+        return false;
     }
 
     /// Moves vertices near a crease onto their closest crease point, nearest first; a vertex next to one
@@ -291,21 +659,7 @@ private:
             for (VertexIndex w : CGAL::vertices_around_target(m_.halfedge(v), m_))
                 crowded =
                     crowded || (onCrease_[w.idx()] && (pos(m_, w) - c.target).norm() < o_.snapRadius * L_);
-            if (crowded) continue;
-            const Vec p = pos(m_, v);
-            std::vector<Tri> before, after;
-            for (HalfedgeIndex h : CGAL::halfedges_around_target(m_.halfedge(v), m_)) {
-                const HalfedgeIndex n1 = m_.next(h);
-                const Vec q = pos(m_, m_.target(n1)), r = pos(m_, m_.target(m_.next(n1)));
-                before.push_back({p, q, r});
-                after.push_back({c.target, q, r});
-            }
-            if (!better(before, after, true, 0.99)) continue;
-            m_.point(v) = Point3(c.target.x(), c.target.y(), c.target.z());
-            if (intersectsAround({v})) {
-                m_.point(v) = Point3(p.x(), p.y(), p.z());
-                continue;
-            }
+            if (crowded || !moveVertex(v, c.target)) continue;
             onCrease_[v.idx()] = c.crease;
             ++snaps;
         }
@@ -315,14 +669,11 @@ private:
     /// Splits, at the crease, edges that pass a crease point farther from both ends than the snap radius and
     /// farther from the edge than a tenth of the edge length (the bevel no snap could remove).
     std::size_t splitSweep() {
-        const auto [ids, haveIds] = m_.property_map<FaceIndex, std::int32_t>(props::faceScanId);
-        const auto [quality, haveQuality] = m_.property_map<FaceIndex, float>(props::faceQuality);
         std::vector<EdgeIndex> edges(m_.edges().begin(), m_.edges().end());
         std::size_t splits = 0;
         for (EdgeIndex e : edges) {
             if (m_.is_removed(e) || m_.is_border(e)) continue;
             const HalfedgeIndex h = m_.halfedge(e), o = m_.opposite(h);
-            const FaceIndex f = m_.face(h), g = m_.face(o);
             const VertexIndex a = m_.source(h), b = m_.target(h);
             const VertexIndex c = m_.target(m_.next(h)), d = m_.target(m_.next(o));
             const Vec pa = pos(m_, a), pb = pos(m_, b), pc = pos(m_, c), pd = pos(m_, d);
@@ -344,29 +695,88 @@ private:
             if (!better({{pa, pb, pc}, {pb, pa, pd}}, {{pa, q, pc}, {q, pb, pc}, {pb, q, pd}, {q, pa, pd}},
                         false, 0.99))
                 continue;
-            const std::int32_t idF = haveIds ? ids[f] : -1, idG = haveIds ? ids[g] : -1;
-            const float qualityF = haveQuality ? quality[f] : 0.f, qualityG = haveQuality ? quality[g] : 0.f;
-            const HalfedgeIndex hn = CGAL::Euler::split_edge(h, m_);
-            const VertexIndex v = m_.target(hn);
-            m_.point(v) = Point3(q.x(), q.y(), q.z());
-            const HalfedgeIndex h3 = CGAL::Euler::split_face(hn, m_.next(m_.next(hn)), m_);
-            const HalfedgeIndex og = m_.opposite(h);
-            const HalfedgeIndex h4 = CGAL::Euler::split_face(og, m_.next(m_.next(og)), m_);
-            for (FaceIndex nf :
-                 {m_.face(h3), m_.face(m_.opposite(h3)), m_.face(h4), m_.face(m_.opposite(h4))}) {
-                const bool sideF = nf == m_.face(h3) || nf == m_.face(m_.opposite(h3));
-                if (haveIds) ids[nf] = sideF ? idF : idG;
-                if (haveQuality) quality[nf] = sideF ? qualityF : qualityG;
-            }
-            if (intersectsAround({v, a, b})) { // undo: the two new edges, then the new vertex
-                CGAL::Euler::join_face(h4, m_);
-                CGAL::Euler::join_face(h3, m_);
-                CGAL::Euler::join_vertex(h, m_); // removes v, the source of h
-                continue;
-            }
-            frozen_.resize(m_.number_of_vertices() + m_.number_of_removed_vertices(), 0);
-            onCrease_.resize(frozen_.size(), 0);
+            const VertexIndex v = splitAt(h, q);
+            if (v == Mesh::null_vertex()) continue;
             onCrease_[v.idx()] = 1;
+            ++splits;
+        }
+        return splits;
+    }
+
+    /// Splits the edge of \p h at \p q (the faces (a, b, c), (b, a, d) become (a, q, c), (q, b, c),
+    /// (b, q, d), (q, a, d); new faces keep the scan id and quality of the face they split), unless the faces
+    /// around the new vertex then intersect others: the null vertex and the mesh as it was. Returns the new
+    /// vertex (not marked on a crease).
+    VertexIndex splitAt(HalfedgeIndex h, const Vec& q) {
+        const auto [ids, haveIds] = m_.property_map<FaceIndex, std::int32_t>(props::faceScanId);
+        const auto [quality, haveQuality] = m_.property_map<FaceIndex, float>(props::faceQuality);
+        const FaceIndex f = m_.face(h), g = m_.face(m_.opposite(h));
+        const VertexIndex a = m_.source(h), b = m_.target(h);
+        const std::int32_t idF = haveIds ? ids[f] : -1, idG = haveIds ? ids[g] : -1;
+        const float qualityF = haveQuality ? quality[f] : 0.f, qualityG = haveQuality ? quality[g] : 0.f;
+        const HalfedgeIndex hn = CGAL::Euler::split_edge(h, m_);
+        const VertexIndex v = m_.target(hn);
+        m_.point(v) = Point3(q.x(), q.y(), q.z());
+        const HalfedgeIndex h3 = CGAL::Euler::split_face(hn, m_.next(m_.next(hn)), m_);
+        const HalfedgeIndex og = m_.opposite(h);
+        const HalfedgeIndex h4 = CGAL::Euler::split_face(og, m_.next(m_.next(og)), m_);
+        for (FaceIndex nf : {m_.face(h3), m_.face(m_.opposite(h3)), m_.face(h4), m_.face(m_.opposite(h4))}) {
+            const bool sideF = nf == m_.face(h3) || nf == m_.face(m_.opposite(h3));
+            if (haveIds) ids[nf] = sideF ? idF : idG;
+            if (haveQuality) quality[nf] = sideF ? qualityF : qualityG;
+        }
+        if (intersectsAround({v, a, b})) { // undo: the two new edges, then the new vertex
+            CGAL::Euler::join_face(h4, m_);
+            CGAL::Euler::join_face(h3, m_);
+            CGAL::Euler::join_vertex(h, m_); // removes v, the source of h
+            return Mesh::null_vertex();
+        }
+        frozen_.resize(m_.number_of_vertices() + m_.number_of_removed_vertices(), 0);
+        onCrease_.resize(frozen_.size(), 0);
+        frozen_[v.idx()] = 0;
+        onCrease_[v.idx()] = 0;
+        return v;
+    }
+
+    /// Splits the longest edge of each face within 1.5 edge lengths of a crease still farther from the
+    /// reference than errorSplitDistance edge lengths (a face the crease runs through, away from its edges'
+    /// ends) at the reference point closest to the edge's midpoint, or at the closest crease point when a
+    /// crease passes within the snap radius of it, where that brings the faces closer (better).
+    std::size_t errorSplitSweep() {
+        std::vector<FaceIndex> faces(m_.faces().begin(), m_.faces().end());
+        std::size_t splits = 0;
+        for (FaceIndex f : faces) {
+            if (m_.is_removed(f)) continue;
+            HalfedgeIndex h = m_.halfedge(f);
+            const Tri t = triangle(f);
+            Vec near;
+            double nearDistance;
+            if (!creases_.closest((t.a + t.b + t.c) / 3.0, near, nearDistance) || nearDistance > 1.5 * L_)
+                continue; // only the faces of a crease
+            if (error(t).max < o_.errorSplitDistance * L_) continue;
+            for (HalfedgeIndex k : CGAL::halfedges_around_face(m_.halfedge(f), m_))
+                if ((pos(m_, m_.source(k)) - pos(m_, m_.target(k))).squaredNorm() >
+                    (pos(m_, m_.source(h)) - pos(m_, m_.target(h))).squaredNorm())
+                    h = k;
+            if (m_.is_border(m_.opposite(h))) continue;
+            const HalfedgeIndex o = m_.opposite(h);
+            const Vec pa = pos(m_, m_.source(h)), pb = pos(m_, m_.target(h));
+            const Vec pc = pos(m_, m_.target(m_.next(h))), pd = pos(m_, m_.target(m_.next(o)));
+            const Vec mid = 0.5 * (pa + pb);
+            Vec q;
+            double d;
+            bool crease = creases_.closest(mid, q, d) && d < o_.snapRadius * L_;
+            if (!crease) {
+                const SurfacePoint sp = caster_.closestPoint(mid);
+                if (!sp) continue;
+                q = sp.point;
+            }
+            if (!better({{pa, pb, pc}, {pb, pa, pd}}, {{pa, q, pc}, {q, pb, pc}, {pb, q, pd}, {q, pa, pd}},
+                        false, 0.99))
+                continue;
+            const VertexIndex v = splitAt(h, q);
+            if (v == Mesh::null_vertex()) continue;
+            onCrease_[v.idx()] = crease;
             ++splits;
         }
         return splits;
@@ -428,7 +838,7 @@ CreaseSnapReport snapToCreases(Mesh& mesh, const Mesh& reference, const CreaseSn
         std::vector<char> marksBefore = snapper.creaseMarks();
         CreaseSnapReport r;
         snapper.round(r);
-        if (r.snaps + r.splits + r.flips == 0) break;
+        if (r.snaps + r.splits + r.flips + r.removals + r.repairs == 0) break;
         if (!intersectedBefore && PMP::does_self_intersect(mesh)) {
             mesh = before;
             snapper.setCreaseMarks(std::move(marksBefore));
@@ -438,6 +848,8 @@ CreaseSnapReport snapToCreases(Mesh& mesh, const Mesh& reference, const CreaseSn
         report.snaps += r.snaps;
         report.splits += r.splits;
         report.flips += r.flips;
+        report.removals += r.removals;
+        report.repairs += r.repairs;
     }
     snapper.markCreaseVertices();
     mesh.collect_garbage();

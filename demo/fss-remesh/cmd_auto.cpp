@@ -150,6 +150,8 @@ int runAuto(const std::vector<std::string>& args) {
         j["crease_snaps"] = result.creaseSnaps;
         j["crease_splits"] = result.creaseSplits;
         j["crease_flips"] = result.creaseFlips;
+        j["crease_removals"] = result.creaseRemovals;
+        j["crease_repairs"] = result.creaseRepairs;
         j["scans_stitched"] = result.scansStitched;
         j["scans_skipped"] = result.scansSkipped;
         nlohmann::json steps = nlohmann::json::array();

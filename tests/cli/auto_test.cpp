@@ -109,6 +109,8 @@ TEST(CliAuto, FandiskIsCoveredClosedManifoldAndFreeOfSelfIntersections) {
     EXPECT_GT(r.report.at("crease_snaps").get<int>(), 0);
     EXPECT_TRUE(r.report.at("crease_splits").is_number_unsigned());
     EXPECT_TRUE(r.report.at("crease_flips").is_number_unsigned());
+    EXPECT_TRUE(r.report.at("crease_removals").is_number_unsigned());
+    EXPECT_TRUE(r.report.at("crease_repairs").is_number_unsigned());
 }
 
 // Other closed CGAL sample meshes, curved and mechanical: the result stays valid and the seam relaxation

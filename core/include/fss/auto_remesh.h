@@ -47,17 +47,22 @@
 ///     lower the vertex count (towards the target: the seams have more vertices than a regular grid).
 ///  7. **Crease recovery.** The views' regions meet at the sharp creases of the reference, so the seams run
 ///     along them, and neither pixel grid has vertices on them: the faces there bevel the creases off by up
-///     to half an edge length, where the largest distances to and from the reference were. Vertices
-///     within L/2 of a crease (reference edges above featureAngleDeg) move onto it, edges that still pass a
-///     crease at a bevel are split at the crease, and edges are flipped to the diagonal that follows it; each
-///     operation only where it does not raise the largest distance of the faces it changes to the reference
-///     and lowers their integrated squared distance, makes no angle below the stitch's minAngleFloorDeg (or
-///     the smallest already there), turns no face over and makes the faces around it intersect no other
-///     (else it is undone at once; a round that still makes the mesh intersect itself is undone as well).
-///     Vertices near a crease but off the reference by more than L/10 (left inside a bevel by the stitches)
-///     go onto their closest reference point under the same conditions. No edge between a face left from the
-///     input and a scanned one is flipped. The seams are then relaxed once more (step 6), with the vertices
-///     put on a crease kept where they are.
+///     to half an edge length, where the largest distances to and from the reference were. The vertex
+///     nearest each corner of the creases (where three meet or one ends) moves onto it, vertices within L/2
+///     of a crease (reference edges above featureAngleDeg) move onto it, vertices of valence 3 standing off
+///     the reference are removed, edges that still pass a crease at a bevel are split at the crease, and
+///     edges are flipped to the diagonal that follows it; each operation only where it does not raise the
+///     largest distance of the faces it changes to the reference and lowers their integrated squared
+///     distance, makes no angle below the stitch's minAngleFloorDeg (or the smallest already there), turns no
+///     face over and makes the faces around it intersect no other (else it is undone at once; a round that
+///     still makes the mesh intersect itself is undone as well). Vertices near a crease but off the reference
+///     by more than L/10 (left inside a bevel by the stitches) go onto their closest reference point under
+///     the same conditions. Faces turned over against the reference (folds the stitches leave at a crease)
+///     and faces within 1.5 L of a crease still farther than 0.15 L from it are repaired by the first flip,
+///     move onto the crease or edge collapse that leaves no face there turned over, no new angle below the
+///     floor and (for the far ones) a largest distance smaller by a fifth. No edge between a face left from
+///     the input and a scanned one is flipped or collapsed. The seams are then relaxed once more (step 6),
+///     with the vertices put on a crease kept where they are.
 ///
 /// Every stitch has the strong guarantee: a scan or stitch that fails is skipped (and reported), the mesh
 /// is never left invalid.
@@ -197,6 +202,11 @@ struct AutoResult {
     std::size_t creaseSnaps = 0;   ///< vertices moved onto a crease of the reference
     std::size_t creaseSplits = 0;  ///< edges split at a crease of the reference
     std::size_t creaseFlips = 0;   ///< edges flipped to follow a crease
+    /// Vertices of valence 3 removed where the face replacing their three lies closer to the reference.
+    std::size_t creaseRemovals = 0;
+    /// Faces turned over against the reference, or near a crease and far from it, repaired by a flip, a move
+    /// onto the crease or a collapse.
+    std::size_t creaseRepairs = 0;
     /// True when a stage of the seam relaxation was undone because its result intersected itself.
     bool seamRelaxDiscarded = false;
     double seconds = 0;       ///< total wall time
