@@ -280,11 +280,7 @@ private:
     /// surface's side.
     bool liesOnReference(const Tri& t, const Vec& n) const {
         const SurfacePoint sp = caster_.closestPoint((t.a + t.b + t.c) / 3.0);
-        if (!sp || sp.distance > 0.1 * L_) return false;
-        const HalfedgeIndex h = ref_.halfedge(sp.face);
-        const Vec rn = unitNormal(pos(ref_, ref_.source(h)), pos(ref_, ref_.target(h)),
-                                  pos(ref_, ref_.target(ref_.next(h))));
-        return rn.dot(n) > 0.5;
+        return sp && sp.distance <= 0.1 * L_ && referenceNormalOf(sp.face).dot(n) > 0.5;
     }
 
     /// Moves, for each corner of the creases (crease_snap.h), the nearest vertex within twice the snap
@@ -396,14 +392,29 @@ private:
     /// The reference's unit normal at the point closest to \p p (zero when there is none).
     Vec referenceNormal(const Vec& p) const {
         const SurfacePoint sp = caster_.closestPoint(p);
-        if (!sp) return Vec::Zero();
-        const HalfedgeIndex h = ref_.halfedge(sp.face);
-        return unitNormal(pos(ref_, ref_.source(h)), pos(ref_, ref_.target(h)),
-                          pos(ref_, ref_.target(ref_.next(h))));
+        return sp ? referenceNormalOf(sp.face) : Vec::Zero();
     }
 
     /// Whether \p t faces away from the reference: its normal against the reference's normal at the point
     /// closest to its centroid (a degenerate triangle counts as turned over).
+    /// Whether \p t lies farther from the reference than errorSplitDistance edge lengths (sampled), looked at
+    /// only for the faces within 1.5 edge lengths of a crease or whose centroid is off the reference by more
+    /// than a tenth of an edge length (\p centroidDistance): a face whose centroid lies on the reference is
+    /// that far from it only across a crease.
+    bool far(const Tri& t, double centroidDistance) const {
+        Vec q;
+        double d;
+        const bool nearCrease = creases_.closest((t.a + t.b + t.c) / 3.0, q, d) && d <= 1.5 * L_;
+        if (!nearCrease && centroidDistance <= 0.1 * L_) return false;
+        return error(t).max > o_.errorSplitDistance * L_;
+    }
+
+    Vec referenceNormalOf(FaceIndex f) const {
+        const HalfedgeIndex h = ref_.halfedge(f);
+        return unitNormal(pos(ref_, ref_.source(h)), pos(ref_, ref_.target(h)),
+                          pos(ref_, ref_.target(ref_.next(h))));
+    }
+
     bool turnedOver(const Tri& t) const {
         const Vec n = unitNormal(t.a, t.b, t.c);
         return n.isZero() || n.dot(referenceNormal((t.a + t.b + t.c) / 3.0)) < 0;
@@ -438,7 +449,7 @@ private:
 
     /// Repairs the faces turned over against the reference (folds the stitches and the seam relaxation leave
     /// at a crease, where two faces overlap) and the faces still farther from it than errorSplitDistance edge
-    /// lengths: for each, the first of these that leaves no face there turned over and (for a far face)
+    /// lengths (far): for each, the first of these that leaves no face there turned over and (for a far face)
     /// lowers the largest distance to the reference by a fifth (repairs) is taken: a flip of one of its
     /// edges, else a move of one of its corners onto the crease within an edge length of it, else a
     /// collapse of one of its edges to one end, to the crease point within an edge length of its midpoint,
@@ -450,11 +461,11 @@ private:
         // where the scans leave such faces): the gain 0.8.
         auto bad = [&](FaceIndex f) {
             const Tri t = triangle(f);
-            if (turnedOver(t)) return 1.0;
-            Vec q;
-            double d;
-            if (!creases_.closest((t.a + t.b + t.c) / 3.0, q, d) || d > 1.5 * L_) return 0.0;
-            return error(t).max > o_.errorSplitDistance * L_ ? 0.8 : 0.0;
+            const SurfacePoint sp = caster_.closestPoint((t.a + t.b + t.c) / 3.0);
+            if (!sp) return 0.0;
+            const Vec n = unitNormal(t.a, t.b, t.c);
+            if (n.isZero() || n.dot(referenceNormalOf(sp.face)) < 0) return 1.0;
+            return far(t, sp.distance) ? 0.8 : 0.0;
         };
         std::vector<FaceIndex> folded;
         for (FaceIndex f : m_.faces())
@@ -738,9 +749,9 @@ private:
         return v;
     }
 
-    /// Splits the longest edge of each face within 1.5 edge lengths of a crease still farther from the
-    /// reference than errorSplitDistance edge lengths (a face the crease runs through, away from its edges'
-    /// ends) at the reference point closest to the edge's midpoint, or at the closest crease point when a
+    /// Splits the longest edge of each face still farther from the reference than errorSplitDistance edge
+    /// lengths (far: a face the crease runs through, away from its edges' ends, or one spanning a sharp bend)
+    /// at the reference point closest to the edge's midpoint, or at the closest crease point when a
     /// crease passes within the snap radius of it, where that brings the faces closer (better).
     std::size_t errorSplitSweep() {
         std::vector<FaceIndex> faces(m_.faces().begin(), m_.faces().end());
@@ -749,11 +760,8 @@ private:
             if (m_.is_removed(f)) continue;
             HalfedgeIndex h = m_.halfedge(f);
             const Tri t = triangle(f);
-            Vec near;
-            double nearDistance;
-            if (!creases_.closest((t.a + t.b + t.c) / 3.0, near, nearDistance) || nearDistance > 1.5 * L_)
-                continue; // only the faces of a crease
-            if (error(t).max < o_.errorSplitDistance * L_) continue;
+            const SurfacePoint sp = caster_.closestPoint((t.a + t.b + t.c) / 3.0);
+            if (!sp || !far(t, sp.distance)) continue;
             for (HalfedgeIndex k : CGAL::halfedges_around_face(m_.halfedge(f), m_))
                 if ((pos(m_, m_.source(k)) - pos(m_, m_.target(k))).squaredNorm() >
                     (pos(m_, m_.source(h)) - pos(m_, m_.target(h))).squaredNorm())

@@ -58,11 +58,12 @@
 ///     still makes the mesh intersect itself is undone as well). Vertices near a crease but off the reference
 ///     by more than L/10 (left inside a bevel by the stitches) go onto their closest reference point under
 ///     the same conditions. Faces turned over against the reference (folds the stitches leave at a crease)
-///     and faces within 1.5 L of a crease still farther than 0.15 L from it are repaired by the first flip,
-///     move onto the crease or edge collapse that leaves no face there turned over, no new angle below the
-///     floor and (for the far ones) a largest distance smaller by a fifth. No edge between a face left from
-///     the input and a scanned one is flipped or collapsed. The seams are then relaxed once more (step 6),
-///     with the vertices put on a crease kept where they are.
+///     and faces still farther than 0.15 L from it (looked for within 1.5 L of a crease and where a face's
+///     centroid is off the reference by L/10: across a crease or a sharp bend) are repaired by the first
+///     flip, move onto the crease or edge collapse that leaves no face there turned over, no new angle below
+///     the floor and (for the far ones) a largest distance smaller by a fifth. No edge between a face left
+///     from the input and a scanned one is flipped or collapsed. The seams are then relaxed once more (step
+///     6), with the vertices put on a crease kept where they are.
 ///
 /// Every stitch has the strong guarantee: a scan or stitch that fails is skipped (and reported), the mesh
 /// is never left invalid.

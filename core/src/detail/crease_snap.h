@@ -34,9 +34,10 @@ struct CreaseSnapOptions {
     /// No operation makes an angle smaller than the smaller of this and the smallest angle of the faces it
     /// replaces (degrees).
     double minAngleDeg = 10.0;
-    /// Faces within 1.5 edge lengths of a crease and farther from the reference than this many edge lengths
-    /// (sampled) are repaired (a flip, a move onto the crease, a collapse) or get their longest edge split at
-    /// the reference (at the crease when it passes within the snap radius), where that brings them closer.
+    /// Faces farther from the reference than this many edge lengths (sampled; looked for within 1.5 edge
+    /// lengths of a crease and where a face's centroid is off the reference by a tenth of one) are repaired
+    /// (a flip, a move onto the crease, a collapse) or get their longest edge split at the reference (at the
+    /// crease when it passes within the snap radius), where that brings them closer.
     double errorSplitDistance = 0.15;
     /// Rounds of (snaps, splits, flips); 0 = nothing.
     int rounds = 3;
