@@ -839,7 +839,6 @@ CreaseSnapReport snapToCreases(Mesh& mesh, const Mesh& reference, const CreaseSn
     if (options.rounds <= 0 || mesh.is_empty() || reference.is_empty()) return report;
     CreaseSnapper snapper(mesh, reference, options);
     report.creaseEdges = snapper.creaseEdges();
-    if (report.creaseEdges == 0) return report;
     const bool intersectedBefore = PMP::does_self_intersect(mesh);
     for (int round = 0; round < options.rounds; ++round) {
         const Mesh before = mesh;

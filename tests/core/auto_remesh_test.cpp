@@ -380,7 +380,8 @@ TEST(AutoRemesh, SeamRelaxationKeepsTheMeshValidOnRandomCases) {
 }
 
 // The crease recovery (auto_remesh.h, step 7) on random cases of shapes with creases (two cubes, a closed
-// cylinder) and without (an open cylinder, a torus): against the same run without it, the mesh stays closed
+// cylinder) and without (an open cylinder, a torus: only the repairs of faces far from it act there):
+// against the same run without it, the mesh stays closed
 // (or keeps its borders), manifold and free of self-intersections, no angle falls below the stitch's floor
 // (10°) unless it was there before, the coverage stays, and the distance from the reference (the creases'
 // bevel) does not grow (falls where there are creases).
@@ -420,10 +421,13 @@ TEST(AutoRemesh, CreaseRecoveryKeepsTheMeshValidOnRandomCases) {
         if (trial == 0 || trial == 1 || trial == 4) {
             EXPECT_LT(*after.hausdorffFromRef, 0.7 * *before.hausdorffFromRef);
         }
-        if (trial == 3) { // the torus has no crease: nothing to do
-            EXPECT_EQ(recovered.creaseSnaps + recovered.creaseSplits + recovered.creaseFlips +
-                          recovered.creaseRemovals,
-                      0u);
+        if (trial == 3) { // the torus has no crease: no vertex goes onto one, no edge is flipped along one
+            EXPECT_EQ(recovered.creaseSnaps + recovered.creaseFlips, 0u);
+            // but faces left far from it across its bends are repaired (measured: Hausdorff distance to the
+            // torus 0.0483 → 0.0285, 30 repairs, one split, one removal).
+            ASSERT_TRUE(before.hausdorffToRef && after.hausdorffToRef);
+            EXPECT_GT(recovered.creaseRepairs, 0u);
+            EXPECT_LT(*after.hausdorffToRef, 0.8 * *before.hausdorffToRef);
         }
     }
 }
