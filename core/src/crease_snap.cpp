@@ -530,8 +530,8 @@ private:
             moved.push_back({q, x, y});
             if (angleBetween(x - q, y - q) > 160.0 * std::numbers::pi / 180.0) caps.push_back(opposite);
         }
-        if (caps.empty()) { // the move alone
-            if (!repairs(measure(before), moved, gain)) return false;
+        const Before measured = measure(before);
+        if (caps.empty() && repairs(measured, moved, gain)) { // the move alone
             m_.point(v) = Point3(q.x(), q.y(), q.z());
             if (intersectsAround({v})) {
                 m_.point(v) = Point3(p.x(), p.y(), p.z());
@@ -540,26 +540,90 @@ private:
             onCrease_[v.idx()] = 1;
             return true;
         }
-        const Mesh saved = m_;
-        auto restore = [&] {
-            m_ = saved;
-            return false;
-        };
-        m_.point(v) = Point3(q.x(), q.y(), q.z());
-        for (HalfedgeIndex c : caps) {
-            const HalfedgeIndex o = m_.opposite(c);
-            if (m_.is_border(o) || !sameKind(c)) return restore();
-            const VertexIndex x = m_.source(c), y = m_.target(c), w = m_.target(m_.next(o));
-            if (w == v || m_.degree(x) <= 3 || m_.degree(y) <= 3 || CGAL::halfedge(v, w, m_).second)
-                return restore();
-            before.push_back(triangle(m_.face(o)));
-            CGAL::Euler::flip_edge(c, m_);
+        // The move alone does not repair: with the caps flipped, then edges around v flipped where that
+        // raises the smaller angle of their two faces (the edges opposite v, the edges from v), it may. Only
+        // worth trying when the move brings the faces close enough and turns none over (its angles are what
+        // the flips mend). The faces compared are those around v and its neighbours, before and after.
+        if (!caps.empty() || closeEnough(measured, moved, gain)) {
+            std::vector<VertexIndex> region{v};
+            for (VertexIndex w : CGAL::vertices_around_target(m_.halfedge(v), m_))
+                region.push_back(w);
+            const std::vector<Tri> regionBefore = facesAround(region);
+            const Mesh saved = m_;
+            auto restore = [&] {
+                m_ = saved;
+                return false;
+            };
+            m_.point(v) = Point3(q.x(), q.y(), q.z());
+            for (HalfedgeIndex c : caps)
+                if (!flipIfValid(c)) return restore();
+            for (int flips = 0; flips < 8; ++flips) {
+                // The edge around v (opposite it or from it) whose flip raises the smaller angle of its two
+                // faces the most.
+                HalfedgeIndex best;
+                double bestGain = 1e-3;
+                for (HalfedgeIndex h : CGAL::halfedges_around_target(m_.halfedge(v), m_))
+                    for (HalfedgeIndex c : {m_.prev(h), h}) {
+                        const double g = flipAngleGain(c);
+                        if (g > bestGain) bestGain = g, best = c;
+                    }
+                if (best == Mesh::null_halfedge() || !flipIfValid(best)) break;
+            }
+            Before limits = measure(regionBefore);
+            limits.maxError = measured.maxError; // no farther than the faces around v were
+            if (!repairs(limits, facesAround(region), gain) || intersectsAround({v})) return restore();
+            onCrease_[v.idx()] = 1;
+            return true;
         }
-        std::vector<Tri> after;
-        for (FaceIndex f : CGAL::faces_around_target(m_.halfedge(v), m_))
-            after.push_back(triangle(f));
-        if (!repairs(measure(before), after, gain) || intersectsAround({v})) return restore();
-        onCrease_[v.idx()] = 1;
+        return false;
+    }
+
+    /// The faces around \p vertices (each once).
+    std::vector<Tri> facesAround(const std::vector<VertexIndex>& vertices) const {
+        std::vector<FaceIndex> faces;
+        for (VertexIndex w : vertices)
+            for (FaceIndex f : CGAL::faces_around_target(m_.halfedge(w), m_))
+                if (f != Mesh::null_face()) faces.push_back(f);
+        std::sort(faces.begin(), faces.end());
+        faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+        std::vector<Tri> tris;
+        for (FaceIndex f : faces)
+            tris.push_back(triangle(f));
+        return tris;
+    }
+
+    /// How much a flip of the edge of \p c raises the smaller angle of its two faces (radians; ≤ 0 when it
+    /// does not, or when the flipped faces would bend by more than 60° against each other).
+    double flipAngleGain(HalfedgeIndex c) const {
+        const HalfedgeIndex o = m_.opposite(c);
+        if (m_.is_border(m_.edge(c))) return 0;
+        const Vec x = pos(m_, m_.source(c)), y = pos(m_, m_.target(c));
+        const Vec a = pos(m_, m_.target(m_.next(c))), b = pos(m_, m_.target(m_.next(o)));
+        // Faces (x, y, a), (y, x, b) become (x, b, a), (b, y, a).
+        if (unitNormal(x, b, a).dot(unitNormal(b, y, a)) < 0.5) return 0;
+        return std::min(minAngle(x, b, a), minAngle(b, y, a)) -
+               std::min(minAngle(x, y, a), minAngle(y, x, b));
+    }
+
+    /// Flips the edge of \p c when that keeps the mesh valid (not a border, faces of one kind, valences above
+    /// 3, the other diagonal not an edge yet).
+    bool flipIfValid(HalfedgeIndex c) {
+        const HalfedgeIndex o = m_.opposite(c);
+        if (m_.is_border(m_.edge(c)) || !sameKind(c)) return false;
+        const VertexIndex x = m_.source(c), y = m_.target(c);
+        const VertexIndex a = m_.target(m_.next(c)), b = m_.target(m_.next(o));
+        if (a == b || m_.degree(x) <= 3 || m_.degree(y) <= 3 || CGAL::halfedge(a, b, m_).second) return false;
+        CGAL::Euler::flip_edge(c, m_);
+        return true;
+    }
+
+    /// Whether \p after, with no face turned over, lies within \p gain times the largest distance of the
+    /// faces measured as \p before (repairs without the angles).
+    bool closeEnough(const Before& before, const std::vector<Tri>& after, double gain) const {
+        for (const Tri& t : after)
+            if (turnedOver(t)) return false;
+        for (const Tri& t : after)
+            if (error(t).max > gain * before.maxError + 1e-6 * L_) return false;
         return true;
     }
 
