@@ -162,6 +162,7 @@ public:
         r.snaps += snapSweep();
         r.removals += removeSweep();
         markFrozen();
+        r.repairs += shortCreaseEdgeSweep();
         r.repairs += repairSweep();
         markFrozen();
         r.splits += splitSweep();
@@ -447,6 +448,31 @@ private:
         return true;
     }
 
+    /// Whether \p v is on a crease: put there by this step, or lying on one (within 10⁻⁶ edge lengths).
+    bool onACrease(VertexIndex v) const {
+        if (onCrease_[v.idx()]) return true;
+        Vec q;
+        double d;
+        return creases_.closest(pos(m_, v), q, d) && d < 1e-6 * L_;
+    }
+
+    /// Collapses edges shorter than a third of an edge length between two vertices on a crease (two snaps,
+    /// splits or grid samples next to each other), onto one of them, where that turns no face over, makes no
+    /// angle below the floor (or the smallest one there) and takes no face farther from the reference.
+    std::size_t shortCreaseEdgeSweep() {
+        std::vector<EdgeIndex> edges;
+        for (EdgeIndex e : m_.edges()) {
+            const HalfedgeIndex h = m_.halfedge(e);
+            if (onACrease(m_.source(h)) && onACrease(m_.target(h)) &&
+                (pos(m_, m_.source(h)) - pos(m_, m_.target(h))).norm() < L_ / 3)
+                edges.push_back(e);
+        }
+        std::size_t collapses = 0;
+        for (EdgeIndex e : edges)
+            if (!m_.is_removed(e) && tryCollapse(m_.halfedge(e), 1.0)) ++collapses;
+        return collapses;
+    }
+
     /// Repairs the faces turned over against the reference (folds the stitches and the seam relaxation leave
     /// at a crease, where two faces overlap) and the faces still farther from it than errorSplitDistance edge
     /// lengths (far): for each, the first of these that leaves no face there turned over and (for a far face)
@@ -557,25 +583,33 @@ private:
             m_.point(v) = Point3(q.x(), q.y(), q.z());
             for (HalfedgeIndex c : caps)
                 if (!flipIfValid(c)) return restore();
-            for (int flips = 0; flips < 8; ++flips) {
-                // The edge around v (opposite it or from it) whose flip raises the smaller angle of its two
-                // faces the most.
-                HalfedgeIndex best;
-                double bestGain = 1e-3;
-                for (HalfedgeIndex h : CGAL::halfedges_around_target(m_.halfedge(v), m_))
-                    for (HalfedgeIndex c : {m_.prev(h), h}) {
-                        const double g = flipAngleGain(c);
-                        if (g > bestGain) bestGain = g, best = c;
-                    }
-                if (best == Mesh::null_halfedge() || !flipIfValid(best)) break;
-            }
-            Before limits = measure(regionBefore);
-            limits.maxError = measured.maxError; // no farther than the faces around v were
-            if (!repairs(limits, facesAround(region), gain) || intersectsAround({v})) return restore();
+            if (!mendAround(v, region, regionBefore, gain * measured.maxError)) return restore();
             onCrease_[v.idx()] = 1;
             return true;
         }
         return false;
+    }
+
+    /// Flips edges around \p v (opposite it or from it) where that raises the smaller angle of their two
+    /// faces (at most eight, the best first), then whether the faces around \p region may replace \p
+    /// regionBefore (the faces around the same vertices before the operation at \p v): none turned over, no
+    /// angle below the floor (or the smallest angle before), none farther than \p maxError from the
+    /// reference, and no intersection around \p v. The caller restores the mesh when not.
+    bool mendAround(VertexIndex v, const std::vector<VertexIndex>& region,
+                    const std::vector<Tri>& regionBefore, double maxError) {
+        for (int flips = 0; flips < 8; ++flips) {
+            HalfedgeIndex best;
+            double bestGain = 1e-3;
+            for (HalfedgeIndex h : CGAL::halfedges_around_target(m_.halfedge(v), m_))
+                for (HalfedgeIndex c : {m_.prev(h), h}) {
+                    const double g = flipAngleGain(c);
+                    if (g > bestGain) bestGain = g, best = c;
+                }
+            if (best == Mesh::null_halfedge() || !flipIfValid(best)) break;
+        }
+        Before limits = measure(regionBefore);
+        limits.maxError = maxError;
+        return repairs(limits, facesAround(region), 1.0) && !intersectsAround({v});
     }
 
     /// The faces around \p vertices (each once).
@@ -633,15 +667,18 @@ private:
         if (m_.is_border(e) || !sameKind(h)) return false;
         const VertexIndex a = m_.source(h), b = m_.target(h);
         const VertexIndex c = m_.target(m_.next(h)), d = m_.target(m_.next(o));
-        if (frozen_[a.idx()] || frozen_[b.idx()] || (onCrease_[a.idx()] && onCrease_[b.idx()])) return false;
+        if (frozen_[a.idx()] || frozen_[b.idx()]) return false;
+        const bool onA = onACrease(a), onB = onACrease(b);
         if (m_.degree(c) <= 3 || m_.degree(d) <= 3 || !CGAL::Euler::does_satisfy_link_condition(e, m_))
             return false;
         const Vec pa = pos(m_, a), pb = pos(m_, b);
         // Where the merged vertex goes, and whether that is on a crease.
         std::vector<std::pair<Vec, bool>> targets;
-        if (onCrease_[a.idx()])
+        if (onA && onB)
+            targets = {{pa, true}, {pb, true}};
+        else if (onA)
             targets = {{pa, true}};
-        else if (onCrease_[b.idx()])
+        else if (onB)
             targets = {{pb, true}};
         else {
             targets = {{pa, false}, {pb, false}};
@@ -665,16 +702,24 @@ private:
         for (FaceIndex g : {m_.face(h), m_.face(o)})
             before.push_back(triangle(g));
         const Before measured = measure(before);
-        for (const auto& [t, marked] : targets) {
+        // The targets that repair, the one with the largest smallest angle first.
+        std::vector<std::pair<double, std::size_t>> order;
+        for (std::size_t i = 0; i < targets.size(); ++i) {
             std::vector<Tri> after;
+            double smallest = std::numbers::pi;
             for (const auto& r : ring) {
                 Vec corner[3];
-                for (int i = 0; i < 3; ++i)
-                    corner[i] =
-                        r[std::size_t(i)] == a || r[std::size_t(i)] == b ? t : pos(m_, r[std::size_t(i)]);
+                for (int k = 0; k < 3; ++k)
+                    corner[k] = r[std::size_t(k)] == a || r[std::size_t(k)] == b ? targets[i].first
+                                                                                 : pos(m_, r[std::size_t(k)]);
                 after.push_back({corner[0], corner[1], corner[2]});
+                smallest = std::min(smallest, minAngle(corner[0], corner[1], corner[2]));
             }
-            if (!repairs(measured, after, gain)) continue;
+            if (repairs(measured, after, gain)) order.emplace_back(-smallest, i);
+        }
+        std::sort(order.begin(), order.end());
+        for (const auto& [negAngle, i] : order) {
+            const auto& [t, marked] = targets[i];
             if (applyOrUndo(
                     [&] {
                         const VertexIndex kept = CGAL::Euler::collapse_edge(e, m_);
@@ -741,6 +786,29 @@ private:
         return snaps;
     }
 
+    /// The split of the edge of \p h at \p q that `better` refused, taken with the flips around the new
+    /// vertex that mend its angles (mendAround) when its four faces, turned over none, lie within \p gain
+    /// times the largest distance of the two faces it replaces; the new vertex, or the null vertex and the
+    /// mesh as it was.
+    VertexIndex mendedSplit(HalfedgeIndex h, const Vec& q, double gain) {
+        const HalfedgeIndex o = m_.opposite(h);
+        const VertexIndex a = m_.source(h), b = m_.target(h);
+        const VertexIndex c = m_.target(m_.next(h)), d = m_.target(m_.next(o));
+        const Vec pa = pos(m_, a), pb = pos(m_, b), pc = pos(m_, c), pd = pos(m_, d);
+        const Before before = measure({{pa, pb, pc}, {pb, pa, pd}});
+        if (!closeEnough(before, {{pa, q, pc}, {q, pb, pc}, {pb, q, pd}, {q, pa, pd}}, gain))
+            return Mesh::null_vertex();
+        std::vector<VertexIndex> region = {a, b, c, d};
+        const std::vector<Tri> regionBefore = facesAround(region);
+        const Mesh saved = m_;
+        const VertexIndex v = splitAt(h, q);
+        if (v == Mesh::null_vertex()) return v;
+        region.push_back(v);
+        if (mendAround(v, region, regionBefore, gain * before.maxError)) return v;
+        m_ = saved;
+        return Mesh::null_vertex();
+    }
+
     /// Splits, at the crease, edges that pass a crease point farther from both ends than the snap radius and
     /// farther from the edge than a tenth of the edge length (the bevel no snap could remove).
     std::size_t splitSweep() {
@@ -767,10 +835,10 @@ private:
             const double radius = o_.snapRadius * L_;
             if ((q - pa).norm() < radius || (q - pb).norm() < radius) continue;
             // Faces (a, b, c), (b, a, d) become (a, q, c), (q, b, c), (b, q, d), (q, a, d).
-            if (!better({{pa, pb, pc}, {pb, pa, pd}}, {{pa, q, pc}, {q, pb, pc}, {pb, q, pd}, {q, pa, pd}},
-                        false, 0.99))
-                continue;
-            const VertexIndex v = splitAt(h, q);
+            const VertexIndex v = better({{pa, pb, pc}, {pb, pa, pd}},
+                                         {{pa, q, pc}, {q, pb, pc}, {pb, q, pd}, {q, pa, pd}}, false, 0.99)
+                                      ? splitAt(h, q)
+                                      : mendedSplit(h, q, 0.9);
             if (v == Mesh::null_vertex()) continue;
             onCrease_[v.idx()] = 1;
             ++splits;
@@ -843,10 +911,10 @@ private:
                 if (!sp) continue;
                 q = sp.point;
             }
-            if (!better({{pa, pb, pc}, {pb, pa, pd}}, {{pa, q, pc}, {q, pb, pc}, {pb, q, pd}, {q, pa, pd}},
-                        false, 0.99))
-                continue;
-            const VertexIndex v = splitAt(h, q);
+            const VertexIndex v = better({{pa, pb, pc}, {pb, pa, pd}},
+                                         {{pa, q, pc}, {q, pb, pc}, {pb, q, pd}, {q, pa, pd}}, false, 0.99)
+                                      ? splitAt(h, q)
+                                      : mendedSplit(h, q, 0.8);
             if (v == Mesh::null_vertex()) continue;
             onCrease_[v.idx()] = crease;
             ++splits;

@@ -195,3 +195,37 @@ TEST(CreaseSnap, BringsABevelledCreaseBackOntoTheCube) {
     EXPECT_LT(*after.hausdorffToRef, 0.1 * kL);
     EXPECT_EQ(facesTurnedOver(m), 0u);
 }
+
+// Two vertices on a crease a tenth of an edge length apart (an edge of the cube split next to its end, as two
+// scans' samples on the same crease): the short edge between them is collapsed onto one of them, which gives
+// the cube's own triangulation back (every angle 45° or 90°).
+TEST(CreaseSnap, CollapsesAShortEdgeBetweenTwoVerticesOnACrease) {
+    const fss::Mesh cube = fss::shapes::cube(kN, kSide);
+    fss::Mesh m = cube;
+    const fss::VertexIndex a = vertexAt(m, Eigen::Vector3d(0.0, 0.5, 0.5));
+    const fss::VertexIndex b = vertexAt(m, Eigen::Vector3d(kL, 0.5, 0.5));
+    ASSERT_NE(a, fss::Mesh::null_vertex());
+    ASSERT_NE(b, fss::Mesh::null_vertex());
+    const auto [h, found] = CGAL::halfedge(a, b, m);
+    ASSERT_TRUE(found);
+    // Split the edge (a, b) at 0.1 L from a, and each of its two faces from the new vertex.
+    const fss::HalfedgeIndex hn = CGAL::Euler::split_edge(h, m); // the new vertex is target(hn)
+    const fss::VertexIndex v = m.target(hn);
+    m.point(v) = fss::Point3(0.1 * kL, 0.5, 0.5);
+    CGAL::Euler::split_face(hn, m.next(m.next(hn)), m);
+    const fss::HalfedgeIndex og = m.opposite(h);
+    CGAL::Euler::split_face(og, m.next(m.next(og)), m);
+    ASSERT_EQ(m.number_of_vertices(), cube.number_of_vertices() + 1);
+    const fss::Metrics before = metricsAgainst(m, cube);
+    ASSERT_LT(before.minAngleDeg, 10.0);
+
+    const fss::detail::CreaseSnapReport r = fss::detail::snapToCreases(m, cube, options());
+    EXPECT_GE(r.repairs, 1u);
+    EXPECT_EQ(m.number_of_vertices(), cube.number_of_vertices());
+    for (fss::VertexIndex w : m.vertices())
+        EXPECT_LT(distanceToCube(at(m, w)), 1e-12);
+    const fss::Metrics after = metricsAgainst(m, cube);
+    fss::test::expectClosedValidMesh(after);
+    EXPECT_NEAR(after.minAngleDeg, 45.0, 1e-9);
+    EXPECT_NEAR(after.area, 6.0 * kSide * kSide, 1e-9);
+}
