@@ -144,15 +144,18 @@ struct AutoOptions {
     /// Rounds of crease recovery after the seam relaxation (file comment, step 7; 0 = none): each round
     /// snaps vertices onto the creases, splits edges at them, then flips edges to follow them.
     int creaseSnapRounds = 3;
-    /// Options of every stitch. Faces with a smallest angle under 10° are refused (trimmed and retried).
+    /// Options of every stitch. Faces with a smallest angle under 10° are refused (trimmed and retried), and
+    /// trimming peels the patch boundary (StitchOptions::peelTrim): the regions of a small or strongly curved
+    /// mesh are only a few pixels wide at the target edge length, and the wide trims cut them apart.
     StitchOptions stitch = defaultStitch();
     /// Quality-mask margin (mask.h QualityMaskOptions::margin) of the regular scans.
     double qualityMargin = 0.1;
 
-    /// StitchOptions with minAngleFloorDeg = 10.
+    /// StitchOptions with minAngleFloorDeg = 10 and peelTrim on.
     static StitchOptions defaultStitch() {
         StitchOptions s;
         s.minAngleFloorDeg = 10.0;
+        s.peelTrim = true;
         return s;
     }
 };
