@@ -27,41 +27,66 @@ public:
           feature_(o.featureAngleDeg * std::numbers::pi / 180.0) {}
 
     /// The relaxation; with \p checkStages, a stage (the projection, a round's flips, its collapses or its
-    /// smoothing) after which the mesh intersects itself is undone, and that kind of stage is not run again.
+    /// smoothing) after which the mesh intersects itself is undone and run again with the vertices of the
+    /// intersecting faces left out of the zone (every operation that made one of those faces moves one of
+    /// them or changes a face around one of them), up to kStageRetries times; a stage that still makes the
+    /// mesh intersect itself is undone, and that kind of stage is not run again.
     SeamRelaxReport run(bool checkStages) {
         SeamRelaxReport report;
         markFeaturesAndZone();
         report.zoneVertices = std::size_t(std::count(zone_.begin(), zone_.end(), 1));
         Mesh before;
-        if (checkStages) before = m_;
-        // Ends one stage: false when it was undone.
-        auto keep = [&](std::size_t count, std::size_t& total) {
-            if (count == 0) return true;
-            if (checkStages) {
-                if (PMP::does_self_intersect(m_)) {
-                    m_ = before;
-                    report.reverted = true;
-                    return false;
+        std::vector<char> fixedBefore, fixedEdgeBefore; // the collapses carry these flags over
+        if (checkStages) before = m_, fixedBefore = fixed_, fixedEdgeBefore = fixedEdge_;
+        // Runs one stage (\p work returns its operation count): false when it was finally undone.
+        auto stage = [&](auto&& work, std::size_t& total) {
+            for (int attempt = 0;; ++attempt) {
+                const std::size_t count = work();
+                if (count == 0) return true;
+                if (checkStages) {
+                    std::vector<std::pair<FaceIndex, FaceIndex>> pairs;
+                    PMP::self_intersections(m_, std::back_inserter(pairs));
+                    if (!pairs.empty()) {
+                        std::vector<VertexIndex> frozen;
+                        for (const auto& [f, g] : pairs)
+                            for (FaceIndex h : {f, g})
+                                for (VertexIndex v : CGAL::vertices_around_face(m_.halfedge(h), m_))
+                                    frozen.push_back(v);
+                        m_ = before; // vertex indices are those of `before` (stages only remove vertices)
+                        fixed_ = fixedBefore;
+                        fixedEdge_ = fixedEdgeBefore;
+                        if (attempt == kStageRetries) {
+                            report.reverted = true;
+                            return false;
+                        }
+                        for (VertexIndex v : frozen)
+                            zone_[v.idx()] = 0;
+                        continue;
+                    }
+                    before = m_, fixedBefore = fixed_, fixedEdgeBefore = fixedEdge_;
                 }
-                before = m_;
+                total += count;
+                return true;
             }
-            total += count;
-            return true;
         };
-        keep(projectOffSurface(), report.projected);
+        stage([&] { return projectOffSurface(); }, report.projected);
         bool flipping = true, collapsing = o_.collapses, smoothing = true;
         for (int round = 0; round < o_.rounds; ++round) {
             std::size_t flips = 0, collapses = 0, moves = 0;
-            for (int sweep = 0; flipping && sweep < 4; ++sweep) {
-                const std::size_t f = flipSweep();
-                flips += f;
-                if (f == 0) break;
-            }
-            flipping = keep(flips, report.flips) && flipping;
-            if (collapsing) collapses = collapseSweep();
-            collapsing = keep(collapses, report.collapses) && collapsing;
-            if (smoothing) moves = smoothSweep();
-            smoothing = keep(moves, report.moves) && smoothing;
+            if (flipping)
+                flipping = stage(
+                    [&] {
+                        flips = 0;
+                        for (int sweep = 0; sweep < 4; ++sweep) {
+                            const std::size_t f = flipSweep();
+                            flips += f;
+                            if (f == 0) break;
+                        }
+                        return flips;
+                    },
+                    report.flips);
+            if (collapsing) collapsing = stage([&] { return collapses = collapseSweep(); }, report.collapses);
+            if (smoothing) smoothing = stage([&] { return moves = smoothSweep(); }, report.moves);
             if (flips == 0 && collapses == 0 && moves == 0) break;
         }
         return report;
@@ -73,6 +98,7 @@ private:
     const SeamRelaxOptions& o_;
     const double floor_, maxTurn_, feature_;
     RayCaster caster_{ref_};
+    static constexpr int kStageRetries = 3;
     std::vector<char> zone_, fixed_, fixedEdge_, touchesInput_;
 
     Vec faceNormal(FaceIndex f) const {

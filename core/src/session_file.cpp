@@ -129,6 +129,7 @@ struct Writer {
         j["max_trim_rounds"] = s.maxTrimRounds;
         j["min_component_faces"] = s.minComponentFaces;
         j["collect_garbage"] = s.collectGarbage;
+        if (s.peelTrim) j["peel_trim"] = true; // written only when on: older files stay byte-identical
         return j;
     }
 
@@ -406,7 +407,7 @@ FishboneParams readFishbone(const Node& n) {
 StitchOptions readStitch(const Node& n) {
     n.onlyKeys({"seam_rings", "optimise_seam", "collapse_edge_ratio", "seam_grading", "min_angle_floor_deg",
                 "max_view_angle_deg", "max_normal_change_deg", "max_gap_ratio", "max_trim_rounds",
-                "min_component_faces", "collect_garbage"});
+                "min_component_faces", "collect_garbage", "peel_trim"});
     StitchOptions s;
     s.seamRings = int(n.at("seam_rings").integer(0, kIntMax, "an integer of at least 0"));
     s.optimiseSeam = n.at("optimise_seam").boolean();
@@ -421,6 +422,7 @@ StitchOptions readStitch(const Node& n) {
         std::size_t(n.at("min_component_faces")
                         .integer(0, std::numeric_limits<std::int64_t>::max(), "an integer of at least 0"));
     s.collectGarbage = n.at("collect_garbage").boolean();
+    s.peelTrim = n.has("peel_trim") && n.at("peel_trim").boolean();
     return s;
 }
 

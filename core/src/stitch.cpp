@@ -593,6 +593,13 @@ private:
         std::sort(bad.begin(), bad.end());
         bad.erase(std::unique(bad.begin(), bad.end()), bad.end());
         bad.erase(std::remove(bad.begin(), bad.end(), -1), bad.end());
+        if (O_.peelTrim) {
+            // Peel: of the vertices near the problem, only those on the component's boundary.
+            std::vector<int> onBoundary;
+            for (int v : bad)
+                if (boundary_.count(v)) onBoundary.push_back(v);
+            if (!onBoundary.empty()) bad.swap(onBoundary);
+        }
         a.bad = std::move(bad);
         return false;
     }
@@ -1088,7 +1095,8 @@ private:
                 if (folded[i] && isSeam.count(std::uint32_t(region_[i]))) clusterAtSeam[find(int(i))] = true;
             // Cut the patch back around the hidden faces, where it lies on their sheet; if that frees
             // nothing, around the whole fold.
-            const double r = margin_ + h2_;
+            // (Peeling: only the patch triangles within snapping distance; the next round sees what is left.)
+            const double r = O_.peelTrim ? margin_ : margin_ + h2_;
             for (int pass = 0; pass < 2 && bad.empty(); ++pass)
                 for (std::size_t i = 0; i < region_.size(); ++i) {
                     if (!folded[i] || !clusterAtSeam.count(find(int(i))) || (pass == 0 && !hidden[i]))

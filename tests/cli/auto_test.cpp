@@ -115,9 +115,10 @@ TEST(CliAuto, FandiskIsCoveredClosedManifoldAndFreeOfSelfIntersections) {
 
 // Other closed CGAL sample meshes, curved and mechanical: the result stays valid and the seam relaxation
 // raises the fraction of valence-6 interior vertices. Measured (GPU renderer) with / without the relaxation:
-// elephant 0.617 / 0.439, couplingdown 0.673 / 0.575, rotor_small 0.679 / 0.447. Their coverage is still far
-// below the 95 % (0.63, 0.38, 0.45): at ~30–60 pixel views most patch pieces are refused by the
-// stitch because the input mesh under their boundary folds over itself in the scan's view.
+// elephant 0.617 / 0.439, couplingdown 0.673 / 0.575, rotor_small 0.679 / 0.447. Their coverage is still
+// below the 95 % (0.75, 0.50, 0.79 with the stitch's peeling trim; 0.63, 0.38, 0.45 before): at
+// ~30–60 pixel views many patch pieces are trimmed by the stitch because the mesh under their boundary
+// folds over itself in the scan's view.
 TEST(CliAuto, OtherClosedMeshesStayValidAndGainValenceSixFromTheSeamRelaxation) {
     struct Case {
         const char* name;

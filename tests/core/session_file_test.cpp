@@ -123,6 +123,7 @@ void expectSame(const fss::ScanStep& a, const fss::ScanStep& b) {
     EXPECT_EQ(sa.maxTrimRounds, sb.maxTrimRounds);
     EXPECT_EQ(sa.minComponentFaces, sb.minComponentFaces);
     EXPECT_EQ(sa.collectGarbage, sb.collectGarbage);
+    EXPECT_EQ(sa.peelTrim, sb.peelTrim);
 }
 
 std::string slurpText(const std::filesystem::path& p) {
@@ -174,6 +175,7 @@ fss::ScanStep regularStep() {
     s.stitch.maxGapRatio = 0.2;
     s.stitch.maxTrimRounds = 9;
     s.stitch.minComponentFaces = 5;
+    s.stitch.peelTrim = true;
     s.stitch.collectGarbage = true;
     return s;
 }

@@ -43,7 +43,8 @@
 ///     seamRelaxMinAngleDeg (or the smallest one already there), turns a face's normal by more than the
 ///     stitch's maxNormalChangeDeg, or takes faces farther from the reference than they were (beyond L/20).
 ///     A stage of the relaxation (a round's flips, collapses or smoothing) after which the mesh would
-///     intersect itself is undone and not run again. Closedness and manifoldness are kept; only collapses
+///     intersect itself is undone and run again without touching the vertices of the intersecting faces
+///     (up to three times), then, if it still would, undone and not run again. Closedness and manifoldness are kept; only collapses
 ///     lower the vertex count (towards the target: the seams have more vertices than a regular grid).
 ///  7. **Crease recovery.** The views' regions meet at the sharp creases of the reference, so the seams run
 ///     along them, and neither pixel grid has vertices on them: the faces there bevel the creases off by up
@@ -150,15 +151,18 @@ struct AutoOptions {
     /// Rounds of crease recovery after the seam relaxation (file comment, step 7; 0 = none): each round
     /// snaps vertices onto the creases, splits edges at them, then flips edges to follow them.
     int creaseSnapRounds = 3;
-    /// Options of every stitch. Faces with a smallest angle under 10° are refused (trimmed and retried).
+    /// Options of every stitch. Faces with a smallest angle under 10° are refused (trimmed and retried), and
+    /// trimming peels the patch boundary (StitchOptions::peelTrim): the regions of a small or strongly curved
+    /// mesh are only a few pixels wide at the target edge length, and the wide trims cut them apart.
     StitchOptions stitch = defaultStitch();
     /// Quality-mask margin (mask.h QualityMaskOptions::margin) of the regular scans.
     double qualityMargin = 0.1;
 
-    /// StitchOptions with minAngleFloorDeg = 10.
+    /// StitchOptions with minAngleFloorDeg = 10 and peelTrim on.
     static StitchOptions defaultStitch() {
         StitchOptions s;
         s.minAngleFloorDeg = 10.0;
+        s.peelTrim = true;
         return s;
     }
 };

@@ -38,7 +38,8 @@
 ///         "stitch": { "seam_rings": 2, "optimise_seam": true, "collapse_edge_ratio": 0.4, "seam_grading": 1,
 ///                     "min_angle_floor_deg": 1, "max_view_angle_deg": 85, "max_normal_change_deg": 20,
 ///                     "max_gap_ratio": 0.25, "max_trim_rounds": 16, "min_component_faces": 8,
-///                     "collect_garbage": false } } },
+///                     "collect_garbage": false, "peel_trim": true (optional: written only when true,
+///                     absent = false) } } },
 ///     { "kind": "undo" }, { "kind": "redo" } ] }
 /// STREAMLINE = { "step": 0.25, "min_step": 0.015625, "max_length": null (unbounded) | L,
 ///                "min_anisotropy": 0.05,

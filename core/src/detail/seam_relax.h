@@ -51,9 +51,10 @@ struct SeamRelaxReport {
     std::size_t projected = 0;    ///< zone vertices off the reference moved onto it (before the rounds)
     std::size_t collapses = 0;    ///< edges collapsed
     std::size_t moves = 0;        ///< vertex moves accepted (a vertex counts once per smoothing sweep)
-    /// True when a stage (the projection, or a round's flips, collapses or smoothing) left the mesh
-    /// intersecting itself while the mesh before relaxSeams did not: that stage was undone (the counts are
-    /// those of the stages kept) and that kind of stage was not run again.
+    /// True when a stage (the projection, or a round's flips, collapses or smoothing) still left the mesh
+    /// intersecting itself, after its retries without the vertices of the intersecting faces, while the mesh
+    /// before relaxSeams did not: that stage was undone (the counts are those of the stages kept) and that
+    /// kind of stage was not run again.
     bool reverted = false;
 };
 
@@ -61,8 +62,9 @@ struct SeamRelaxReport {
 /// edge flips and vertex moves projected onto \p reference (closest point). Every flip keeps the mesh a
 /// valid, oriented, edge-manifold triangle mesh (no flip creates an existing edge or a vertex of valence
 /// < 3; collapses satisfy the link condition); border edges and their vertices are never touched. \p mesh
-/// is garbage collected on return. A stage that creates self-intersections is undone and not run again
-/// (the other stages go on).
+/// is garbage collected on return. A stage that creates self-intersections is undone and run again with the
+/// vertices of the intersecting faces left alone (up to three times); if it still creates some, it is undone
+/// and not run again (the other stages go on).
 /// \pre \p mesh is a valid triangle mesh; \p reference is a triangle mesh (the surface \p mesh approximates).
 SeamRelaxReport relaxSeams(Mesh& mesh, const Mesh& reference, const SeamRelaxOptions& options);
 
