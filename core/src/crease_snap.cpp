@@ -206,13 +206,18 @@ private:
         for (VertexIndex v : vertices)
             for (VertexIndex w : CGAL::vertices_around_target(m_.halfedge(v), m_))
                 ring.push_back(w);
+        return PMP::does_self_intersect(faceIndicesAround(ring), m_);
+    }
+
+    /// The faces around \p vertices (each once).
+    std::vector<FaceIndex> faceIndicesAround(const std::vector<VertexIndex>& vertices) const {
         std::vector<FaceIndex> faces;
-        for (VertexIndex v : ring)
+        for (VertexIndex v : vertices)
             for (FaceIndex f : CGAL::faces_around_target(m_.halfedge(v), m_))
                 if (f != Mesh::null_face()) faces.push_back(f);
         std::sort(faces.begin(), faces.end());
         faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
-        return PMP::does_self_intersect(faces, m_);
+        return faces;
     }
 
     /// Distance of a triangle to the reference, sampled at its centroid, edge midpoints and three inner
@@ -612,16 +617,10 @@ private:
         return repairs(limits, facesAround(region), 1.0) && !intersectsAround({v});
     }
 
-    /// The faces around \p vertices (each once).
+    /// The triangles around \p vertices (each once).
     std::vector<Tri> facesAround(const std::vector<VertexIndex>& vertices) const {
-        std::vector<FaceIndex> faces;
-        for (VertexIndex w : vertices)
-            for (FaceIndex f : CGAL::faces_around_target(m_.halfedge(w), m_))
-                if (f != Mesh::null_face()) faces.push_back(f);
-        std::sort(faces.begin(), faces.end());
-        faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
         std::vector<Tri> tris;
-        for (FaceIndex f : faces)
+        for (FaceIndex f : faceIndicesAround(vertices))
             tris.push_back(triangle(f));
         return tris;
     }

@@ -338,6 +338,23 @@ TEST(AutoRemesh, SeamRelaxationRaisesValenceSixOnTheSphere) {
     EXPECT_LT(*after.hausdorffToRef, 0.05 * relaxed.edgeLength);
 }
 
+namespace {
+
+// The result \p after of a step that must keep the mesh valid: closed, manifold, without self-intersections;
+// an \p open shape (the open cylinder) keeps the two borders it had in \p before instead of being closed.
+void expectValidKeepingBorders(const fss::Metrics& after, const fss::Metrics& before, bool open) {
+    if (!open) {
+        fss::test::expectClosedValidMesh(after);
+        return;
+    }
+    EXPECT_EQ(after.boundaryEdges, before.boundaryEdges);
+    EXPECT_EQ(after.boundaryLoops, 2u);
+    EXPECT_EQ(after.nonManifoldVertices, 0u);
+    EXPECT_EQ(after.selfIntersections, std::optional<std::size_t>(0));
+}
+
+} // namespace
+
 // Invariants on random cases: shapes, vertex counts and relaxation options drawn at random (fixed seed); the
 // relaxed result is valid (closed, manifold, no self-intersections; an open cylinder keeps its borders),
 // never has a smaller angle than the unrelaxed one or the relaxation's angle floor allows, has no more
@@ -362,14 +379,7 @@ TEST(AutoRemesh, SeamRelaxationKeepsTheMeshValidOnRandomCases) {
         const fss::AutoResult relaxed = fss::autoRemesh(shape, o);
         const fss::Metrics before = metricsAgainst(plain.mesh, shape);
         const fss::Metrics after = metricsAgainst(relaxed.mesh, shape);
-        if (trial < 4) {
-            fss::test::expectClosedValidMesh(after);
-        } else { // the open cylinder: its two borders stay as they were
-            EXPECT_EQ(after.boundaryEdges, before.boundaryEdges);
-            EXPECT_EQ(after.boundaryLoops, 2u);
-            EXPECT_EQ(after.nonManifoldVertices, 0u);
-            EXPECT_EQ(after.selfIntersections, std::optional<std::size_t>(0));
-        }
+        expectValidKeepingBorders(after, before, /*open=*/trial == 4);
         EXPECT_GE(after.minAngleDeg, std::min(before.minAngleDeg, o.seamRelaxMinAngleDeg) - 1e-9);
         EXPECT_LE(after.vertices, before.vertices);
         EXPECT_GE(relaxed.coverage, plain.coverage - 1e-3);
@@ -404,14 +414,7 @@ TEST(AutoRemesh, CreaseRecoveryKeepsTheMeshValidOnRandomCases) {
         const fss::AutoResult recovered = fss::autoRemesh(shape, o);
         const fss::Metrics before = metricsAgainst(plain.mesh, shape);
         const fss::Metrics after = metricsAgainst(recovered.mesh, shape);
-        if (trial != 2) {
-            fss::test::expectClosedValidMesh(after);
-        } else { // the open cylinder: its two borders stay as they were
-            EXPECT_EQ(after.boundaryEdges, before.boundaryEdges);
-            EXPECT_EQ(after.boundaryLoops, 2u);
-            EXPECT_EQ(after.nonManifoldVertices, 0u);
-            EXPECT_EQ(after.selfIntersections, std::optional<std::size_t>(0));
-        }
+        expectValidKeepingBorders(after, before, /*open=*/trial == 2);
         EXPECT_GE(after.minAngleDeg, std::min(before.minAngleDeg, o.stitch.minAngleFloorDeg) - 1e-9);
         // Vertices on the border between faces left from the input and scanned ones move onto a crease: the
         // scanned area shifts a little (measured: at most 0.0025, on the cube of trial 0).
