@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <unordered_map>
 #include <vector>
@@ -293,23 +294,46 @@ private:
     /// radius onto it (else the next nearest, up to three), where that brings its faces closer to the
     /// reference: the snap sweep alone puts a vertex on one of the creases there, not at their meeting point.
     std::size_t cornerSweep() {
-        std::size_t snaps = 0;
+        const std::vector<Vec>& corners = creases_.corners();
+        if (corners.empty()) return 0;
         const double radius = 2 * o_.snapRadius * L_;
-        for (const Vec& corner : creases_.corners()) {
-            std::vector<std::pair<double, VertexIndex>> near;
-            bool taken = false;
-            for (VertexIndex v : m_.vertices()) {
-                const double d = (pos(m_, v) - corner).norm();
-                if (d < 1e-9 * L_)
-                    taken = true;
-                else if (d < radius && !frozen_[v.idx()])
-                    near.emplace_back(d, v);
-            }
-            if (taken) continue;
-            std::sort(near.begin(), near.end());
-            if (near.size() > 3) near.resize(3);
-            for (const auto& [d, v] : near)
-                if (moveVertex(v, corner)) {
+        // The corners in a uniform grid of cells of the radius: the vertices within the radius of a corner
+        // lie in the 27 cells around their own.
+        auto cellOf = [&](const Vec& p) {
+            return std::array<std::int64_t, 3>{std::int64_t(std::floor(p.x() / radius)),
+                                               std::int64_t(std::floor(p.y() / radius)),
+                                               std::int64_t(std::floor(p.z() / radius))};
+        };
+        std::map<std::array<std::int64_t, 3>, std::vector<std::size_t>> grid;
+        for (std::size_t i = 0; i < corners.size(); ++i)
+            grid[cellOf(corners[i])].push_back(i);
+        std::vector<std::vector<std::pair<double, VertexIndex>>> near(corners.size());
+        std::vector<char> taken(corners.size(), 0);
+        for (VertexIndex v : m_.vertices()) {
+            const Vec p = pos(m_, v);
+            const auto c = cellOf(p);
+            for (std::int64_t dx = -1; dx <= 1; ++dx)
+                for (std::int64_t dy = -1; dy <= 1; ++dy)
+                    for (std::int64_t dz = -1; dz <= 1; ++dz) {
+                        const auto it = grid.find({c[0] + dx, c[1] + dy, c[2] + dz});
+                        if (it == grid.end()) continue;
+                        for (std::size_t i : it->second) {
+                            const double d = (p - corners[i]).norm();
+                            if (d < 1e-9 * L_)
+                                taken[i] = 1;
+                            else if (d < radius && !frozen_[v.idx()])
+                                near[i].emplace_back(d, v);
+                        }
+                    }
+        }
+        std::size_t snaps = 0;
+        for (std::size_t i = 0; i < corners.size(); ++i) {
+            if (taken[i] || near[i].empty()) continue;
+            std::sort(near[i].begin(), near[i].end());
+            if (near[i].size() > 3) near[i].resize(3);
+            for (const auto& [d, v] : near[i])
+                if (!m_.is_removed(v) && (pos(m_, v) - corners[i]).norm() < radius &&
+                    moveVertex(v, corners[i])) {
                     onCrease_[v.idx()] = 1;
                     ++snaps;
                     break;
