@@ -353,13 +353,17 @@ private:
             before.push_back({p, q, r});
             after.push_back({target, q, r});
         }
-        if (!better(before, after, true, 0.99)) return false;
+        return better(before, after, true, 0.99) && place(v, target);
+    }
+
+    /// Puts \p v at \p target unless the faces around it then intersect others (then \p v stays where it
+    /// was).
+    bool place(VertexIndex v, const Vec& target) {
+        const Point3 old = m_.point(v);
         m_.point(v) = Point3(target.x(), target.y(), target.z());
-        if (intersectsAround({v})) {
-            m_.point(v) = Point3(p.x(), p.y(), p.z());
-            return false;
-        }
-        return true;
+        if (!intersectsAround({v})) return true;
+        m_.point(v) = old;
+        return false;
     }
 
     /// Removes vertices of valence 3 whose three faces lie farther from the reference than the one face
@@ -587,11 +591,7 @@ private:
         }
         const Before measured = measure(before);
         if (caps.empty() && repairs(measured, moved, gain)) { // the move alone
-            m_.point(v) = Point3(q.x(), q.y(), q.z());
-            if (intersectsAround({v})) {
-                m_.point(v) = Point3(p.x(), p.y(), p.z());
-                return false;
-            }
+            if (!place(v, q)) return false;
             onCrease_[v.idx()] = 1;
             return true;
         }
