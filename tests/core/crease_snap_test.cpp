@@ -1,8 +1,8 @@
-// The crease recovery of `fss-remesh auto` (internal: core/src/detail/crease_snap.h) on the cube, whose
+// The crease recovery of `fss-remesh auto` (internal: core/src/remesh/crease_snap.h) on the cube, whose
 // creases and corners are known exactly. Each test damages a regular triangulation of the cube in one way
 // the stitches do (a corner cut off, a vertex standing off a face, a fold) and checks that snapToCreases
 // repairs exactly that: the result is measured against the cube itself, never against the code's own view.
-#include "detail/crease_snap.h"
+#include "remesh/crease_snap.h"
 
 #include "fss/metrics.h"
 #include "fss/shapes.h"

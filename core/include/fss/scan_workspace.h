@@ -41,7 +41,7 @@ public:
     /// Frees everything the workspace holds.
     void release();
 
-    /// Internal: the buffers, for the scan stages (core/src/detail/scan_workspace_impl.h).
+    /// Internal: the buffers, for the scan stages (core/src/scan/scan_workspace_impl.h).
     struct Impl;
     Impl& impl();
 

@@ -3,7 +3,7 @@
 /// fss::MeshRenderer on the GPU: the scan pipeline (scan_pipeline.h) rendering through a Rasterizer.
 
 #include "fss/render/rasterizer.h"
-#include "fss/scan_pipeline.h"
+#include "fss/mesh_renderer.h"
 
 namespace fss::render {
 

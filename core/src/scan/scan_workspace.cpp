@@ -1,6 +1,6 @@
 #include "fss/scan_workspace.h"
 
-#include "detail/scan_workspace_impl.h"
+#include "scan/scan_workspace_impl.h"
 
 #include <utility>
 

@@ -1,6 +1,6 @@
-#include "detail/crease_snap.h"
+#include "remesh/crease_snap.h"
 
-#include "detail/triangle_geometry.h"
+#include "mesh/triangle_geometry.h"
 
 #include "fss/raycast.h"
 
@@ -994,14 +994,14 @@ CreaseSnapReport snapToCreases(Mesh& mesh, const Mesh& reference, const CreaseSn
     if (options.rounds <= 0 || mesh.is_empty() || reference.is_empty()) return report;
     CreaseSnapper snapper(mesh, reference, options);
     report.creaseEdges = snapper.creaseEdges();
-    const bool intersectedBefore = PMP::does_self_intersect(mesh);
+    const bool intersectedBefore = PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh);
     for (int round = 0; round < options.rounds; ++round) {
         const Mesh before = mesh;
         std::vector<char> marksBefore = snapper.creaseMarks();
         CreaseSnapReport r;
         snapper.round(r);
         if (r.snaps + r.splits + r.flips + r.removals + r.repairs == 0) break;
-        if (!intersectedBefore && PMP::does_self_intersect(mesh)) {
+        if (!intersectedBefore && PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh)) {
             mesh = before;
             snapper.setCreaseMarks(std::move(marksBefore));
             ++report.roundsReverted;

@@ -3,7 +3,7 @@
 #include "fss/camera_projector.h"
 #include "fss/error.h"
 
-#include "detail/parallel_rows.h"
+#include "base/parallel_rows.h"
 
 #include <algorithm>
 #include <chrono>

@@ -1,7 +1,6 @@
 #include "fss/scan_pipeline.h"
 
 #include "fss/error.h"
-#include "fss/raycast.h"
 
 #include <chrono>
 
@@ -13,27 +12,6 @@ using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 } // namespace
-
-struct CpuMeshRenderer::Impl {
-    std::unique_ptr<RayCaster> caster;
-};
-
-CpuMeshRenderer::CpuMeshRenderer() : impl_(std::make_unique<Impl>()) {}
-CpuMeshRenderer::~CpuMeshRenderer() = default;
-
-void CpuMeshRenderer::setMesh(const Mesh& mesh) {
-    if (mesh.number_of_faces() == 0) throw InvalidInputError("The mesh to render has no faces.");
-    impl_->caster = std::make_unique<RayCaster>(mesh);
-}
-
-FrameBuffers CpuMeshRenderer::render(const Camera& camera) {
-    if (!impl_->caster) throw InvalidInputError("No mesh was given to the CPU renderer before rendering.");
-    const Mesh& mesh = impl_->caster->mesh();
-    Camera fitted = camera;
-    fitted.fitClippingRange(boundingBox(mesh));
-    fitted.validate();
-    return rasterizeOnCpu(*impl_->caster, fitted);
-}
 
 ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, const Mesh& current,
                      MeshRenderer& currentRenderer, const ScanParams& params, const Progress& progress) {

@@ -1,6 +1,6 @@
 // Mesh I/O: strict parsers for OFF, OBJ, PLY and STL into a polygon soup, soup statistics, repair with
 // CGAL's polygon-soup functions, and writers that replace the target atomically. See fss/mesh_io.h.
-#include "detail/disjoint_sets.h"
+#include "base/disjoint_sets.h"
 #include "fss/mesh_io.h"
 
 #include "fss/error.h"

@@ -1,7 +1,7 @@
-#include "detail/seam_relax.h"
+#include "remesh/seam_relax.h"
 
-#include "detail/crease_snap.h"
-#include "detail/triangle_geometry.h"
+#include "remesh/crease_snap.h"
+#include "mesh/triangle_geometry.h"
 
 #include "fss/raycast.h"
 
@@ -396,7 +396,7 @@ private:
 
 SeamRelaxReport relaxSeams(Mesh& mesh, const Mesh& reference, const SeamRelaxOptions& options) {
     if (options.rounds <= 0 || mesh.is_empty()) return {};
-    const bool intersectedBefore = PMP::does_self_intersect(mesh);
+    const bool intersectedBefore = PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh);
     SeamRelaxReport report = Relaxer(mesh, reference, options).run(!intersectedBefore);
     mesh.collect_garbage();
     return report;

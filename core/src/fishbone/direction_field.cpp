@@ -2,7 +2,7 @@
 
 #include "fss/error.h"
 
-#include "detail/parallel_rows.h"
+#include "base/parallel_rows.h"
 
 #include <algorithm>
 #include <array>

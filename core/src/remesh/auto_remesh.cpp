@@ -1,7 +1,7 @@
 #include "fss/auto_remesh.h"
 
-#include "detail/crease_snap.h"
-#include "detail/seam_relax.h"
+#include "remesh/crease_snap.h"
+#include "remesh/seam_relax.h"
 
 #include "fss/error.h"
 #include "fss/fishbone_scan.h"

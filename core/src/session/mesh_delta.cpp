@@ -1,5 +1,5 @@
-// MeshDelta (detail/mesh_delta.h): index-wise difference of two garbage-free meshes.
-#include "detail/mesh_delta.h"
+// MeshDelta (session/mesh_delta.h): index-wise difference of two garbage-free meshes.
+#include "session/mesh_delta.h"
 
 #include <algorithm>
 #include <bit>

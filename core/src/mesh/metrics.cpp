@@ -1,4 +1,4 @@
-#include "detail/disjoint_sets.h"
+#include "base/disjoint_sets.h"
 #include "fss/metrics.h"
 
 #include "fss/error.h"
@@ -257,7 +257,8 @@ struct PairCounter {
 
 std::size_t countSelfIntersections(const Mesh& m) {
     std::size_t count = 0;
-    PMP::self_intersections(m.faces(), m, PairCounter{&count});
+    // In parallel with TBB (CGAL collects the pairs in a concurrent vector, then counts them here).
+    PMP::self_intersections<CGAL::Parallel_if_available_tag>(m.faces(), m, PairCounter{&count});
     return count;
 }
 

@@ -7,7 +7,7 @@
 // 100k faces); the record itself, and undo / redo, are O(change).
 #include "fss/session.h"
 
-#include "detail/mesh_delta.h"
+#include "session/mesh_delta.h"
 #include "fss/error.h"
 
 #include <chrono>

@@ -3,8 +3,8 @@
 #include "fss/error.h"
 #include "fss/scan.h"
 
-#include "detail/parallel_rows.h"
-#include "detail/scan_workspace_impl.h"
+#include "base/parallel_rows.h"
+#include "scan/scan_workspace_impl.h"
 
 #include <algorithm>
 #include <array>

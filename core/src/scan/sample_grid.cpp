@@ -1,6 +1,6 @@
 #include "fss/sample_grid.h"
 
-#include "detail/huge_pages.h"
+#include "base/huge_pages.h"
 
 #include <cstdint>
 

@@ -3,9 +3,9 @@
 #include "fss/camera_projector.h"
 #include "fss/error.h"
 
-#include "detail/huge_pages.h"
-#include "detail/parallel_rows.h"
-#include "detail/scan_workspace_impl.h"
+#include "base/huge_pages.h"
+#include "base/parallel_rows.h"
+#include "scan/scan_workspace_impl.h"
 
 #include <algorithm>
 #include <atomic>

@@ -1,0 +1,2 @@
+// Fixture for the layering_check test: core never includes Qt.
+#include <QString>

@@ -1,0 +1,2 @@
+// Fixture for the layering_check test: mesh may not include the session module.
+#include "fss/session.h"

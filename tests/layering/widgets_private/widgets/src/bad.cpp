@@ -1,0 +1,2 @@
+// Fixture for the layering_check test: widgets never include core's private headers.
+#include "stitch/stitch_stages.h"
