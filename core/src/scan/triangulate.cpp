@@ -251,40 +251,11 @@ bool hasPatchPropertiesOnly(const Mesh& mesh) {
            mesh.property_map<FaceIndex, std::int32_t>(props::faceScanId).second;
 }
 
-} // namespace
-
-Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options) {
-    ScanWorkspace workspace;
-    return triangulateGrid(grid, options, workspace);
-}
-
-Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options, ScanWorkspace& workspace) {
-    if (grid.rows < 0 || grid.cols < 0 ||
-        grid.samples.size() != std::size_t(grid.rows) * std::size_t(grid.cols))
-        throw InvalidInputError("The sample grid holds " + std::to_string(grid.samples.size()) +
-                                " samples instead of its " + std::to_string(grid.rows) + "x" +
-                                std::to_string(grid.cols) + ".");
-    if (!(options.maxEdgeFootprints > 0))
-        throw InvalidInputError("The triangulation's maximum edge length of " +
-                                std::to_string(options.maxEdgeFootprints) + " footprints is not positive.");
-    if (!(options.maxSamplingAngleDeg > 0 && options.maxSamplingAngleDeg <= 90))
-        throw InvalidInputError("The triangulation's maximum sampling angle of " +
-                                std::to_string(options.maxSamplingAngleDeg) +
-                                " degrees is outside the range (0, 90].");
-
-    ScanWorkspace::Impl& w = workspace.impl();
-    Patch patch;
-    if (w.hasPatch) { // a recycled patch: its arrays are refilled below, every value written
-        patch = std::move(w.patch);
-        w.patch = Patch();
-        w.hasPatch = false;
-        patch.report = {};
-    }
-    patch.rows = grid.rows;
-    patch.cols = grid.cols;
-    patch.scanId = grid.scanId;
-    TriangulateReport& report = patch.report;
-
+/// Triangulation stage 1: both triangles of every quad with four usable corners, judged in one pass over the
+/// quad rows (in blocks, one per thread); the kept ones in row order, in the grid's orientation. Fills the
+/// report's quad and rejection counts, the dense sample qualities (w.sampleQuality) and \p mirrored.
+std::vector<Triangle>& judgeQuadTriangles(const SampleGrid& grid, const TriangulateOptions& options,
+                                          ScanWorkspace::Impl& w, TriangulateReport& report, bool& mirrored) {
     const Viewer viewer(grid.camera);
     const double maxAngle = options.maxSamplingAngleDeg * std::numbers::pi / 180.0;
     const JudgeLimits limits{options.maxEdgeFootprints, maxAngle, std::cos(maxAngle)};
@@ -376,7 +347,7 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
         rightTurns += b.rightTurns;
         leftTurns += b.leftTurns;
     }
-    const bool mirrored = leftTurns > rightTurns;
+    mirrored = leftTurns > rightTurns;
     const std::uint8_t kept = mirrored ? kKeptIfMirrored : kKeptIfNotMirrored;
     std::vector<Triangle>& triangles = w.triangles;
     triangles.clear();
@@ -404,9 +375,15 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
         report.grazing += v[std::size_t(Verdict::Grazing)];
     }
 
-    report.nonManifoldVertices =
-        makeVerticesManifold(triangles, grid.rows, grid.cols, mirrored, report.nonManifoldTriangles, w);
+    return triangles;
+}
 
+/// Triangulation stage 2: the patch's halfedge structure built directly from \p triangles (grid sample
+/// indices), with its points, grid indices, face qualities and scan ids.
+void buildPatchMesh(const SampleGrid& grid, const std::vector<Triangle>& triangles, ScanWorkspace::Impl& w,
+                    Patch& patch) {
+    const std::size_t sampleCount = grid.samples.size();
+    const std::vector<float>& sampleQuality = w.sampleQuality;
     // The halfedge structure directly (Surface_mesh::add_face searches each new edge around its vertex,
     // and add_vertex / add_edge / add_face grow every property array one element at a time). Pass 1
     // numbers vertices in order of first use and edges in order of first use by the faces — the numbering
@@ -538,6 +515,50 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
         mesh.set_next(b, borderFrom[end.idx()]);
         mesh.set_halfedge(end, b);
     }
+}
+
+} // namespace
+
+Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options) {
+    ScanWorkspace workspace;
+    return triangulateGrid(grid, options, workspace);
+}
+
+Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options, ScanWorkspace& workspace) {
+    if (grid.rows < 0 || grid.cols < 0 ||
+        grid.samples.size() != std::size_t(grid.rows) * std::size_t(grid.cols))
+        throw InvalidInputError("The sample grid holds " + std::to_string(grid.samples.size()) +
+                                " samples instead of its " + std::to_string(grid.rows) + "x" +
+                                std::to_string(grid.cols) + ".");
+    if (!(options.maxEdgeFootprints > 0))
+        throw InvalidInputError("The triangulation's maximum edge length of " +
+                                std::to_string(options.maxEdgeFootprints) + " footprints is not positive.");
+    if (!(options.maxSamplingAngleDeg > 0 && options.maxSamplingAngleDeg <= 90))
+        throw InvalidInputError("The triangulation's maximum sampling angle of " +
+                                std::to_string(options.maxSamplingAngleDeg) +
+                                " degrees is outside the range (0, 90].");
+
+    ScanWorkspace::Impl& w = workspace.impl();
+    Patch patch;
+    if (w.hasPatch) { // a recycled patch: its arrays are refilled below, every value written
+        patch = std::move(w.patch);
+        w.patch = Patch();
+        w.hasPatch = false;
+        patch.report = {};
+    }
+    patch.rows = grid.rows;
+    patch.cols = grid.cols;
+    patch.scanId = grid.scanId;
+    TriangulateReport& report = patch.report;
+
+    bool mirrored = false;
+    std::vector<Triangle>& triangles = judgeQuadTriangles(grid, options, w, report, mirrored);
+
+    report.nonManifoldVertices =
+        makeVerticesManifold(triangles, grid.rows, grid.cols, mirrored, report.nonManifoldTriangles, w);
+
+    buildPatchMesh(grid, triangles, w, patch);
+    const Mesh& mesh = patch.mesh;
     report.faces = mesh.number_of_faces();
     report.vertices = mesh.number_of_vertices();
     return patch;
