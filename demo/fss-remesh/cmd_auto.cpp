@@ -2,20 +2,19 @@
 //                  [--renderer auto|gpu|cpu] [--max-views N] [--no-metrics]
 #include "args.h"
 #include "commands.h"
+#include "terminal_progress.h"
 
 #include "fss/auto_remesh.h"
 #include "fss/error.h"
 #include "fss/mesh_io.h"
 #include "fss/metrics.h"
-#include "fss/render/gpu_mesh_renderer.h"
+#include "fss/render/renderer_choice.h"
 
 #include <nlohmann/json.hpp>
 
-#include <unistd.h>
-
-#include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 namespace fss::cli {
 namespace {
@@ -32,24 +31,6 @@ const char* kindName(AutoStep::Kind kind) {
         return "fishbone";
     }
     return "?";
-}
-
-// The renderer factory of --renderer: GPU (head-less EGL) when asked or available, else CPU ray casting.
-RendererFactory rendererFactory(const std::string& kind, std::string& used) {
-    if (kind == "cpu") {
-        used = "cpu";
-        return [] { return std::make_unique<CpuMeshRenderer>(); };
-    }
-    try {
-        auto probe = std::make_unique<render::GpuMeshRenderer>();
-        used = "gpu";
-    } catch (const Error& e) {
-        if (kind == "gpu") throw;
-        std::cerr << "fss-remesh auto: note: " << e.what() << " Falling back to CPU ray casting.\n";
-        used = "cpu";
-        return [] { return std::make_unique<CpuMeshRenderer>(); };
-    }
-    return [] { return std::make_unique<render::GpuMeshRenderer>(); };
 }
 
 } // namespace
@@ -107,22 +88,17 @@ int runAuto(const std::vector<std::string>& args) {
     options.fishbone = haveFishbone;
 
     const Mesh reference = readMesh(meshPath);
-    std::string rendererUsed;
-    options.renderer = rendererFactory(rendererKind, rendererUsed);
+    const render::RendererSelection renderer =
+        render::chooseRenderer(*render::parseRendererChoice(rendererKind));
+    if (!renderer.fallbackReason.empty())
+        std::cerr << "fss-remesh auto: note: " << renderer.fallbackReason
+                  << " Falling back to CPU ray casting.\n";
+    const std::string rendererUsed(render::rendererChoiceName(renderer.used));
+    options.renderer = renderer.factory;
 
-    // A one-line progress bar on stderr, only when it is a terminal.
-    Progress progress;
-    const bool tty = isatty(fileno(stderr)) != 0;
-    if (tty)
-        progress = Progress([](double fraction, std::string_view stage) {
-            const int width = 30, filled = int(fraction * width + 0.5);
-            std::cerr << "\r[" << std::string(std::size_t(filled), '#')
-                      << std::string(std::size_t(width - filled), ' ') << "] " << int(fraction * 100 + 0.5)
-                      << "% " << stage << "          " << std::flush;
-            return true;
-        });
-    const AutoResult result = autoRemesh(reference, options, progress);
-    if (tty) std::cerr << "\r" << std::string(60, ' ') << "\r";
+    TerminalProgress bar;
+    const AutoResult result = autoRemesh(reference, options, bar.progress());
+    bar.finish();
     writeMesh(result.mesh, outPath, WriteOptions{.binary = false});
 
     std::optional<Metrics> metrics;

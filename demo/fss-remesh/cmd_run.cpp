@@ -4,12 +4,13 @@
 #include "args.h"
 #include "commands.h"
 #include "stitch_json.h"
+#include "terminal_progress.h"
 
 #include "fss/camera.h"
 #include "fss/error.h"
 #include "fss/mesh_io.h"
 #include "fss/metrics.h"
-#include "fss/render/gpu_mesh_renderer.h"
+#include "fss/render/renderer_choice.h"
 #include "fss/render/snapshot.h"
 #include "fss/session_file.h"
 
@@ -17,7 +18,6 @@
 
 #include <unistd.h>
 
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -35,61 +35,6 @@ using Clock = std::chrono::steady_clock;
 
 double since(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
-// A one-line progress bar redrawn in place on stderr (only used when stderr is a terminal).
-class ProgressBar {
-public:
-    bool update(double fraction, std::string_view stage) {
-        const int percent = int(fraction * 100.0 + 1e-9);
-        const auto now = Clock::now();
-        if (percent == lastPercent_ && std::string(stage) == lastStage_ &&
-            std::chrono::duration<double>(now - lastDraw_).count() < 0.2)
-            return true;
-        lastPercent_ = percent;
-        lastStage_ = std::string(stage);
-        lastDraw_ = now;
-        constexpr int kWidth = 30;
-        const int filled = std::clamp(int(fraction * kWidth), 0, kWidth);
-        std::string text = "\r[" + std::string(std::size_t(filled), '#') +
-                           std::string(std::size_t(kWidth - filled), ' ') + "] " + std::to_string(percent) +
-                           "% " + lastStage_;
-        if (text.size() > 100) text.resize(100);
-        std::fprintf(stderr, "%s\x1b[K", text.c_str());
-        std::fflush(stderr);
-        drawn_ = true;
-        return true;
-    }
-    void finish() {
-        if (drawn_) std::fprintf(stderr, "\r\x1b[K");
-        std::fflush(stderr);
-        drawn_ = false;
-    }
-    ~ProgressBar() { finish(); }
-
-private:
-    int lastPercent_ = -1;
-    std::string lastStage_;
-    Clock::time_point lastDraw_{};
-    bool drawn_ = false;
-};
-
-// The renderer factory for the replay: "cpu", "gpu" (fails without GL) or "auto" (GPU, else CPU).
-RendererFactory makeFactory(const std::string& kind, std::string& used, const std::string& command) {
-    if (kind == "cpu") {
-        used = "cpu";
-        return [] { return std::make_unique<CpuMeshRenderer>(); };
-    }
-    try {
-        render::GpuMeshRenderer probe; // creates the head-less context: fails here when there is no GL
-    } catch (const Error& e) {
-        if (kind == "gpu") throw;
-        std::cerr << command << ": note: " << e.what() << " Falling back to CPU ray casting.\n";
-        used = "cpu";
-        return [] { return std::make_unique<CpuMeshRenderer>(); };
-    }
-    used = "gpu";
-    return [] { return std::make_unique<render::GpuMeshRenderer>(); };
 }
 
 } // namespace
@@ -163,20 +108,20 @@ int runRun(const std::vector<std::string>& args) {
     const double loadSeconds = since(start);
 
     const std::string kind = rendererKind == "session" ? file.renderer : rendererKind;
-    std::string used;
-    const RendererFactory factory = makeFactory(kind, used, command);
+    const render::RendererSelection renderer =
+        render::chooseRenderer(render::parseRendererChoice(kind).value_or(render::RendererChoice::Auto));
+    if (!renderer.fallbackReason.empty())
+        std::cerr << command << ": note: " << renderer.fallbackReason
+                  << " Falling back to CPU ray casting.\n";
+    const std::string used(render::rendererChoiceName(renderer.used));
     if (used != file.renderer)
         std::cerr << command << ": note: the session was recorded with the " << file.renderer
                   << " renderer and is replayed with the " << used << " one; the mesh may differ slightly.\n";
 
-    const bool showProgress = !quiet && ::isatty(STDERR_FILENO) == 1;
-    ProgressBar bar;
-    Progress progress;
-    if (showProgress)
-        progress = Progress([&bar](double f, std::string_view stage) { return bar.update(f, stage); });
+    TerminalProgress bar(!quiet);
 
     const auto replayStart = Clock::now();
-    ReplayResult replay = replaySession(file, factory, progress);
+    ReplayResult replay = replaySession(file, renderer.factory, bar.progress());
     const double replaySeconds = since(replayStart);
     const Mesh& result = replay.session.current();
 
@@ -193,7 +138,7 @@ int runRun(const std::vector<std::string>& args) {
         MetricsOptions options;
         options.selfIntersections = !noSelf;
         options.reference = &replay.session.reference();
-        if (showProgress) bar.update(1.0, "metrics");
+        bar.update(1.0, "metrics");
         metrics = computeMetrics(result, options);
         options.reference = nullptr;
         inputMetrics = computeMetrics(replay.session.reference(), options);
@@ -203,7 +148,7 @@ int runRun(const std::vector<std::string>& args) {
     double snapshotSeconds = 0;
     render::Snapshot shot;
     if (haveSnapshot) {
-        if (showProgress) bar.update(1.0, "snapshot");
+        bar.update(1.0, "snapshot");
         t = Clock::now();
         Camera camera = Camera::standardView(*view, boundingBox(result), snapW, snapH);
         camera.zoom(zoom);

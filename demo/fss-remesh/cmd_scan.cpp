@@ -10,7 +10,7 @@
 #include "fss/fishbone_scan.h"
 #include "fss/mesh_io.h"
 #include "fss/raycast.h"
-#include "fss/render/gpu_mesh_renderer.h"
+#include "fss/render/renderer_choice.h"
 #include "fss/scan_pipeline.h"
 #include "fss/stitch.h"
 
@@ -36,15 +36,6 @@ void addPatchCounts(nlohmann::json& counts, const Patch& patch) {
     counts["dropped_long_edges"] = tr.longEdges;
     counts["dropped_grazing"] = tr.grazing;
     counts["dropped_non_manifold"] = tr.nonManifoldTriangles;
-}
-
-Eigen::AlignedBox3d boundingBox(const Mesh& mesh) {
-    Eigen::AlignedBox3d box;
-    for (VertexIndex v : mesh.vertices()) {
-        const Point3& p = mesh.point(v);
-        box.extend(Eigen::Vector3d(p.x(), p.y(), p.z()));
-    }
-    return box;
 }
 
 // "ex,ey,ez,fx,fy,fz,ux,uy,uz[,angle]"
@@ -161,23 +152,6 @@ FishboneParams parseFishbone(const std::string& text, int w, int h) {
     if (fb.keyRibs.size() == 1)
         throw UsageError("The --fishbone keyribs need at least two points to blend between.");
     return fb;
-}
-
-std::unique_ptr<MeshRenderer> makeRenderer(const std::string& kind, std::string& used) {
-    if (kind == "cpu") {
-        used = "cpu";
-        return std::make_unique<CpuMeshRenderer>();
-    }
-    try {
-        auto gpu = std::make_unique<render::GpuMeshRenderer>();
-        used = "gpu";
-        return gpu;
-    } catch (const Error& e) {
-        if (kind == "gpu") throw;
-        std::cerr << "fss-remesh scan: note: " << e.what() << " Falling back to CPU ray casting.\n";
-        used = "cpu";
-        return std::make_unique<CpuMeshRenderer>();
-    }
 }
 
 // What either kind of scan produced, with its part of the JSON report and of the text summary.
@@ -422,26 +396,31 @@ int runScan(const std::vector<std::string>& args) {
     const Mesh& current = intoMesh ? *intoMesh : reference;
     if (haveInto && !haveScanId) params.scan.scanId = nextScanId(current);
 
-    std::string rendererUsed;
-    std::unique_ptr<MeshRenderer> renderer = makeRenderer(rendererKind, rendererUsed);
+    // The reference's renderer, and the current mesh's (a second GPU context that fails falls back to CPU).
+    auto newRenderer = [](render::RendererChoice choice) {
+        std::string why;
+        std::unique_ptr<MeshRenderer> renderer = render::makeRenderer(choice, &why);
+        if (!why.empty()) std::cerr << "fss-remesh scan: note: " << why << " Falling back to CPU ray casting.\n";
+        return renderer;
+    };
+    std::unique_ptr<MeshRenderer> renderer = newRenderer(*render::parseRendererChoice(rendererKind));
+    const render::RendererChoice kind = render::rendererKind(*renderer);
+    const std::string rendererUsed(render::rendererChoiceName(kind));
     renderer->setMesh(reference);
     std::unique_ptr<MeshRenderer> currentRenderer;
     if (intoMesh) {
-        std::string used; // the kind the reference got (a second GPU context that fails falls back to CPU)
-        currentRenderer = makeRenderer(rendererUsed == "cpu" ? "cpu" : "auto", used);
+        currentRenderer = newRenderer(kind == render::RendererChoice::Cpu ? kind : render::RendererChoice::Auto);
         currentRenderer->setMesh(*intoMesh);
     }
     MeshRenderer& renderCurrent = currentRenderer ? *currentRenderer : *renderer;
     ScanRun run = fishbone ? fishboneScan(reference, *renderer, current, renderCurrent, params, *fishbone, meshPath,
                                           rendererUsed)
                            : regularScan(reference, *renderer, current, renderCurrent, params, meshPath, rendererUsed);
-    if (auto* gpu = dynamic_cast<render::GpuMeshRenderer*>(renderer.get()))
-        rendererUsed = "gpu (" + gpu->rasterizer().glRenderer() + ")";
 
     nlohmann::json j;
     j["input"] = meshPath;
     j["output"] = outPath;
-    j["renderer"] = rendererUsed;
+    j["renderer"] = render::rendererDescription(*renderer);
     j.update(run.json);
     std::string summary = run.summary;
     if (haveInto) {

@@ -2,7 +2,6 @@
 #include "fss/render/snapshot.h"
 
 #include "fss/error.h"
-#include "fss/render/rasterizer.h"
 #include "fss/scan_pipeline.h"
 
 #include <vtkImageData.h>
@@ -134,30 +133,10 @@ Snapshot renderSnapshot(const Mesh& mesh, const Camera& camera, const SnapshotOp
     if (mesh.number_of_faces() == 0) throw InvalidInputError("The mesh to picture has no faces.");
     camera.validate();
     Snapshot snapshot;
-    FrameBuffers buffers;
-    bool rendered = false;
-    if (options.renderer != SnapshotOptions::Renderer::Cpu) {
-        std::unique_ptr<Rasterizer> rasterizer;
-        try {
-            rasterizer = std::make_unique<Rasterizer>();
-        } catch (const InvalidInputError&) {
-            throw;
-        } catch (const Error&) {
-            if (options.renderer == SnapshotOptions::Renderer::Gpu) throw;
-        }
-        if (rasterizer) {
-            rasterizer->setMesh(mesh);
-            buffers = rasterizer->render(camera);
-            snapshot.renderer = "gpu (" + rasterizer->glRenderer() + ")";
-            rendered = true;
-        }
-    }
-    if (!rendered) {
-        CpuMeshRenderer cpu;
-        cpu.setMesh(mesh);
-        buffers = cpu.render(camera);
-        snapshot.renderer = "cpu";
-    }
+    const std::unique_ptr<MeshRenderer> renderer = makeRenderer(options.renderer);
+    renderer->setMesh(mesh);
+    const FrameBuffers buffers = renderer->render(camera);
+    snapshot.renderer = rendererDescription(*renderer);
     snapshot.covered = buffers.coveredCount();
     if (snapshot.covered == 0) throw InvalidInputError("The snapshot camera sees no part of the mesh.");
     snapshot.image = shadeFaces(mesh, buffers, minAngleFaceColors(mesh), options);

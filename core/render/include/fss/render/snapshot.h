@@ -10,6 +10,7 @@
 #include "fss/camera.h"
 #include "fss/frame_buffers.h"
 #include "fss/mesh.h"
+#include "fss/render/renderer_choice.h"
 
 #include <array>
 #include <cstddef>
@@ -51,9 +52,10 @@ struct SnapshotOptions {
     /// Pixels where the face id changes to another face (to the right or below) are multiplied by this
     /// factor: the triangulation shows as thin dark lines. 1 = no outlines.
     double outline = 0.8;
-    /// Which renderer makes the ID buffer: the GPU Rasterizer with a fallback to the CPU (Auto), only the
-    /// GPU (Gpu: no fallback), or CPU ray casting (Cpu).
-    enum class Renderer { Auto, Gpu, Cpu } renderer = Renderer::Auto;
+    /// Which renderer makes the ID buffer (renderer_choice.h): the GPU with a fallback to the CPU (Auto),
+    /// only the GPU (Gpu: no fallback), or CPU ray casting (Cpu).
+    using Renderer = RendererChoice;
+    Renderer renderer = Renderer::Auto; ///< see Renderer
 };
 
 /// Shades \p buffers (rendered from \p mesh) with one colour per face: see the file comment. Covered pixels
