@@ -30,6 +30,8 @@
 
 #include "fss/stitch.h"
 
+#include "base/disjoint_sets.h"
+
 #include "fss/error.h"
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
@@ -1050,14 +1052,8 @@ private:
         // patch they are simply replaced; where the patch boundary crosses them there is no height field
         // to cut, so the patch is cut back around every fold that reaches its boundary.
         {
-            std::vector<int> parent(region_.size());
-            for (std::size_t i = 0; i < parent.size(); ++i)
-                parent[i] = int(i);
-            auto find = [&](int x) {
-                while (parent[std::size_t(x)] != x)
-                    x = parent[std::size_t(x)] = parent[std::size_t(parent[std::size_t(x)])];
-                return x;
-            };
+            detail::DisjointSets clusters(region_.size());
+            auto find = [&](int x) { return int(clusters.find(std::size_t(x))); };
             std::vector<char> folded(region_.size(), 0), hidden(region_.size(), 0);
             // Only the clusters of overlapping faces that reach a seam face matter: found by a flood over
             // overlaps from the seam faces (work proportional to the seam and its folds, not to the faces
@@ -1080,7 +1076,7 @@ private:
                     const std::size_t lo = std::min(i, j), hi = std::max(i, j);
                     if (!interiorsOverlap(region_[lo], region_[hi])) return;
                     folded[lo] = folded[hi] = 1;
-                    parent[std::size_t(find(int(hi)))] = find(int(lo));
+                    clusters.unite(lo, hi);
                     // The one farther from the eye where they overlap is hidden there.
                     const Point2 q = overlapCentre(faceTriangle(region_[lo]), faceTriangle(region_[hi]));
                     hidden[depthAt(region_[lo], q) > depthAt(region_[hi], q) ? lo : hi] = 1;
@@ -3327,22 +3323,12 @@ PatchData readPatch(const Mesh& patch, const View& view, std::size_t& dropped) {
 
 // Components of patch faces connected through vertices, largest first.
 std::vector<std::vector<int>> components(const PatchData& P, const std::vector<int>& faces) {
-    std::unordered_map<int, int> parent;
-    auto find = [&](int x) {
-        auto it = parent.try_emplace(x, x).first;
-        while (it->second != x) {
-            auto& px = parent[it->second];
-            it->second = px;
-            x = it->second;
-            it = parent.find(x);
-        }
-        return x;
-    };
+    detail::DisjointSets sets(P.uv.size());
+    auto find = [&](int x) { return int(sets.find(std::size_t(x))); };
     for (int f : faces) {
         const auto& t = P.tri[std::size_t(f)];
-        const int a = find(t[0]), b = find(t[1]), c = find(t[2]);
-        parent[b] = a;
-        parent[find(c)] = a;
+        sets.unite(std::size_t(t[0]), std::size_t(t[1]));
+        sets.unite(std::size_t(t[0]), std::size_t(t[2]));
     }
     std::unordered_map<int, std::size_t> which;
     std::vector<std::vector<int>> out;

@@ -1,0 +1,98 @@
+// OBJ: the strict reader (positions and faces; the other statements are checked and ignored) and the writer.
+#include "mesh/io_detail.h"
+
+namespace fss::detail::io {
+
+Soup readObj(const Source& src, ReadReport& report) {
+    report.format = "obj";
+    static constexpr std::string_view ignored[] = {
+        "vt",       "vn",     "vp",         "l",         "p",     "o",     "g",      "s",     "usemtl",
+        "mtllib",   "cstype", "deg",        "bmat",      "step",  "curv",  "curv2",  "surf",  "parm",
+        "trim",     "hole",   "scrv",       "sp",        "end",   "con",   "mg",     "bevel", "c_interp",
+        "d_interp", "lod",    "shadow_obj", "trace_obj", "ctech", "stech", "maplib", "usemap"};
+    Lines lines(skipBomAndSpace(src.data), '#');
+    Soup soup;
+    std::vector<std::size_t> faceLine;
+    std::string_view line, t;
+    while (lines.next(line)) {
+        Tokens tok(line);
+        tok.next(t);
+        const std::string where = lines.where();
+        if (t == "v") {
+            const std::size_t index = soup.points.size();
+            soup.points.push_back(readCoordinates(src, tok, where, index, false));
+            expectOnlyNumbers(src, tok, where, "the coordinates of vertex " + std::to_string(index));
+        } else if (t == "f") {
+            const std::string face = "face " + std::to_string(soup.polygons.size());
+            Polygon poly;
+            while (tok.next(t)) {
+                // v, v/vt, v//vn or v/vt/vn: only the position index matters, the others must be integers.
+                const std::string_view v = t.substr(0, std::min(t.find('/'), t.size()));
+                long long index = 0;
+                bool ok = parseInteger(v, index);
+                for (std::size_t s = t.find('/'); ok && s != std::string_view::npos;) {
+                    const std::size_t e = std::min(t.find('/', s + 1), t.size());
+                    long long other = 0;
+                    const std::string_view part = t.substr(s + 1, e - s - 1);
+                    ok = part.empty() || parseInteger(part, other);
+                    s = e < t.size() ? e : std::string_view::npos;
+                }
+                if (!ok)
+                    src.fail(where + "expected a vertex index of " + face + " but found " + quoteToken(t));
+                if (index == 0) src.fail(where + face + " uses vertex index 0, but OBJ indices start at 1");
+                if (index < 0) {
+                    const long long absolute = static_cast<long long>(soup.points.size()) + index;
+                    if (absolute < 0)
+                        src.fail(where + face + " uses relative vertex index " + std::to_string(index) +
+                                 ", but only " + quantity(soup.points.size(), "vertex", "vertices") +
+                                 " precede it");
+                    poly.push_back(std::size_t(absolute));
+                } else {
+                    poly.push_back(std::size_t(index - 1));
+                }
+            }
+            if (poly.size() < 3)
+                src.fail(where + face + " has " + std::to_string(poly.size()) +
+                         " corners, but a face needs at least 3");
+            soup.polygons.push_back(std::move(poly));
+            faceLine.push_back(lines.number());
+        } else if (std::find(std::begin(ignored), std::end(ignored), t) == std::end(ignored)) {
+            src.fail(where + "unknown OBJ statement " + quoteToken(t));
+        }
+    }
+    // Positive indices may refer to vertices defined later in the file, so check them at the end.
+    const std::size_t nv = soup.points.size();
+    for (std::size_t f = 0; f < soup.polygons.size(); ++f)
+        for (std::size_t index : soup.polygons[f])
+            if (index >= nv)
+                src.fail("line " + std::to_string(faceLine[f]) + ": face " + std::to_string(f) +
+                         " uses vertex " + std::to_string(index + 1) + ", but the file has " +
+                         (nv == 0 ? std::string("no vertices")
+                                  : "only " + quantity(nv, "vertex", "vertices") + " (OBJ counts from 1)"));
+    return soup;
+}
+
+void writeObj(const FlatMesh& m, const std::filesystem::path& path, const WriteOptions& options) {
+    const int precision = options.precision;
+    AtomicFile file(path);
+    std::string& s = file.out();
+    s += "# written by FSS\n";
+    for (const Point3& p : m.points) {
+        s += "v ";
+        putPoint(s, p, precision);
+        s += '\n';
+        file.flushIfLarge();
+    }
+    for (std::size_t f = 0; f < m.faces(); ++f) {
+        s += 'f';
+        for (std::size_t j = 0; j < m.degree(f); ++j) {
+            s += ' ';
+            putInteger(s, m.corner(f, j) + 1);
+        }
+        s += '\n';
+        file.flushIfLarge();
+    }
+    file.commit();
+}
+
+} // namespace fss::detail::io
