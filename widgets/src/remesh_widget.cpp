@@ -2,6 +2,7 @@
 
 #include "fss/error.h"
 #include "fss/mesh_io.h"
+#include "fss/replay.h"
 #include "fss/session_file.h"
 #include "fss/widgets/fishbone_tool.h"
 #include "fss/widgets/lasso_tool.h"
@@ -100,15 +101,13 @@ private:
     bool first_ = true;
 };
 
-/// A session file being replayed by loadSession: the new session is built here and replaces the widget's
-/// only when every event has been applied.
+/// A session file being replayed by loadSession (by SessionReplay): the new session is built there and
+/// replaces the widget's only when every event has been applied.
 struct RemeshWidget::Replay {
-    SessionFile file;
-    QString path;      // the session file, as given
-    QString meshPath;  // its mesh
+    QString path;     // the session file, as given
+    QString meshPath; // its mesh
     bool cpuRenderer = false;
-    std::unique_ptr<Session> session;
-    std::size_t next = 0; // the next event to apply
+    std::unique_ptr<SessionReplay> engine;
 };
 
 struct RemeshWidget::Impl {
@@ -464,12 +463,12 @@ bool RemeshWidget::loadSession(const QString& path) {
     r->path = path;
     auto fallback = std::make_shared<std::atomic<bool>>(false);
     try {
-        r->file = loadSessionFile(path.toStdString());
-        r->meshPath = QString::fromStdString(r->file.meshPath.string());
-        r->cpuRenderer = r->file.renderer == "cpu";
-        Mesh mesh = readMesh(r->file.meshPath);
-        r->session = std::make_unique<Session>(
-            std::move(mesh), widgetSessionOptions(d_->view, r->cpuRenderer, fallback, r->file.curvature));
+        SessionFile file = loadSessionFile(path.toStdString());
+        r->meshPath = QString::fromStdString(file.meshPath.string());
+        r->cpuRenderer = file.renderer == "cpu";
+        const RendererFactory renderer =
+            widgetSessionOptions(d_->view, r->cpuRenderer, fallback, file.curvature).renderer;
+        r->engine = std::make_unique<SessionReplay>(std::move(file), renderer);
     } catch (const std::exception& e) {
         reportError(sentence(e));
         return false;
@@ -493,55 +492,43 @@ void RemeshWidget::failReplay(const QString& message) {
 
 void RemeshWidget::replayNext() {
     Replay& r = *d_->replay;
-    const std::vector<SessionEvent>& events = r.file.events;
+    SessionReplay* replay = r.engine.get();
     const auto where = [&r](std::size_t i, const QString& why) {
         return tr("%1, events[%2]: %3").arg(QFileInfo(r.path).fileName()).arg(i).arg(why);
     };
-    while (r.next < events.size()) {
+    // Undo and redo here; a scan on the GUI thread (it needs the view's GL context), its stitch and the
+    // reference's curvature on the worker thread.
+    while (!replay->done()) {
         if (d_->job->cancel.load()) return failReplay({});
-        const std::size_t i = r.next;
-        const SessionEvent& e = events[i];
-        Session* s = r.session.get();
-        d_->job->base = double(i) / double(events.size());
-        d_->job->span = 1.0 / double(events.size());
+        const std::size_t i = replay->nextEvent();
+        d_->job->base = double(i) / double(replay->eventCount());
+        d_->job->span = 1.0 / double(replay->eventCount());
         d_->job->fraction = d_->job->base;
         try {
-            if (e.kind == SessionEvent::Kind::Undo) {
-                s->undo();
-                ++r.next;
+            if (replay->file().events[i].kind != SessionEvent::Kind::Accept) {
+                replay->finishNext();
                 continue;
             }
-            if (e.kind == SessionEvent::Kind::Redo) {
-                s->redo();
-                ++r.next;
-                continue;
-            }
-            if (e.step.fishbone && (!s->fishboneCache().hasCurvature(s->reference()) ||
-                                    !s->fishboneCache().hasRayCaster(s->reference()))) {
+            if (replay->needsFishboneCache()) {
                 // The curvature of the reference, once, on the worker thread; then this event again.
-                startWork(
-                    [s](const Progress& progress) {
-                        s->fishboneCache().curvature(s->reference(), {}, progress);
-                        s->fishboneCache().rayCaster(s->reference());
-                    },
-                    [this, where, i] {
-                        if (!d_->job->error.empty())
-                            return failReplay(where(i, QString::fromStdString(d_->job->error)));
-                        if (d_->job->cancelled) return failReplay({});
-                        replayNext();
-                    });
+                startWork([replay](const Progress& progress) { replay->buildFishboneCache(progress); },
+                          [this, where, i] {
+                              if (!d_->job->error.empty())
+                                  return failReplay(where(i, QString::fromStdString(d_->job->error)));
+                              if (d_->job->cancelled) return failReplay({});
+                              replayNext();
+                          });
                 return;
             }
-            s->scan(e.step); // needs the view's GL context: GUI thread
+            replay->scanNext();
         } catch (const std::exception& ex) {
             return failReplay(where(i, sentence(ex)));
         }
-        startWork([s](const Progress& progress) { s->accept(progress); },
+        startWork([replay](const Progress& progress) { replay->finishNext(progress); },
                   [this, where, i] {
                       if (!d_->job->error.empty())
                           return failReplay(where(i, QString::fromStdString(d_->job->error)));
                       if (d_->job->cancelled) return failReplay({});
-                      ++d_->replay->next;
                       replayNext();
                   });
         return;
@@ -554,7 +541,8 @@ void RemeshWidget::finishReplay() {
     const bool fellBack = !r->cpuRenderer && d_->cpuFallbackPending->load();
     d_->cpuFallback = std::move(d_->cpuFallbackPending);
     setBusy(false);
-    installSession(std::move(r->session), r->meshPath, r->cpuRenderer, r->file.curvature);
+    const CurvatureOptions curvature = r->engine->file().curvature;
+    installSession(r->engine->takeSession(), r->meshPath, r->cpuRenderer, curvature);
     if (fellBack)
         d_->status->setText(tr("The session was recorded with the GPU renderer, which this view cannot "
                                "give; it was replayed with the CPU renderer and may differ slightly."));
