@@ -64,8 +64,13 @@ SessionOptions widgetSessionOptions(VtkView* view, bool cpuRenderer,
     SessionOptions options;
     options.curvature = curvature;
     options.renderer = [view, cpuRenderer, cpuFallback]() -> std::unique_ptr<MeshRenderer> {
-        if (!cpuRenderer)
-            if (auto renderer = bridge::createRenderer(view)) return renderer;
+        if (!cpuRenderer) {
+            try {
+                if (auto renderer = view->createMeshRenderer()) return renderer;
+            } catch (const std::exception&) {
+                // No GL context yet (never shown) or no usable GL: the CPU renderer serves.
+            }
+        }
         if (!cpuRenderer) *cpuFallback = true;
         return std::make_unique<CpuMeshRenderer>();
     };
@@ -233,7 +238,6 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     d.ghostAction = d.toolBar->addAction(tr("Ghost"));
     d.ghostAction->setCheckable(true);
     d.ghostAction->setToolTip(tr("Show the input mesh as a translucent ghost"));
-    d.ghostAction->setEnabled(bridge::features().contains(QLatin1String("ghost")));
     connect(d.ghostAction, &QAction::toggled, this, &RemeshWidget::setGhostVisible);
 
     d.undoAction = d.undoStack->createUndoAction(this, tr("&Undo"));
@@ -322,7 +326,6 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
         // Lasso and fishbone positions are screen positions of the old camera: they no longer apply.
         d_->lasso->clear();
         if (d_->fishbone->hasInput()) d_->fishbone->clear();
-        bridge::refreshPreview(d_->view);
         if (d_->session)
             d_->scanPanel->updateEdgeLength(d_->view->camera(),
                                             boundingBox(d_->session->reference()).center());
@@ -391,7 +394,7 @@ void RemeshWidget::installSession(std::unique_ptr<Session> session, const QStrin
     d_->nextScanId = nextId;
     d_->lasso->clear();
     d_->fishbone->clear();
-    bridge::setPreview(d_->view, nullptr);
+    d_->view->clearPreviewMesh();
     d_->updatingView = true;
     d_->view->setMesh(d_->mesh);
     d_->updatingView = false;
@@ -810,7 +813,10 @@ void RemeshWidget::setGhostVisible(bool visible) {
         const QSignalBlocker blocker(d_->ghostAction);
         d_->ghostAction->setChecked(visible);
     }
-    bridge::setGhost(d_->view, visible && d_->session ? &d_->session->reference() : nullptr);
+    if (visible && d_->session)
+        d_->view->setGhostMesh(d_->session->reference());
+    else
+        d_->view->clearGhostMesh();
 }
 
 void RemeshWidget::undoStep() {
@@ -849,7 +855,10 @@ void RemeshWidget::afterMeshChange() {
 
 void RemeshWidget::showPreview() {
     const ScanPreview* preview = d_->session ? d_->session->preview() : nullptr;
-    bridge::setPreview(d_->view, preview ? &preview->patch.mesh : nullptr);
+    if (preview)
+        d_->view->setPreviewMesh(preview->patch.mesh);
+    else
+        d_->view->clearPreviewMesh();
     d_->scanTool->setPreviewPending(preview != nullptr);
     d_->acceptAction->setEnabled(preview != nullptr && !isBusy());
     d_->rejectAction->setEnabled(preview != nullptr && !isBusy());
