@@ -8,6 +8,8 @@
 #include <fss/camera.h>
 #include <fss/error.h>
 #include <fss/mesh_io.h>
+#include <fss/render/colour_maps.h>
+#include <fss/render/snapshot.h>
 #include <fss/scan_pipeline.h>
 #include <fss/shapes.h>
 #include <fss/widgets/vtk_view.h>
@@ -123,6 +125,45 @@ private slots:
                     std::abs(fss::widgets::scanIdColor(a).hsvHue() - fss::widgets::scanIdColor(b).hsvHue());
                 QVERIFY2(std::min(d, 360 - d) >= 20, qPrintable(QString("ids %1 and %2").arg(a).arg(b)));
             }
+        }
+    }
+
+    void colourMapsAreTheRenderLayers() {
+        // The view colours faces with the render layer's maps (colour_maps.h), those of the snapshots.
+        for (int id : {-1, 0, 1, 5, 11}) {
+            const fss::render::Rgb c = fss::render::scanIdColor(id);
+            QCOMPARE(fss::widgets::scanIdColor(id), QColor(c[0], c[1], c[2]));
+        }
+        // A grid of right isosceles triangles (smallest angle 45°) seen frontally: every face centre has the
+        // hue of minAngleColor(45) in the view and in a snapshot from the view's camera.
+        const fss::Mesh mesh = fss::shapes::grid(8, 8);
+        auto view = std::make_unique<VtkView>();
+        view->setColorMap(ColorMap::MinAngle);
+        view->resize(400, 400);
+        view->setInitialView(fss::StandardView::PosZ);
+        view->setMesh(mesh);
+        view->show();
+        QVERIFY(QTest::qWaitForWindowExposed(view.get()));
+        const QImage image = view->grabImage();
+        const fss::Camera camera = view->camera();
+        fss::render::SnapshotOptions options;
+        options.renderer = fss::render::SnapshotOptions::Renderer::Cpu;
+        const fss::render::Snapshot snapshot = fss::render::renderSnapshot(mesh, camera, options);
+        QCOMPARE(snapshot.image.width, image.width());
+        const fss::render::Rgb c = fss::render::minAngleColor(45);
+        const int expected = QColor(c[0], c[1], c[2]).hsvHue();
+        auto hueDistance = [](int a, int b) { return std::min(std::abs(a - b), 360 - std::abs(a - b)); };
+        for (fss::FaceIndex f : mesh.faces()) {
+            const QPoint p = pixelOf(camera, centroid(mesh, f));
+            const QColor inView(at(image, p));
+            const fss::render::Rgb s = snapshot.image.pixel(p.x(), p.y());
+            const QColor inSnapshot(s[0], s[1], s[2]);
+            QVERIFY2(inView.hsvSaturation() > 100 && hueDistance(inView.hsvHue(), expected) <= 8,
+                     qPrintable(QString("face %1 is %2 in the view").arg(std::size_t(f)).arg(inView.name())));
+            QVERIFY2(hueDistance(inSnapshot.hsvHue(), inView.hsvHue()) <= 8,
+                     qPrintable(QString("face %1: view %2, snapshot %3")
+                                    .arg(std::size_t(f))
+                                    .arg(inView.name(), inSnapshot.name())));
         }
     }
 

@@ -2,6 +2,7 @@
 
 #include "fss/error.h"
 #include "fss/mesh_io.h"
+#include "fss/replay.h"
 #include "fss/session_file.h"
 #include "fss/widgets/fishbone_tool.h"
 #include "fss/widgets/lasso_tool.h"
@@ -63,8 +64,13 @@ SessionOptions widgetSessionOptions(VtkView* view, bool cpuRenderer,
     SessionOptions options;
     options.curvature = curvature;
     options.renderer = [view, cpuRenderer, cpuFallback]() -> std::unique_ptr<MeshRenderer> {
-        if (!cpuRenderer)
-            if (auto renderer = bridge::createRenderer(view)) return renderer;
+        if (!cpuRenderer) {
+            try {
+                if (auto renderer = view->createMeshRenderer()) return renderer;
+            } catch (const std::exception&) {
+                // No GL context yet (never shown) or no usable GL: the CPU renderer serves.
+            }
+        }
         if (!cpuRenderer) *cpuFallback = true;
         return std::make_unique<CpuMeshRenderer>();
     };
@@ -100,15 +106,13 @@ private:
     bool first_ = true;
 };
 
-/// A session file being replayed by loadSession: the new session is built here and replaces the widget's
-/// only when every event has been applied.
+/// A session file being replayed by loadSession (by SessionReplay): the new session is built there and
+/// replaces the widget's only when every event has been applied.
 struct RemeshWidget::Replay {
-    SessionFile file;
-    QString path;      // the session file, as given
-    QString meshPath;  // its mesh
+    QString path;     // the session file, as given
+    QString meshPath; // its mesh
     bool cpuRenderer = false;
-    std::unique_ptr<Session> session;
-    std::size_t next = 0; // the next event to apply
+    std::unique_ptr<SessionReplay> engine;
 };
 
 struct RemeshWidget::Impl {
@@ -234,7 +238,6 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     d.ghostAction = d.toolBar->addAction(tr("Ghost"));
     d.ghostAction->setCheckable(true);
     d.ghostAction->setToolTip(tr("Show the input mesh as a translucent ghost"));
-    d.ghostAction->setEnabled(bridge::features().contains(QLatin1String("ghost")));
     connect(d.ghostAction, &QAction::toggled, this, &RemeshWidget::setGhostVisible);
 
     d.undoAction = d.undoStack->createUndoAction(this, tr("&Undo"));
@@ -323,7 +326,6 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
         // Lasso and fishbone positions are screen positions of the old camera: they no longer apply.
         d_->lasso->clear();
         if (d_->fishbone->hasInput()) d_->fishbone->clear();
-        bridge::refreshPreview(d_->view);
         if (d_->session)
             d_->scanPanel->updateEdgeLength(d_->view->camera(),
                                             boundingBox(d_->session->reference()).center());
@@ -392,7 +394,7 @@ void RemeshWidget::installSession(std::unique_ptr<Session> session, const QStrin
     d_->nextScanId = nextId;
     d_->lasso->clear();
     d_->fishbone->clear();
-    bridge::setPreview(d_->view, nullptr);
+    d_->view->clearPreviewMesh();
     d_->updatingView = true;
     d_->view->setMesh(d_->mesh);
     d_->updatingView = false;
@@ -464,12 +466,12 @@ bool RemeshWidget::loadSession(const QString& path) {
     r->path = path;
     auto fallback = std::make_shared<std::atomic<bool>>(false);
     try {
-        r->file = loadSessionFile(path.toStdString());
-        r->meshPath = QString::fromStdString(r->file.meshPath.string());
-        r->cpuRenderer = r->file.renderer == "cpu";
-        Mesh mesh = readMesh(r->file.meshPath);
-        r->session = std::make_unique<Session>(
-            std::move(mesh), widgetSessionOptions(d_->view, r->cpuRenderer, fallback, r->file.curvature));
+        SessionFile file = loadSessionFile(path.toStdString());
+        r->meshPath = QString::fromStdString(file.meshPath.string());
+        r->cpuRenderer = file.renderer == "cpu";
+        const RendererFactory renderer =
+            widgetSessionOptions(d_->view, r->cpuRenderer, fallback, file.curvature).renderer;
+        r->engine = std::make_unique<SessionReplay>(std::move(file), renderer);
     } catch (const std::exception& e) {
         reportError(sentence(e));
         return false;
@@ -493,55 +495,43 @@ void RemeshWidget::failReplay(const QString& message) {
 
 void RemeshWidget::replayNext() {
     Replay& r = *d_->replay;
-    const std::vector<SessionEvent>& events = r.file.events;
+    SessionReplay* replay = r.engine.get();
     const auto where = [&r](std::size_t i, const QString& why) {
         return tr("%1, events[%2]: %3").arg(QFileInfo(r.path).fileName()).arg(i).arg(why);
     };
-    while (r.next < events.size()) {
+    // Undo and redo here; a scan on the GUI thread (it needs the view's GL context), its stitch and the
+    // reference's curvature on the worker thread.
+    while (!replay->done()) {
         if (d_->job->cancel.load()) return failReplay({});
-        const std::size_t i = r.next;
-        const SessionEvent& e = events[i];
-        Session* s = r.session.get();
-        d_->job->base = double(i) / double(events.size());
-        d_->job->span = 1.0 / double(events.size());
+        const std::size_t i = replay->nextEvent();
+        d_->job->base = double(i) / double(replay->eventCount());
+        d_->job->span = 1.0 / double(replay->eventCount());
         d_->job->fraction = d_->job->base;
         try {
-            if (e.kind == SessionEvent::Kind::Undo) {
-                s->undo();
-                ++r.next;
+            if (replay->file().events[i].kind != SessionEvent::Kind::Accept) {
+                replay->finishNext();
                 continue;
             }
-            if (e.kind == SessionEvent::Kind::Redo) {
-                s->redo();
-                ++r.next;
-                continue;
-            }
-            if (e.step.fishbone && (!s->fishboneCache().hasCurvature(s->reference()) ||
-                                    !s->fishboneCache().hasRayCaster(s->reference()))) {
+            if (replay->needsFishboneCache()) {
                 // The curvature of the reference, once, on the worker thread; then this event again.
-                startWork(
-                    [s](const Progress& progress) {
-                        s->fishboneCache().curvature(s->reference(), {}, progress);
-                        s->fishboneCache().rayCaster(s->reference());
-                    },
-                    [this, where, i] {
-                        if (!d_->job->error.empty())
-                            return failReplay(where(i, QString::fromStdString(d_->job->error)));
-                        if (d_->job->cancelled) return failReplay({});
-                        replayNext();
-                    });
+                startWork([replay](const Progress& progress) { replay->buildFishboneCache(progress); },
+                          [this, where, i] {
+                              if (!d_->job->error.empty())
+                                  return failReplay(where(i, QString::fromStdString(d_->job->error)));
+                              if (d_->job->cancelled) return failReplay({});
+                              replayNext();
+                          });
                 return;
             }
-            s->scan(e.step); // needs the view's GL context: GUI thread
+            replay->scanNext();
         } catch (const std::exception& ex) {
             return failReplay(where(i, sentence(ex)));
         }
-        startWork([s](const Progress& progress) { s->accept(progress); },
+        startWork([replay](const Progress& progress) { replay->finishNext(progress); },
                   [this, where, i] {
                       if (!d_->job->error.empty())
                           return failReplay(where(i, QString::fromStdString(d_->job->error)));
                       if (d_->job->cancelled) return failReplay({});
-                      ++d_->replay->next;
                       replayNext();
                   });
         return;
@@ -554,7 +544,8 @@ void RemeshWidget::finishReplay() {
     const bool fellBack = !r->cpuRenderer && d_->cpuFallbackPending->load();
     d_->cpuFallback = std::move(d_->cpuFallbackPending);
     setBusy(false);
-    installSession(std::move(r->session), r->meshPath, r->cpuRenderer, r->file.curvature);
+    const CurvatureOptions curvature = r->engine->file().curvature;
+    installSession(r->engine->takeSession(), r->meshPath, r->cpuRenderer, curvature);
     if (fellBack)
         d_->status->setText(tr("The session was recorded with the GPU renderer, which this view cannot "
                                "give; it was replayed with the CPU renderer and may differ slightly."));
@@ -822,7 +813,10 @@ void RemeshWidget::setGhostVisible(bool visible) {
         const QSignalBlocker blocker(d_->ghostAction);
         d_->ghostAction->setChecked(visible);
     }
-    bridge::setGhost(d_->view, visible && d_->session ? &d_->session->reference() : nullptr);
+    if (visible && d_->session)
+        d_->view->setGhostMesh(d_->session->reference());
+    else
+        d_->view->clearGhostMesh();
 }
 
 void RemeshWidget::undoStep() {
@@ -861,7 +855,10 @@ void RemeshWidget::afterMeshChange() {
 
 void RemeshWidget::showPreview() {
     const ScanPreview* preview = d_->session ? d_->session->preview() : nullptr;
-    bridge::setPreview(d_->view, preview ? &preview->patch.mesh : nullptr);
+    if (preview)
+        d_->view->setPreviewMesh(preview->patch.mesh);
+    else
+        d_->view->clearPreviewMesh();
     d_->scanTool->setPreviewPending(preview != nullptr);
     d_->acceptAction->setEnabled(preview != nullptr && !isBusy());
     d_->rejectAction->setEnabled(preview != nullptr && !isBusy());

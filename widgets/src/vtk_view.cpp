@@ -1,6 +1,7 @@
 #include "fss/widgets/vtk_view.h"
 
 #include "fss/error.h"
+#include "fss/render/colour_maps.h"
 #include "fss/render/gpu_mesh_renderer.h"
 
 // GL constants come from Qt's qopengl.h (through QOpenGLWidget); vtk_glew.h cannot be combined with it
@@ -70,39 +71,6 @@ public:
     }
 };
 vtkStandardNewMacro(NavigationStyle);
-
-using Rgb = std::array<double, 3>;
-
-Rgb mix(const Rgb& a, const Rgb& b, double t) {
-    return {a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t};
-}
-
-constexpr Rgb kRed{0.85, 0.12, 0.10};
-constexpr Rgb kOrange{0.95, 0.50, 0.10};
-constexpr Rgb kYellow{0.95, 0.85, 0.15};
-constexpr Rgb kGreen{0.15, 0.70, 0.25};
-constexpr Rgb kGrey{0.60, 0.60, 0.60};
-
-// 0° red → 30° yellow → 60° green.
-Rgb minAngleColor(double deg) {
-    const double t = std::clamp(deg / 60.0, 0.0, 1.0);
-    return t < 0.5 ? mix(kRed, kYellow, t * 2) : mix(kYellow, kGreen, (t - 0.5) * 2);
-}
-
-Rgb valenceColor(int deviation) {
-    switch (deviation) {
-    case -1:
-        return kGrey;
-    case 0:
-        return kGreen;
-    case 1:
-        return kYellow;
-    case 2:
-        return kOrange;
-    default:
-        return kRed;
-    }
-}
 
 double cornerAngleDeg(const Point3& at, const Point3& a, const Point3& b) {
     const Vector3 u = a - at, v = b - at;
@@ -240,10 +208,8 @@ private:
 } // namespace
 
 QColor scanIdColor(int scanId) {
-    if (scanId < 0) return QColor::fromRgbF(0.6f, 0.6f, 0.6f);
-    // Golden-ratio hue steps: any two ids among the first dozen differ by at least ~20° of hue.
-    const double hue = std::fmod(0.05 + 0.6180339887498949 * double(scanId), 1.0);
-    return QColor::fromHsvF(float(hue), 0.80f, 0.95f);
+    const render::Rgb c = render::scanIdColor(scanId);
+    return QColor(c[0], c[1], c[2]);
 }
 
 std::optional<ColorMap> parseColorMap(std::string_view name) {
@@ -320,22 +286,20 @@ struct VtkView::Impl {
         colors->SetNumberOfTuples(n);
         for (vtkIdType f = 0; f < n; ++f) {
             const std::size_t i = std::size_t(f);
-            Rgb c;
+            // The render layer's colour maps (colour_maps.h), the snapshots' colours.
+            render::Rgb c;
             switch (colorMap) {
             case ColorMap::MinAngle:
-                c = minAngleColor(faceMinAngle[i]);
+                c = render::minAngleColor(faceMinAngle[i]);
                 break;
             case ColorMap::Valence:
-                c = valenceColor(faceValenceDeviation[i]);
+                c = render::valenceColor(faceValenceDeviation[i]);
                 break;
-            default: {
-                const QColor q = scanIdColor(faceScanId[i]);
-                c = {q.redF(), q.greenF(), q.blueF()};
-            }
+            default:
+                c = render::scanIdColor(faceScanId[i]);
             }
             for (int k = 0; k < 3; ++k)
-                colors->SetTypedComponent(f, k,
-                                          static_cast<unsigned char>(std::lround(c[std::size_t(k)] * 255)));
+                colors->SetTypedComponent(f, k, c[std::size_t(k)]);
         }
         polyData->GetCellData()->SetScalars(colors);
         mapper->ScalarVisibilityOn();

@@ -33,14 +33,6 @@ double cornerAngleDeg(const Eigen::Vector3d& at, const Eigen::Vector3d& a, const
     return std::acos(std::clamp(u.dot(v) / (lu * lv), -1.0, 1.0)) * 180.0 / std::numbers::pi;
 }
 
-Rgb mix(const Rgb& a, const Rgb& b, double t) {
-    Rgb c;
-    for (int i = 0; i < 3; ++i)
-        c[std::size_t(i)] =
-            std::uint8_t(std::lround(a[std::size_t(i)] + t * (b[std::size_t(i)] - a[std::size_t(i)])));
-    return c;
-}
-
 } // namespace
 
 std::size_t Image::countDifferentFrom(const Rgb& colour) const {
@@ -48,12 +40,6 @@ std::size_t Image::countDifferentFrom(const Rgb& colour) const {
     for (std::size_t i = 0; i + 2 < rgb.size(); i += 3)
         n += rgb[i] != colour[0] || rgb[i + 1] != colour[1] || rgb[i + 2] != colour[2];
     return n;
-}
-
-Rgb minAngleColor(double minAngleDeg) {
-    static constexpr Rgb kRed{215, 25, 28}, kYellow{250, 220, 40}, kGreen{26, 150, 65};
-    const double t = std::clamp(minAngleDeg / 60.0, 0.0, 1.0);
-    return t < 0.5 ? mix(kRed, kYellow, t * 2) : mix(kYellow, kGreen, (t - 0.5) * 2);
 }
 
 std::vector<Rgb> minAngleFaceColors(const Mesh& mesh) {

@@ -2,6 +2,7 @@
 
 #include "fss/camera_projector.h"
 #include "fss/error.h"
+#include "fss/mask_triangulate.h"
 
 #include "base/parallel_rows.h"
 
@@ -543,35 +544,29 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
     if (result.counts.frontFacing == 0)
         throw InvalidInputError("No rib vertex of the fishbone lands on the front of the surface.");
 
-    progress.report(0.7, "masks");
-    t = Clock::now();
-    if (params.lasso) applyLasso(result.grid, *params.lasso);
-    result.counts.afterLasso = result.grid.admissibleCount();
-    if (result.counts.afterLasso == 0)
-        throw InvalidInputError("The lasso selects no part of the fishbone grid.");
-    if (!currentIsReference) applyQualityMask(result.grid, current, result.currentBuffers, params.quality);
-    result.counts.afterQuality = result.grid.admissibleCount();
-    erode(result.grid, params.erodeRadius);
-    dilate(result.grid, params.dilateRadius);
-    removeUntriangulatableSamples(result.grid);
-    result.counts.afterMorphology = result.grid.validCount();
-    result.timings.masks = secondsSince(t);
-
-    progress.report(0.85, "triangulate");
-    t = Clock::now();
-    TriangulateOptions tri = params.triangulate;
-    tri.maxEdgeFootprints *= std::max(1.0, h);
-    result.patch = triangulateGrid(result.grid, tri);
-    result.timings.triangulate = secondsSince(t);
-    if (result.patch.mesh.number_of_faces() == 0) {
-        if (result.counts.afterQuality == 0)
-            throw InvalidInputError(
-                "Every sample of this scan is worse than the mesh already there, so nothing "
-                "would change (use force-replace to override).");
-        throw InvalidInputError(
-            "Nothing is left to triangulate after the masks; enlarge the lasso, reduce the "
-            "erosion or reduce h.");
+    MaskStages stages;
+    if (params.lasso) stages.lasso = &*params.lasso;
+    if (!currentIsReference) {
+        stages.current = &current;
+        stages.currentBuffers = &result.currentBuffers;
     }
+    stages.quality = params.quality;
+    stages.morphology = {.radius = params.erodeRadius, .dilateRadius = params.dilateRadius};
+    stages.triangulate = params.triangulate;
+    stages.triangulate.maxEdgeFootprints *= std::max(1.0, h);
+    stages.atLasso = {0.7, "masks"};
+    stages.atQuality = stages.atMorphology = {};
+    stages.atTriangulate = {0.85, "triangulate"};
+    stages.lassoSelectsNothing = "The lasso selects no part of the fishbone grid.";
+    stages.nothingLeft = "Nothing is left to triangulate after the masks; enlarge the lasso, reduce the "
+                         "erosion or reduce h.";
+    MaskedPatch masked = maskAndTriangulate(result.grid, stages, progress);
+    result.patch = std::move(masked.patch);
+    result.counts.afterLasso = masked.counts.afterLasso;
+    result.counts.afterQuality = masked.counts.afterQuality;
+    result.counts.afterMorphology = masked.counts.afterMorphology;
+    result.timings.masks = masked.timings.lasso + masked.timings.qualityMask + masked.timings.morphology;
+    result.timings.triangulate = masked.timings.triangulate;
     result.timings.total = secondsSince(start);
     return result;
 }

@@ -6,6 +6,7 @@
 #include "fss/error.h"
 #include "fss/fishbone_scan.h"
 #include "fss/mask.h"
+#include "fss/mask_triangulate.h"
 #include "fss/scan.h"
 #include "fss/scan_pipeline.h"
 #include "fss/triangulate.h"
@@ -324,21 +325,24 @@ RegularScan regularScan(const Mesh& reference, MeshRenderer& referenceRenderer, 
     const double maxAngle = maxSamplingAngleDeg * std::numbers::pi / 180.0;
     for (Sample& s : grid.samples)
         if (s.admissible && s.samplingAngle > maxAngle) s.admissible = s.valid = false;
-    QualityMaskOptions q;
-    q.margin = options.qualityMargin;
-    applyQualityMask(grid, current, out.currentBuffers, q);
+    MaskStages stages;
+    stages.current = &current;
+    stages.currentBuffers = &out.currentBuffers;
+    stages.quality.margin = options.qualityMargin;
+    std::vector<char> readmit;
     if (fillRadius >= 0) {
-        // Pixels that show an input face of the current mesh, dilated by fillRadius.
-        const std::vector<char> near = pixelsNearInputFaces(current, out.currentBuffers, fillRadius);
+        // Pixels that show an input face of the current mesh, dilated by fillRadius: their samples come
+        // back after the quality mask.
+        readmit = pixelsNearInputFaces(current, out.currentBuffers, fillRadius);
         for (std::size_t i = 0; i < grid.samples.size(); ++i)
-            if (admissibleBefore[i] && near[i]) grid.samples[i].admissible = grid.samples[i].valid = true;
+            readmit[i] = readmit[i] && admissibleBefore[i];
+        stages.readmit = &readmit;
     }
-    erode(grid, options.morphologyRadius);
-    dilate(grid, options.morphologyRadius);
-    removeUntriangulatableSamples(grid);
-    out.patch = triangulateGrid(grid, TriangulateOptions{});
-    if (out.patch.mesh.number_of_faces() == 0)
-        throw InvalidInputError("No sample of the view is better than the mesh already there.");
+    stages.morphology = {.radius = options.morphologyRadius, .dilateRadius = options.morphologyRadius};
+    stages.atQuality = stages.atMorphology = stages.atTriangulate = {};
+    stages.nothingBetter = stages.nothingLeft =
+        "No sample of the view is better than the mesh already there.";
+    out.patch = maskAndTriangulate(grid, stages).patch;
     return out;
 }
 
@@ -518,12 +522,11 @@ Patch regionScan(const Mesh& reference, const FrameBuffers& ref, const std::vect
     for (std::size_t i = 0; i < grid.samples.size(); ++i)
         if (!keep[i] || (restrictTo && !(*restrictTo)[i]))
             grid.samples[i].admissible = grid.samples[i].valid = false;
-    erode(grid, morphologyRadius);
-    dilate(grid, morphologyRadius);
-    removeUntriangulatableSamples(grid);
-    Patch patch = triangulateGrid(grid, TriangulateOptions{});
-    if (patch.mesh.number_of_faces() == 0) throw InvalidInputError("The view owns no part of the surface.");
-    return patch;
+    MaskStages stages; // no lasso, no quality mask: the region replaces whatever is there
+    stages.morphology = {.radius = morphologyRadius, .dilateRadius = morphologyRadius};
+    stages.atQuality = stages.atMorphology = stages.atTriangulate = {};
+    stages.nothingBetter = stages.nothingLeft = "The view owns no part of the surface.";
+    return maskAndTriangulate(grid, stages).patch;
 }
 
 } // namespace

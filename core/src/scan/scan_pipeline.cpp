@@ -1,8 +1,11 @@
 #include "fss/scan_pipeline.h"
 
 #include "fss/error.h"
+#include "fss/mask_triangulate.h"
 
 #include <chrono>
+#include <string>
+#include <utility>
 
 namespace fss {
 namespace {
@@ -11,7 +14,60 @@ using Clock = std::chrono::steady_clock;
 
 double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+void reportAt(const Progress& progress, const ProgressMark& mark) {
+    if (!mark.stage.empty()) progress.report(mark.fraction, mark.stage);
+}
+
 } // namespace
+
+MaskedPatch maskAndTriangulate(SampleGrid& grid, const MaskStages& stages, const Progress& progress) {
+    ScanWorkspace workspace;
+    return maskAndTriangulate(grid, stages, workspace, progress);
+}
+
+MaskedPatch maskAndTriangulate(SampleGrid& grid, const MaskStages& stages, ScanWorkspace& workspace,
+                               const Progress& progress) {
+    MaskedPatch result;
+    reportAt(progress, stages.atLasso);
+    auto t = Clock::now();
+    if (stages.lasso) applyLasso(grid, *stages.lasso);
+    result.timings.lasso = secondsSince(t);
+    result.counts.afterLasso = grid.admissibleCount();
+    if (stages.lasso && result.counts.afterLasso == 0) throw InvalidInputError(stages.lassoSelectsNothing);
+
+    reportAt(progress, stages.atQuality);
+    t = Clock::now();
+    if (stages.current) {
+        if (!stages.currentBuffers)
+            throw InvalidInputError(
+                "The quality mask needs the current mesh's buffers from the scan camera.");
+        applyQualityMask(grid, *stages.current, *stages.currentBuffers, stages.quality);
+    }
+    if (stages.readmit) {
+        const std::vector<char>& readmit = *stages.readmit;
+        if (readmit.size() != grid.samples.size())
+            throw InvalidInputError("The re-admission mask has " + std::to_string(readmit.size()) +
+                                    " flags for " + std::to_string(grid.samples.size()) + " samples.");
+        for (std::size_t i = 0; i < grid.samples.size(); ++i)
+            if (readmit[i]) grid.samples[i].admissible = grid.samples[i].valid = true;
+    }
+    result.timings.qualityMask = secondsSince(t);
+    result.counts.afterQuality = grid.admissibleCount();
+
+    reportAt(progress, stages.atMorphology);
+    t = Clock::now();
+    applyMorphology(grid, stages.morphology, workspace);
+    result.timings.morphology = secondsSince(t);
+    result.counts.afterMorphology = grid.validCount();
+
+    reportAt(progress, stages.atTriangulate);
+    t = Clock::now();
+    result.patch = triangulateGrid(grid, stages.triangulate, workspace);
+    result.timings.triangulate = secondsSince(t);
+    if (result.patch.mesh.number_of_faces() == 0)
+        throw InvalidInputError(result.counts.afterQuality == 0 ? stages.nothingBetter : stages.nothingLeft);
+    return result;
+}
 
 ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, const Mesh& current,
                      MeshRenderer& currentRenderer, const ScanParams& params, const Progress& progress) {
@@ -61,37 +117,24 @@ ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, con
     if (result.counts.frontFacing == 0)
         throw InvalidInputError("The scan camera sees only the back of the surface; it is probably inside the mesh.");
 
-    t = Clock::now();
-    if (params.lasso) applyLasso(result.grid, *params.lasso);
-    result.timings.lasso = secondsSince(t);
-    result.counts.afterLasso = result.grid.admissibleCount();
-    if (result.counts.afterLasso == 0)
-        throw InvalidInputError("The lasso selects no part of the visible surface.");
-
-    progress.report(0.6, "quality mask");
-    t = Clock::now();
-    if (!currentIsReference) applyQualityMask(result.grid, current, result.currentBuffers, params.quality);
-    result.timings.qualityMask = secondsSince(t);
-    result.counts.afterQuality = result.grid.admissibleCount();
-
-    progress.report(0.7, "morphology");
-    t = Clock::now();
-    applyMorphology(result.grid, {.radius = params.erodeRadius, .dilateRadius = params.dilateRadius},
-                    workspace);
-    result.timings.morphology = secondsSince(t);
-    result.counts.afterMorphology = result.grid.validCount();
-
-    progress.report(0.8, "triangulate");
-    t = Clock::now();
-    result.patch = triangulateGrid(result.grid, params.triangulate, workspace);
-    result.timings.triangulate = secondsSince(t);
-    if (result.patch.mesh.number_of_faces() == 0) {
-        if (result.counts.afterQuality == 0)
-            throw InvalidInputError("Every sample of this scan is worse than the mesh already there, so nothing "
-                                    "would change (use force-replace to override).");
-        throw InvalidInputError("Nothing is left to triangulate after the masks; enlarge the lasso or reduce the "
-                                "erosion.");
+    MaskStages stages;
+    if (params.lasso) stages.lasso = &*params.lasso;
+    if (!currentIsReference) {
+        stages.current = &current;
+        stages.currentBuffers = &result.currentBuffers;
     }
+    stages.quality = params.quality;
+    stages.morphology = {.radius = params.erodeRadius, .dilateRadius = params.dilateRadius};
+    stages.triangulate = params.triangulate;
+    MaskedPatch masked = maskAndTriangulate(result.grid, stages, workspace, progress);
+    result.patch = std::move(masked.patch);
+    result.counts.afterLasso = masked.counts.afterLasso;
+    result.counts.afterQuality = masked.counts.afterQuality;
+    result.counts.afterMorphology = masked.counts.afterMorphology;
+    result.timings.lasso = masked.timings.lasso;
+    result.timings.qualityMask = masked.timings.qualityMask;
+    result.timings.morphology = masked.timings.morphology;
+    result.timings.triangulate = masked.timings.triangulate;
     result.timings.total = secondsSince(start);
     progress.report(1.0, "done");
     return result;

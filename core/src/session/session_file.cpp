@@ -1,8 +1,10 @@
-// Session files: JSON writer, validating reader and replay (session_file.h).
+// Session files: JSON writer, validating reader and replay (session_file.h; the replay itself is
+// SessionReplay, replay.h).
 #include "fss/session_file.h"
 
 #include "fss/error.h"
 #include "fss/mesh_io.h"
+#include "fss/replay.h"
 #include "fss/sha256.h"
 
 #include <nlohmann/json.hpp>
@@ -640,72 +642,11 @@ SessionFile loadSessionFile(const std::filesystem::path& path, const SessionFile
 ReplayResult replaySession(const SessionFile& file, const RendererFactory& renderer,
                            const Progress& progress) {
     const auto start = std::chrono::steady_clock::now();
-    const std::string name = file.source.empty() ? std::string("the session") : file.source.string();
-    if (!file.meshSha256.empty() && sha256OfFile(file.meshPath) != file.meshSha256)
-        throw IoError(name + ": the mesh " + file.meshPath.string() +
-                      " does not match mesh.sha256 (the file changed since the session was recorded).");
-    Mesh reference = readMesh(file.meshPath);
-    const double readSeconds = seconds(start);
-
-    SessionOptions options;
-    options.renderer = renderer;
-    options.curvature = file.curvature;
-    std::size_t accepts = 0;
-    for (const SessionEvent& e : file.events)
-        accepts += e.kind == SessionEvent::Kind::Accept;
-    options.maxUndoSteps = std::max<std::size_t>(options.maxUndoSteps, accepts);
-    ReplayResult result{Session(std::move(reference), std::move(options)), {}, readSeconds, 0};
-
-    const std::size_t n = file.events.size();
-    // Inner stages report their own fractions (some restart at 0 per sub-stage): keep the total monotone.
-    double last = 0;
-    auto report = [&progress, &last](double fraction, const std::string& stage) {
-        last = std::max(last, std::min(fraction, 1.0));
-        progress.report(last, stage);
-    };
-    for (std::size_t i = 0; i < n; ++i) {
-        const SessionEvent& e = file.events[i];
-        const std::string label = "events[" + std::to_string(i) + "]";
-        auto inner = [&](double from, double to, const std::string& what) {
-            return Progress([&report, i, n, from, to, what](double f, std::string_view stage) {
-                report((double(i) + from + (to - from) * std::clamp(f, 0.0, 1.0)) / double(n),
-                       what + (stage.empty() ? std::string() : ": " + std::string(stage)));
-                return true;
-            });
-        };
-        ReplayedEvent done;
-        done.kind = e.kind;
-        const auto eventStart = std::chrono::steady_clock::now();
-        try {
-            switch (e.kind) {
-            case SessionEvent::Kind::Accept: {
-                done.fishbone = e.step.fishbone.has_value();
-                const ScanPreview& preview = result.session.scan(e.step, inner(0.0, 0.8, label + " scan"));
-                done.scanSeconds = seconds(eventStart);
-                done.patchFaces = preview.patch.mesh.number_of_faces();
-                const auto stitchStart = std::chrono::steady_clock::now();
-                done.stitch = result.session.accept(inner(0.8, 1.0, label + " stitch"));
-                done.stitchSeconds = seconds(stitchStart);
-                break;
-            }
-            case SessionEvent::Kind::Undo:
-                report(double(i) / double(n), label + " undo");
-                result.session.undo();
-                break;
-            case SessionEvent::Kind::Redo:
-                report(double(i) / double(n), label + " redo");
-                result.session.redo();
-                break;
-            }
-        } catch (const CancelledError&) {
-            throw;
-        } catch (const InvalidInputError& err) {
-            throw InvalidInputError(name + ", " + label + " (" + sessionEventKindName(e.kind) + "): " + err.what());
-        }
-        done.seconds = seconds(eventStart);
-        result.events.push_back(std::move(done));
-    }
-    report(1.0, "done");
+    SessionReplay replay(file, renderer);
+    while (!replay.done())
+        replay.step(progress);
+    progress.report(1.0, "done");
+    ReplayResult result{std::move(*replay.takeSession()), replay.events(), replay.readSeconds(), 0};
     result.totalSeconds = seconds(start);
     return result;
 }

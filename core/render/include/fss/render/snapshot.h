@@ -10,6 +10,7 @@
 #include "fss/camera.h"
 #include "fss/frame_buffers.h"
 #include "fss/mesh.h"
+#include "fss/render/colour_maps.h"
 #include "fss/render/renderer_choice.h"
 
 #include <array>
@@ -20,9 +21,6 @@
 #include <vector>
 
 namespace fss::render {
-
-/// An 8-bit colour.
-using Rgb = std::array<std::uint8_t, 3>;
 
 /// An 8-bit RGB image, row 0 at the top, 3 bytes per pixel, row-major.
 struct Image {
@@ -37,12 +35,8 @@ struct Image {
     std::size_t countDifferentFrom(const Rgb& colour) const;
 };
 
-/// The minimum-angle colour map of fss-demo: red at 0°, yellow at 30°, green at 60° (an equilateral
-/// triangle) and above, linear in between.
-Rgb minAngleColor(double minAngleDeg);
-
-/// Per-face colours of \p mesh by its smallest corner angle (minAngleColor), indexed by Face_index (one
-/// entry per face slot, removed faces included and grey).
+/// Per-face colours of \p mesh by its smallest corner angle (minAngleColor, colour_maps.h), indexed by
+/// Face_index (one entry per face slot, removed faces included and grey).
 std::vector<Rgb> minAngleFaceColors(const Mesh& mesh);
 
 /// How a snapshot is drawn.
