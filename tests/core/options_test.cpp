@@ -33,13 +33,21 @@ template <class Options> struct Case {
     std::string requirement; // "must be in [0, 30), not 45"
 };
 
+// "Owner::field requirement" (appended piece by piece: GCC 12 warns falsely about chains of operator+).
+std::string sentence(const char* owner, const std::string& field, const std::string& requirement,
+                     const char* end = "") {
+    std::string s = owner;
+    s.append("::").append(field).append(" ").append(requirement).append(end);
+    return s;
+}
+
 // Applies every case to \p valid and checks the error: its type, field(), requirement() and what().
 template <class Options>
 void expectRefused(const char* owner, const Options& valid, const std::vector<Case<Options>>& cases,
                    const std::function<void(const Options&)>& validate) {
     ASSERT_NO_THROW(validate(valid));
     for (const Case<Options>& c : cases) {
-        SCOPED_TRACE(std::string(owner) + "::" + c.field + " " + c.requirement);
+        SCOPED_TRACE(sentence(owner, c.field, c.requirement));
         Options o = valid;
         c.edit(o);
         try {
@@ -49,7 +57,7 @@ void expectRefused(const char* owner, const Options& valid, const std::vector<Ca
             EXPECT_EQ(e.owner(), owner);
             EXPECT_EQ(e.field(), c.field);
             EXPECT_EQ(e.requirement(), c.requirement);
-            EXPECT_EQ(std::string(e.what()), std::string(owner) + "::" + c.field + " " + c.requirement + ".");
+            EXPECT_EQ(std::string(e.what()), sentence(owner, c.field, c.requirement, "."));
         }
     }
 }
