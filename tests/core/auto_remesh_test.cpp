@@ -476,6 +476,15 @@ TEST(AutoRemesh, BadOptionsAreRefusedWithOneSentence) {
     o.seamRelaxMinAngleDeg = 60;
     EXPECT_THROW(fss::autoRemesh(cube, o), fss::InvalidInputError);
     EXPECT_THROW(fss::autoRemesh(fss::Mesh{}, {}), fss::InvalidInputError);
+    // The sentence names the field and its range (AutoOptions::validate), the stitch's options as its own.
+    o = {};
+    o.stitch.minAngleFloorDeg = 30;
+    try {
+        fss::autoRemesh(cube, o);
+        ADD_FAILURE() << "no error";
+    } catch (const fss::InvalidOptionError& e) {
+        EXPECT_STREQ(e.what(), "AutoOptions::stitch.minAngleFloorDeg must be in [0, 30), not 30.");
+    }
 }
 
 TEST(AutoRemesh, CancellationStopsTheRun) {

@@ -267,7 +267,7 @@ TEST(FishboneScan, BadFishbonesGiveOneSentence) {
             [&] { fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache); });
     };
     fss::FishboneParams fb;
-    EXPECT_EQ(scan(fb), "A fishbone scan needs a seed point or a drawn backbone.");
+    EXPECT_EQ(scan(fb), "FishboneParams::seed must be given when there is no drawn backbone.");
     // A background pixel of the sampling image (the default h = 4 samples the 160² scan on 40²), as a
     // point of the scan image.
     const fss::Camera sampling = fss::fishboneSamplingCamera(scene.camera, fb);
@@ -282,21 +282,29 @@ TEST(FishboneScan, BadFishbonesGiveOneSentence) {
     EXPECT_EQ(scan(fb), "The fishbone seed " + point(background) +
                             " lies on the background; pick a point on the surface.");
     fb.seed = Vector2d(500, 1);
-    EXPECT_EQ(scan(fb), "The fishbone seed (500.0, 1.0) lies outside the 160x160 scan image.");
+    EXPECT_EQ(scan(fb), "FishboneParams::seed must lie inside the 160x160 scan image, not (500, 1).");
     fb.seed = scene.ridgeSeed();
     fb.spacing = 100;
-    EXPECT_EQ(scan(fb), "The fishbone spacing h = 100 pixels is outside [0.5, 40] for a 160x160 scan.");
+    EXPECT_EQ(scan(fb),
+              "FishboneParams::spacing must be in [0.5, 40] for a 160x160 scan: the spacing h = 100 "
+              "pixels is outside it.");
     fb.spacing = 3;
     fb.samplingFactor = -1;
-    EXPECT_EQ(scan(fb), "The fishbone sampling factor -1 is negative (0 chooses it automatically).");
+    EXPECT_EQ(scan(fb),
+              "FishboneParams::samplingFactor must be at least 0 (0 chooses it automatically), not -1.");
     fb.samplingFactor = 3;
-    EXPECT_EQ(scan(fb), "The fishbone sampling factor 3 does not divide the 160x160 scan image.");
+    EXPECT_EQ(scan(fb),
+              "FishboneParams::samplingFactor must divide the scan image's width and height: the sampling "
+              "factor 3 does not divide the 160x160 scan image.");
     fb.samplingFactor = 4;
-    EXPECT_EQ(scan(fb), "The fishbone sampling factor 4 exceeds the spacing h = 3 pixels (the sampling image "
-                        "needs at least one pixel per sample).");
+    EXPECT_EQ(scan(fb), "FishboneParams::samplingFactor must be at most the spacing h: the sampling factor 4 "
+                        "exceeds the spacing h = 3 pixels (the sampling image needs at least one pixel per "
+                        "sample).");
     fb.samplingFactor = 0;
     fb.keyRibs = {*fb.seed};
-    EXPECT_EQ(scan(fb), "Key-rib mode needs at least two key-ribs to blend between, 1 given.");
+    EXPECT_EQ(scan(fb),
+              "FishboneParams::keyRibs must give, with the other key-ribs, none or at least two key-ribs "
+              "to blend between, not 1.");
     fb.keyRibs = {*fb.seed, *fb.seed + Vector2d(0.5, 0)};
     EXPECT_NE(scan(fb).find("Two key-ribs fall on the same backbone sample"), std::string::npos);
     fb.keyRibs = {*fb.seed, *fb.seed + Vector2d(0, 30)};

@@ -18,6 +18,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -124,6 +125,7 @@ void expectSame(const fss::ScanStep& a, const fss::ScanStep& b) {
     EXPECT_EQ(sa.minComponentFaces, sb.minComponentFaces);
     EXPECT_EQ(sa.collectGarbage, sb.collectGarbage);
     EXPECT_EQ(sa.peelTrim, sb.peelTrim);
+    EXPECT_TRUE(sameBits(sa.outsideMinAngleFloorDeg, sb.outsideMinAngleFloorDeg));
 }
 
 std::string slurpText(const std::filesystem::path& p) {
@@ -176,6 +178,7 @@ fss::ScanStep regularStep() {
     s.stitch.maxTrimRounds = 9;
     s.stitch.minComponentFaces = 5;
     s.stitch.peelTrim = true;
+    s.stitch.outsideMinAngleFloorDeg = 7.5;
     s.stitch.collectGarbage = true;
     return s;
 }
@@ -208,7 +211,7 @@ fss::ScanStep fishboneStep() {
     fb.raycast.verifyUnoccluded = true;
     fb.creaseAngleDeg = 42.5;
     fb.creaseSnapRadius = 0.75;
-    fb.samplingFactor = 3;
+    fb.samplingFactor = 2; // divides 200 x 150 and is at most h, as FishboneParams::validate requires
     s.fishbone = fb;
     return s;
 }
@@ -417,7 +420,7 @@ TEST_F(BadSessionFile, FishboneSamplingFactorIsOptionalAndOneWhenAbsent) {
     };
     Json j = good_;
     ASSERT_TRUE(j["events"][1]["step"]["fishbone"].contains("sampling_factor"));
-    EXPECT_EQ(samplingFactorOf(j), 3);
+    EXPECT_EQ(samplingFactorOf(j), 2);
     j["events"][1]["step"]["fishbone"]["sampling_factor"] = 0;
     EXPECT_EQ(samplingFactorOf(j), 0);
     j["events"][1]["step"]["fishbone"].erase("sampling_factor");
@@ -450,17 +453,19 @@ TEST_F(BadSessionFile, WrongTypesAndValues) {
          },
          ": events[0].step.lasso must enclose an area (at least 3 points, not all collinear)."},
         {[](Json& j) { j["events"][0]["step"]["erode_radius"] = -1; },
-         ": events[0].step.erode_radius must be an integer in [0, 1024]."},
+         ": events[0].step.erode_radius must be in [0, 1024], not -1."},
         {[](Json& j) { j["events"][0]["step"]["quality_mask"]["force_replace"] = 1; },
          ": events[0].step.quality_mask.force_replace must be true or false."},
         {[](Json& j) { j["events"][0]["step"]["quality_mask"]["margin"] = 1.5; },
-         ": events[0].step.quality_mask.margin must be a number in [0, 1)."},
+         ": events[0].step.quality_mask.margin must be in [0, 1), not 1.5."},
         {[](Json& j) { j["events"][0]["step"]["grid"] = "hexagonal"; },
          ": events[0].step.grid must be one of \"regular\", \"fishbone\", not \"hexagonal\"."},
         {[](Json& j) { j["events"][0]["step"]["fishbone"] = j["events"][1]["step"]["fishbone"]; },
          ": events[0].step.fishbone must not be given when grid is \"regular\"."},
         {[](Json& j) { j["events"][1]["step"]["fishbone"]["h"] = -4; },
-         ": events[1].step.fishbone.h must be a positive number."},
+         ": events[1].step.fishbone.h must be in [0.5, 37.5] for a 200x150 scan: the spacing h = -4 pixels "
+         "is "
+         "outside it."},
         {[](Json& j) { j["events"][1]["step"]["fishbone"]["direction"] = "sideways"; },
          ": events[1].step.fishbone.direction must be one of \"min\", \"max\", not \"sideways\"."},
         {[](Json& j) {
@@ -471,14 +476,15 @@ TEST_F(BadSessionFile, WrongTypesAndValues) {
              j["events"][1]["step"]["fishbone"]["seed"] = nullptr;
              j["events"][1]["step"]["fishbone"]["drawn_backbone"] = Json::array();
          },
-         ": events[1].step.fishbone.seed must be given when drawn_backbone is empty."},
+         ": events[1].step.fishbone.seed must be given when there is no drawn backbone."},
         {[](Json& j) { j["events"][1]["step"]["fishbone"]["tracing"]["backbone"]["low_anisotropy"] = true; },
          ": events[1].step.fishbone.tracing.backbone.low_anisotropy must be one of \"stop\", "
          "\"continue_straight\"."},
         {[](Json& j) { j["events"][1]["step"]["fishbone"]["sampling_factor"] = 65; },
-         ": events[1].step.fishbone.sampling_factor must be an integer from 0 (automatic) to 64."},
+         ": events[1].step.fishbone.sampling_factor must divide the scan image's width and height: the "
+         "sampling factor 65 does not divide the 200x150 scan image."},
         {[](Json& j) { j["events"][1]["step"]["stitch"]["seam_rings"] = 1.5; },
-         ": events[1].step.stitch.seam_rings must be an integer of at least 0."},
+         ": events[1].step.stitch.seam_rings must be an integer."},
         {[](Json& j) { j["events"][0]["step"]["camera"]["eyes"] = 1; },
          ": events[0].step.camera has an unknown field 'eyes'."},
         {[](Json& j) { j["events"][2]["kind"] = "rotate"; },
@@ -495,7 +501,7 @@ TEST_F(BadSessionFile, WrongTypesAndValues) {
         {[](Json& j) { j["events"] = Json::object(); }, ": events must be an array of events."},
         {[](Json& j) { j["renderer"] = "vulkan"; },
          ": renderer must be one of \"cpu\", \"gpu\", not \"vulkan\"."},
-        {[](Json& j) { j["curvature"]["jet_degree"] = 4; }, ": curvature.jet_degree must be 2 or 3."},
+        {[](Json& j) { j["curvature"]["jet_degree"] = 4; }, ": curvature.jet_degree must be 2 or 3, not 4."},
         {[](Json& j) { j["mesh"]["sha256"] = "abc"; },
          ": mesh.sha256 must be 64 lowercase hexadecimal digits."},
     };
@@ -504,6 +510,103 @@ TEST_F(BadSessionFile, WrongTypesAndValues) {
         edit(j);
         EXPECT_EQ(load(j), expected);
     }
+}
+
+// The reader takes the ranges from the options' validate() (as the API does) and names the JSON field.
+TEST_F(BadSessionFile, OptionsOutOfRangeNameTheFieldAndItsRange) {
+    const std::pair<std::function<void(Json&)>, std::string> cases[] = {
+        {[](Json& j) { j["events"][0]["step"]["stitch"]["min_angle_floor_deg"] = 45; },
+         ": events[0].step.stitch.min_angle_floor_deg must be in [0, 30), not 45."},
+        {[](Json& j) { j["events"][0]["step"]["stitch"]["min_angle_floor_deg"] = 30; },
+         ": events[0].step.stitch.min_angle_floor_deg must be in [0, 30), not 30."},
+        {[](Json& j) { j["events"][0]["step"]["stitch"]["outside_min_angle_floor_deg"] = -1; },
+         ": events[0].step.stitch.outside_min_angle_floor_deg must be in [0, 30), not -1."},
+        {[](Json& j) { j["events"][0]["step"]["stitch"]["max_view_angle_deg"] = 90; },
+         ": events[0].step.stitch.max_view_angle_deg must be in (0, 90), not 90."},
+        {[](Json& j) { j["events"][0]["step"]["stitch"]["collapse_edge_ratio"] = 0.5; },
+         ": events[0].step.stitch.collapse_edge_ratio must be in [0, 0.5), not 0.5."},
+        {[](Json& j) { j["events"][0]["step"]["stitch"]["max_normal_change_deg"] = 181; },
+         ": events[0].step.stitch.max_normal_change_deg must be in [0, 180], not 181."},
+        {[](Json& j) { j["events"][0]["step"]["stitch"]["seam_rings"] = -1; },
+         ": events[0].step.stitch.seam_rings must be at least 0, not -1."},
+        {[](Json& j) { j["events"][0]["step"]["stitch"]["max_gap_ratio"] = 0; },
+         ": events[0].step.stitch.max_gap_ratio must be a positive finite number, not 0."},
+        {[](Json& j) { j["events"][0]["step"]["scan"]["quality_angle_limit_deg"] = 90; },
+         ": events[0].step.scan.quality_angle_limit_deg must be in (0, 90), not 90."},
+        {[](Json& j) { j["events"][0]["step"]["quality_mask"]["search_rings"] = -1; },
+         ": events[0].step.quality_mask.search_rings must be at least 0, not -1."},
+        {[](Json& j) { j["events"][0]["step"]["triangulate"]["max_sampling_angle_deg"] = 0; },
+         ": events[0].step.triangulate.max_sampling_angle_deg must be in (0, 90], not 0."},
+        {[](Json& j) { j["events"][0]["step"]["dilate_radius"] = 2000; },
+         ": events[0].step.dilate_radius must be in [0, 1024], not 2000."},
+        {[](Json& j) { j["events"][1]["step"]["fishbone"]["h"] = 40; },
+         ": events[1].step.fishbone.h must be in [0.5, 37.5] for a 200x150 scan: the spacing h = 40 pixels "
+         "is "
+         "outside it."},
+        {[](Json& j) { j["events"][1]["step"]["fishbone"]["tracing"]["backbone"]["min_step"] = 0.5; },
+         ": events[1].step.fishbone.tracing.backbone.min_step must be in (0, step] = (0, 0.3], not 0.5."},
+        {[](Json& j) { j["events"][1]["step"]["fishbone"]["tracing"]["ribs"]["max_steps"] = 0; },
+         ": events[1].step.fishbone.tracing.ribs.max_steps must be in [1, 9223372036854775807], not 0."},
+        {[](Json& j) { j["events"][1]["step"]["fishbone"]["tracing"]["spacing"] = 0; },
+         ": events[1].step.fishbone.tracing.spacing must be a positive finite number, not 0."},
+        {[](Json& j) { j["events"][1]["step"]["fishbone"]["crease"]["angle_deg"] = 180; },
+         ": events[1].step.fishbone.crease.angle_deg must be in [0, 180), not 180."},
+        {[](Json& j) { j["events"][1]["step"]["fishbone"]["crease"]["snap_radius"] = 0; },
+         ": events[1].step.fishbone.crease.snap_radius must be a positive finite number, not 0."},
+        {[](Json& j) {
+             j["events"][1]["step"]["fishbone"]["drawn_key_ribs"][1] = Json::array({{1, 2}});
+         },
+         ": events[1].step.fishbone.drawn_key_ribs[1] must have at least 2 points, not 1."},
+        {[](Json& j) {
+             j["events"][1]["step"]["fishbone"]["drawn_backbone"] = Json::array({{1, 2}});
+         },
+         ": events[1].step.fishbone.drawn_backbone must be empty or have at least 2 points, not 1."},
+        {[](Json& j) { j["events"][1]["step"]["fishbone"]["min_seed_anisotropy"] = 1.5; },
+         ": events[1].step.fishbone.min_seed_anisotropy must be in [0, 1], not 1.5."},
+        {[](Json& j) { j["events"][1]["step"]["fishbone"]["raycast"]["rings"] = -1; },
+         ": events[1].step.fishbone.raycast.rings must be at least 0, not -1."},
+        {[](Json& j) { j["events"][1]["step"]["fishbone"]["sampling_factor"] = 5; },
+         ": events[1].step.fishbone.sampling_factor must be at most the spacing h: the sampling factor 5 "
+         "exceeds the spacing h = 3.5 pixels (the sampling image needs at least one pixel per sample)."},
+        {[](Json& j) { j["curvature"]["min_points"] = 5; },
+         ": curvature.min_points must be at least 6, not 5."},
+        {[](Json& j) { j["curvature"]["anisotropy_epsilon"] = 0; },
+         ": curvature.anisotropy_epsilon must be a positive finite number, not 0."},
+    };
+    for (const auto& [edit, expected] : cases) {
+        Json j = good_;
+        edit(j);
+        EXPECT_EQ(load(j), expected);
+    }
+}
+
+// Options added after version 1 was first written are optional: absent, they are what the older files were
+// recorded with, and they are written only when they differ from that, so older files stay byte-identical.
+TEST_F(BadSessionFile, LaterStitchOptionsAreOptional) {
+    const Json& written = good_["events"][0]["step"]["stitch"];
+    EXPECT_EQ(written["outside_min_angle_floor_deg"], 7.5);
+    EXPECT_EQ(written["peel_trim"], true);
+    const Json& defaults =
+        good_["events"][1]["step"]["stitch"]; // the fishbone step has default stitch options
+    EXPECT_FALSE(defaults.contains("outside_min_angle_floor_deg"));
+    EXPECT_FALSE(defaults.contains("peel_trim"));
+
+    auto stitchOf = [&](const Json& j) {
+        return fss::sessionFileFromJson(j.dump(2), "s.json", ".", {.verifyMesh = false})
+            .events.at(0)
+            .step.stitch;
+    };
+    Json j = good_;
+    j["events"][0]["step"]["stitch"].erase("outside_min_angle_floor_deg");
+    j["events"][0]["step"]["stitch"].erase("peel_trim");
+    EXPECT_EQ(stitchOf(j).outsideMinAngleFloorDeg, 0.0);
+    EXPECT_FALSE(stitchOf(j).peelTrim);
+    // -0.0 is not 0 bit for bit: it is written, and comes back with its sign.
+    fss::SessionFile f = sampleFile(mesh_);
+    f.events[0].step.stitch.outsideMinAngleFloorDeg = -0.0;
+    const Json negativeZero = Json::parse(fss::sessionFileToJson(f));
+    ASSERT_TRUE(negativeZero["events"][0]["step"]["stitch"].contains("outside_min_angle_floor_deg"));
+    EXPECT_TRUE(std::signbit(stitchOf(negativeZero).outsideMinAngleFloorDeg));
 }
 
 TEST_F(BadSessionFile, UnknownMeshAndChangedMesh) {
@@ -541,6 +644,10 @@ TEST(SessionFile, SavingRefusesWhatCannotBeStored) {
     }
     f = sampleFile(mesh);
     f.events[1].step.fishbone->tracing.ribTracing.insideRegion = [](const Vector2d&) { return true; };
+    EXPECT_THROW(fss::sessionFileToJson(f), fss::InvalidInputError);
+    f = sampleFile(mesh);
+    f.events[1].step.fishbone->tracing.backboneTracing.attractor =
+        [](const Vector2d& q, const Vector2d&) -> std::optional<Vector2d> { return q; };
     EXPECT_THROW(fss::sessionFileToJson(f), fss::InvalidInputError);
     f = sampleFile(mesh);
     f.renderer = "opengl";
@@ -642,6 +749,41 @@ TEST(SessionFile, ReplayReproducesTheRecordedMesh) {
     } catch (const fss::InvalidInputError& e) {
         EXPECT_EQ(std::string(e.what()).rfind(path.string() + ", events[0] (accept): ", 0), 0u) << e.what();
     }
+}
+
+// A step the reader accepts is one the stitch accepts: the options at the edges of the reader's ranges (which
+// are the stitch's, StitchOptions::validate) replay without an option error.
+TEST(SessionFile, WhatTheReaderAcceptsTheStitchAccepts) {
+    const fss::Mesh cylinder = fss::shapes::cylinder(48, 12, 1.0, 2.0, true);
+    fss::SessionFile file;
+    file.meshPath = "cylinder.off";
+    file.meshSha256 = std::string(64, '0');
+    file.events.push_back({fss::SessionEvent::Kind::Accept, viewStep(cylinder, fss::StandardView::PosX, 96)});
+    Json j = Json::parse(fss::sessionFileToJson(file));
+    Json& stitch = j["events"][0]["step"]["stitch"];
+    stitch["min_angle_floor_deg"] = std::nextafter(30.0, 0.0);
+    stitch["outside_min_angle_floor_deg"] = std::nextafter(30.0, 0.0);
+    stitch["max_view_angle_deg"] = std::nextafter(90.0, 0.0);
+    stitch["collapse_edge_ratio"] = std::nextafter(0.5, 0.0);
+    stitch["max_normal_change_deg"] = 180;
+    stitch["seam_grading"] = 0;
+    const fss::SessionFile loaded =
+        fss::sessionFileFromJson(j.dump(2), "edges.json", ".", {.verifyMesh = false});
+    const fss::ScanStep& step = loaded.events.at(0).step;
+    EXPECT_EQ(step.stitch.minAngleFloorDeg, std::nextafter(30.0, 0.0));
+    fss::Session session(cylinder);
+    session.scan(step); // checks the stitch options too
+    try {
+        session.accept();
+    } catch (const fss::InvalidOptionError& e) {
+        FAIL() << "the stitch refused an option the reader accepted: " << e.what();
+    } catch (const fss::InvalidInputError& e) {
+        // Nothing stitchable under such floors is not an option error.
+        EXPECT_EQ(std::string(e.what()).find("Options::"), std::string::npos) << e.what();
+    }
+    // And the other way round: what the stitch refuses, the reader refuses.
+    stitch["min_angle_floor_deg"] = 30;
+    EXPECT_THROW(fss::sessionFileFromJson(j.dump(2), "edges.json", ".", {.verifyMesh = false}), fss::IoError);
 }
 
 } // namespace

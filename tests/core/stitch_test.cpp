@@ -585,6 +585,15 @@ TEST(Stitch, FailureLeavesTheMeshBitIdentical) {
     EXPECT_THROW(fss::stitchPatch(m, Mesh(), cam), fss::InvalidInputError);
     const std::vector<std::uint32_t> wrongSize(10, 0);
     EXPECT_THROW(fss::stitchPatch(m, patch, cam, {}, wrongSize), fss::InvalidInputError);
+    // An option out of range is named, with its range (StitchOptions::validate).
+    fss::StitchOptions steep;
+    steep.minAngleFloorDeg = 45;
+    try {
+        fss::stitchPatch(m, patch, cam, steep);
+        ADD_FAILURE() << "no error";
+    } catch (const fss::InvalidOptionError& e) {
+        EXPECT_STREQ(e.what(), "StitchOptions::minAngleFloorDeg must be in [0, 30), not 45.");
+    }
     expectBitIdentical(m, before);
 }
 

@@ -158,6 +158,17 @@ struct AutoOptions {
     /// Quality-mask margin (mask.h QualityMaskOptions::margin) of the regular scans.
     double qualityMargin = 0.1;
 
+    /// Checks every field's range: edgeLength finite and ≥ 0; servedAngleDeg in (0, 80];
+    /// maxSamplingAngleDeg in (servedAngleDeg, 85]; followUpMaxSamplingAngleDeg and
+    /// regionMarginMaxSamplingAngleDeg in (0, 85]; partitionSmoothing, minRegionArea and minFeatureLength
+    /// finite and ≥ 0; regionMarginPx in [0, 16]; regionFillPasses, followUpRounds, seamRelaxRounds and
+    /// creaseSnapRounds ≥ 0; minViewAreaFraction and coverageGoal in [0, 1]; maxViews ≥ 1; footprintRatio in
+    /// (0.1, 4]; featureAngleDeg in [0, 180); fishboneBandWidth finite and > 0; morphologyRadius in
+    /// [0, 1024]; flipSliversBelowDeg and seamRelaxMinAngleDeg in [0, 60); qualityMargin in [0, 1); stitch
+    /// (StitchOptions::validate, named "AutoOptions::stitch.minAngleFloorDeg" ...).
+    /// \throw InvalidOptionError naming the first field out of range and its range.
+    void validate() const;
+
     /// StitchOptions with minAngleFloorDeg = 10 and peelTrim on.
     static StitchOptions defaultStitch() {
         StitchOptions s;

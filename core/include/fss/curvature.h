@@ -42,6 +42,10 @@ struct CurvatureOptions {
     /// diagonal). Curvatures far below ε (radius of curvature ≫ the whole model) count as flat, so flat
     /// regions report anisotropy ≈ 0 instead of amplified round-off. Must be > 0.
     double anisotropyEpsilon = 1e-3;
+
+    /// Checks the ranges: jetDegree 2 or 3, minPoints ≥ 6, maxRings ≥ 1, anisotropyEpsilon finite and > 0.
+    /// \throw InvalidOptionError naming the field ("CurvatureOptions::jetDegree must be 2 or 3, not 4.").
+    void validate() const;
 };
 
 /// Per-vertex principal curvatures, indexed by vertex index (`VertexIndex::idx()`); arrays have one entry
@@ -79,7 +83,8 @@ struct CurvatureField {
 /// \param progress  receives fractions in [0, 1] with stage "curvature"; may cancel
 /// \pre options.jetDegree ∈ {2, 3}, options.minPoints ≥ 6, options.maxRings ≥ 1,
 ///      options.anisotropyEpsilon > 0 and finite; mesh points finite.
-/// \throw InvalidInputError when a precondition is violated.
+/// \throw InvalidInputError when a precondition is violated (InvalidOptionError for \p options,
+///        CurvatureOptions::validate).
 /// \throw CancelledError when \p progress asks to stop (nothing is returned).
 CurvatureField estimateCurvature(const Mesh& mesh, const CurvatureOptions& options = {},
                                  const Progress& progress = {});

@@ -52,6 +52,11 @@ struct FishboneOptions {
     /// Key-rib mode: backbone samples before the first and after the last key-rib get a copy of the
     /// nearest key-rib's shape (true) or are left out of the grid (false).
     bool extendBeyondKeyRibs = true;
+
+    /// Checks the ranges: spacing finite and > 0, and both tracings (StreamlineOptions::validate, named
+    /// "FishboneOptions::backboneTracing.step" ...).
+    /// \throw InvalidOptionError naming the field.
+    void validate() const;
 };
 
 /// The backbone: samples every h along a streamline or a drawn spline.

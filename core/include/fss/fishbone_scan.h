@@ -126,6 +126,16 @@ struct FishboneParams {
     /// replay with k = 1 (the scan resolution), as they were recorded.
     int samplingFactor = 0;
 
+    /// Checks the fishbone for a scan with \p scanCamera: spacing in [0.5, min(W, H)/4]; a seed or a drawn
+    /// backbone (empty or ≥ 2 points); a traced backbone's seed inside the W × H image; no key-ribs or at
+    /// least two (keyRibs and drawnKeyRibs together), each drawn key-rib with ≥ 2 points; every point
+    /// finite; tracing (FishboneOptions::validate); minSeedAnisotropy in [0, 1]; creaseAngleDeg in
+    /// [0, 180); creaseSnapRadius finite and > 0; raycast.rings ≥ 0; samplingFactor 0 or a divisor of W and
+    /// H of at most h. scanFishbonePatch and the session-file reader call it.
+    /// \throw InvalidOptionError naming the field ("FishboneParams::creaseAngleDeg must be in [0, 180), not
+    ///        180.").
+    void validate(const Camera& scanCamera) const;
+
     /// Tracing with LowAnisotropyPolicy::ContinueStraight; RK4 steps of half a pixel for the backbone and of
     /// one pixel for the ribs (rib turns limited to 12° per step, which ends ribs at field seams about where
     /// 10° per half pixel did). Sessions store these options, so older sessions replay with their own.
@@ -206,10 +216,10 @@ Camera fishboneSamplingCamera(const Camera& scan, const FishboneParams& fishbone
 /// pixels of the scan image long, h/k of the sampling image). All positions in \p params and \p fishbone
 /// (seed, key-ribs, drawn curves, lasso) are in pixels of the scan image; the scan itself runs on the
 /// sampling image (FishboneParams::samplingFactor, fishboneSamplingCamera).
-/// \throw InvalidInputError with one sentence when: the camera, lasso or radii are invalid (as scanPatch);
-///        h is not in [0.5, min(W, H)/4]; neither a seed nor a drawn backbone is given; the seed lies
-///        outside the image, on the background, or on a flat / isotropic region; fewer than two key-ribs
-///        are given in key-rib mode, or two fall on one backbone sample, or one lies farther than 2h from
+/// \throw InvalidInputError with one sentence when: \p params are invalid (ScanParams::validate);
+///        \p fishbone is (FishboneParams::validate: h not in [0.5, min(W, H)/4], neither a seed nor a drawn
+///        backbone, the seed outside the image, one key-rib, ...); the seed lies on the background, or on a
+///        flat / isotropic region; two key-ribs fall on one backbone sample, or one lies farther than 2h from
 ///        the backbone; the backbone has fewer than two samples; or nothing is left to triangulate.
 ///        CancelledError through \p progress.
 FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& referenceRenderer, const Mesh& current,

@@ -61,6 +61,10 @@ struct QualityMaskOptions {
     bool forceReplace = false;
     /// Vertex rings searched around the current best face in the local closest-point walk (raycast.h).
     int searchRings = 2;
+
+    /// Checks the ranges: margin in [0, 1), searchRings ≥ 0.
+    /// \throw InvalidOptionError naming the field ("QualityMaskOptions::margin must be in [0, 1), not 1.5.").
+    void validate() const;
 };
 
 /// Sampling-quality mask against the *current* mesh. For every admissible sample, the face of
@@ -76,7 +80,7 @@ struct QualityMaskOptions {
 /// \pre \p currentBuffers are \p current rendered from the grid's camera (same image size).
 /// \return the number of admissible samples that were dropped.
 /// \throw InvalidInputError when the buffers' size differs from the grid's camera, a buffer face id is not
-///        a face of \p current, margin is not in [0, 1) or searchRings < 0.
+///        a face of \p current; InvalidOptionError when \p options are out of range (validate()).
 std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameBuffers& currentBuffers,
                              const QualityMaskOptions& options = {});
 

@@ -43,6 +43,11 @@ struct ScanOptions {
     /// point by at most this many pixel footprints; a larger move means the face id and the depth disagree
     /// (a corrupted ID buffer), and the unprojected point is kept.
     double maxSnapFootprints = 2.0;
+
+    /// Checks the ranges: qualityAngleLimitDeg in (0, 90), maxSnapFootprints finite and ≥ 0.
+    /// \throw InvalidOptionError naming the field ("ScanOptions::qualityAngleLimitDeg must be in (0, 90), not
+    ///        90.").
+    void validate() const;
 };
 
 /// The sampling quality q = footprint / max(cos(samplingAngle), cos(qualityAngleLimitDeg)) (see the file

@@ -32,6 +32,15 @@ struct ScanParams {
     ScanOptions scan;               ///< sampling options (scan id, quality angle limit)
     QualityMaskOptions quality;     ///< quality mask (margin, forceReplace)
     TriangulateOptions triangulate; ///< triangulation thresholds
+
+    /// Checks everything a scan needs before it renders: the camera (Camera::validate), the erosion and
+    /// dilation radii (in [0, 1024]), the lasso (validateLasso) when there is one, and the scan,
+    /// quality-mask and triangulation options (their validate()). scanPatch, scanFishbonePatch and the
+    /// session-file reader call it.
+    /// \throw InvalidInputError with one sentence naming the problem; InvalidOptionError for an option out of
+    ///        range, named as a field of ScanParams ("ScanParams::quality.margin must be in [0, 1),
+    ///        not 1.5.").
+    void validate() const;
 };
 
 /// Wall-clock seconds of each stage of scanPatch.
@@ -66,16 +75,15 @@ struct ScanResult {
     ScanTimings timings;
 };
 
-/// Checks the parts of \p params every scan needs before it renders: the camera (Camera::validate), the
-/// erosion and dilation radii (not negative) and the lasso (validateLasso), when there is one.
-/// \throw InvalidInputError with one sentence naming the problem.
+/// params.validate() (kept for its callers).
 void validateScanParams(const ScanParams& params);
 
 /// Runs one scan. \p referenceRenderer must hold \p reference (setMesh) and \p currentRenderer
 /// \p current; when \p current is the reference itself (same object, the first scan) pass the same
 /// renderer: the current mesh is then not rendered again and the quality mask is skipped (input faces
 /// rank lowest, every sample beats them).
-/// \throw InvalidInputError with one sentence when the camera is invalid, the mesh lies behind the camera,
+/// \throw InvalidInputError with one sentence when \p params are invalid (ScanParams::validate: the camera,
+///        an option out of range, the lasso), the mesh lies behind the camera,
 ///        the camera sees no part of the mesh, sees only the back of the surface (it is inside the mesh),
 ///        the lasso is degenerate or selects nothing, or nothing is left to triangulate.
 ///        CancelledError through \p progress.

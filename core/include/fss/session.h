@@ -96,7 +96,8 @@ struct SessionOptions {
 class Session {
 public:
     /// Takes \p reference as the input mesh; the current mesh starts as a copy of it.
-    /// \throw InvalidInputError when the mesh is empty, not a triangle mesh, or invalid.
+    /// \throw InvalidInputError when the mesh is empty, not a triangle mesh, or invalid; InvalidOptionError
+    ///        when options.curvature is out of range (CurvatureOptions::validate).
     explicit Session(Mesh reference, SessionOptions options = {});
     ~Session();
     Session(Session&&) noexcept;
@@ -111,7 +112,8 @@ public:
 
     /// Scans the reference from `step.params.camera` against the current mesh (quality mask) and keeps the
     /// result as the pending preview, replacing any earlier one. The current mesh does not change.
-    /// \throw InvalidInputError (one sentence, as scanPatch / scanFishbonePatch); CancelledError. The
+    /// \throw InvalidInputError (one sentence, as scanPatch / scanFishbonePatch, or StitchOptions::validate
+    ///        for `step.stitch`, checked here rather than at accept()); CancelledError. The
     ///        previous preview is kept on failure.
     const ScanPreview& scan(const ScanStep& step, const Progress& progress = {});
     /// The pending preview, or nullptr.

@@ -34,20 +34,25 @@
 ///             "min_seed_anisotropy": 0.1,
 ///             "crease": { "angle_deg": 30, "snap_radius": 1.5 },  (optional; missing: these defaults)
 ///             "raycast": { "rings": 2, "verify_unoccluded": false },
-///             "sampling_factor": 0 },       (0 = automatic, 1..64; optional: missing = 1, the scan resolution)
+///             "sampling_factor": 0 },    (0 = automatic, or a divisor of width and height of at most h;
+///                                         optional: missing = 1, the scan resolution)
 ///         "stitch": { "seam_rings": 2, "optimise_seam": true, "collapse_edge_ratio": 0.4, "seam_grading": 1,
 ///                     "min_angle_floor_deg": 1, "max_view_angle_deg": 85, "max_normal_change_deg": 20,
 ///                     "max_gap_ratio": 0.25, "max_trim_rounds": 16, "min_component_faces": 8,
 ///                     "collect_garbage": false, "peel_trim": true (optional: written only when true,
-///                     absent = false) } } },
+///                     absent = false), "outside_min_angle_floor_deg": 10 (optional: written only when
+///                     not 0, absent = 0) } } },
 ///     { "kind": "undo" }, { "kind": "redo" } ] }
 /// STREAMLINE = { "step": 0.25, "min_step": 0.015625, "max_length": null (unbounded) | L,
 ///                "min_anisotropy": 0.05,
 ///                "low_anisotropy": "stop" | "continue_straight", "max_turn_deg": 10, "max_steps": 1000000 }
 /// \endcode
 /// Doubles are written in the shortest form that reads back to the same bits, so a loaded step is
-/// bit-identical to the saved one. Not stored: StreamlineOptions::insideRegion (a function; saving a step
-/// that has one is an error) and the test hook StitchOptions::failValidationForTesting (loaded as false).
+/// bit-identical to the saved one. Not stored: StreamlineOptions::insideRegion and ::attractor (functions;
+/// saving a step that has one is an error) and the test hook StitchOptions::failValidationForTesting
+/// (loaded as false). The ranges of the options are those of their validate() (ScanParams,
+/// FishboneParams with the step's camera, StitchOptions, CurvatureOptions), which the scans and the stitch
+/// call too: a file that loads does not fail at replay for an option out of range.
 
 #include "fss/curvature.h"
 #include "fss/progress.h"
@@ -112,7 +117,9 @@ struct SessionFileLoadOptions {
 /// undone one). \throw IoError with one sentence naming the file and the offending field, e.g.
 /// "session.json: events[3].step.camera.width must be a positive integer.", for invalid JSON (with line
 /// and column), a wrong format or version, missing, unknown or mistyped fields, values out of range, an
-/// inconsistent event log, a missing mesh file, or a mesh whose SHA-256 differs from the recorded one.
+/// inconsistent event log, a missing mesh file, or a mesh whose SHA-256 differs from the recorded one. An
+/// option out of range is named by its JSON path with the range its validate() states:
+/// "session.json: events[3].step.stitch.min_angle_floor_deg must be in [0, 30), not 45.".
 SessionFile sessionFileFromJson(const std::string& text, const std::string& name,
                                 const std::filesystem::path& baseDir,
                                 const SessionFileLoadOptions& options = {});

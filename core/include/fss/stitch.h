@@ -84,6 +84,14 @@ struct StitchOptions {
     bool collectGarbage = false;
     /// Test hook: makes the final check of every component fail, to exercise the strong guarantee.
     bool failValidationForTesting = false;
+
+    /// Checks every field's range: seamRings ≥ 0, collapseEdgeRatio in [0, 0.5), seamGrading ≥ 0,
+    /// minAngleFloorDeg and outsideMinAngleFloorDeg in [0, 30), maxViewAngleDeg in (0, 90),
+    /// maxNormalChangeDeg in [0, 180], maxGapRatio > 0, maxTrimRounds ≥ 0, minComponentFaces ≤ 2^63 − 1
+    /// (every number finite). stitchPatch and the session-file reader call it, so the two accept the same.
+    /// \throw InvalidOptionError naming the first field out of range and its range
+    ///        ("StitchOptions::minAngleFloorDeg must be in [0, 30), not 45.").
+    void validate() const;
 };
 
 /// What stitchPatch did.
@@ -140,10 +148,11 @@ struct StitchReport {
 /// of \p current therefore stay valid between calls.
 ///
 /// \return what was done, with seam quality figures.
-/// \throw InvalidInputError when the camera, the patch, the options or the ID buffer are invalid, or when no
-///        component could be stitched (the sentence gives the first reason). Strong guarantee: all checks of
-///        a component run before \p current is touched, so an exception leaves \p current unchanged bit for
-///        bit (short of running out of memory while a checked component is being applied).
+/// \throw InvalidInputError when the camera, the patch, the options (StitchOptions::validate, naming the
+///        field) or the ID buffer are invalid, or when no component could be stitched (the sentence gives
+///        the first reason). Strong guarantee: all checks of a component run before \p current is touched,
+///        so an exception leaves \p current unchanged bit for bit (short of running out of memory while a
+///        checked component is being applied).
 /// \param progress reports (stage "stitch", fractions that never decrease, below 1 until the last component
 ///                 is applied) and may cancel: before each component and each trim round, and inside a
 ///                 component's computation every few thousand elementary operations (faces visited,

@@ -78,6 +78,12 @@ struct StreamlineOptions {
         attractor{};
     /// Safety limit on the number of accepted steps per half.
     std::size_t maxSteps = 1'000'000;
+
+    /// Checks the ranges: step finite and > 0, minStep in (0, step], maxLength > 0 (infinity allowed),
+    /// minAnisotropy in [0, 1], maxTurnDeg finite and > 0, maxSteps in [1, 2^63 − 1].
+    /// \throw InvalidOptionError naming the field ("StreamlineOptions::step must be a positive finite
+    ///        number, not 0.").
+    void validate() const;
 };
 
 /// One half of a streamline: from the seed in one direction.

@@ -53,6 +53,11 @@ struct TriangulateOptions {
     /// A triangle with a corner sample, or a normal, at a larger angle to the viewing ray is a grazing
     /// sliver and is dropped. Degrees, in (0, 90].
     double maxSamplingAngleDeg = 80.0;
+
+    /// Checks the ranges: maxEdgeFootprints finite and > 0, maxSamplingAngleDeg in (0, 90].
+    /// \throw InvalidOptionError naming the field ("TriangulateOptions::maxEdgeFootprints must be a positive
+    ///        finite number, not 0.").
+    void validate() const;
 };
 
 /// What triangulateGrid did. Each dropped triangle is counted once, under the first test it failed in

@@ -5,6 +5,7 @@
 #include "fss/mask_triangulate.h"
 
 #include "base/parallel_rows.h"
+#include "fishbone/fishbone_options.h"
 
 #include <algorithm>
 #include <chrono>
@@ -576,20 +577,8 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
 int fishboneSamplingFactor(const Camera& scan, const FishboneParams& fb) {
     const int W = scan.width, H = scan.height;
     const double h = fb.spacing;
-    if (fb.samplingFactor < 0)
-        throw InvalidInputError("The fishbone sampling factor " + std::to_string(fb.samplingFactor) +
-                                " is negative (0 chooses it automatically).");
-    if (fb.samplingFactor > 0) {
-        const int k = fb.samplingFactor;
-        if (W % k != 0 || H % k != 0)
-            throw InvalidInputError("The fishbone sampling factor " + std::to_string(k) + " does not divide the " +
-                                    std::to_string(W) + "x" + std::to_string(H) + " scan image.");
-        if (!(double(k) <= h))
-            throw InvalidInputError("The fishbone sampling factor " + std::to_string(k) +
-                                    " exceeds the spacing h = " + fmt(h) +
-                                    " pixels (the sampling image needs at least one pixel per sample).");
-        return k;
-    }
+    detail::validateSamplingFactor(scan, fb);
+    if (fb.samplingFactor > 0) return fb.samplingFactor;
     if (!(h >= 2) || W <= 0 || H <= 0) return 1;
     for (int k = int(std::min({std::floor(h), double(W), double(H)})); k > 1; --k)
         if (W % k == 0 && H % k == 0) return k;
@@ -609,35 +598,8 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
                                      const ScanParams& params, const FishboneParams& fb, FishboneCache& cache,
                                      const Progress& progress) {
     const auto start = Clock::now();
-    validateScanParams(params);
-    const double h = fb.spacing;
-    const double maxH = std::min(params.camera.width, params.camera.height) / 4.0;
-    if (!std::isfinite(h) || h < 0.5 || h > maxH)
-        throw InvalidInputError("The fishbone spacing h = " + fmt(h) + " pixels is outside [0.5, " +
-                                fmt(maxH) + "] for a " + std::to_string(params.camera.width) + "x" +
-                                std::to_string(params.camera.height) + " scan.");
-    const bool drawnBackbone = !fb.drawnBackbone.empty();
-    if (!drawnBackbone && !fb.seed)
-        throw InvalidInputError("A fishbone scan needs a seed point or a drawn backbone.");
-    if (drawnBackbone && fb.drawnBackbone.size() < 2)
-        throw InvalidInputError("A drawn backbone needs at least two points.");
-    const std::size_t keyRibCount = fb.keyRibs.size() + fb.drawnKeyRibs.size();
-    const bool keyRibMode = keyRibCount > 0;
-    if (keyRibMode && keyRibCount < 2)
-        throw InvalidInputError("Key-rib mode needs at least two key-ribs to blend between, " +
-                                std::to_string(keyRibCount) + " given.");
-    auto insideImage = [&](const Eigen::Vector2d& p) {
-        return std::isfinite(p.x()) && std::isfinite(p.y()) && p.x() >= 0 && p.y() >= 0 &&
-               p.x() < params.camera.width && p.y() < params.camera.height;
-    };
-    if (!std::isfinite(fb.creaseAngleDeg) || fb.creaseAngleDeg < 0 || fb.creaseAngleDeg >= 180 ||
-        !std::isfinite(fb.creaseSnapRadius) || !(fb.creaseSnapRadius > 0))
-        throw InvalidInputError("The crease angle must lie in [0, 180) degrees and the crease snap radius "
-                                "must be positive.");
-    if (fb.seed && !drawnBackbone && !insideImage(*fb.seed))
-        throw InvalidInputError("The fishbone seed " + point(*fb.seed) + " lies outside the " +
-                                std::to_string(params.camera.width) + "x" +
-                                std::to_string(params.camera.height) + " scan image.");
+    params.validate();
+    fb.validate(params.camera);
 
     const int k = fishboneSamplingFactor(params.camera, fb);
     FishboneScanResult result;

@@ -18,16 +18,6 @@ std::string pointName(const Eigen::Vector2d& p) {
     return s.str();
 }
 
-void validate(const StreamlineOptions& o) {
-    if (!(o.step > 0) || !std::isfinite(o.step))
-        throw InvalidInputError("The streamline step must be positive and finite.");
-    if (!(o.minStep > 0) || o.minStep > o.step)
-        throw InvalidInputError("The streamline minimum step must be positive and not larger than the step.");
-    if (!(o.maxLength > 0)) throw InvalidInputError("The streamline maximum length must be positive.");
-    if (!std::isfinite(o.minAnisotropy) || !std::isfinite(o.maxTurnDeg) || o.maxTurnDeg <= 0)
-        throw InvalidInputError("The streamline anisotropy and turn thresholds must be finite (turn > 0).");
-}
-
 // Field evaluation with the stop tests of one position.
 struct Evaluation {
     std::optional<Eigen::Vector2d> direction;
@@ -95,7 +85,7 @@ public:
                const StreamlineOptions& options)
         : tracer_(field, options), o_(options), seed_(seed),
           cosMaxTurn_(std::cos(options.maxTurnDeg * std::numbers::pi / 180.0)), step_(options.step) {
-        validate(options);
+        options.validate();
         if (!seed.allFinite() || !initialDirection.allFinite() || initialDirection.isZero())
             throw InvalidInputError("A streamline needs a finite seed and a non-zero initial direction.");
         const Evaluation start = tracer_.evaluate(seed, initialDirection);
@@ -261,7 +251,7 @@ std::vector<StreamlineHalf> traceHalvesInLockstep(const DirectionField& field, c
 
 Streamline traceStreamline(const DirectionField& field, const Eigen::Vector2d& seed,
                            const StreamlineOptions& options, const Eigen::Vector2d& preferredDirection) {
-    validate(options);
+    options.validate();
     if (!seed.allFinite()) throw InvalidInputError("The streamline seed must be finite.");
     const int px = int(std::floor(seed.x())), py = int(std::floor(seed.y()));
     const int cx = std::min(px, field.width - 1), cy = std::min(py, field.height - 1);

@@ -8,6 +8,8 @@
 
 #include "fss/error.h"
 
+#include "base/option_check.h"
+
 #include <CGAL/Monge_via_jet_fitting.h>
 
 #include <algorithm>
@@ -75,19 +77,18 @@ bool finite(const Eigen::Vector3d& v) {
 
 } // namespace
 
+void CurvatureOptions::validate() const {
+    const detail::OptionCheck check("CurvatureOptions");
+    if (jetDegree != 2 && jetDegree != 3)
+        check.fail("jetDegree", "must be 2 or 3, not " + std::to_string(jetDegree));
+    check.intAtLeast("minPoints", minPoints, 6);
+    check.intAtLeast("maxRings", maxRings, 1);
+    check.positive("anisotropyEpsilon", anisotropyEpsilon);
+}
+
 CurvatureField estimateCurvature(const Mesh& mesh, const CurvatureOptions& options,
                                  const Progress& progress) {
-    if (options.jetDegree != 2 && options.jetDegree != 3)
-        throw InvalidInputError("The curvature jet degree must be 2 or 3, not " +
-                                std::to_string(options.jetDegree) + ".");
-    if (options.minPoints < 6)
-        throw InvalidInputError("The curvature neighbourhood needs at least 6 points (minPoints = " +
-                                std::to_string(options.minPoints) + ").");
-    if (options.maxRings < 1)
-        throw InvalidInputError("The curvature neighbourhood needs at least one ring (maxRings = " +
-                                std::to_string(options.maxRings) + ").");
-    if (!(options.anisotropyEpsilon > 0) || !std::isfinite(options.anisotropyEpsilon))
-        throw InvalidInputError("The curvature anisotropy epsilon must be positive and finite.");
+    options.validate();
 
     const std::size_t slots = mesh.number_of_vertices() + mesh.number_of_removed_vertices();
     CurvatureField field;

@@ -542,28 +542,7 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
     if (reference.number_of_faces() == 0) throw InvalidInputError("The mesh to remesh has no faces.");
     if (!CGAL::is_triangle_mesh(reference))
         throw InvalidInputError("The mesh to remesh is not a triangle mesh.");
-    if (!(options.edgeLength >= 0) || !std::isfinite(options.edgeLength))
-        throw InvalidInputError("The target edge length must be a positive number.");
-    if (!(options.servedAngleDeg > 0 && options.servedAngleDeg <= 80))
-        throw InvalidInputError("The served angle of the view plan must be in (0, 80] degrees.");
-    if (!(options.maxSamplingAngleDeg > options.servedAngleDeg && options.maxSamplingAngleDeg <= 85) ||
-        !(options.followUpMaxSamplingAngleDeg > 0 && options.followUpMaxSamplingAngleDeg <= 85))
-        throw InvalidInputError("The largest sampling angles must be in (served angle, 85] degrees.");
-    if (options.regionMarginPx < 0 || options.regionMarginPx > 16)
-        throw InvalidInputError("The region margin of the initial views must be in [0, 16] pixels.");
-    if (!(options.regionMarginMaxSamplingAngleDeg > 0 && options.regionMarginMaxSamplingAngleDeg <= 85))
-        throw InvalidInputError(
-            "The largest sampling angle of the region margins must be in (0, 85] degrees.");
-    if (options.regionFillPasses < 0) throw InvalidInputError("The region fill passes must not be negative.");
-    if (!(options.partitionSmoothing >= 0) || !(options.minRegionArea >= 0))
-        throw InvalidInputError("The partition smoothing and the smallest region area must not be negative.");
-    if (options.seamRelaxRounds < 0 ||
-        !(options.seamRelaxMinAngleDeg >= 0 && options.seamRelaxMinAngleDeg < 60))
-        throw InvalidInputError("The seam relaxation rounds must not be negative and its smallest angle must "
-                                "be in [0, 60) degrees.");
-    if (options.maxViews < 1) throw InvalidInputError("The view budget must be at least one view.");
-    if (!(options.footprintRatio > 0.1 && options.footprintRatio <= 4))
-        throw InvalidInputError("The footprint ratio must be in (0.1, 4].");
+    options.validate();
 
     AutoResult result;
     // Reference geometry: per-face normals and areas, bounding box.

@@ -242,12 +242,7 @@ std::size_t applyQualityMask(SampleGrid& grid, const Mesh& current, const FrameB
         throw InvalidInputError("The current mesh's face-id buffer holds " +
                                 std::to_string(currentBuffers.faceId.size()) + " values instead of " +
                                 std::to_string(n) + ".");
-    if (!(options.margin >= 0 && options.margin < 1))
-        throw InvalidInputError("The quality margin " + std::to_string(options.margin) +
-                                " is outside the range [0, 1).");
-    if (options.searchRings < 0)
-        throw InvalidInputError("The quality mask's search rings " + std::to_string(options.searchRings) +
-                                " is negative.");
+    options.validate();
     if (options.forceReplace) return 0;
 
     const auto [qualityMap, hasQuality] = current.property_map<FaceIndex, float>(props::faceQuality);

@@ -75,18 +75,11 @@ ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, con
     return scanPatch(reference, referenceRenderer, current, currentRenderer, params, workspace, progress);
 }
 
-void validateScanParams(const ScanParams& params) {
-    params.camera.validate();
-    if (params.erodeRadius < 0 || params.dilateRadius < 0)
-        throw InvalidInputError("The erosion and dilation radii must not be negative.");
-    if (params.lasso) validateLasso(*params.lasso);
-}
-
 ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, const Mesh& current,
                      MeshRenderer& currentRenderer, const ScanParams& params, ScanWorkspace& workspace,
                      const Progress& progress) {
     const auto start = Clock::now();
-    validateScanParams(params);
+    params.validate();
 
     ScanResult result;
     progress.report(0.0, "render reference");

@@ -530,13 +530,7 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
         throw InvalidInputError("The sample grid holds " + std::to_string(grid.samples.size()) +
                                 " samples instead of its " + std::to_string(grid.rows) + "x" +
                                 std::to_string(grid.cols) + ".");
-    if (!(options.maxEdgeFootprints > 0))
-        throw InvalidInputError("The triangulation's maximum edge length of " +
-                                std::to_string(options.maxEdgeFootprints) + " footprints is not positive.");
-    if (!(options.maxSamplingAngleDeg > 0 && options.maxSamplingAngleDeg <= 90))
-        throw InvalidInputError("The triangulation's maximum sampling angle of " +
-                                std::to_string(options.maxSamplingAngleDeg) +
-                                " degrees is outside the range (0, 90].");
+    options.validate();
 
     ScanWorkspace::Impl& w = workspace.impl();
     Patch patch;

@@ -82,6 +82,7 @@ Session::Session(Mesh reference, SessionOptions options) : impl_(std::make_uniqu
     if (!CGAL::is_triangle_mesh(reference))
         throw InvalidInputError("The session's input mesh is not a triangle mesh.");
     if (!reference.is_valid(false)) throw InvalidInputError("The session's input mesh is not a valid halfedge mesh.");
+    options.curvature.validate();
     if (options.maxUndoSteps < 50) options.maxUndoSteps = 50;
     impl_->options = std::move(options);
     // The history needs a garbage-free current mesh (collect_garbage renumbers: do it on the reference
@@ -104,6 +105,9 @@ const Mesh& Session::current() const { return impl_->current; }
 const ScanPreview& Session::scan(const ScanStep& step, const Progress& progress) {
     Impl& d = *impl_;
     const auto start = std::chrono::steady_clock::now();
+    // The stitch options too are checked now, not at accept(): a step that scans can be accepted (and
+    // replayed from a session file) without an option out of range.
+    step.stitch.validate();
     // Until the first step the current mesh is the reference itself: scan with the one renderer.
     const bool first = d.applied == 0 && d.forgotten == 0;
     const Mesh& current = first ? d.reference : d.current;

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -79,6 +80,9 @@ struct Writer {
         if (s.insideRegion)
             throw InvalidInputError("The session cannot be saved: " + f +
                                     " has a region mask (a function), which a session file cannot hold.");
+        if (s.attractor)
+            throw InvalidInputError("The session cannot be saved: " + f +
+                                    " has an attractor (a function), which a session file cannot hold.");
         Json j;
         j["step"] = number(s.step, f + ".step");
         j["min_step"] = number(s.minStep, f + ".min_step");
@@ -132,6 +136,11 @@ struct Writer {
         j["min_component_faces"] = s.minComponentFaces;
         j["collect_garbage"] = s.collectGarbage;
         if (s.peelTrim) j["peel_trim"] = true; // written only when on: older files stay byte-identical
+        // Written only when not 0 (+0.0; -0.0 is written to keep the bits): older files, recorded with 0,
+        // stay byte-identical.
+        if (std::bit_cast<std::uint64_t>(s.outsideMinAngleFloorDeg) != 0)
+            j["outside_min_angle_floor_deg"] =
+                number(s.outsideMinAngleFloorDeg, f + ".outside_min_angle_floor_deg");
         return j;
     }
 
@@ -206,6 +215,11 @@ public:
         throw IoError(file_ + ": " + path_ + " " + what + ".");
     }
 
+    /// Fails naming the field \p relative ("crease.angle_deg") below this node, whether present or not.
+    [[noreturn]] void failAt(const std::string& relative, const std::string& what) const {
+        throw IoError(file_ + ": " + child(relative) + " " + what + ".");
+    }
+
     bool isNull() const { return v_.is_null(); }
 
     /// The member \p key of this object (which must be one).
@@ -241,11 +255,6 @@ public:
     double positive() const {
         const double d = number();
         if (!(d > 0)) fail("must be a positive number");
-        return d;
-    }
-    double nonNegative() const {
-        const double d = number();
-        if (!(d >= 0)) fail("must be a number of at least 0");
         return d;
     }
     double inRange(double lo, double hi, bool loOpen, bool hiOpen) const {
@@ -315,6 +324,55 @@ private:
 };
 
 constexpr std::int64_t kIntMax = std::numeric_limits<int>::max();
+constexpr std::int64_t kIntMin = std::numeric_limits<int>::min();
+constexpr std::int64_t kInt64Max = std::numeric_limits<std::int64_t>::max();
+
+// An int field: its type only (the range is the options' validate()).
+int intField(const Node& n) {
+    return int(n.integer(kIntMin, kIntMax, "an integer"));
+}
+// A count (std::size_t) field.
+std::size_t countField(const Node& n) {
+    return std::size_t(n.integer(0, kInt64Max, "an integer of at least 0"));
+}
+
+// Where the file spells an option other than as validate() names it (camelCase becomes snake_case by
+// itself): the C++ name's prefix and the file's.
+using Renames = std::initializer_list<std::pair<const char*, const char*>>;
+
+// The path below an options struct's node of the field \p field as validate() names it
+// ("tracing.backboneTracing.minStep" -> "tracing.backbone.min_step").
+std::string jsonField(const std::string& field, Renames renames) {
+    std::string out, rest = field;
+    for (const auto& [from, to] : renames) {
+        if (field.rfind(from, 0) == 0) {
+            out = to;
+            rest = field.substr(std::string(from).size());
+            break;
+        }
+    }
+    for (char c : rest) {
+        if (c >= 'A' && c <= 'Z') {
+            out += '_';
+            out += char(c - 'A' + 'a');
+        } else {
+            out += c;
+        }
+    }
+    return out;
+}
+
+// Runs \p validate (an options struct's validate(), the one statement of its ranges that the API uses too)
+// and reports a field out of range at its path below \p n, with the range.
+template <class Validate> void validated(const Node& n, Validate&& validate, Renames renames = {}) {
+    try {
+        validate();
+    } catch (const InvalidOptionError& e) {
+        n.failAt(jsonField(e.field(), renames), e.requirement());
+    } catch (const InvalidInputError& e) {
+        n.fail(std::string("is invalid (") + e.what() + ")");
+    }
+}
 
 Camera readCamera(const Node& n) {
     n.onlyKeys({"eye", "focal", "up", "projection", "view_angle_deg", "parallel_scale", "near", "far",
@@ -348,19 +406,17 @@ StreamlineOptions readStreamline(const Node& n) {
     n.onlyKeys(
         {"step", "min_step", "max_length", "min_anisotropy", "low_anisotropy", "max_turn_deg", "max_steps"});
     StreamlineOptions s;
-    s.step = n.at("step").positive();
-    s.minStep = n.at("min_step").positive();
-    if (s.minStep > s.step) n.at("min_step").fail("must not exceed step");
+    s.step = n.at("step").number();
+    s.minStep = n.at("min_step").number();
     const Node maxLength = n.at("max_length");
-    s.maxLength = maxLength.isNull() ? std::numeric_limits<double>::infinity() : maxLength.positive();
-    s.minAnisotropy = n.at("min_anisotropy").inRange(0, 1, false, false);
+    s.maxLength = maxLength.isNull() ? std::numeric_limits<double>::infinity() : maxLength.number();
+    s.minAnisotropy = n.at("min_anisotropy").number();
     s.lowAnisotropy = n.at("low_anisotropy").choice({"stop", "continue_straight"}) == "stop"
                           ? LowAnisotropyPolicy::Stop
                           : LowAnisotropyPolicy::ContinueStraight;
-    s.maxTurnDeg = n.at("max_turn_deg").positive();
-    s.maxSteps = std::size_t(
-        n.at("max_steps").integer(1, std::numeric_limits<std::int64_t>::max(), "a positive integer"));
-    return s;
+    s.maxTurnDeg = n.at("max_turn_deg").number();
+    s.maxSteps = countField(n.at("max_steps"));
+    return s; // validated with its FishboneParams
 }
 
 FishboneParams readFishbone(const Node& n) {
@@ -371,60 +427,56 @@ FishboneParams readFishbone(const Node& n) {
     if (!seed.isNull()) p.seed = seed.vec2();
     p.direction =
         n.at("direction").choice({"min", "max"}) == "min" ? PrincipalDirection::Min : PrincipalDirection::Max;
-    p.spacing = n.at("h").positive();
+    p.spacing = n.at("h").number();
     p.keyRibs = n.at("key_ribs").points();
     const Node drawn = n.at("drawn_key_ribs");
     const std::size_t count = drawn.arraySize("an array of polylines");
-    for (std::size_t i = 0; i < count; ++i) {
+    for (std::size_t i = 0; i < count; ++i)
         p.drawnKeyRibs.push_back(drawn.element(i).points());
-        if (p.drawnKeyRibs.back().size() < 2) drawn.element(i).fail("must have at least 2 points");
-    }
     p.drawnBackbone = n.at("drawn_backbone").points();
-    if (p.drawnBackbone.size() == 1) n.at("drawn_backbone").fail("must be empty or have at least 2 points");
-    if (!p.seed && p.drawnBackbone.empty()) n.at("seed").fail("must be given when drawn_backbone is empty");
     const Node t = n.at("tracing");
     t.onlyKeys({"spacing", "extend_beyond_key_ribs", "backbone", "ribs"});
-    p.tracing.spacing = t.at("spacing").positive();
+    p.tracing.spacing = t.at("spacing").number();
     p.tracing.extendBeyondKeyRibs = t.at("extend_beyond_key_ribs").boolean();
     p.tracing.backboneTracing = readStreamline(t.at("backbone"));
     p.tracing.ribTracing = readStreamline(t.at("ribs"));
-    p.minSeedAnisotropy = n.at("min_seed_anisotropy").inRange(0, 1, false, false);
+    p.minSeedAnisotropy = n.at("min_seed_anisotropy").number();
     if (n.has("crease")) { // optional: files written before crease following get its defaults
         const Node c = n.at("crease");
         c.onlyKeys({"angle_deg", "snap_radius"});
-        p.creaseAngleDeg = c.at("angle_deg").inRange(0, 180, false, true);
-        p.creaseSnapRadius = c.at("snap_radius").positive();
+        p.creaseAngleDeg = c.at("angle_deg").number();
+        p.creaseSnapRadius = c.at("snap_radius").number();
     }
     const Node r = n.at("raycast");
     r.onlyKeys({"rings", "verify_unoccluded"});
-    p.raycast.rings = int(r.at("rings").integer(0, kIntMax, "an integer of at least 0"));
+    p.raycast.rings = intField(r.at("rings"));
     p.raycast.verifyUnoccluded = r.at("verify_unoccluded").boolean();
     // Optional: files written before the sampling image sampled at the scan resolution (k = 1).
-    p.samplingFactor = n.has("sampling_factor")
-                           ? int(n.at("sampling_factor").integer(0, 64, "an integer from 0 (automatic) to 64"))
-                           : 1;
-    return p;
+    p.samplingFactor = n.has("sampling_factor") ? intField(n.at("sampling_factor")) : 1;
+    return p; // validated by readStep, which knows the camera
 }
 
 StitchOptions readStitch(const Node& n) {
     n.onlyKeys({"seam_rings", "optimise_seam", "collapse_edge_ratio", "seam_grading", "min_angle_floor_deg",
                 "max_view_angle_deg", "max_normal_change_deg", "max_gap_ratio", "max_trim_rounds",
-                "min_component_faces", "collect_garbage", "peel_trim"});
+                "min_component_faces", "collect_garbage", "peel_trim", "outside_min_angle_floor_deg"});
     StitchOptions s;
-    s.seamRings = int(n.at("seam_rings").integer(0, kIntMax, "an integer of at least 0"));
+    s.seamRings = intField(n.at("seam_rings"));
     s.optimiseSeam = n.at("optimise_seam").boolean();
-    s.collapseEdgeRatio = n.at("collapse_edge_ratio").nonNegative();
-    s.seamGrading = n.at("seam_grading").nonNegative();
-    s.minAngleFloorDeg = n.at("min_angle_floor_deg").inRange(0, 60, false, false);
-    s.maxViewAngleDeg = n.at("max_view_angle_deg").inRange(0, 90, true, false);
-    s.maxNormalChangeDeg = n.at("max_normal_change_deg").inRange(0, 180, true, false);
-    s.maxGapRatio = n.at("max_gap_ratio").positive();
-    s.maxTrimRounds = int(n.at("max_trim_rounds").integer(0, kIntMax, "an integer of at least 0"));
-    s.minComponentFaces =
-        std::size_t(n.at("min_component_faces")
-                        .integer(0, std::numeric_limits<std::int64_t>::max(), "an integer of at least 0"));
+    s.collapseEdgeRatio = n.at("collapse_edge_ratio").number();
+    s.seamGrading = n.at("seam_grading").number();
+    s.minAngleFloorDeg = n.at("min_angle_floor_deg").number();
+    s.maxViewAngleDeg = n.at("max_view_angle_deg").number();
+    s.maxNormalChangeDeg = n.at("max_normal_change_deg").number();
+    s.maxGapRatio = n.at("max_gap_ratio").number();
+    s.maxTrimRounds = intField(n.at("max_trim_rounds"));
+    s.minComponentFaces = countField(n.at("min_component_faces"));
     s.collectGarbage = n.at("collect_garbage").boolean();
+    // Optional, absent in files written before they were stored: what those files were recorded with.
     s.peelTrim = n.has("peel_trim") && n.at("peel_trim").boolean();
+    s.outsideMinAngleFloorDeg =
+        n.has("outside_min_angle_floor_deg") ? n.at("outside_min_angle_floor_deg").number() : 0.0;
+    validated(n, [&] { s.validate(); });
     return s;
 }
 
@@ -443,28 +495,36 @@ ScanStep readStep(const Node& n) {
             lasso.fail("must enclose an area (at least 3 points, not all collinear)");
         }
     }
-    p.erodeRadius = int(n.at("erode_radius").integer(0, 1024, "an integer in [0, 1024]"));
-    p.dilateRadius = int(n.at("dilate_radius").integer(0, 1024, "an integer in [0, 1024]"));
+    p.erodeRadius = intField(n.at("erode_radius"));
+    p.dilateRadius = intField(n.at("dilate_radius"));
     const Node scan = n.at("scan");
     scan.onlyKeys({"scan_id", "quality_angle_limit_deg", "max_snap_footprints"});
     p.scan.scanId = std::int32_t(scan.at("scan_id").integer(std::numeric_limits<std::int32_t>::min(),
                                                             std::numeric_limits<std::int32_t>::max(),
                                                             "a 32-bit integer"));
-    p.scan.qualityAngleLimitDeg = scan.at("quality_angle_limit_deg").inRange(0, 90, true, true);
-    p.scan.maxSnapFootprints = scan.at("max_snap_footprints").nonNegative();
+    p.scan.qualityAngleLimitDeg = scan.at("quality_angle_limit_deg").number();
+    p.scan.maxSnapFootprints = scan.at("max_snap_footprints").number();
     const Node quality = n.at("quality_mask");
     quality.onlyKeys({"margin", "force_replace", "search_rings"});
-    p.quality.margin = quality.at("margin").inRange(0, 1, false, true);
+    p.quality.margin = quality.at("margin").number();
     p.quality.forceReplace = quality.at("force_replace").boolean();
-    p.quality.searchRings = int(quality.at("search_rings").integer(0, kIntMax, "an integer of at least 0"));
+    p.quality.searchRings = intField(quality.at("search_rings"));
     const Node tri = n.at("triangulate");
     tri.onlyKeys({"max_edge_footprints", "max_sampling_angle_deg"});
-    p.triangulate.maxEdgeFootprints = tri.at("max_edge_footprints").positive();
-    p.triangulate.maxSamplingAngleDeg = tri.at("max_sampling_angle_deg").inRange(0, 90, true, false);
+    p.triangulate.maxEdgeFootprints = tri.at("max_edge_footprints").number();
+    p.triangulate.maxSamplingAngleDeg = tri.at("max_sampling_angle_deg").number();
+    validated(n, [&] { p.validate(); }, {{"quality.", "quality_mask."}});
     const bool fishbone = n.at("grid").choice({"regular", "fishbone"}) == "fishbone";
-    if (fishbone)
-        step.fishbone = readFishbone(n.at("fishbone"));
-    else if (n.has("fishbone"))
+    if (fishbone) {
+        const Node fb = n.at("fishbone");
+        step.fishbone = readFishbone(fb);
+        validated(fb, [&] { step.fishbone->validate(p.camera); },
+                  {{"spacing", "h"},
+                   {"tracing.backboneTracing.", "tracing.backbone."},
+                   {"tracing.ribTracing.", "tracing.ribs."},
+                   {"creaseAngleDeg", "crease.angle_deg"},
+                   {"creaseSnapRadius", "crease.snap_radius"}});
+    } else if (n.has("fishbone"))
         n.at("fishbone").fail("must not be given when grid is \"regular\"");
     step.stitch = readStitch(n.at("stitch"));
     return step;
@@ -581,11 +641,11 @@ SessionFile sessionFileFromJson(const std::string& text, const std::string& name
     file.renderer = root.at("renderer").choice({"cpu", "gpu"});
     const Node curvature = root.at("curvature");
     curvature.onlyKeys({"jet_degree", "min_points", "max_rings", "anisotropy_epsilon"});
-    file.curvature.jetDegree = int(curvature.at("jet_degree").integer(2, 3, "2 or 3"));
-    file.curvature.minPoints =
-        int(curvature.at("min_points").integer(6, kIntMax, "an integer of at least 6"));
-    file.curvature.maxRings = int(curvature.at("max_rings").integer(1, kIntMax, "an integer of at least 1"));
-    file.curvature.anisotropyEpsilon = curvature.at("anisotropy_epsilon").positive();
+    file.curvature.jetDegree = intField(curvature.at("jet_degree"));
+    file.curvature.minPoints = intField(curvature.at("min_points"));
+    file.curvature.maxRings = intField(curvature.at("max_rings"));
+    file.curvature.anisotropyEpsilon = curvature.at("anisotropy_epsilon").number();
+    validated(curvature, [&] { file.curvature.validate(); });
 
     const Node events = root.at("events");
     const std::size_t count = events.arraySize("an array of events");

@@ -3356,15 +3356,7 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
             "The ID buffer has " + std::to_string(faceIds.size()) +
             " pixels but the scan camera's image has " +
             std::to_string(std::size_t(scanCamera.width) * std::size_t(scanCamera.height)) + ".");
-    if (!(options.collapseEdgeRatio >= 0 && options.collapseEdgeRatio < 0.5) || options.seamRings < 0 ||
-        !(options.maxViewAngleDeg > 0 && options.maxViewAngleDeg < 90) ||
-        !(options.maxNormalChangeDeg >= 0) || !(options.maxGapRatio > 0) || options.maxTrimRounds < 0 ||
-        !(options.seamGrading >= 0) || !(options.minAngleFloorDeg >= 0 && options.minAngleFloorDeg < 30) ||
-        !(options.outsideMinAngleFloorDeg >= 0 && options.outsideMinAngleFloorDeg < 30))
-        throw InvalidInputError(
-            "The stitch options are out of range (collapseEdgeRatio in [0, 0.5), seamRings >= 0, "
-            "maxViewAngleDeg in (0, 90), maxNormalChangeDeg >= 0, maxGapRatio > 0, maxTrimRounds >= 0, "
-            "seamGrading >= 0, minAngleFloorDeg and outsideMinAngleFloorDeg in [0, 30)).");
+    options.validate();
 
     const View view(scanCamera);
     StitchReport report;

@@ -1,0 +1,46 @@
+// validate() of the scan's options (scan.h, mask.h, triangulate.h, scan_pipeline.h): the one statement of
+// their ranges, used by the scan functions and by the session-file reader.
+#include "fss/mask.h"
+#include "fss/scan.h"
+#include "fss/scan_pipeline.h"
+#include "fss/triangulate.h"
+
+#include "base/option_check.h"
+
+namespace fss {
+
+void ScanOptions::validate() const {
+    const detail::OptionCheck check("ScanOptions");
+    check.inRange("qualityAngleLimitDeg", qualityAngleLimitDeg, 0, 90, true, true);
+    check.nonNegative("maxSnapFootprints", maxSnapFootprints);
+}
+
+void QualityMaskOptions::validate() const {
+    const detail::OptionCheck check("QualityMaskOptions");
+    check.inRange("margin", margin, 0, 1, false, true);
+    check.intAtLeast("searchRings", searchRings, 0);
+}
+
+void TriangulateOptions::validate() const {
+    const detail::OptionCheck check("TriangulateOptions");
+    check.positive("maxEdgeFootprints", maxEdgeFootprints);
+    check.inRange("maxSamplingAngleDeg", maxSamplingAngleDeg, 0, 90, true, false);
+}
+
+void ScanParams::validate() const {
+    camera.validate();
+    const char* owner = "ScanParams";
+    const detail::OptionCheck check(owner);
+    check.intRange("erodeRadius", erodeRadius, 0, 1024);
+    check.intRange("dilateRadius", dilateRadius, 0, 1024);
+    if (lasso) validateLasso(*lasso);
+    detail::nestedOptions(owner, "scan.", [&] { scan.validate(); });
+    detail::nestedOptions(owner, "quality.", [&] { quality.validate(); });
+    detail::nestedOptions(owner, "triangulate.", [&] { triangulate.validate(); });
+}
+
+void validateScanParams(const ScanParams& params) {
+    params.validate();
+}
+
+} // namespace fss
