@@ -6,7 +6,7 @@ here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 packages=(
   cmake ninja-build g++ pkg-config ccache lld
-  libcgal-dev libeigen3-dev libgmp-dev libmpfr-dev nlohmann-json3-dev
+  libcgal-dev libeigen3-dev libgmp-dev libmpfr-dev nlohmann-json3-dev libcli11-dev
   libvtk9-dev libglew-dev libegl-dev libgl-dev libgl1-mesa-dri libegl-mesa0 libgbm1
   qt6-base-dev qt6-base-dev-tools libqt6opengl6-dev qt6-tools-dev qt6-tools-dev-tools
   libgtest-dev libgmock-dev libbenchmark-dev
