@@ -6,7 +6,8 @@ here=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 
 packages=(
   cmake ninja-build g++ pkg-config ccache lld
-  libcgal-dev libeigen3-dev libgmp-dev libmpfr-dev nlohmann-json3-dev libssl-dev libtbb-dev clang-format
+  libcgal-dev libeigen3-dev libgmp-dev libmpfr-dev nlohmann-json3-dev libssl-dev libtbb-dev libcli11-dev
+  clang-format
   libvtk9-dev libglew-dev libegl-dev libgl-dev libgl1-mesa-dri libegl-mesa0 libgbm1
   qt6-base-dev qt6-base-dev-tools libqt6opengl6-dev qt6-tools-dev qt6-tools-dev-tools
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -5,10 +5,11 @@
 //            [--size WxH] [--scan VIEW]... [--resolution N] [MESH | --session FILE.json]
 //
 // Without MESH the bundled default mesh (CGAL's fandisk) is opened. --session loads and replays a session
-// file (as File > Open Session) instead of opening a mesh; --scan steps then follow its last step. --screenshot renders the window to
-// FILE and exits: 0 on success, 1 with one sentence on stderr when it failed, 2 for a wrong command line.
-// Each --scan VIEW first takes a regular scan of the whole view from that standard view (at --resolution,
-// default 256) and accepts it, as a user would with Take scan and Accept.
+// file (as File > Open Session) instead of opening a mesh; --scan steps then follow its last step.
+// --screenshot renders the window to FILE and exits: 0 on success, 1 with one sentence on stderr when it
+// failed, 2 for a wrong command line. Each --scan VIEW first takes a regular scan of the whole view from that
+// standard view (at --resolution, default 256) and accepts it, as a user would with Take scan and Accept.
+// --help and --version print and exit. The command line is read with QCommandLineParser.
 #include "main_window.h"
 
 #include <fss/camera.h>
@@ -19,6 +20,8 @@
 #include <fss/widgets/vtk_view.h>
 
 #include <QApplication>
+#include <QCommandLineParser>
+#include <QCoreApplication>
 #include <QElapsedTimer>
 #include <QThread>
 
@@ -30,10 +33,6 @@
 #include <vector>
 
 namespace {
-
-const char* const kUsage =
-    "usage: fss-demo [--screenshot FILE.png] [--view iso|+x|-x|+y|-y|+z|-z] [--colormap none|angle|valence|scan-id]\n"
-    "                [--size WxH] [--scan VIEW]... [--resolution N] [MESH | --session FILE.json]\n";
 
 struct Options {
     std::string mesh = FSS_DEFAULT_MESH;
@@ -54,113 +53,123 @@ public:
     }
 };
 
-// Parses the command line; prints one sentence and returns nullopt when it is wrong.
-std::optional<Options> parse(int argc, char** argv, bool& help) {
-    Options o;
-    bool haveMesh = false;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        auto value = [&](const char* name) -> std::optional<std::string> {
-            if (i + 1 >= argc) {
-                std::cerr << "Option " << name << " needs a value.\n" << kUsage;
-                return std::nullopt;
-            }
-            return std::string(argv[++i]);
-        };
-        if (a == "-h" || a == "--help") {
-            help = true;
-            return o;
-        } else if (a == "--screenshot") {
-            const auto v = value("--screenshot");
-            if (!v) return std::nullopt;
-            o.screenshot = *v;
-        } else if (a == "--session") {
-            const auto v = value("--session");
-            if (!v) return std::nullopt;
-            o.session = *v;
-        } else if (a == "--view") {
-            const auto v = value("--view");
-            if (!v) return std::nullopt;
-            const auto view = fss::parseStandardView(*v);
-            if (!view) {
-                std::cerr << "Unknown view '" << *v << "': use iso, +x, -x, +y, -y, +z or -z.\n";
-                return std::nullopt;
-            }
-            o.view = *view;
-        } else if (a == "--scan") {
-            const auto v = value("--scan");
-            if (!v) return std::nullopt;
-            const auto view = fss::parseStandardView(*v);
-            if (!view) {
-                std::cerr << "Unknown scan view '" << *v << "': use iso, +x, -x, +y, -y, +z or -z.\n";
-                return std::nullopt;
-            }
-            o.scans.push_back(*view);
-        } else if (a == "--resolution") {
-            const auto v = value("--resolution");
-            if (!v) return std::nullopt;
-            char rest = 0;
-            if (std::sscanf(v->c_str(), "%d%c", &o.resolution, &rest) != 1 || o.resolution < 16 ||
-                o.resolution > 4096) {
-                std::cerr << "Bad resolution '" << *v << "': use a number of pixels between 16 and 4096.\n";
-                return std::nullopt;
-            }
-        } else if (a == "--colormap") {
-            const auto v = value("--colormap");
-            if (!v) return std::nullopt;
-            const auto map = fss::widgets::parseColorMap(*v);
-            if (!map) {
-                std::cerr << "Unknown colour map '" << *v << "': use none, angle or valence.\n";
-                return std::nullopt;
-            }
-            o.colorMap = *map;
-        } else if (a == "--size") {
-            const auto v = value("--size");
-            if (!v) return std::nullopt;
-            int w = 0, h = 0;
-            char rest = 0;
-            if (std::sscanf(v->c_str(), "%dx%d%c", &w, &h, &rest) != 2 || w < 64 || h < 64 || w > 8192 ||
-                h > 8192) {
-                std::cerr << "Bad size '" << *v << "': use WIDTHxHEIGHT, each between 64 and 8192.\n";
-                return std::nullopt;
-            }
-            o.width = w;
-            o.height = h;
-        } else if (!a.empty() && a[0] == '-') {
-            std::cerr << "Unknown option '" << a << "'.\n" << kUsage;
-            return std::nullopt;
-        } else if (haveMesh) {
-            std::cerr << "Only one mesh file can be given.\n" << kUsage;
-            return std::nullopt;
-        } else {
-            o.mesh = a;
-            haveMesh = true;
-        }
+// What the command line asks for.
+enum class Request { Run, Help, Version, Wrong };
+
+// Parses the command line into \p o with QCommandLineParser (no QApplication needed: --help, --version and
+// a wrong command line work without a display). A wrong command line is told in one sentence on stderr.
+Request parse(int argc, char** argv, Options& o, QCommandLineParser& parser) {
+    parser.setApplicationDescription(
+        "The FSS demo application: a main window around the remeshing widget, opening MESH (by default the "
+        "bundled fandisk) or replaying a session file.\n\n"
+        "--screenshot renders the window to FILE.png and exits: 0 on success, 1 with one sentence on stderr "
+        "when it failed, 2 for a wrong command line. Each --scan VIEW first takes a regular scan of the "
+        "whole view from that standard view (at --resolution) and accepts it, as a user would with Take scan "
+        "and Accept; with --session the scans follow the session's last step.");
+    const QCommandLineOption help(QStringList{"h", "help"}, "Print this help and exit.");
+    parser.addOption(help);
+    const QCommandLineOption version = parser.addVersionOption();
+    const QCommandLineOption screenshot("screenshot", "Render the window to FILE.png and exit.", "FILE.png");
+    const QCommandLineOption view("view", "Standard view: iso, +x, -x, +y, -y, +z or -z (default iso).", "V");
+    const QCommandLineOption colorMap("colormap",
+                                      "Colour map: none, angle, valence or scan-id (default none).", "C");
+    const QCommandLineOption size("size", "Window size WIDTHxHEIGHT, each 64 to 8192 (default 1024x768).",
+                                  "WxH");
+    const QCommandLineOption scan(
+        "scan",
+        "Scan and accept the whole view from this standard view first (repeatable; with --screenshot).",
+        "VIEW");
+    const QCommandLineOption resolution("resolution",
+                                        "Resolution of the --scan scans, 16 to 4096 (default 256).", "N");
+    const QCommandLineOption session(
+        "session", "Load and replay this session file instead of opening a mesh.", "FILE.json");
+    parser.addOptions({screenshot, view, colorMap, size, scan, resolution, session});
+    parser.addPositionalArgument("MESH", "The mesh to open (.off .obj .ply .stl; default: fandisk).",
+                                 "[MESH]");
+
+    QStringList arguments;
+    for (int i = 0; i < argc; ++i)
+        arguments << QString::fromLocal8Bit(argv[i]);
+    auto wrong = [](const std::string& sentence) {
+        std::cerr << sentence << "\n";
+        return Request::Wrong;
+    };
+    if (!parser.parse(arguments))
+        return wrong(parser.errorText().toStdString() + " Run 'fss-demo --help' for the options.");
+    if (parser.isSet(help)) return Request::Help;
+    if (parser.isSet(version)) return Request::Version;
+
+    if (parser.isSet(screenshot)) o.screenshot = parser.value(screenshot).toStdString();
+    if (parser.isSet(session)) o.session = parser.value(session).toStdString();
+    // Each option's last value counts; --scan counts every time.
+    if (parser.isSet(view)) {
+        const std::string v = parser.value(view).toStdString();
+        const auto parsed = fss::parseStandardView(v);
+        if (!parsed) return wrong("Unknown view '" + v + "': use iso, +x, -x, +y, -y, +z or -z.");
+        o.view = *parsed;
     }
-    if (haveMesh && o.session) {
-        std::cerr << "Give either a mesh or --session, not both.\n" << kUsage;
-        return std::nullopt;
+    for (const QString& value : parser.values(scan)) {
+        const std::string v = value.toStdString();
+        const auto parsed = fss::parseStandardView(v);
+        if (!parsed) return wrong("Unknown scan view '" + v + "': use iso, +x, -x, +y, -y, +z or -z.");
+        o.scans.push_back(*parsed);
     }
-    return o;
+    if (parser.isSet(resolution)) {
+        const std::string v = parser.value(resolution).toStdString();
+        char rest = 0;
+        if (std::sscanf(v.c_str(), "%d%c", &o.resolution, &rest) != 1 || o.resolution < 16 ||
+            o.resolution > 4096)
+            return wrong("Bad resolution '" + v + "': use a number of pixels between 16 and 4096.");
+    }
+    if (parser.isSet(colorMap)) {
+        const std::string v = parser.value(colorMap).toStdString();
+        const auto map = fss::widgets::parseColorMap(v);
+        if (!map) return wrong("Unknown colour map '" + v + "': use none, angle, valence or scan-id.");
+        o.colorMap = *map;
+    }
+    if (parser.isSet(size)) {
+        const std::string v = parser.value(size).toStdString();
+        int w = 0, h = 0;
+        char rest = 0;
+        if (std::sscanf(v.c_str(), "%dx%d%c", &w, &h, &rest) != 2 || w < 64 || h < 64 || w > 8192 || h > 8192)
+            return wrong("Bad size '" + v + "': use WIDTHxHEIGHT, each between 64 and 8192.");
+        o.width = w;
+        o.height = h;
+    }
+    const QStringList meshes = parser.positionalArguments();
+    if (meshes.size() > 1) return wrong("Only one mesh file can be given.");
+    if (!meshes.isEmpty()) {
+        if (o.session) return wrong("Give either a mesh or --session, not both.");
+        o.mesh = meshes.front().toStdString();
+    }
+    return Request::Run;
 }
 
 } // namespace
 
 int main(int argc, char** argv) {
-    bool help = false;
-    const std::optional<Options> options = parse(argc, argv, help);
-    if (help) {
-        std::cout << kUsage;
+    Options options;
+    QCommandLineParser parser;
+    switch (parse(argc, argv, options, parser)) {
+    case Request::Help: {
+        const QCoreApplication application(argc, argv); // the program's name in the usage line
+        std::cout << parser.helpText().toStdString();
         return 0;
     }
-    if (!options) return 2;
-
+    case Request::Version:
+        std::cout << "fss-demo " << FSS_VERSION << "\n";
+        return 0;
+    case Request::Wrong:
+        return 2;
+    case Request::Run:
+        break;
+    }
     // In --screenshot mode the mesh is read before any window exists, so that a bad file ends the program
     // with its one sentence and nothing else.
     std::optional<fss::Mesh> mesh;
-    if (options->screenshot && !options->session) {
+    if (options.screenshot && !options.session) {
         try {
-            mesh = fss::readMesh(options->mesh);
+            mesh = fss::readMesh(options.mesh);
         } catch (const std::exception& e) {
             std::cerr << e.what() << "\n";
             return 1;
@@ -174,20 +183,20 @@ int main(int argc, char** argv) {
     QApplication::setApplicationVersion(QStringLiteral(FSS_VERSION));
 
     std::unique_ptr<fss::demo::MessagePresenter> presenter;
-    if (options->screenshot) presenter = std::make_unique<StderrPresenter>();
+    if (options.screenshot) presenter = std::make_unique<StderrPresenter>();
     fss::demo::MainWindow window(std::move(presenter));
-    window.resize(options->width, options->height);
-    window.view()->setInitialView(options->view);
-    window.setColorMap(options->colorMap);
+    window.resize(options.width, options.height);
+    window.view()->setInitialView(options.view);
+    window.setColorMap(options.colorMap);
 
-    if (options->screenshot) {
-        if (options->session) {
+    if (options.screenshot) {
+        if (options.session) {
             QString failure;
             QObject::connect(&window, &fss::demo::MainWindow::errorOccurred,
                              [&failure](const QString& message) { failure = message; });
             window.show(); // the replay's scans render in the view's GL context
             QApplication::processEvents();
-            if (window.openSession(QString::fromStdString(*options->session)))
+            if (window.openSession(QString::fromStdString(*options.session)))
                 while (window.remeshWidget()->isLoadingSession()) {
                     QApplication::processEvents(QEventLoop::AllEvents, 50);
                     QThread::msleep(5);
@@ -195,17 +204,17 @@ int main(int argc, char** argv) {
             if (!failure.isEmpty() || window.mesh().is_empty()) return 1; // the presenter printed why
         } else {
             window.setMesh(std::move(*mesh),
-                           QString::fromStdString(std::filesystem::path(options->mesh).filename().string()));
+                           QString::fromStdString(std::filesystem::path(options.mesh).filename().string()));
         }
-        if (!options->scans.empty()) {
+        if (!options.scans.empty()) {
             window.show(); // the scans use the view's camera at its final size
             QApplication::processEvents();
             fss::widgets::RemeshWidget* remesh = window.remeshWidget();
-            remesh->scanPanel()->setResolution(options->resolution);
+            remesh->scanPanel()->setResolution(options.resolution);
             QString failure;
             QObject::connect(remesh, &fss::widgets::RemeshWidget::errorOccurred,
                              [&failure](const QString& message) { failure = message; });
-            for (const fss::StandardView v : options->scans) {
+            for (const fss::StandardView v : options.scans) {
                 window.view()->setStandardView(v);
                 QApplication::processEvents();
                 if (remesh->scan()) {
@@ -221,9 +230,9 @@ int main(int argc, char** argv) {
                     return 1;
                 }
             }
-            window.view()->setStandardView(options->view);
+            window.view()->setStandardView(options.view);
         }
-        const QString error = window.saveScreenshot(QString::fromStdString(*options->screenshot));
+        const QString error = window.saveScreenshot(QString::fromStdString(*options.screenshot));
         if (!error.isEmpty()) {
             std::cerr << error.toStdString() << "\n";
             return 1;
@@ -231,9 +240,9 @@ int main(int argc, char** argv) {
         return 0;
     }
     window.show();
-    if (options->session)
-        window.openSession(QString::fromStdString(*options->session));
+    if (options.session)
+        window.openSession(QString::fromStdString(*options.session));
     else
-        window.openMesh(QString::fromStdString(options->mesh));
+        window.openMesh(QString::fromStdString(options.mesh));
     return app.exec();
 }

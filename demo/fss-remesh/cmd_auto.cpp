@@ -1,6 +1,6 @@
 // fss-remesh auto MESH -o OUT [--edge-length L | --target-vertices N] [--fishbone auto] [--json]
 //                  [--renderer auto|gpu|cpu] [--max-views N] [--no-metrics]
-#include "args.h"
+#include "command_line.h"
 #include "commands.h"
 #include "terminal_progress.h"
 
@@ -33,63 +33,26 @@ const char* kindName(AutoStep::Kind kind) {
     return "?";
 }
 
-} // namespace
+struct CliAutoOptions {
+    std::string meshPath, outPath, fishbone, rendererKind = "auto";
+    double edgeLength = 0;
+    int targetVertices = 0, maxViews = 80;
+    const CLI::Option* edge = nullptr;     // --edge-length, given when count() > 0
+    const CLI::Option* vertices = nullptr; // --target-vertices, given when count() > 0
+    bool json = false, noMetrics = false;
+};
 
-int runAuto(const std::vector<std::string>& args) {
-    std::string meshPath, outPath, edgeText, verticesText, fishboneText, rendererKind = "auto",
-                                                                         maxViewsText = "80";
-    bool haveEdge = false, haveVertices = false, haveFishbone = false, json = false, noMetrics = false;
-    ArgParser p(
-        "fss-remesh auto",
-        "Remesh the whole visible surface of MESH without a person: choose views that cover the surface, a "
-        "scan resolution from the target edge length, scan and stitch view after view (the quality mask "
-        "keeps the best view of each region), then aim extra views at what is left from the input.");
-    p.positional("MESH", "The mesh to remesh (.off .obj .ply .stl).", &meshPath);
-    p.option("-o", "OUT", "Output mesh (.ply keeps per-face quality and scan id).", &outPath);
-    p.option("--output", "OUT", "Same as -o.", &outPath);
-    p.option("--edge-length", "L", "Target edge length in model units.", &edgeText, &haveEdge);
-    p.option("--target-vertices", "N",
-             "Target vertex count (default: the input's); the edge length follows from the area, "
-             "area = N * (sqrt(3)/2) * L^2.",
-             &verticesText, &haveVertices);
-    p.option("--fishbone", "auto",
-             "'auto': chain the sharp feature lines of the mesh and scan each with a fishbone grid along it "
-             "first.",
-             &fishboneText, &haveFishbone);
-    p.option("--max-views", "N", "Largest number of scans (default 80).", &maxViewsText);
-    p.option("--renderer", "R", "auto (GPU, else CPU), gpu (head-less OpenGL) or cpu (ray casting).",
-             &rendererKind);
-    p.flag("--json",
-           "Print a JSON report: edge length, coverage, every scan, timings and the metrics of the result.",
-           &json);
-    p.flag("--no-metrics", "Leave the metrics (distance to the input, self-intersections) out of the report.",
-           &noMetrics);
-    p.epilog("examples:\n  fss-remesh auto fandisk.off -o fandisk-auto.off\n"
-             "  fss-remesh auto fandisk.off -o out.ply --target-vertices 10000 --fishbone auto --json");
-    if (!p.parse(args)) return 0;
-
-    if (outPath.empty()) throw UsageError("'fss-remesh auto' needs an output file: -o OUT.");
-    if (!isSupportedMeshFile(outPath))
-        throw UsageError("The output file " + outPath + " has no supported extension (.off .obj .ply .stl).");
-    if (haveEdge && haveVertices)
-        throw UsageError("Give either --edge-length or --target-vertices, not both.");
-    if (rendererKind != "auto" && rendererKind != "gpu" && rendererKind != "cpu")
-        throw UsageError("The value '" + rendererKind + "' of --renderer is not one of auto, gpu, cpu.");
-    if (haveFishbone && fishboneText != "auto")
-        throw UsageError("The value '" + fishboneText + "' of --fishbone is not 'auto'.");
+int runAuto(const CliAutoOptions& o) {
+    requireNotBoth(*o.edge, *o.vertices);
     AutoOptions options;
-    if (haveEdge) {
-        options.edgeLength = parseDouble("--edge-length", edgeText);
-        if (!(options.edgeLength > 0)) throw UsageError("The value of --edge-length must be positive.");
-    }
-    if (haveVertices)
-        options.targetVertices = std::size_t(parseInt("--target-vertices", verticesText, 4, 1 << 30));
-    options.maxViews = parseInt("--max-views", maxViewsText, 1, 10000);
-    options.fishbone = haveFishbone;
+    if (o.edge->count() > 0) options.edgeLength = o.edgeLength;
+    if (o.vertices->count() > 0) options.targetVertices = std::size_t(o.targetVertices);
+    options.maxViews = o.maxViews;
+    options.fishbone = !o.fishbone.empty();
 
-    const Mesh reference = readMesh(meshPath);
+    const Mesh reference = readMesh(o.meshPath);
     const render::RendererSelection renderer =
-        render::chooseRenderer(*render::parseRendererChoice(rendererKind));
+        render::chooseRenderer(*render::parseRendererChoice(o.rendererKind));
     if (!renderer.fallbackReason.empty())
         std::cerr << "fss-remesh auto: note: " << renderer.fallbackReason
                   << " Falling back to CPU ray casting.\n";
@@ -99,18 +62,18 @@ int runAuto(const std::vector<std::string>& args) {
     TerminalProgress bar;
     const AutoResult result = autoRemesh(reference, options, bar.progress());
     bar.finish();
-    writeMesh(result.mesh, outPath, WriteOptions{.binary = false});
+    writeMesh(result.mesh, o.outPath, WriteOptions{.binary = false});
 
     std::optional<Metrics> metrics;
-    if (!noMetrics) {
+    if (!o.noMetrics) {
         MetricsOptions mo;
         mo.reference = &reference;
         metrics = computeMetrics(result.mesh, mo);
     }
-    if (json) {
+    if (o.json) {
         nlohmann::json j;
-        j["input"] = meshPath;
-        j["output"] = outPath;
+        j["input"] = o.meshPath;
+        j["output"] = o.outPath;
         j["renderer"] = rendererUsed;
         j["edge_length"] = result.edgeLength;
         j["input_vertices"] = reference.number_of_vertices();
@@ -154,15 +117,50 @@ int runAuto(const std::vector<std::string>& args) {
         j["metrics"] = metrics ? nlohmann::json::parse(metricsToJson(*metrics)) : nlohmann::json();
         std::cout << j.dump(2) << "\n";
     } else {
-        std::cout << "remeshed " << meshPath << " (" << rendererUsed << ") at edge length "
+        std::cout << "remeshed " << o.meshPath << " (" << rendererUsed << ") at edge length "
                   << result.edgeLength << ": " << result.scansStitched << " scans stitched, "
                   << result.scansSkipped << " skipped, coverage " << result.coverage * 100
                   << " % of the area (" << result.inputFacesLeft << " input faces left), "
                   << result.mesh.number_of_vertices() << " vertices, " << result.mesh.number_of_faces()
-                  << " faces in " << result.seconds << " s, written to " << outPath << "\n";
+                  << " faces in " << result.seconds << " s, written to " << o.outPath << "\n";
         if (metrics) std::cout << metricsToText(*metrics);
     }
     return 0;
+}
+
+} // namespace
+
+Subcommand addAuto(CLI::App& app) {
+    auto o = std::make_shared<CliAutoOptions>();
+    CLI::App* p = addCommand(
+        app, "auto",
+        "Remesh the whole visible surface of MESH without a person: choose views that cover the surface, a "
+        "scan resolution from the target edge length, scan and stitch view after view (the quality mask "
+        "keeps the best view of each region), then aim extra views at what is left from the input.",
+        "examples:\n  fss-remesh auto fandisk.off -o fandisk-auto.off\n"
+        "  fss-remesh auto fandisk.off -o out.ply --target-vertices 10000 --fishbone auto --json");
+    p->add_option("MESH", o->meshPath, "The mesh to remesh (.off .obj .ply .stl).")
+        ->required()
+        ->type_name("");
+    addOutputMesh(*p, o->outPath, "Output mesh (.ply keeps per-face quality and scan id).");
+    o->edge = addDouble(*p, "--edge-length", o->edgeLength, true, "L", "Target edge length in model units.");
+    o->vertices = addInt(*p, "--target-vertices", o->targetVertices, 4, 1 << 30, "N",
+                         "Target vertex count (default: the input's); the edge length follows from the area, "
+                         "area = N * (sqrt(3)/2) * L^2.");
+    p->add_option("--fishbone", o->fishbone,
+                  "'auto': chain the sharp feature lines of the mesh and scan each with a fishbone grid "
+                  "along it first.")
+        ->type_name("auto")
+        ->check(oneOf("--fishbone", {"auto"}));
+    addInt(*p, "--max-views", o->maxViews, 1, 10000, "N", "Largest number of scans (default 80).");
+    addRenderer(*p, o->rendererKind, {},
+                "auto (GPU, else CPU), gpu (head-less OpenGL) or cpu (ray casting).");
+    p->add_flag(
+        "--json", o->json,
+        "Print a JSON report: edge length, coverage, every scan, timings and the metrics of the result.");
+    p->add_flag("--no-metrics", o->noMetrics,
+                "Leave the metrics (distance to the input, self-intersections) out of the report.");
+    return {p, [o] { return runAuto(*o); }};
 }
 
 } // namespace fss::cli

@@ -1,5 +1,5 @@
 // fss-remesh info MESH [--ref REF] [--json] [--no-self-intersections]
-#include "args.h"
+#include "command_line.h"
 #include "commands.h"
 
 #include "fss/mesh_io.h"
@@ -8,36 +8,33 @@
 #include <nlohmann/json.hpp>
 
 #include <iostream>
+#include <memory>
 
 namespace fss::cli {
+namespace {
 
-int runInfo(const std::vector<std::string>& args) {
+struct InfoOptions {
     std::string meshPath, refPath;
-    bool haveRef = false, json = false, noSelf = false;
-    ArgParser p("fss-remesh info", "Print quality metrics of MESH: counts, topology, valence regularity, triangle "
-                                   "shape and, with --ref, distances to a reference surface.");
-    p.positional("MESH", "Mesh file (.off .obj .ply .stl).", &meshPath);
-    p.option("--ref", "REF", "Reference mesh: adds Hausdorff distances both ways and the RMS distance.", &refPath,
-             &haveRef);
-    p.flag("--json", "Print one JSON object (snake_case keys) instead of text.", &json);
-    p.flag("--no-self-intersections", "Skip the self-intersection test (slow on huge meshes).", &noSelf);
-    p.epilog("example:\n  fss-remesh info fandisk.off --json");
-    if (!p.parse(args)) return 0;
+    const CLI::Option* ref = nullptr; // --ref, given when its count() > 0
+    bool json = false, noSelf = false;
+};
 
+int runInfo(const InfoOptions& o) {
+    const bool haveRef = o.ref->count() > 0;
     ReadReport report;
-    const Mesh mesh = readMesh(meshPath, &report);
+    const Mesh mesh = readMesh(o.meshPath, &report);
     Mesh reference;
     MetricsOptions options;
-    options.selfIntersections = !noSelf;
+    options.selfIntersections = !o.noSelf;
     if (haveRef) {
-        reference = readMesh(refPath);
+        reference = readMesh(o.refPath);
         options.reference = &reference;
     }
     Metrics m = computeMetrics(mesh, options);
 
-    if (json) {
+    if (o.json) {
         nlohmann::json j = nlohmann::json::parse(metricsToJson(m));
-        j["file"] = meshPath;
+        j["file"] = o.meshPath;
         j["format"] = report.format;
         j["binary"] = report.binary;
         j["non_manifold_edges"] = report.soup.nonManifoldEdges;
@@ -45,16 +42,35 @@ int runInfo(const std::vector<std::string>& args) {
         j["soup_polygons"] = report.soup.polygons;
         j["soup_points"] = report.soup.points;
         j["repairs"] = report.repairs;
-        if (haveRef) j["reference"] = refPath;
+        if (haveRef) j["reference"] = o.refPath;
         std::cout << j.dump(2) << "\n";
     } else {
-        std::cout << meshPath << " (" << report.format << (report.binary ? ", binary" : "") << ")\n";
-        for (const std::string& r : report.repairs) std::cout << "  repaired: " << r << "\n";
+        std::cout << o.meshPath << " (" << report.format << (report.binary ? ", binary" : "") << ")\n";
+        for (const std::string& r : report.repairs)
+            std::cout << "  repaired: " << r << "\n";
         std::cout << "  non-manifold edges (file): " << report.soup.nonManifoldEdges << "\n"
                   << "  non-manifold vertices (file): " << report.soup.nonManifoldVertices << "\n";
         std::cout << metricsToText(m);
     }
     return 0;
+}
+
+} // namespace
+
+Subcommand addInfo(CLI::App& app) {
+    auto o = std::make_shared<InfoOptions>();
+    CLI::App* p = addCommand(app, "info",
+                             "Print quality metrics of MESH: counts, topology, valence regularity, triangle "
+                             "shape and, with --ref, distances to a reference surface.",
+                             "example:\n  fss-remesh info fandisk.off --json");
+    p->add_option("MESH", o->meshPath, "Mesh file (.off .obj .ply .stl).")->required()->type_name("");
+    o->ref = p->add_option("--ref", o->refPath,
+                           "Reference mesh: adds Hausdorff distances both ways and the RMS distance.")
+                 ->type_name("REF");
+    p->add_flag("--json", o->json, "Print one JSON object (snake_case keys) instead of text.");
+    p->add_flag("--no-self-intersections", o->noSelf,
+                "Skip the self-intersection test (slow on huge meshes).");
+    return {p, [o] { return runInfo(*o); }};
 }
 
 } // namespace fss::cli

@@ -1,7 +1,7 @@
 // fss-remesh run SESSION.json -o OUT [--report R.json] [--json] [--snapshot S.png] [--snapshot-size WxH]
 //                [--snapshot-view V] [--renderer session|auto|gpu|cpu] [--no-self-intersections]
 // Replays a session file head-less (session_file.h) and reports what it made.
-#include "args.h"
+#include "command_line.h"
 #include "commands.h"
 #include "stitch_json.h"
 #include "terminal_progress.h"
@@ -37,77 +37,27 @@ double since(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-} // namespace
+struct RunOptions {
+    std::string sessionPath, outPath, reportPath, snapshotPath, snapshotView = "iso",
+                                                                rendererKind = "session";
+    int snapW = 1024, snapH = 768;
+    double zoom = 1;
+    const CLI::Option* report = nullptr;   // given when count() > 0
+    const CLI::Option* snapshot = nullptr; // given when count() > 0
+    bool json = false, noSelf = false, quiet = false;
+};
 
-int runRun(const std::vector<std::string>& args) {
+int runRun(const RunOptions& o) {
     const std::string command = "fss-remesh run";
-    std::string sessionPath, outPath, reportPath, snapshotPath,
-        snapshotSize = "1024x768", snapshotView = "iso", snapshotZoom = "1", rendererKind = "session";
-    bool haveReport = false, haveSnapshot = false, json = false, noSelf = false, quiet = false;
-    ArgParser p(command,
-                "Replay the session file SESSION.json head-less: read its input mesh (checking its "
-                "SHA-256), apply every recorded scan, undo and redo in order, and write the resulting mesh "
-                "to OUT. With the renderer the session was recorded with, OUT is identical to the mesh "
-                "the recording session produced.");
-    p.positional("SESSION.json", "Session file (fss-session JSON, written by fss-demo or the C++ API).",
-                 &sessionPath);
-    p.option("-o", "OUT", "Output mesh (.off .obj .ply .stl; .ply keeps per-face quality and scan id).",
-             &outPath);
-    p.option("--output", "OUT", "Same as -o.", &outPath);
-    p.option(
-        "--report", "R.json",
-        "Write a JSON report: every metric of 'fss-remesh info' for OUT (with Hausdorff distances to the "
-        "input) and for the input, and per event the scan and stitch times and the stitch report.",
-        &reportPath, &haveReport);
-    p.flag("--json", "Print the same JSON report on stdout instead of the text summary.", &json);
-    p.option(
-        "--snapshot", "S.png",
-        "Render OUT head-less into a PNG coloured by each triangle's minimum angle (red 0, yellow 30, green "
-        "60 degrees).",
-        &snapshotPath, &haveSnapshot);
-    p.option("--snapshot-size", "WxH", "Size of the snapshot in pixels (default 1024x768).", &snapshotSize);
-    p.option("--snapshot-view", "V", "View of the snapshot: iso, +x, -x, +y, -y, +z, -z (default iso).",
-             &snapshotView);
-    p.option("--snapshot-zoom", "F", "Zoom factor of the snapshot camera (> 0, default 1: the whole mesh).",
-             &snapshotZoom);
-    p.option(
-        "--renderer", "R",
-        "session (default: the renderer the session was recorded with), auto (GPU, else CPU), gpu or cpu. "
-        "Another renderer than the recording's gives a slightly different mesh.",
-        &rendererKind);
-    p.flag("--no-self-intersections", "Skip the self-intersection count in the report (slow on huge meshes).",
-           &noSelf);
-    p.flag("--quiet", "No progress bar (it is shown only when stderr is a terminal anyway).", &quiet);
-    p.epilog("example:\n  fss-remesh run examples/fandisk.session.json -o fandisk_remeshed.ply --report "
-             "report.json "
-             "--snapshot fandisk.png");
-    if (!p.parse(args)) return 0;
-
-    if (outPath.empty()) throw UsageError("'fss-remesh run' needs an output file: -o OUT.");
-    if (!isSupportedMeshFile(outPath))
-        throw UsageError("The output file " + outPath + " has no supported extension (.off .obj .ply .stl).");
-    if (rendererKind != "session" && rendererKind != "auto" && rendererKind != "gpu" && rendererKind != "cpu")
-        throw UsageError("The value '" + rendererKind +
-                         "' of --renderer is not one of session, auto, gpu, cpu.");
-    if (haveReport && reportPath.empty()) throw UsageError("The option --report needs a file name.");
-    if (haveSnapshot) {
-        const std::string ext = std::filesystem::path(snapshotPath).extension().string();
-        if (ext != ".png" && ext != ".PNG")
-            throw UsageError("The snapshot " + snapshotPath + " must be a .png file.");
-    }
-    const auto [snapW, snapH] = parseResolution("--snapshot-size", snapshotSize, Camera::kMaxResolution);
-    const double zoom = parseDouble("--snapshot-zoom", snapshotZoom);
-    if (!(zoom > 0)) throw UsageError("The value of --snapshot-zoom must be positive.");
-    const auto view = parseStandardView(snapshotView);
-    if (!view)
-        throw UsageError("The value '" + snapshotView +
-                         "' of --snapshot-view is not one of iso, +x, -x, +y, -y, +z, -z.");
+    const bool haveReport = o.report->count() > 0, haveSnapshot = o.snapshot->count() > 0, json = o.json;
+    if (haveReport && o.reportPath.empty()) throw UsageError("The option --report needs a file name.");
+    const auto view = parseStandardView(o.snapshotView);
 
     const auto start = Clock::now();
-    const SessionFile file = loadSessionFile(sessionPath);
+    const SessionFile file = loadSessionFile(o.sessionPath);
     const double loadSeconds = since(start);
 
-    const std::string kind = rendererKind == "session" ? file.renderer : rendererKind;
+    const std::string kind = o.rendererKind == "session" ? file.renderer : o.rendererKind;
     const render::RendererSelection renderer =
         render::chooseRenderer(render::parseRendererChoice(kind).value_or(render::RendererChoice::Auto));
     if (!renderer.fallbackReason.empty())
@@ -118,7 +68,7 @@ int runRun(const std::vector<std::string>& args) {
         std::cerr << command << ": note: the session was recorded with the " << file.renderer
                   << " renderer and is replayed with the " << used << " one; the mesh may differ slightly.\n";
 
-    TerminalProgress bar(!quiet);
+    TerminalProgress bar(!o.quiet);
 
     const auto replayStart = Clock::now();
     ReplayResult replay = replaySession(file, renderer.factory, bar.progress());
@@ -126,7 +76,7 @@ int runRun(const std::vector<std::string>& args) {
     const Mesh& result = replay.session.current();
 
     auto t = Clock::now();
-    writeMesh(result, outPath);
+    writeMesh(result, o.outPath);
     const double writeSeconds = since(t);
 
     const bool wantReport = haveReport || json;
@@ -136,7 +86,7 @@ int runRun(const std::vector<std::string>& args) {
     t = Clock::now();
     {
         MetricsOptions options;
-        options.selfIntersections = !noSelf;
+        options.selfIntersections = !o.noSelf;
         options.reference = &replay.session.reference();
         bar.update(1.0, "metrics");
         metrics = computeMetrics(result, options);
@@ -150,12 +100,12 @@ int runRun(const std::vector<std::string>& args) {
     if (haveSnapshot) {
         bar.update(1.0, "snapshot");
         t = Clock::now();
-        Camera camera = Camera::standardView(*view, boundingBox(result), snapW, snapH);
-        camera.zoom(zoom);
+        Camera camera = Camera::standardView(*view, boundingBox(result), o.snapW, o.snapH);
+        camera.zoom(o.zoom);
         render::SnapshotOptions options;
-        if (rendererKind == "cpu") options.renderer = render::SnapshotOptions::Renderer::Cpu;
+        if (o.rendererKind == "cpu") options.renderer = render::SnapshotOptions::Renderer::Cpu;
         shot = render::renderSnapshot(result, camera, options);
-        render::writePng(shot.image, snapshotPath);
+        render::writePng(shot.image, o.snapshotPath);
         snapshotSeconds = since(t);
     }
     bar.finish();
@@ -168,10 +118,10 @@ int runRun(const std::vector<std::string>& args) {
     }
 
     if (wantReport) {
-        report["session"] = sessionPath;
+        report["session"] = o.sessionPath;
         report["input"] = file.meshPath.string();
         report["input_sha256"] = file.meshSha256;
-        report["output"] = outPath;
+        report["output"] = o.outPath;
         report["renderer"] = used;
         report["renderer_recorded"] = file.renderer;
         report["counts"] = {{"events", replay.events.size()},
@@ -204,24 +154,25 @@ int runRun(const std::vector<std::string>& args) {
         report["input_metrics"] = Json::parse(metricsToJson(*inputMetrics));
         if (haveSnapshot)
             report["snapshot"] = {
-                {"file", snapshotPath},
-                {"width", snapW},
-                {"height", snapH},
-                {"view", snapshotView},
+                {"file", o.snapshotPath},
+                {"width", o.snapW},
+                {"height", o.snapH},
+                {"view", o.snapshotView},
                 {"renderer", shot.renderer},
-                {"covered_fraction", double(shot.covered) / (double(snapW) * double(snapH))}};
+                {"covered_fraction", double(shot.covered) / (double(o.snapW) * double(o.snapH))}};
         if (haveReport) {
-            const std::string tmp = reportPath + ".tmp" + std::to_string(::getpid());
+            const std::string tmp = o.reportPath + ".tmp" + std::to_string(::getpid());
             {
                 std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-                if (!out) throw IoError("The report " + reportPath + " cannot be written.");
+                if (!out) throw IoError("The report " + o.reportPath + " cannot be written.");
                 out << report.dump(2) << "\n";
                 if (!out.flush())
-                    throw IoError("The report " + reportPath + " could not be written completely.");
+                    throw IoError("The report " + o.reportPath + " could not be written completely.");
             }
             std::error_code ec;
-            std::filesystem::rename(tmp, reportPath, ec);
-            if (ec) throw IoError("The report " + reportPath + " cannot be written (" + ec.message() + ").");
+            std::filesystem::rename(tmp, o.reportPath, ec);
+            if (ec)
+                throw IoError("The report " + o.reportPath + " cannot be written (" + ec.message() + ").");
         }
     }
 
@@ -229,9 +180,9 @@ int runRun(const std::vector<std::string>& args) {
         std::cout << report.dump(2) << "\n";
     } else {
         const Metrics& m = *metrics;
-        std::cout << "replayed " << sessionPath << " (" << accepts << " scans, " << undos << " undos, "
+        std::cout << "replayed " << o.sessionPath << " (" << accepts << " scans, " << undos << " undos, "
                   << redos << " redos; " << used << " renderer) in " << replaySeconds << " s: " << m.vertices
-                  << " vertices, " << m.faces << " faces, written to " << outPath << "\n";
+                  << " vertices, " << m.faces << " faces, written to " << o.outPath << "\n";
         std::cout << metricsToText(m);
         if (inputMetrics) {
             const Metrics& in = *inputMetrics;
@@ -250,11 +201,64 @@ int runRun(const std::vector<std::string>& args) {
             row("min angle < 30 deg (%)", 100 * in.fracMinAngleBelow30, 100 * m.fracMinAngleBelow30,
                 "    %-24s %10.2f  %10.2f\n");
         }
-        if (haveReport) std::cout << "report written to " << reportPath << "\n";
+        if (haveReport) std::cout << "report written to " << o.reportPath << "\n";
         if (haveSnapshot)
-            std::cout << "snapshot (" << shot.renderer << ") written to " << snapshotPath << "\n";
+            std::cout << "snapshot (" << shot.renderer << ") written to " << o.snapshotPath << "\n";
     }
     return 0;
+}
+
+} // namespace
+
+Subcommand addRun(CLI::App& app) {
+    auto o = std::make_shared<RunOptions>();
+    CLI::App* p = addCommand(
+        app, "run",
+        "Replay the session file SESSION.json head-less: read its input mesh (checking its SHA-256), apply "
+        "every recorded scan, undo and redo in order, and write the resulting mesh to OUT. With the renderer "
+        "the session was recorded with, OUT is identical to the mesh the recording session produced.",
+        "example:\n  fss-remesh run examples/fandisk.session.json -o fandisk_remeshed.ply --report "
+        "report.json --snapshot fandisk.png");
+    p->add_option("SESSION.json", o->sessionPath,
+                  "Session file (fss-session JSON, written by fss-demo or the C++ API).")
+        ->required()
+        ->type_name("");
+    addOutputMesh(*p, o->outPath,
+                  "Output mesh (.off .obj .ply .stl; .ply keeps per-face quality and scan id).");
+    o->report =
+        p->add_option(
+             "--report", o->reportPath,
+             "Write a JSON report: every metric of 'fss-remesh info' for OUT (with Hausdorff distances to "
+             "the input) and for the input, and per event the scan and stitch times and the stitch report.")
+            ->type_name("R.json");
+    p->add_flag("--json", o->json, "Print the same JSON report on stdout instead of the text summary.");
+    o->snapshot = p->add_option("--snapshot", o->snapshotPath,
+                                "Render OUT head-less into a PNG coloured by each triangle's minimum angle "
+                                "(red 0, yellow 30, green 60 degrees).")
+                      ->type_name("S.png")
+                      ->check(CLI::Validator(
+                          [](std::string& path) {
+                              const std::string ext = std::filesystem::path(path).extension().string();
+                              if (ext != ".png" && ext != ".PNG")
+                                  throw UsageError("The snapshot " + path + " must be a .png file.");
+                              return std::string();
+                          },
+                          "", "png file"));
+    addResolution(*p, "--snapshot-size", o->snapW, o->snapH, Camera::kMaxResolution, "WxH",
+                  "Size of the snapshot in pixels (default 1024x768).");
+    p->add_option("--snapshot-view", o->snapshotView,
+                  "View of the snapshot: iso, +x, -x, +y, -y, +z, -z (default iso).")
+        ->type_name("V")
+        ->check(standardViewName("--snapshot-view"));
+    addDouble(*p, "--snapshot-zoom", o->zoom, true, "F",
+              "Zoom factor of the snapshot camera (> 0, default 1: the whole mesh).");
+    addRenderer(*p, o->rendererKind, {"session"},
+                "session (default: the renderer the session was recorded with), auto (GPU, else CPU), gpu or "
+                "cpu. Another renderer than the recording's gives a slightly different mesh.");
+    p->add_flag("--no-self-intersections", o->noSelf,
+                "Skip the self-intersection count in the report (slow on huge meshes).");
+    p->add_flag("--quiet", o->quiet, "No progress bar (it is shown only when stderr is a terminal anyway).");
+    return {p, [o] { return runRun(*o); }};
 }
 
 } // namespace fss::cli

@@ -1,7 +1,9 @@
-// fss-remesh scan MESH -o OUT [--into CURRENT] [--view V | --camera ...] [--parallel] [--resolution W[xH]] [--zoom F]
+// fss-remesh scan MESH -o OUT [--into CURRENT] [--view V | --camera ...] [--parallel] [--resolution W[xH]]
+// [--zoom F]
 //                  [--lasso "x,y;x,y;..."] [--erode N] [--dilate N] [--json] ...
-//                  [--fishbone "seed=X,Y[;dir=min|max][;h=PIXELS][;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...][;sampling=K]"]
-#include "args.h"
+//                  [--fishbone
+//                  "seed=X,Y[;dir=min|max][;h=PIXELS][;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...][;sampling=K]"]
+#include "command_line.h"
 #include "commands.h"
 #include "stitch_json.h"
 
@@ -38,13 +40,18 @@ void addPatchCounts(nlohmann::json& counts, const Patch& patch) {
     counts["dropped_non_manifold"] = tr.nonManifoldTriangles;
 }
 
-// "ex,ey,ez,fx,fy,fz,ux,uy,uz[,angle]"
-Camera parseCamera(const std::string& text, const Eigen::AlignedBox3d& box, int w, int h, bool parallel) {
-    const std::vector<double> v = parseDoubleList("--camera", text);
+// "ex,ey,ez,fx,fy,fz,ux,uy,uz[,angle]" → its 9 or 10 numbers.
+std::vector<double> parseCameraNumbers(const std::string& text) {
+    std::vector<double> v = parseDoubleList("--camera", text);
     if (v.size() != 9 && v.size() != 10)
-        throw UsageError("The option --camera needs 9 or 10 comma-separated numbers "
-                         "(eye, focal point, up, and optionally the view angle in degrees), not " +
+        throw UsageError("The option --camera needs 9 or 10 comma-separated numbers (eye, focal point, up, "
+                         "and optionally the view angle in degrees), not " +
                          std::to_string(v.size()) + ".");
+    return v;
+}
+
+// The camera of --camera's numbers \p v for a mesh in \p box, at w × h pixels.
+Camera makeCamera(const std::vector<double>& v, const Eigen::AlignedBox3d& box, int w, int h, bool parallel) {
     Camera c;
     c.eye = {v[0], v[1], v[2]};
     c.focal = {v[3], v[4], v[5]};
@@ -59,42 +66,58 @@ Camera parseCamera(const std::string& text, const Eigen::AlignedBox3d& box, int 
     return c;
 }
 
-// "x,y;x,y;..." in normalised image coordinates (0,0 top-left, 1,1 bottom-right) → pixels.
-Lasso parseLasso(const std::string& text, int w, int h) {
+// "x,y;x,y;..." in normalised image coordinates (0,0 top-left, 1,1 bottom-right), kept normalised.
+Lasso parseLasso(const std::string& text) {
     Lasso lasso;
     std::size_t start = 0;
     while (start <= text.size()) {
         const auto semi = text.find(';', start);
-        const std::string item = text.substr(start, semi == std::string::npos ? std::string::npos : semi - start);
+        const std::string item =
+            text.substr(start, semi == std::string::npos ? std::string::npos : semi - start);
         if (!item.empty()) {
             const std::vector<double> xy = parseDoubleList("--lasso", item);
             if (xy.size() != 2)
-                throw UsageError("Each --lasso point needs two numbers x,y (normalised 0..1), not '" + item + "'.");
-            lasso.points.emplace_back(xy[0] * w, xy[1] * h);
+                throw UsageError("Each --lasso point needs two numbers x,y (normalised 0..1), not '" + item +
+                                 "'.");
+            lasso.points.emplace_back(xy[0], xy[1]);
         }
         if (semi == std::string::npos) break;
         start = semi + 1;
     }
-    try {
-        validateLasso(lasso);
-    } catch (const InvalidInputError& e) {
-        throw UsageError(std::string("The --lasso polygon is degenerate: ") + e.what());
-    }
     return lasso;
 }
 
-// "x,y|x,y|..." (normalised) → pixels.
-std::vector<Eigen::Vector2d> parsePointList(const std::string& key, const std::string& text, int w, int h) {
+// \p p in normalised image coordinates → pixels of a w × h image.
+Eigen::Vector2d toPixels(const Eigen::Vector2d& p, int w, int h) {
+    return Eigen::Vector2d(p.x() * w, p.y() * h);
+}
+
+// The normalised \p lasso in pixels of a w × h image, checked for an enclosed area.
+Lasso lassoInPixels(const Lasso& lasso, int w, int h) {
+    Lasso pixels;
+    for (const Eigen::Vector2d& p : lasso.points)
+        pixels.points.push_back(toPixels(p, w, h));
+    try {
+        validateLasso(pixels);
+    } catch (const InvalidInputError& e) {
+        throw UsageError(std::string("The --lasso polygon is degenerate: ") + e.what());
+    }
+    return pixels;
+}
+
+// "x,y|x,y|..." (normalised, kept so).
+std::vector<Eigen::Vector2d> parsePointList(const std::string& key, const std::string& text) {
     std::vector<Eigen::Vector2d> points;
     std::size_t start = 0;
     while (start <= text.size()) {
         const auto bar = text.find('|', start);
-        const std::string item = text.substr(start, bar == std::string::npos ? std::string::npos : bar - start);
+        const std::string item =
+            text.substr(start, bar == std::string::npos ? std::string::npos : bar - start);
         const std::vector<double> xy = parseDoubleList("--fishbone " + key, item);
         if (xy.size() != 2)
             throw UsageError("Each point of the --fishbone key '" + key +
                              "' needs two numbers x,y (normalised 0..1), not '" + item + "'.");
-        points.emplace_back(xy[0] * w, xy[1] * h);
+        points.emplace_back(xy[0], xy[1]);
         if (bar == std::string::npos) break;
         start = bar + 1;
     }
@@ -102,35 +125,39 @@ std::vector<Eigen::Vector2d> parsePointList(const std::string& key, const std::s
 }
 
 // "seed=X,Y[;dir=min|max][;h=PIXELS][;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...][;sampling=K]", points
-// normalised.
-FishboneParams parseFishbone(const std::string& text, int w, int h) {
+// normalised (and kept so: see fishboneInPixels).
+FishboneParams parseFishbone(const std::string& text) {
     FishboneParams fb;
     bool haveSeed = false;
     std::size_t start = 0;
     while (start <= text.size()) {
         const auto semi = text.find(';', start);
-        const std::string item = text.substr(start, semi == std::string::npos ? std::string::npos : semi - start);
+        const std::string item =
+            text.substr(start, semi == std::string::npos ? std::string::npos : semi - start);
         if (!item.empty()) {
             const auto eq = item.find('=');
             if (eq == std::string::npos)
                 throw UsageError("The --fishbone item '" + item + "' is not of the form key=value.");
             const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
             if (key == "seed") {
-                const std::vector<Eigen::Vector2d> p = parsePointList(key, value, w, h);
+                const std::vector<Eigen::Vector2d> p = parsePointList(key, value);
                 if (p.size() != 1)
                     throw UsageError("The --fishbone seed must be one point x,y (normalised 0..1).");
                 fb.seed = p.front();
                 haveSeed = true;
             } else if (key == "dir") {
-                if (value == "min") fb.direction = PrincipalDirection::Min;
-                else if (value == "max") fb.direction = PrincipalDirection::Max;
-                else throw UsageError("The --fishbone direction '" + value + "' is not one of min, max.");
+                if (value == "min")
+                    fb.direction = PrincipalDirection::Min;
+                else if (value == "max")
+                    fb.direction = PrincipalDirection::Max;
+                else
+                    throw UsageError("The --fishbone direction '" + value + "' is not one of min, max.");
             } else if (key == "h") {
                 fb.spacing = parseDouble("--fishbone h", value);
             } else if (key == "keyribs") {
-                fb.keyRibs = parsePointList(key, value, w, h);
+                fb.keyRibs = parsePointList(key, value);
             } else if (key == "backbone") {
-                fb.drawnBackbone = parsePointList(key, value, w, h);
+                fb.drawnBackbone = parsePointList(key, value);
             } else if (key == "sampling") {
                 const double k = parseDouble("--fishbone sampling", value);
                 if (!(k >= 0 && k <= 64) || k != std::floor(k))
@@ -152,6 +179,16 @@ FishboneParams parseFishbone(const std::string& text, int w, int h) {
     if (fb.keyRibs.size() == 1)
         throw UsageError("The --fishbone keyribs need at least two points to blend between.");
     return fb;
+}
+
+// The normalised points of \p fishbone in pixels of a w × h image.
+FishboneParams fishboneInPixels(FishboneParams fishbone, int w, int h) {
+    if (fishbone.seed) fishbone.seed = toPixels(*fishbone.seed, w, h);
+    for (Eigen::Vector2d& p : fishbone.keyRibs)
+        p = toPixels(p, w, h);
+    for (Eigen::Vector2d& p : fishbone.drawnBackbone)
+        p = toPixels(p, w, h);
+    return fishbone;
 }
 
 // What either kind of scan produced, with its part of the JSON report and of the text summary.
@@ -191,14 +228,18 @@ ScanRun fishboneScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& 
                    {"after_quality", c.afterQuality},
                    {"after_morphology", c.afterMorphology}};
     addPatchCounts(j["counts"], result.patch);
-    j["timings_s"] = {{"curvature", t.curvature},          {"ray_caster_build", t.rayCasterBuild},
-                      {"render_reference", t.renderReference}, {"direction_field", t.directionField},
-                      {"tracing", t.tracing},              {"ray_casting", t.rayCasting},
-                      {"masks", t.masks},                  {"triangulate", t.triangulate},
+    j["timings_s"] = {{"curvature", t.curvature},
+                      {"ray_caster_build", t.rayCasterBuild},
+                      {"render_reference", t.renderReference},
+                      {"direction_field", t.directionField},
+                      {"tracing", t.tracing},
+                      {"ray_casting", t.rayCasting},
+                      {"masks", t.masks},
+                      {"triangulate", t.triangulate},
                       {"total", t.total}};
     std::ostringstream text;
-    text << "fishbone-scanned " << meshPath << " at " << params.camera.width << "x" << params.camera.height << " ("
-         << rendererUsed << "): " << c.rows << " ribs x " << c.cols << " columns, " << c.covered
+    text << "fishbone-scanned " << meshPath << " at " << params.camera.width << "x" << params.camera.height
+         << " (" << rendererUsed << "): " << c.rows << " ribs x " << c.cols << " columns, " << c.covered
          << " samples -> patch of " << result.patch.mesh.number_of_vertices() << " vertices, "
          << result.patch.mesh.number_of_faces() << " faces in " << t.total << " s";
     run.summary = text.str();
@@ -208,8 +249,9 @@ ScanRun fishboneScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& 
     return run;
 }
 
-ScanRun regularScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& current, MeshRenderer& currentRenderer,
-                    const ScanParams& params, const std::string& meshPath, const std::string& rendererUsed) {
+ScanRun regularScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& current,
+                    MeshRenderer& currentRenderer, const ScanParams& params, const std::string& meshPath,
+                    const std::string& rendererUsed) {
     ScanResult result = scanPatch(reference, renderer, current, currentRenderer, params);
     const ScanCounts& c = result.counts;
     const ScanTimings& t = result.timings;
@@ -229,10 +271,14 @@ ScanRun regularScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& c
                    {"after_quality", c.afterQuality},
                    {"after_morphology", c.afterMorphology}};
     addPatchCounts(j["counts"], result.patch);
-    j["timings_s"] = {{"render_reference", t.renderReference}, {"render_current", t.renderCurrent},
-                      {"sample", t.sample},                    {"lasso", t.lasso},
-                      {"quality_mask", t.qualityMask},         {"morphology", t.morphology},
-                      {"triangulate", t.triangulate},          {"total", t.total}};
+    j["timings_s"] = {{"render_reference", t.renderReference},
+                      {"render_current", t.renderCurrent},
+                      {"sample", t.sample},
+                      {"lasso", t.lasso},
+                      {"quality_mask", t.qualityMask},
+                      {"morphology", t.morphology},
+                      {"triangulate", t.triangulate},
+                      {"total", t.total}};
     std::ostringstream text;
     text << "scanned " << meshPath << " at " << params.camera.width << "x" << params.camera.height << " ("
          << rendererUsed << "): " << c.covered << " covered pixels -> patch of "
@@ -250,7 +296,8 @@ int nextScanId(const Mesh& mesh) {
     const auto [ids, has] = mesh.property_map<FaceIndex, std::int32_t>(props::faceScanId);
     std::int32_t next = 0;
     if (has)
-        for (FaceIndex f : mesh.faces()) next = std::max(next, ids[f] + 1);
+        for (FaceIndex f : mesh.faces())
+            next = std::max(next, ids[f] + 1);
     return next;
 }
 
@@ -287,139 +334,84 @@ void requireRemeshingOf(const Mesh& current, const std::string& currentPath, con
     }
 }
 
-} // namespace
+struct ScanOptions {
+    std::string meshPath, outPath, view = "iso", intoPath, rendererKind = "auto";
+    std::vector<double> camera; // --camera's numbers
+    int w = 256, h = 256, erode = 1, dilate = 1, scanId = 0;
+    double zoom = 1, maxEdge = 3, maxAngle = 80, margin = 0.1;
+    Lasso lasso;                             // normalised
+    FishboneParams fishbone;                 // normalised
+    const CLI::Option* viewOption = nullptr; // the options below are given when their count() > 0
+    const CLI::Option* cameraOption = nullptr;
+    const CLI::Option* lassoOption = nullptr;
+    const CLI::Option* fishboneOption = nullptr;
+    const CLI::Option* intoOption = nullptr;
+    const CLI::Option* scanIdOption = nullptr;
+    bool parallel = false, json = false, force = false;
+};
 
-int runScan(const std::vector<std::string>& args) {
-    std::string meshPath, outPath, view = "iso", cameraText, resolution = "256", zoom = "1", lassoText, erodeText = "1",
-                                   dilateText = "1", rendererKind = "auto", scanIdText = "0", maxEdge = "3",
-                                   maxAngle = "80", margin = "0.1";
-    std::string fishboneText, intoPath;
-    bool haveFishbone = false, haveInto = false, haveScanId = false;
-    bool haveView = false, haveCamera = false, haveLasso = false, parallel = false, json = false, force = false;
-    ArgParser p("fss-remesh scan", "Scan MESH from a camera: render it off-screen, turn every covered pixel into a "
-                                   "sample on the surface, mask the samples and triangulate the pixel grid into a "
-                                   "regular patch (interior valence 6), written to OUT. With --into CURRENT the patch "
-                                   "is stitched into CURRENT and the result written to OUT.");
-    p.positional("MESH", "The reference mesh to scan (.off .obj .ply .stl).", &meshPath);
-    p.option("-o", "OUT", "Output file of the patch, or of the stitched mesh with --into (.ply keeps per-face "
-                          "quality and scan id).", &outPath);
-    p.option("--output", "OUT", "Same as -o.", &outPath);
-    p.option("--view", "V", "Standard view fitted to the mesh: iso, +x, -x, +y, -y, +z, -z (default iso). '+x' looks "
-                            "from the +x side.", &view, &haveView);
-    p.option("--camera", "E,F,U[,A]",
-             "Explicit camera \"ex,ey,ez,fx,fy,fz,ux,uy,uz[,angle]\": eye, focal point, up vector and the vertical "
-             "view angle in degrees (default 30).", &cameraText, &haveCamera);
-    p.flag("--parallel", "Parallel (orthographic) projection instead of perspective.", &parallel);
-    p.option("--resolution", "W[xH]", "Scan resolution in pixels, 1 to 8192 per side (default 256).", &resolution);
-    p.option("--zoom", "F", "Zoom factor > 0 (2 = twice as close, finer sampling; default 1).", &zoom);
-    p.option("--lasso", "\"x,y;x,y;...\"",
-             "Keep only samples inside this polygon, in normalised image coordinates (0,0 top-left, 1,1 "
-             "bottom-right). Self-intersecting polygons use the non-zero winding rule.", &lassoText, &haveLasso);
-    p.option("--fishbone", "SPEC",
-             "Feature-sensitive (fishbone) grid instead of the pixel grid: \"seed=X,Y[;dir=min|max][;h=PIXELS]"
-             "[;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...][;sampling=K]\". seed: a point on a curved feature; the backbone is "
-             "traced through it along the min (default) or max curvature direction, ribs along the other; h: "
-             "sample spacing in pixels (default 4); keyribs: ribs only at the backbone samples nearest these points "
-             "(at least two), blended in between; backbone: a hand-drawn backbone through these points instead of "
-             "the seed; sampling: the fishbone renders and traces on the image at 1/K of the resolution (default 0: "
-             "K = the largest integer <= h dividing both sides, about one pixel per sample as a regular scan; 1 "
-             "= full resolution, finer direction fields at up to h^2 times the render cost). Points in "
-             "normalised image coordinates as for --lasso. --max-edge-footprints is multiplied by h/K.", &fishboneText, &haveFishbone);
-    p.option("--erode", "N", "Erosion radius in samples (default 1; 0 = none).", &erodeText);
-    p.option("--dilate", "N", "Dilation radius after the erosion (default 1); never re-admits rejected samples.",
-             &dilateText);
-    p.option("--max-edge-footprints", "X", "Drop triangles with an edge longer than X pixel footprints (default 3).",
-             &maxEdge);
-    p.option("--max-angle", "DEG", "Drop triangles seen at more than DEG degrees from frontal (default 80).",
-             &maxAngle);
-    p.option("--quality-margin", "M", "A sample replaces a face only when better by this fraction (default 0.1).",
-             &margin);
-    p.flag("--force-replace", "Keep every sample regardless of the quality of the mesh already there.", &force);
-    p.option("--into", "CURRENT",
-             "Stitch the patch into the mesh CURRENT and write the result to OUT instead of the patch. MESH stays "
-             "the reference the samples come from; CURRENT's faces decide where the scan is better (quality "
-             "mask) and are replaced there. Give MESH itself for the first scan and chain through .ply files, "
-             "which keep each face's quality and scan id. CURRENT must be a remeshing of MESH (every "
-             "vertex within 1 % of MESH's bounding-box diagonal from its surface).", &intoPath, &haveInto);
-    p.option("--scan-id", "N", "Scan id stored on the patch faces (default 0; with --into one more than the "
-                               "largest in CURRENT).", &scanIdText, &haveScanId);
-    p.option("--renderer", "R", "auto (GPU, else CPU), gpu (head-less OpenGL) or cpu (ray casting).",
-             &rendererKind);
-    p.flag("--json", "Print a JSON report: counts and the timing of each stage (with --into also the stitch "
-                      "report under \"stitch\").", &json);
-    p.epilog("examples:\n  fss-remesh scan fandisk.off -o patch.ply --view iso --resolution 512\n"
-             "  fss-remesh scan fandisk.off -o patch.ply --view +x --lasso \"0.2,0.2;0.8,0.2;0.5,0.9\" --erode 2\n"
-             "  fss-remesh scan fandisk.off -o patch.ply --renderer cpu --fishbone \"seed=0.4,0.55;dir=min;h=3\"\n"
-             "  fss-remesh scan fandisk.off --into fandisk.off -o step1.ply --view iso\n"
-             "  fss-remesh scan fandisk.off --into step1.ply -o step2.ply --view +x --json");
-    if (!p.parse(args)) return 0;
-
-    if (outPath.empty()) throw UsageError("'fss-remesh scan' needs an output file: -o OUT.");
-    if (!isSupportedMeshFile(outPath))
-        throw UsageError("The output file " + outPath + " has no supported extension (.off .obj .ply .stl).");
-    if (haveView && haveCamera) throw UsageError("Give either --view or --camera, not both.");
-    if (rendererKind != "auto" && rendererKind != "gpu" && rendererKind != "cpu")
-        throw UsageError("The value '" + rendererKind + "' of --renderer is not one of auto, gpu, cpu.");
-    const auto [w, h] = parseResolution("--resolution", resolution, Camera::kMaxResolution);
-    const double zoomFactor = parseDouble("--zoom", zoom);
-    if (!(zoomFactor > 0)) throw UsageError("The value of --zoom must be positive.");
+int runScan(const ScanOptions& o) {
+    requireNotBoth(*o.viewOption, *o.cameraOption);
+    const std::string& meshPath = o.meshPath;
+    const int w = o.w, h = o.h;
+    const bool haveInto = o.intoOption->count() > 0;
     ScanParams params;
-    params.erodeRadius = parseInt("--erode", erodeText, 0, 64);
-    params.dilateRadius = parseInt("--dilate", dilateText, 0, 64);
-    params.triangulate.maxEdgeFootprints = parseDouble("--max-edge-footprints", maxEdge);
-    params.triangulate.maxSamplingAngleDeg = parseDouble("--max-angle", maxAngle);
-    params.quality.margin = parseDouble("--quality-margin", margin);
-    params.quality.forceReplace = force;
-    params.scan.scanId = parseInt("--scan-id", scanIdText, 0, 1 << 30);
+    params.erodeRadius = o.erode;
+    params.dilateRadius = o.dilate;
+    params.triangulate.maxEdgeFootprints = o.maxEdge;
+    params.triangulate.maxSamplingAngleDeg = o.maxAngle;
+    params.quality.margin = o.margin;
+    params.quality.forceReplace = o.force;
+    params.scan.scanId = o.scanId;
 
     const Mesh reference = readMesh(meshPath);
     const Eigen::AlignedBox3d box = boundingBox(reference);
-    if (haveCamera) {
-        params.camera = parseCamera(cameraText, box, w, h, parallel);
-    } else {
-        const auto sv = parseStandardView(view);
-        if (!sv) throw UsageError("The value '" + view + "' of --view is not one of iso, +x, -x, +y, -y, +z, -z.");
-        params.camera = Camera::standardView(*sv, box, w, h, parallel);
-    }
-    params.camera.zoom(zoomFactor);
-    if (haveLasso) params.lasso = parseLasso(lassoText, w, h);
+    if (o.cameraOption->count() > 0)
+        params.camera = makeCamera(o.camera, box, w, h, o.parallel);
+    else
+        params.camera = Camera::standardView(*parseStandardView(o.view), box, w, h, o.parallel);
+    params.camera.zoom(o.zoom);
+    if (o.lassoOption->count() > 0) params.lasso = lassoInPixels(o.lasso, w, h);
 
     std::optional<FishboneParams> fishbone;
-    if (haveFishbone) fishbone = parseFishbone(fishboneText, w, h);
+    if (o.fishboneOption->count() > 0) fishbone = fishboneInPixels(o.fishbone, w, h);
 
     // The current mesh: the reference itself (first scan, or --into MESH) or the mesh of --into.
     std::optional<Mesh> intoMesh;
-    if (haveInto && !sameFile(intoPath, meshPath)) {
-        intoMesh = readMesh(intoPath);
-        requireRemeshingOf(*intoMesh, intoPath, reference, meshPath, box);
+    if (haveInto && !sameFile(o.intoPath, meshPath)) {
+        intoMesh = readMesh(o.intoPath);
+        requireRemeshingOf(*intoMesh, o.intoPath, reference, meshPath, box);
     }
     const Mesh& current = intoMesh ? *intoMesh : reference;
-    if (haveInto && !haveScanId) params.scan.scanId = nextScanId(current);
+    if (haveInto && o.scanIdOption->count() == 0) params.scan.scanId = nextScanId(current);
 
     // The reference's renderer, and the current mesh's (a second GPU context that fails falls back to CPU).
     auto newRenderer = [](render::RendererChoice choice) {
         std::string why;
         std::unique_ptr<MeshRenderer> renderer = render::makeRenderer(choice, &why);
-        if (!why.empty()) std::cerr << "fss-remesh scan: note: " << why << " Falling back to CPU ray casting.\n";
+        if (!why.empty())
+            std::cerr << "fss-remesh scan: note: " << why << " Falling back to CPU ray casting.\n";
         return renderer;
     };
-    std::unique_ptr<MeshRenderer> renderer = newRenderer(*render::parseRendererChoice(rendererKind));
+    std::unique_ptr<MeshRenderer> renderer = newRenderer(*render::parseRendererChoice(o.rendererKind));
     const render::RendererChoice kind = render::rendererKind(*renderer);
     const std::string rendererUsed(render::rendererChoiceName(kind));
     renderer->setMesh(reference);
     std::unique_ptr<MeshRenderer> currentRenderer;
     if (intoMesh) {
-        currentRenderer = newRenderer(kind == render::RendererChoice::Cpu ? kind : render::RendererChoice::Auto);
+        currentRenderer =
+            newRenderer(kind == render::RendererChoice::Cpu ? kind : render::RendererChoice::Auto);
         currentRenderer->setMesh(*intoMesh);
     }
     MeshRenderer& renderCurrent = currentRenderer ? *currentRenderer : *renderer;
-    ScanRun run = fishbone ? fishboneScan(reference, *renderer, current, renderCurrent, params, *fishbone, meshPath,
-                                          rendererUsed)
-                           : regularScan(reference, *renderer, current, renderCurrent, params, meshPath, rendererUsed);
+    ScanRun run =
+        fishbone ? fishboneScan(reference, *renderer, current, renderCurrent, params, *fishbone, meshPath,
+                                rendererUsed)
+                 : regularScan(reference, *renderer, current, renderCurrent, params, meshPath, rendererUsed);
 
     nlohmann::json j;
     j["input"] = meshPath;
-    j["output"] = outPath;
+    j["output"] = o.outPath;
     j["renderer"] = render::rendererDescription(*renderer);
     j.update(run.json);
     std::string summary = run.summary;
@@ -430,26 +422,115 @@ int runScan(const std::vector<std::string>& args) {
         stitchOptions.collectGarbage = true;
         const StitchReport report =
             stitchPatch(result, run.patch.mesh, run.samplingCamera, stitchOptions, run.currentBuffers.faceId);
-        writeMesh(result, outPath, WriteOptions{.binary = false});
-        j["into"] = intoPath;
+        writeMesh(result, o.outPath, WriteOptions{.binary = false});
+        j["into"] = o.intoPath;
         j["scan_id"] = params.scan.scanId;
         j["stitch"] = stitchReportJson<nlohmann::json>(report);
         j["result"] = {{"vertices", result.number_of_vertices()}, {"faces", result.number_of_faces()}};
         j["timings_s"]["stitch"] = report.seconds;
         std::ostringstream text;
-        text << "; stitched into " << intoPath << " (scan id " << params.scan.scanId << "): " << report.facesRemoved
-             << " faces replaced by " << report.facesAdded << " (" << report.componentsStitched
-             << " components stitched, " << report.componentsSkipped << " skipped, seam min angle "
-             << report.seamMinAngleDeg << " deg) in " << report.seconds << " s -> " << result.number_of_faces()
-             << " faces, written to " << outPath;
+        text << "; stitched into " << o.intoPath << " (scan id " << params.scan.scanId
+             << "): " << report.facesRemoved << " faces replaced by " << report.facesAdded << " ("
+             << report.componentsStitched << " components stitched, " << report.componentsSkipped
+             << " skipped, seam min angle " << report.seamMinAngleDeg << " deg) in " << report.seconds
+             << " s -> " << result.number_of_faces() << " faces, written to " << o.outPath;
         summary += text.str();
     } else {
-        writeMesh(run.patch.mesh, outPath, WriteOptions{.binary = false});
-        summary += ", written to " + outPath;
+        writeMesh(run.patch.mesh, o.outPath, WriteOptions{.binary = false});
+        summary += ", written to " + o.outPath;
     }
-    if (json) std::cout << j.dump(2) << "\n";
-    else std::cout << summary << "\n";
+    if (o.json)
+        std::cout << j.dump(2) << "\n";
+    else
+        std::cout << summary << "\n";
     return 0;
+}
+
+} // namespace
+
+Subcommand addScan(CLI::App& app) {
+    auto o = std::make_shared<ScanOptions>();
+    CLI::App* p = addCommand(
+        app, "scan",
+        "Scan MESH from a camera: render it off-screen, turn every covered pixel into a sample on the "
+        "surface, mask the samples and triangulate the pixel grid into a regular patch (interior valence 6), "
+        "written to OUT. With --into CURRENT the patch is stitched into CURRENT and the result written to "
+        "OUT.",
+        "examples:\n  fss-remesh scan fandisk.off -o patch.ply --view iso --resolution 512\n"
+        "  fss-remesh scan fandisk.off -o patch.ply --view +x --lasso \"0.2,0.2;0.8,0.2;0.5,0.9\" --erode 2\n"
+        "  fss-remesh scan fandisk.off -o patch.ply --renderer cpu --fishbone \"seed=0.4,0.55;dir=min;h=3\"\n"
+        "  fss-remesh scan fandisk.off --into fandisk.off -o step1.ply --view iso\n"
+        "  fss-remesh scan fandisk.off --into step1.ply -o step2.ply --view +x --json");
+    p->add_option("MESH", o->meshPath, "The reference mesh to scan (.off .obj .ply .stl).")
+        ->required()
+        ->type_name("");
+    addOutputMesh(*p, o->outPath,
+                  "Output file of the patch, or of the stitched mesh with --into (.ply keeps per-face "
+                  "quality and scan id).");
+    o->viewOption = p->add_option("--view", o->view,
+                                  "Standard view fitted to the mesh: iso, +x, -x, +y, -y, +z, -z (default "
+                                  "iso). '+x' looks from the +x side.")
+                        ->type_name("V")
+                        ->check(standardViewName("--view"));
+    o->cameraOption = p->add_option_function<std::string>(
+                           "--camera", [o](const std::string& text) { o->camera = parseCameraNumbers(text); },
+                           "Explicit camera \"ex,ey,ez,fx,fy,fz,ux,uy,uz[,angle]\": eye, focal point, up "
+                           "vector and the vertical view angle in degrees (default 30).")
+                          ->type_name("E,F,U[,A]");
+    p->add_flag("--parallel", o->parallel, "Parallel (orthographic) projection instead of perspective.");
+    addResolution(*p, "--resolution", o->w, o->h, Camera::kMaxResolution, "W[xH]",
+                  "Scan resolution in pixels, 1 to 8192 per side (default 256).");
+    addDouble(*p, "--zoom", o->zoom, true, "F",
+              "Zoom factor > 0 (2 = twice as close, finer sampling; default 1).");
+    o->lassoOption =
+        p->add_option_function<std::string>(
+             "--lasso", [o](const std::string& text) { o->lasso = parseLasso(text); },
+             "Keep only samples inside this polygon, in normalised image coordinates (0,0 top-left, 1,1 "
+             "bottom-right). Self-intersecting polygons use the non-zero winding rule.")
+            ->type_name("\"x,y;x,y;...\"");
+    o->fishboneOption =
+        p->add_option_function<std::string>(
+             "--fishbone", [o](const std::string& text) { o->fishbone = parseFishbone(text); },
+             "Feature-sensitive (fishbone) grid instead of the pixel grid: "
+             "\"seed=X,Y[;dir=min|max][;h=PIXELS][;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...][;sampling=K]\". "
+             "seed: a point on a curved feature; the backbone is traced through it along the min (default) "
+             "or max curvature direction, ribs along the other; h: sample spacing in pixels (default 4); "
+             "keyribs: ribs only at the backbone samples nearest these points (at least two), blended in "
+             "between; backbone: a hand-drawn backbone through these points instead of the seed; sampling: "
+             "the fishbone renders and traces on the image at 1/K of the resolution (default 0: K = the "
+             "largest integer <= h dividing both sides, about one pixel per sample as a regular scan; 1 = "
+             "full resolution, finer direction fields at up to h^2 times the render cost). Points in "
+             "normalised image coordinates as for --lasso. --max-edge-footprints is multiplied by h/K.")
+            ->type_name("SPEC");
+    addInt(*p, "--erode", o->erode, 0, 64, "N", "Erosion radius in samples (default 1; 0 = none).");
+    addInt(*p, "--dilate", o->dilate, 0, 64, "N",
+           "Dilation radius after the erosion (default 1); never re-admits rejected samples.");
+    addDouble(*p, "--max-edge-footprints", o->maxEdge, false, "X",
+              "Drop triangles with an edge longer than X pixel footprints (default 3).");
+    addDouble(*p, "--max-angle", o->maxAngle, false, "DEG",
+              "Drop triangles seen at more than DEG degrees from frontal (default 80).");
+    addDouble(*p, "--quality-margin", o->margin, false, "M",
+              "A sample replaces a face only when better by this fraction (default 0.1).");
+    p->add_flag("--force-replace", o->force,
+                "Keep every sample regardless of the quality of the mesh already there.");
+    o->intoOption =
+        p->add_option(
+             "--into", o->intoPath,
+             "Stitch the patch into the mesh CURRENT and write the result to OUT instead of the patch. MESH "
+             "stays the reference the samples come from; CURRENT's faces decide where the scan is better "
+             "(quality mask) and are replaced there. Give MESH itself for the first scan and chain through "
+             ".ply files, which keep each face's quality and scan id. CURRENT must be a remeshing of MESH "
+             "(every vertex within 1 % of MESH's bounding-box diagonal from its surface).")
+            ->type_name("CURRENT");
+    o->scanIdOption = addInt(
+        *p, "--scan-id", o->scanId, 0, 1 << 30, "N",
+        "Scan id stored on the patch faces (default 0; with --into one more than the largest in CURRENT).");
+    addRenderer(*p, o->rendererKind, {},
+                "auto (GPU, else CPU), gpu (head-less OpenGL) or cpu (ray casting).");
+    p->add_flag("--json", o->json,
+                "Print a JSON report: counts and the timing of each stage (with --into also the stitch "
+                "report under \"stitch\").");
+    return {p, [o] { return runScan(*o); }};
 }
 
 } // namespace fss::cli
