@@ -55,8 +55,8 @@ public:
     /// Seconds the AABB tree took when it was built (0 before).
     double rayCasterSeconds() const { return rayCasterSeconds_; }
     /// The sharp edges of \p reference: interior edges whose faces' normals differ by more than
-    /// \p minDihedralDeg degrees, found on the first call for this mesh and threshold and cached (a call
-    /// with another threshold recomputes them). Cost O(edges).
+    /// \p minDihedralDeg degrees (CGAL's detect_sharp_edges; mesh/features.h), found on the first call for
+    /// this mesh and threshold and cached (a call with another threshold recomputes them). Cost O(edges).
     const std::vector<EdgeIndex>& creaseEdges(const Mesh& reference, double minDihedralDeg);
     /// True when the curvature of \p reference is already cached.
     bool hasCurvature(const Mesh& reference) const;

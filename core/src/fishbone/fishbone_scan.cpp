@@ -6,6 +6,7 @@
 
 #include "base/parallel_rows.h"
 #include "fishbone/fishbone_options.h"
+#include "mesh/features.h"
 
 #include <algorithm>
 #include <chrono>
@@ -261,23 +262,10 @@ const RayCaster& FishboneCache::rayCaster(const Mesh& reference) {
 
 const std::vector<EdgeIndex>& FishboneCache::creaseEdges(const Mesh& reference, double minDihedralDeg) {
     if (holds(reference) && creases_ && creaseAngleDeg_ == minDihedralDeg) return *creases_;
-    const double cosMax = std::cos(minDihedralDeg * std::numbers::pi / 180.0);
-    auto normal = [&](FaceIndex f) {
-        const HalfedgeIndex h = reference.halfedge(f);
-        const Point3 &a = reference.point(reference.source(h)), &b = reference.point(reference.target(h)),
-                     &c = reference.point(reference.target(reference.next(h)));
-        const Eigen::Vector3d u(b.x() - a.x(), b.y() - a.y(), b.z() - a.z()),
-            v(c.x() - a.x(), c.y() - a.y(), c.z() - a.z());
-        return Eigen::Vector3d(u.cross(v));
-    };
+    const std::vector<char> sharp = detail::sharpEdges(reference, minDihedralDeg);
     std::vector<EdgeIndex> edges;
-    for (EdgeIndex e : reference.edges()) {
-        const HalfedgeIndex h = reference.halfedge(e);
-        if (reference.is_border(e)) continue;
-        const Eigen::Vector3d n0 = normal(reference.face(h)), n1 = normal(reference.face(reference.opposite(h)));
-        const double l = n0.norm() * n1.norm();
-        if (l > 0 && n0.dot(n1) < cosMax * l) edges.push_back(e);
-    }
+    for (EdgeIndex e : reference.edges())
+        if (sharp[e.idx()]) edges.push_back(e);
     bind(reference);
     creases_ = std::move(edges);
     creaseAngleDeg_ = minDihedralDeg;

@@ -1,5 +1,7 @@
 #include "fss/auto_remesh.h"
 
+#include "mesh/features.h"
+#include "mesh/local_ops.h"
 #include "remesh/crease_snap.h"
 #include "remesh/seam_relax.h"
 
@@ -125,76 +127,6 @@ Coverage measureCoverage(Mesh& mesh) {
     return c;
 }
 
-/// Sharp feature chains of \p mesh: polylines of edges whose dihedral angle exceeds the threshold, between
-/// vertices where the chain ends, branches or turns sharply, each with the mean bisector of its two
-/// sides' normals.
-struct FeatureChain {
-    std::vector<Eigen::Vector3d> points;
-    Eigen::Vector3d bisector{0, 0, 0};
-    double length = 0;
-};
-
-std::vector<FeatureChain> featureChains(const Mesh& mesh, double featureAngleDeg, double maxBisectorTurnDeg) {
-    const double cosFeature = std::cos(featureAngleDeg * std::numbers::pi / 180.0);
-    const double cosTurn = std::cos(maxBisectorTurnDeg * std::numbers::pi / 180.0);
-    std::vector<char> sharp(mesh.number_of_edges() + mesh.number_of_removed_edges(), 0);
-    std::vector<int> degree(mesh.number_of_vertices() + mesh.number_of_removed_vertices(), 0);
-    for (EdgeIndex e : mesh.edges()) {
-        if (mesh.is_border(e)) continue;
-        const HalfedgeIndex h = mesh.halfedge(e);
-        const Eigen::Vector3d n1 = faceGeometry(mesh, mesh.face(h)).normal;
-        const Eigen::Vector3d n2 = faceGeometry(mesh, mesh.face(mesh.opposite(h))).normal;
-        if (n1.dot(n2) < cosFeature) {
-            sharp[e.idx()] = 1;
-            ++degree[mesh.source(h).idx()];
-            ++degree[mesh.target(h).idx()];
-        }
-    }
-    auto bisectorOf = [&](HalfedgeIndex h) {
-        const Eigen::Vector3d b =
-            faceGeometry(mesh, mesh.face(h)).normal + faceGeometry(mesh, mesh.face(mesh.opposite(h))).normal;
-        return b.norm() > 1e-12 ? Eigen::Vector3d(b.normalized()) : Eigen::Vector3d(0, 0, 0);
-    };
-    std::vector<char> used(sharp.size(), 0);
-    std::vector<FeatureChain> chains;
-    auto walk = [&](HalfedgeIndex start) {
-        FeatureChain chain;
-        chain.points.push_back(toEigen(mesh.point(mesh.source(start))));
-        Eigen::Vector3d sum(0, 0, 0);
-        HalfedgeIndex h = start;
-        while (true) {
-            used[mesh.edge(h).idx()] = 1;
-            const Eigen::Vector3d p = toEigen(mesh.point(mesh.target(h)));
-            const double len = (p - chain.points.back()).norm();
-            sum += bisectorOf(h) * len;
-            chain.length += len;
-            chain.points.push_back(p);
-            const VertexIndex v = mesh.target(h);
-            if (degree[v.idx()] != 2) break;
-            HalfedgeIndex next;
-            for (HalfedgeIndex o : CGAL::halfedges_around_source(v, mesh))
-                if (sharp[mesh.edge(o).idx()] && !used[mesh.edge(o).idx()]) next = o;
-            if (next == Mesh::null_halfedge()) break;
-            const Eigen::Vector3d b = bisectorOf(next);
-            if (sum.norm() > 0 && b.dot(sum.normalized()) < cosTurn) break; // the next piece faces elsewhere
-            h = next;
-        }
-        if (sum.norm() > 0) chain.bisector = sum.normalized();
-        chains.push_back(std::move(chain));
-    };
-    // Chains from their ends first (vertices of degree ≠ 2), then the closed loops.
-    for (int pass = 0; pass < 2; ++pass)
-        for (HalfedgeIndex h : mesh.halfedges()) {
-            const EdgeIndex e = mesh.edge(h);
-            if (!sharp[e.idx()] || used[e.idx()]) continue;
-            if (pass == 0 && degree[mesh.source(h).idx()] == 2) continue;
-            walk(h);
-        }
-    // A chain that stopped at a turn of the bisector continues as a new chain from where it stopped: the
-    // walk above leaves the remaining edges unused, and the second pass starts them from a degree-2 vertex.
-    return chains;
-}
-
 double minCornerAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
     auto angle = [](const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& r) {
         const Eigen::Vector3d u = q - p, v = r - p;
@@ -206,8 +138,9 @@ double minCornerAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const 
 /// Flips edges between two nearly coplanar faces (normals within \p maxDihedralDeg) where the flip raises
 /// the smaller of the two faces' smallest angles, for faces with a smallest angle under \p belowDeg: the
 /// slivers that seams leave. A flip is done only when the new edge does not exist yet, both end vertices keep
-/// valence ≥ 3, and both new faces keep the orientation of the old ones (normals within maxDihedralDeg):
-/// connectivity stays manifold and the surface moves nowhere (the quad is flat to within the dihedral limit).
+/// valence ≥ 3 (canFlip), and both new faces keep the orientation of the old ones (normals within
+/// maxDihedralDeg): connectivity stays manifold and the surface moves nowhere (the quad is flat to within the
+/// dihedral limit).
 std::size_t flipSlivers(Mesh& mesh, double belowDeg, double maxDihedralDeg, int rounds) {
     const double below = belowDeg * std::numbers::pi / 180.0;
     const double cosDihedral = std::cos(maxDihedralDeg * std::numbers::pi / 180.0);
@@ -215,11 +148,10 @@ std::size_t flipSlivers(Mesh& mesh, double belowDeg, double maxDihedralDeg, int 
     for (int round = 0; round < rounds; ++round) {
         std::size_t flipsThisRound = 0;
         for (EdgeIndex e : mesh.edges()) {
-            if (mesh.is_border(e)) continue;
             const HalfedgeIndex h = mesh.halfedge(e), o = mesh.opposite(h);
+            if (!detail::canFlip(mesh, h)) continue;
             const VertexIndex va = mesh.source(h), vb = mesh.target(h);
             const VertexIndex vc = mesh.target(mesh.next(h)), vd = mesh.target(mesh.next(o));
-            if (vc == vd) continue;
             const Eigen::Vector3d a = toEigen(mesh.point(va)), b = toEigen(mesh.point(vb));
             const Eigen::Vector3d c = toEigen(mesh.point(vc)), d = toEigen(mesh.point(vd));
             const double before = std::min(minCornerAngle(a, b, c), minCornerAngle(b, a, d));
@@ -234,8 +166,6 @@ std::size_t flipSlivers(Mesh& mesh, double belowDeg, double maxDihedralDeg, int 
             if (m1.normalized().dot(n) < cosDihedral || m2.normalized().dot(n) < cosDihedral) continue;
             const double after = std::min(minCornerAngle(c, a, d), minCornerAngle(d, b, c));
             if (after <= before + 1e-6) continue;
-            if (mesh.degree(va) <= 3 || mesh.degree(vb) <= 3) continue;
-            if (CGAL::halfedge(vc, vd, mesh).second) continue;
             CGAL::Euler::flip_edge(h, mesh);
             ++flipsThisRound;
         }
@@ -610,13 +540,14 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
     if (options.fishbone) {
         progress.report(0.0, "fishbone");
         auto t = Clock::now();
-        const std::vector<FeatureChain> chains = featureChains(reference, options.featureAngleDeg, 40.0);
+        const std::vector<detail::CreaseChain> chains =
+            detail::creaseChains(reference, detail::sharpEdges(reference, options.featureAngleDeg), 40.0);
         result.featureChains = chains.size();
         result.planSeconds += secondsSince(t);
         FishboneCache cache;
         const double h = 4.0; // rib and backbone spacing in pixels
         std::size_t done = 0;
-        for (const FeatureChain& chain : chains) {
+        for (const detail::CreaseChain& chain : chains) {
             ++done;
             if (!budgetLeft()) break;
             if (chain.length < options.minFeatureLength * L || chain.bisector.norm() == 0) continue;

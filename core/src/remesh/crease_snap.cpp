@@ -1,5 +1,7 @@
 #include "remesh/crease_snap.h"
 
+#include "mesh/features.h"
+#include "mesh/local_ops.h"
 #include "mesh/triangle_geometry.h"
 
 #include "fss/raycast.h"
@@ -61,18 +63,12 @@ void closestSegmentParameters(const Vec& p1, const Vec& q1, const Vec& p2, const
 /// segments within one cell of a point are found in the point's cell.
 class CreaseIndex {
 public:
-    CreaseIndex(const Mesh& reference, double creaseAngle, double cell) : cell_(cell) {
-        const double cosCrease = std::cos(creaseAngle);
-        std::vector<int> degree(reference.number_of_vertices() + reference.number_of_removed_vertices(), 0);
+    CreaseIndex(const Mesh& reference, double creaseAngleDeg, double cell) : cell_(cell) {
+        const std::vector<char> sharp = sharpEdges(reference, creaseAngleDeg);
         for (EdgeIndex e : reference.edges()) {
-            if (reference.is_border(e)) continue;
-            const HalfedgeIndex h = reference.halfedge(e), o = reference.opposite(h);
+            if (!sharp[e.idx()]) continue;
+            const HalfedgeIndex h = reference.halfedge(e);
             const Vec a = pos(reference, reference.source(h)), b = pos(reference, reference.target(h));
-            const Vec n1 = unitNormal(a, b, pos(reference, reference.target(reference.next(h))));
-            const Vec n2 = unitNormal(b, a, pos(reference, reference.target(reference.next(o))));
-            if (n1.isZero() || n2.isZero() || n1.dot(n2) >= cosCrease) continue;
-            ++degree[reference.source(h).idx()];
-            ++degree[reference.target(h).idx()];
             const int id = int(segments_.size());
             segments_.push_back({a, b});
             const Vec lo = a.cwiseMin(b).array() - cell, hi = a.cwiseMax(b).array() + cell;
@@ -82,8 +78,8 @@ public:
                     for (std::int64_t z = k0.z; z <= k1.z; ++z)
                         cells_[hash({x, y, z})].push_back(id);
         }
-        for (VertexIndex v : reference.vertices())
-            if (degree[v.idx()] != 0 && degree[v.idx()] != 2) corners_.push_back(pos(reference, v));
+        for (VertexIndex v : creaseCorners(reference, sharp))
+            corners_.push_back(pos(reference, v));
     }
     /// The corners of the creases: reference vertices where a crease ends or branches (one crease edge,
     /// or three and more).
@@ -141,7 +137,7 @@ public:
     CreaseSnapper(Mesh& mesh, const Mesh& reference, const CreaseSnapOptions& o)
         : m_(mesh), ref_(reference), o_(o), L_(o.edgeLength),
           floor_(o.minAngleDeg * std::numbers::pi / 180.0), caster_(reference),
-          creases_(reference, o.creaseAngleDeg * std::numbers::pi / 180.0, o.edgeLength) {}
+          creases_(reference, o.creaseAngleDeg, o.edgeLength) {}
 
     std::size_t creaseEdges() const { return creases_.size(); }
 
@@ -559,10 +555,9 @@ private:
 
     bool tryFlip(HalfedgeIndex h, double gain) {
         const HalfedgeIndex o = m_.opposite(h);
-        if (m_.is_border(m_.edge(h)) || !sameKind(h)) return false;
+        if (m_.is_border(m_.edge(h)) || !sameKind(h) || !canFlip(m_, h)) return false;
         const VertexIndex a = m_.source(h), b = m_.target(h);
         const VertexIndex c = m_.target(m_.next(h)), d = m_.target(m_.next(o));
-        if (c == d || m_.degree(a) <= 3 || m_.degree(b) <= 3 || CGAL::halfedge(c, d, m_).second) return false;
         const Vec pa = pos(m_, a), pb = pos(m_, b), pc = pos(m_, c), pd = pos(m_, d);
         if (!repairs(measure({{pa, pb, pc}, {pb, pa, pd}}), {{pa, pd, pc}, {pd, pb, pc}}, gain)) return false;
         return applyOrUndo([&] { CGAL::Euler::flip_edge(h, m_); }, {a, b, c, d});
@@ -665,11 +660,7 @@ private:
     /// Flips the edge of \p c when that keeps the mesh valid (not a border, faces of one kind, valences above
     /// 3, the other diagonal not an edge yet).
     bool flipIfValid(HalfedgeIndex c) {
-        const HalfedgeIndex o = m_.opposite(c);
-        if (m_.is_border(m_.edge(c)) || !sameKind(c)) return false;
-        const VertexIndex x = m_.source(c), y = m_.target(c);
-        const VertexIndex a = m_.target(m_.next(c)), b = m_.target(m_.next(o));
-        if (a == b || m_.degree(x) <= 3 || m_.degree(y) <= 3 || CGAL::halfedge(a, b, m_).second) return false;
+        if (m_.is_border(m_.edge(c)) || !sameKind(c) || !canFlip(m_, c)) return false;
         CGAL::Euler::flip_edge(c, m_);
         return true;
     }
@@ -692,8 +683,7 @@ private:
         const VertexIndex c = m_.target(m_.next(h)), d = m_.target(m_.next(o));
         if (frozen_[a.idx()] || frozen_[b.idx()]) return false;
         const bool onA = onACrease(a), onB = onACrease(b);
-        if (m_.degree(c) <= 3 || m_.degree(d) <= 3 || !CGAL::Euler::does_satisfy_link_condition(e, m_))
-            return false;
+        if (!canCollapse(m_, e)) return false;
         const Vec pa = pos(m_, a), pb = pos(m_, b);
         // Where the merged vertex goes, and whether that is on a crease.
         std::vector<std::pair<Vec, bool>> targets;
@@ -880,21 +870,16 @@ private:
         const VertexIndex a = m_.source(h), b = m_.target(h);
         const std::int32_t idF = haveIds ? ids[f] : -1, idG = haveIds ? ids[g] : -1;
         const float qualityF = haveQuality ? quality[f] : 0.f, qualityG = haveQuality ? quality[g] : 0.f;
-        const HalfedgeIndex hn = CGAL::Euler::split_edge(h, m_);
-        const VertexIndex v = m_.target(hn);
-        m_.point(v) = Point3(q.x(), q.y(), q.z());
-        const HalfedgeIndex h3 = CGAL::Euler::split_face(hn, m_.next(m_.next(hn)), m_);
-        const HalfedgeIndex og = m_.opposite(h);
-        const HalfedgeIndex h4 = CGAL::Euler::split_face(og, m_.next(m_.next(og)), m_);
+        const EdgeSplit split = splitEdge(m_, h, Point3(q.x(), q.y(), q.z()));
+        const VertexIndex v = split.vertex;
+        const HalfedgeIndex h3 = split.first, h4 = split.second;
         for (FaceIndex nf : {m_.face(h3), m_.face(m_.opposite(h3)), m_.face(h4), m_.face(m_.opposite(h4))}) {
             const bool sideF = nf == m_.face(h3) || nf == m_.face(m_.opposite(h3));
             if (haveIds) ids[nf] = sideF ? idF : idG;
             if (haveQuality) quality[nf] = sideF ? qualityF : qualityG;
         }
-        if (intersectsAround({v, a, b})) { // undo: the two new edges, then the new vertex
-            CGAL::Euler::join_face(h4, m_);
-            CGAL::Euler::join_face(h3, m_);
-            CGAL::Euler::join_vertex(h, m_); // removes v, the source of h
+        if (intersectsAround({v, a, b})) {
+            undoSplitEdge(m_, h, split);
             return Mesh::null_vertex();
         }
         frozen_.resize(m_.number_of_vertices() + m_.number_of_removed_vertices(), 0);
@@ -954,14 +939,13 @@ private:
             if (m_.is_border(e)) continue;
             const HalfedgeIndex h = m_.halfedge(e), o = m_.opposite(h);
             if (isInput(m_.face(h)) != isInput(m_.face(o))) continue; // the scanned area stays
+            if (!canFlip(m_, h)) continue;
             const VertexIndex a = m_.source(h), b = m_.target(h);
             const VertexIndex c = m_.target(m_.next(h)), d = m_.target(m_.next(o));
-            if (c == d || m_.degree(a) <= 3 || m_.degree(b) <= 3) continue;
             const Vec pa = pos(m_, a), pb = pos(m_, b), pc = pos(m_, c), pd = pos(m_, d);
             Vec q;
             double dist;
             if (!creases_.closest(0.25 * (pa + pb + pc + pd), q, dist) || dist > L_) continue;
-            if (CGAL::halfedge(c, d, m_).second) continue;
             // Faces (a, b, c), (b, a, d) become (a, d, c), (d, b, c).
             if (!better({{pa, pb, pc}, {pb, pa, pd}}, {{pa, pd, pc}, {pd, pb, pc}}, false, 0.8, 0.02 * L_))
                 continue;

@@ -1,7 +1,9 @@
 #include "remesh/seam_relax.h"
 
-#include "remesh/crease_snap.h"
+#include "mesh/features.h"
+#include "mesh/local_ops.h"
 #include "mesh/triangle_geometry.h"
+#include "remesh/crease_snap.h"
 
 #include "fss/raycast.h"
 
@@ -101,11 +103,6 @@ private:
     static constexpr int kStageRetries = 3;
     std::vector<char> zone_, fixed_, fixedEdge_, touchesInput_;
 
-    Vec faceNormal(FaceIndex f) const {
-        const HalfedgeIndex h = m_.halfedge(f);
-        return unitNormal(pos(m_, m_.source(h)), pos(m_, m_.target(h)), pos(m_, m_.target(m_.next(h))));
-    }
-
     void markFeaturesAndZone() {
         const std::size_t nv = m_.number_of_vertices() + m_.number_of_removed_vertices();
         fixedEdge_.assign(m_.number_of_edges() + m_.number_of_removed_edges(), 0);
@@ -114,6 +111,7 @@ private:
         touchesInput_.assign(nv, 0);
         const auto [ids, haveIds] = m_.property_map<FaceIndex, std::int32_t>(props::faceScanId);
         auto isInput = [&](FaceIndex f) { return f != Mesh::null_face() && (!haveIds || ids[f] < 0); };
+        const std::vector<char> sharp = sharpEdges(m_, o_.featureAngleDeg);
         // Border and feature edges, and the edges between a face left from the input and a scanned one (so
         // that the scanned area, the coverage, stays as it is), are fixed: never flipped or collapsed, their
         // vertices never smoothed.
@@ -123,8 +121,7 @@ private:
             const bool border = m_.is_border(e);
             const bool input1 = isInput(m_.face(h)), input2 = isInput(m_.face(m_.opposite(h)));
             if (input1 || input2) touchesInput_[a.idx()] = touchesInput_[b.idx()] = 1;
-            if (border || input1 != input2 ||
-                angleBetween(faceNormal(m_.face(h)), faceNormal(m_.face(m_.opposite(h)))) > feature_) {
+            if (border || input1 != input2 || sharp[e.idx()]) {
                 fixedEdge_[e.idx()] = 1;
                 fixed_[a.idx()] = fixed_[b.idx()] = 1;
             }
@@ -173,13 +170,12 @@ private:
             const VertexIndex a = m_.source(h), b = m_.target(h);
             const VertexIndex c = m_.target(m_.next(h)), d = m_.target(m_.next(o));
             if (c == d || !zone_[a.idx()] || !zone_[b.idx()] || !zone_[c.idx()] || !zone_[d.idx()]) continue;
+            if (!canFlip(m_, h)) continue;
             const int da = int(m_.degree(a)), db = int(m_.degree(b));
             const int dc = int(m_.degree(c)), dd = int(m_.degree(d));
-            if (da <= 3 || db <= 3) continue;
             const int before = deviation(da) + deviation(db) + deviation(dc) + deviation(dd);
             const int after = deviation(da - 1) + deviation(db - 1) + deviation(dc + 1) + deviation(dd + 1);
             if (after >= before) continue;
-            if (CGAL::halfedge(c, d, m_).second) continue;
             const Vec pa = pos(m_, a), pb = pos(m_, b), pc = pos(m_, c), pd = pos(m_, d);
             // Faces (a, b, c), (b, a, d) become (a, d, c), (d, b, c).
             const double oldMin = std::min(minAngle(pa, pb, pc), minAngle(pb, pa, pd));
@@ -224,7 +220,7 @@ private:
             const int before = deviation(da) + deviation(db) + deviation(dc) + deviation(dd);
             const int after = deviation(da + db - 4) + deviation(dc - 1) + deviation(dd - 1);
             if (after >= before) continue;
-            if (!CGAL::Euler::does_satisfy_link_condition(e, m_)) continue;
+            if (!canCollapse(m_, e)) continue;
             Vec q;
             if (fixed_[a.idx()] || fixed_[b.idx()]) {
                 q = pos(m_, fixed_[a.idx()] ? a : b);
@@ -306,17 +302,7 @@ private:
             const SurfacePoint sp = caster_.closestPoint(p);
             if (!sp || sp.distance <= tolerance) continue;
             const Vec q = sp.point;
-            double oldMin = std::numbers::pi, newMin = std::numbers::pi;
-            bool ok = true;
-            for (HalfedgeIndex h : CGAL::halfedges_around_target(m_.halfedge(v), m_)) {
-                const HalfedgeIndex n1 = m_.next(h);
-                const Vec s = pos(m_, m_.target(n1)), t = pos(m_, m_.target(m_.next(n1)));
-                oldMin = std::min(oldMin, minAngle(p, s, t));
-                newMin = std::min(newMin, minAngle(q, s, t));
-                const Vec n0 = unitNormal(p, s, t), n = unitNormal(q, s, t);
-                if (n0.isZero() || n.isZero() || angleBetween(n, n0) > maxTurn) ok = false;
-            }
-            if (!ok || newMin < std::min(oldMin, floor_)) continue;
+            if (!moveKeepsStar(m_, v, q, maxTurn, floor_)) continue;
             m_.point(v) = Point3(q.x(), q.y(), q.z());
             ++moves;
         }
@@ -349,18 +335,13 @@ private:
             for (VertexIndex w : CGAL::vertices_around_target(m_.halfedge(v), m_))
                 centroid += pos(m_, w), ++n;
             struct Corner {
-                FaceIndex face;
                 Vec q, r; // the face's other two vertices, in order after v
-                Vec normal;
             };
             std::vector<Corner> star;
             for (HalfedgeIndex h : CGAL::halfedges_around_target(m_.halfedge(v), m_)) {
-                const FaceIndex f = m_.face(h);
                 const HalfedgeIndex n1 = m_.next(h);
-                Corner k{f, pos(m_, m_.target(n1)), pos(m_, m_.target(m_.next(n1))), Vec(0, 0, 0)};
-                const Vec raw = (k.q - p).cross(k.r - p);
-                k.normal = unitNormal(p, k.q, k.r);
-                normal += raw;
+                const Corner k{pos(m_, m_.target(n1)), pos(m_, m_.target(m_.next(n1)))};
+                normal += (k.q - p).cross(k.r - p);
                 star.push_back(k);
             }
             if (n < 3 || normal.isZero()) continue;
@@ -372,18 +353,7 @@ private:
             if (!sp) continue;
             const Vec q = sp.point;
             if ((q - p).norm() <= 1e-9 * o_.edgeLength) continue;
-            double oldMin = std::numbers::pi, newMin = std::numbers::pi;
-            bool ok = true;
-            for (const Corner& k : star) {
-                oldMin = std::min(oldMin, minAngle(p, k.q, k.r));
-                newMin = std::min(newMin, minAngle(q, k.q, k.r));
-                const Vec nn = unitNormal(q, k.q, k.r);
-                if (nn.isZero() || k.normal.isZero() || angleBetween(nn, k.normal) > maxTurn_) {
-                    ok = false;
-                    break;
-                }
-            }
-            if (!ok || newMin < std::min(oldMin, floor_)) continue;
+            if (!moveKeepsStar(m_, v, q, maxTurn_, floor_)) continue;
             if (!staysNearReference(p, q, star)) continue;
             m_.point(v) = Point3(q.x(), q.y(), q.z());
             ++moves;

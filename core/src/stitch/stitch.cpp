@@ -31,6 +31,7 @@
 #include "fss/stitch.h"
 
 #include "base/disjoint_sets.h"
+#include "mesh/local_ops.h"
 
 #include "fss/error.h"
 
@@ -2269,7 +2270,7 @@ private:
             const HalfedgeIndex h = S.halfedge(a, b);
             if (h == Mesh::null_halfedge() || !isNewFace(S.face(h)) || !isNewFace(S.face(S.opposite(h))))
                 return false;
-            if (!CGAL::Euler::does_satisfy_link_condition(S.edge(h), S)) return false;
+            if (!detail::canCollapse(S, S.edge(h), false)) return false;
             double oldMin = std::numbers::pi, newMin = std::numbers::pi;
             for (HalfedgeIndex g : CGAL::halfedges_around_target(S.halfedge(a), S)) {
                 const FaceIndex f = S.face(g);
@@ -2652,20 +2653,16 @@ private:
             if (std::min({minAngle(X, mid, Z), minAngle(mid, Y, Z), minAngle(Y, mid, U),
                           minAngle(mid, X, U)}) < 0.99 * std::min(minAngle(X, Y, Z), minAngle(Y, X, U)))
                 continue;
-            const HalfedgeIndex hn = CGAL::Euler::split_edge(h, S);
-            const VertexIndex v = S.target(hn);
-            S.point(v) = toPoint(mid);
+            const detail::EdgeSplit split = detail::splitEdge(S, h, toPoint(mid));
+            const VertexIndex v = split.vertex;
             loc.uv[v] = uv;
             loc.lid[v] = -1;
             loc.locked[v] = false;
             loc.star.cur[v] = kNone;
-            const HalfedgeIndex h3 = CGAL::Euler::split_face(hn, S.next(S.next(hn)), S);
-            copyFace(loc, f, S.face(h3));
-            copyFace(loc, f, S.face(S.opposite(h3)));
-            const HalfedgeIndex og = S.opposite(h);
-            const HalfedgeIndex h4 = CGAL::Euler::split_face(og, S.next(S.next(og)), S);
-            copyFace(loc, g, S.face(h4));
-            copyFace(loc, g, S.face(S.opposite(h4)));
+            copyFace(loc, f, S.face(split.first));
+            copyFace(loc, f, S.face(S.opposite(split.first)));
+            copyFace(loc, g, S.face(split.second));
+            copyFace(loc, g, S.face(S.opposite(split.second)));
             ++splits;
         }
         return splits;
@@ -2696,9 +2693,7 @@ private:
         if (!isNewFace(S.face(h)) || !isNewFace(S.face(o))) return false;
         const VertexIndex x = S.source(h), y = S.target(h), z1 = S.target(S.next(h)), z2 = S.target(S.next(o));
         if (!near.count(std::uint32_t(x)) || !near.count(std::uint32_t(y))) return false;
-        if (loc.seam.count(seamKey(x, y)) || z1 == z2) return false;
-        if (S.degree(x) <= 3 || S.degree(y) <= 3) return false;
-        if (S.halfedge(z1, z2) != Mesh::null_halfedge()) return false;
+        if (loc.seam.count(seamKey(x, y)) || !detail::canFlip(S, h)) return false;
         // New faces (x, z2, z1) and (z2, y, z1).
         if (loc.offView[S.face(h)] != loc.offView[S.face(o)] || !oriented(loc, S.face(h), x, z2, z1) ||
             !oriented(loc, S.face(o), z2, y, z1))

@@ -1,0 +1,61 @@
+// Guarded local operations: flip and collapse guards, edge split, vertex-move guard. See mesh/local_ops.h.
+#include "mesh/local_ops.h"
+
+#include "mesh/triangle_geometry.h"
+
+#include <CGAL/boost/graph/Euler_operations.h>
+
+#include <numbers>
+
+namespace fss::detail {
+
+bool canFlip(const Mesh& mesh, HalfedgeIndex h) {
+    if (mesh.is_border(mesh.edge(h))) return false;
+    const HalfedgeIndex o = mesh.opposite(h);
+    const VertexIndex c = mesh.target(mesh.next(h)), d = mesh.target(mesh.next(o));
+    return c != d && mesh.degree(mesh.source(h)) > 3 && mesh.degree(mesh.target(h)) > 3 &&
+           !CGAL::halfedge(c, d, mesh).second;
+}
+
+bool canCollapse(const Mesh& mesh, EdgeIndex e, bool keepOppositeValence) {
+    if (keepOppositeValence) {
+        const HalfedgeIndex h = mesh.halfedge(e), o = mesh.opposite(h);
+        if (mesh.degree(mesh.target(mesh.next(h))) <= 3 || mesh.degree(mesh.target(mesh.next(o))) <= 3)
+            return false;
+    }
+    return CGAL::Euler::does_satisfy_link_condition(e, mesh);
+}
+
+EdgeSplit splitEdge(Mesh& mesh, HalfedgeIndex h, const Point3& at) {
+    EdgeSplit s;
+    const HalfedgeIndex hn = CGAL::Euler::split_edge(h, mesh);
+    s.vertex = mesh.target(hn);
+    mesh.point(s.vertex) = at;
+    s.first = CGAL::Euler::split_face(hn, mesh.next(mesh.next(hn)), mesh);
+    const HalfedgeIndex og = mesh.opposite(h);
+    s.second = CGAL::Euler::split_face(og, mesh.next(mesh.next(og)), mesh);
+    return s;
+}
+
+void undoSplitEdge(Mesh& mesh, HalfedgeIndex h, const EdgeSplit& split) {
+    // The two new edges, then the new vertex.
+    CGAL::Euler::join_face(split.second, mesh);
+    CGAL::Euler::join_face(split.first, mesh);
+    CGAL::Euler::join_vertex(h, mesh); // removes the new vertex, the source of h
+}
+
+bool moveKeepsStar(const Mesh& mesh, VertexIndex v, const Eigen::Vector3d& to, double maxTurn, double floor) {
+    const Eigen::Vector3d p = pos(mesh, v);
+    double oldMin = std::numbers::pi, newMin = std::numbers::pi;
+    for (HalfedgeIndex h : CGAL::halfedges_around_target(mesh.halfedge(v), mesh)) {
+        const HalfedgeIndex n1 = mesh.next(h);
+        const Eigen::Vector3d s = pos(mesh, mesh.target(n1)), t = pos(mesh, mesh.target(mesh.next(n1)));
+        oldMin = std::min(oldMin, minAngle(p, s, t));
+        newMin = std::min(newMin, minAngle(to, s, t));
+        const Eigen::Vector3d n0 = unitNormal(p, s, t), n = unitNormal(to, s, t);
+        if (n0.isZero() || n.isZero() || angleBetween(n, n0) > maxTurn) return false;
+    }
+    return newMin >= std::min(oldMin, floor);
+}
+
+} // namespace fss::detail
