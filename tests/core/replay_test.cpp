@@ -130,7 +130,7 @@ TEST(SessionReplay, PartsOfStepsGiveTheSameMesh) {
     recorded.accept();
     recorded.undo();
     const fss::SessionFile file = fss::sessionFileFromSession(recorded, meshFile);
-    ASSERT_EQ(file.events.size(), 7u);
+    ASSERT_EQ(file.events.size(), 6u);
 
     fss::SessionReplay replay(file);
     std::size_t cacheBuilds = 0;
