@@ -10,11 +10,11 @@
 //    fishbone's sample count (calibrated once before timing: covered ∝ resolution²).
 // Both scans run alternately in the same loop; counters: fishbone_ms, regular_ms, ratio =
 // fishbone_ms / regular_ms (wall clock: the target), cpu_ratio (the same with the process's CPU time, all
-// threads: steadier than the wall clock when the machine is shared), the two sample counts, and the stage times of the fishbone scan. The direction
-// fields are lazy (computed per tile while tracing, so their cost is in f_trace_ms); f_dir_pixels counts the
-// pixels they computed. Curvature and
-// the AABB tree are per-reference precomputations (cached in FishboneCache, as the Session keeps them):
-// measured once before the loop and reported as curvature_ms / aabb_ms, not in fishbone_ms.
+// threads: steadier than the wall clock when the machine is shared), the two sample counts, and the stage
+// times of the fishbone scan. The direction fields are lazy (computed per tile while tracing, so their cost
+// is in f_trace_ms); f_dir_pixels counts the pixels they computed. Curvature and the AABB tree are
+// per-reference precomputations (cached in FishboneCache, as the Session keeps them): measured once before
+// the loop and reported as curvature_ms / aabb_ms, not in fishbone_ms.
 #include "fss/fishbone_scan.h"
 #include "fss/mesh_io.h"
 #include "fss/parallel.h"
@@ -104,8 +104,8 @@ void BM_FishboneVsRegular(benchmark::State& state) {
     fss::ScanParams regParams;
     regParams.camera = scene.camera;
     const fss::ScanResult full = fss::scanPatch(scene.mesh, renderer, scene.mesh, renderer, regParams);
-    const int res =
-        std::max(8, int(std::lround(resolution * std::sqrt(double(fishSamples) / double(full.counts.covered)))));
+    const int res = std::max(
+        8, int(std::lround(resolution * std::sqrt(double(fishSamples) / double(full.counts.covered)))));
     regParams.camera.width = regParams.camera.height = res;
 
     double fishCpu = 0, regCpu = 0;
@@ -153,9 +153,9 @@ void BM_FishboneVsRegular(benchmark::State& state) {
     state.counters["aabb_ms"] = aabbMs;
     state.counters["threads"] = fss::scanThreads();
     state.counters["k"] = probe.samplingFactor;
-    state.SetLabel(std::string(state.range(0) == 0 ? "fandisk" : "torus 100k") + ", h = " + std::to_string(h) +
-                   " px at " + std::to_string(resolution) + "², sampling image " +
-                   std::to_string(probe.grid.camera.width) + "²");
+    state.SetLabel(std::string(state.range(0) == 0 ? "fandisk" : "torus 100k") +
+                   ", h = " + std::to_string(h) + " px at " + std::to_string(resolution) +
+                   "², sampling image " + std::to_string(probe.grid.camera.width) + "²");
 }
 
 } // namespace

@@ -68,7 +68,7 @@ BENCHMARK(BM_Scan)
     ->ArgsProduct({{100000, 1000000}, {256, 512, 1024}})
     ->ArgNames({"faces", "px"})
     ->Unit(benchmark::kMillisecond)
-    ->MeasureProcessCPUTime()  // CPU column: all threads (llvmpipe renders on worker threads)
+    ->MeasureProcessCPUTime() // CPU column: all threads (llvmpipe renders on worker threads)
     ->UseRealTime();
 
 // setMesh + the first render at 512² (VTK uploads the buffers then): what changing the mesh costs.
@@ -91,7 +91,7 @@ BENCHMARK(BM_SetMeshAndFirstScan)
     ->Arg(1000000)
     ->ArgName("faces")
     ->Unit(benchmark::kMillisecond)
-    ->MeasureProcessCPUTime()  // CPU column: all threads (llvmpipe renders on worker threads)
+    ->MeasureProcessCPUTime() // CPU column: all threads (llvmpipe renders on worker threads)
     ->UseRealTime();
 
 } // namespace

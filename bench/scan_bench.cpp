@@ -65,7 +65,8 @@ std::size_t writeOutputsOnly(int rows, int cols, std::size_t vertices, std::size
     mesh.resize(0, 0, 0);
     mesh.resize(fss::Mesh::size_type(vertices), fss::Mesh::size_type(edges), fss::Mesh::size_type(faces));
     auto gridIndex =
-        mesh.add_property_map<fss::VertexIndex, fss::GridIndex>(fss::props::vertexGridIndex, fss::GridIndex{}).first;
+        mesh.add_property_map<fss::VertexIndex, fss::GridIndex>(fss::props::vertexGridIndex, fss::GridIndex{})
+            .first;
     auto quality = mesh.add_property_map<fss::FaceIndex, float>(fss::props::faceQuality, 0.0f).first;
     auto scanId = mesh.add_property_map<fss::FaceIndex, std::int32_t>(fss::props::faceScanId, -1).first;
     for (std::size_t v = 0; v < vertices; ++v) {

@@ -5,7 +5,8 @@
 // 10k. Also the scan time of the same patch (GPU render of the reference + sampling + masks +
 // triangulation; CPU ray casting when FSS::render is not built) and the ratio stitch / scan.
 //
-// BM_Stitch/faces:N/spare:S   stitch time only: CPU time of the stitching thread (the machine is shared; wall time
+// BM_Stitch/faces:N/spare:S   stitch time only: CPU time of the stitching thread (the machine is shared; wall
+// time
 //                     in the counter wall_ms); copying the mesh before each stitch is not timed.
 //                     Counters: patch_faces, faces_removed, faces_added, seam_edges.
 // BM_Scan/faces:N     scanPatch of the same view and lasso on the sphere of N faces: time = CPU time of the
@@ -25,8 +26,8 @@
 #include <benchmark/benchmark.h>
 
 #include <chrono>
-#include <ctime>
 #include <cstdio>
+#include <ctime>
 #include <map>
 #include <memory>
 
@@ -179,7 +180,13 @@ BENCHMARK(BM_Stitch)
     ->ArgNames({"faces", "spare"})
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime();
-BENCHMARK(BM_Scan)->Arg(10000)->Arg(100000)->Arg(1000000)->ArgName("faces")->Unit(benchmark::kMillisecond)->UseManualTime();
+BENCHMARK(BM_Scan)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->ArgName("faces")
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
 
 int main(int argc, char** argv) {
     benchmark::Initialize(&argc, argv);
@@ -192,6 +199,7 @@ int main(int argc, char** argv) {
         if (scanMs.count(faces))
             std::printf("faces %d: stitch %.1f ms CPU; scan %.1f ms wall, %.1f ms CPU of the calling thread; "
                         "stitch / scan: %.2f (scan wall), %.2f (scan thread CPU)\n",
-                        faces, ms, scanMs[faces], scanCpuMs[faces], ms / scanMs[faces], ms / scanCpuMs[faces]);
+                        faces, ms, scanMs[faces], scanCpuMs[faces], ms / scanMs[faces],
+                        ms / scanCpuMs[faces]);
     return 0;
 }

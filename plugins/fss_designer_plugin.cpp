@@ -33,14 +33,15 @@ WidgetCollection::WidgetCollection(QObject* parent) : QObject(parent) {
                                  "reference, a preview patch and 2D overlays; trackball navigation.",
                                  {400, 300},
                                  {}});
-    addWidget<widgets::RemeshWidget>({"fss::widgets::RemeshWidget",
-                                      "fss/widgets/remesh_widget.h",
-                                      "remeshWidget",
-                                      "Drop-in remeshing widget: view, tools, scan and quality panels, history",
-                                      "Virtual range scanning of a mesh with lasso, scan and fishbone tools, "
-                                      "undo/redo and live quality histograms.",
-                                      {800, 600},
-                                      {}});
+    addWidget<widgets::RemeshWidget>(
+        {"fss::widgets::RemeshWidget",
+         "fss/widgets/remesh_widget.h",
+         "remeshWidget",
+         "Drop-in remeshing widget: view, tools, scan and quality panels, history",
+         "Virtual range scanning of a mesh with lasso, scan and fishbone tools, "
+         "undo/redo and live quality histograms.",
+         {800, 600},
+         {}});
     addWidget<widgets::ScanPanel>({"fss::widgets::ScanPanel",
                                    "fss/widgets/scan_panel.h",
                                    "scanPanel",

@@ -76,7 +76,8 @@ void MainWindow::createMenus() {
     file->addAction(tr("&Open…"), QKeySequence::Open, this, &MainWindow::openDialog);
     file->addAction(tr("&Save As…"), QKeySequence::SaveAs, this, &MainWindow::saveDialog);
     file->addSeparator();
-    file->addAction(tr("Open Sess&ion…"), QKeySequence(tr("Ctrl+Shift+O")), this, &MainWindow::openSessionDialog);
+    file->addAction(tr("Open Sess&ion…"), QKeySequence(tr("Ctrl+Shift+O")), this,
+                    &MainWindow::openSessionDialog);
     file->addAction(tr("Save S&ession As…"), QKeySequence(tr("Ctrl+Shift+E")), this,
                     &MainWindow::saveSessionDialog);
     file->addSeparator();

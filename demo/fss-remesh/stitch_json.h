@@ -7,8 +7,7 @@
 namespace fss::cli {
 
 /// \p r as a JSON object (nlohmann::json or nlohmann::ordered_json).
-template <class Json>
-Json stitchReportJson(const StitchReport& r) {
+template <class Json> Json stitchReportJson(const StitchReport& r) {
     return Json{{"faces_removed", r.facesRemoved},
                 {"faces_added", r.facesAdded},
                 {"seam_edges", r.seamEdges},

@@ -36,7 +36,8 @@ TEST(CliFishbone, FishboneScanOfFandisk) {
     EXPECT_GT(c.at("rows").get<int>(), 20);
     EXPECT_GT(c.at("rib_vertices").get<int>(), 1000);
     EXPECT_GT(c.at("patch_faces").get<int>(), 500);
-    for (const char* stage : {"curvature", "direction_field", "tracing", "ray_casting", "masks", "triangulate", "total"})
+    for (const char* stage :
+         {"curvature", "direction_field", "tracing", "ray_casting", "masks", "triangulate", "total"})
         EXPECT_GT(j.at("timings_s").at(stage).get<double>(), 0.0) << stage;
 
     const fss::Mesh patch = fss::readMesh(out);
@@ -76,5 +77,6 @@ TEST(CliFishbone, MalformedSpecsFailWithOneSentence) {
     expectCleanFailure(scan("seed=0.4,0.55;sampling=2.5"), "is not an integer from 0 (automatic) to 64");
     expectCleanFailure(scan("seed=0.4,0.55;h=4;sampling=3"), "sampling factor 3 does not divide the 256x256");
     expectCleanFailure(scan("seed=0.4,0.55;h=2;sampling=4"), "sampling factor 4 exceeds the spacing h = 2");
-    expectCleanFailure(scan("seed=0.4,0.55;keyribs=0.4,0.45|0.4,0.65"), "pixels from the backbone, farther than 2h");
+    expectCleanFailure(scan("seed=0.4,0.55;keyribs=0.4,0.45|0.4,0.65"),
+                       "pixels from the backbone, farther than 2h");
 }

@@ -55,7 +55,7 @@ TEST(CliInfo, JsonReportOfFandisk) {
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j.at("vertices").get<int>(), 6475);
     EXPECT_EQ(j.at("faces").get<int>(), 12946);
-    EXPECT_EQ(j.at("edges").get<int>(), 6475 + 12946 - 2);  // closed genus 0: V - E + F = 2
+    EXPECT_EQ(j.at("edges").get<int>(), 6475 + 12946 - 2); // closed genus 0: V - E + F = 2
     EXPECT_EQ(j.at("boundary_edges").get<int>(), 0);
     EXPECT_EQ(j.at("boundary_loops").get<int>(), 0);
     EXPECT_EQ(j.at("components").get<int>(), 1);
@@ -105,7 +105,8 @@ TEST(CliInfo, BadInputsGiveOneSentenceAndNonZeroExit) {
         {"inf.obj", "v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n", "inf.obj"},
         {"badindex.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n", "badindex.off"},
         {"unknown.xyz", "hello world\n", "unknown.xyz"},
-        {"binary_truncated.stl", std::string(80, ' ') + std::string("\x10\x00\x00\x00", 4) + std::string(30, '\0'),
+        {"binary_truncated.stl",
+         std::string(80, ' ') + std::string("\x10\x00\x00\x00", 4) + std::string(30, '\0'),
          "binary_truncated.stl"},
         {"nothing_left.off", "OFF\n3 1 0\n0 0 0\n0 0 0\n0 0 0\n3 0 1 2\n", "nothing_left.off"},
     };
@@ -115,5 +116,5 @@ TEST(CliInfo, BadInputsGiveOneSentenceAndNonZeroExit) {
         expectCleanFailure(remesh({"info", (dir / c.name).string()}), c.mention);
     }
     expectCleanFailure(remesh({"info", (dir / "does_not_exist.off").string()}), "does_not_exist.off");
-    expectCleanFailure(remesh({"info", dir.string()}), "cli_bad");  // a folder, not a file
+    expectCleanFailure(remesh({"info", dir.string()}), "cli_bad"); // a folder, not a file
 }

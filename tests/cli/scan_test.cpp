@@ -38,7 +38,8 @@ TEST(CliScan, HeadlessIsoScanOfFandiskIsRegularAndClose) {
     const auto& c = j.at("counts");
     EXPECT_EQ(c.at("pixels").get<int>(), 256 * 256);
     EXPECT_GT(c.at("covered").get<int>(), 10000);
-    for (const char* stage : {"render_reference", "sample", "lasso", "quality_mask", "morphology", "triangulate", "total"})
+    for (const char* stage :
+         {"render_reference", "sample", "lasso", "quality_mask", "morphology", "triangulate", "total"})
         EXPECT_GE(j.at("timings_s").at(stage).get<double>(), 0.0) << stage;
 
     fss::ReadReport report;
@@ -52,11 +53,12 @@ TEST(CliScan, HeadlessIsoScanOfFandiskIsRegularAndClose) {
     EXPECT_EQ(m.nonManifoldVertices, 0u);
     EXPECT_LE(*m.hausdorffToRefRel, 0.0025);
     // Edges never span a silhouette: at most 3 pixel footprints (footprint ≈ 2·d·tan(15°)/256 at the mesh).
-    const double footprintUpper = 2.0 * 3.0 * std::tan(15.0 * 3.14159265 / 180.0) / 256.0;  // eye at d < 3
+    const double footprintUpper = 2.0 * 3.0 * std::tan(15.0 * 3.14159265 / 180.0) / 256.0; // eye at d < 3
     for (auto e : patch.edges()) {
         const auto h = patch.halfedge(e);
-        EXPECT_LE(std::sqrt(CGAL::squared_distance(patch.point(patch.source(h)), patch.point(patch.target(h)))),
-                  3.0 * footprintUpper);
+        EXPECT_LE(
+            std::sqrt(CGAL::squared_distance(patch.point(patch.source(h)), patch.point(patch.target(h)))),
+            3.0 * footprintUpper);
     }
 }
 
@@ -67,18 +69,21 @@ TEST(CliScan, CpuRendererGivesTheSamePatchSize) {
                              "--resolution", "96", "--json", "--renderer", "cpu"});
     ASSERT_EQ(gpu.exitCode, 0) << gpu.err;
     ASSERT_EQ(cpu.exitCode, 0) << cpu.err;
-    const auto g = nlohmann::json::parse(gpu.out).at("counts"), c = nlohmann::json::parse(cpu.out).at("counts");
+    const auto g = nlohmann::json::parse(gpu.out).at("counts"),
+               c = nlohmann::json::parse(cpu.out).at("counts");
     EXPECT_EQ(nlohmann::json::parse(cpu.out).at("renderer"), "cpu");
     // The GPU and the exact CPU ray caster may disagree on a few pixel centres lying on edges.
-    EXPECT_NEAR(g.at("covered").get<double>(), c.at("covered").get<double>(), 0.002 * c.at("covered").get<double>());
+    EXPECT_NEAR(g.at("covered").get<double>(), c.at("covered").get<double>(),
+                0.002 * c.at("covered").get<double>());
     EXPECT_NEAR(g.at("patch_faces").get<double>(), c.at("patch_faces").get<double>(),
                 0.01 * c.at("patch_faces").get<double>());
 }
 
 TEST(CliScan, LassoSelectsAStrictSubsetIndependentOfResolution) {
     auto facesWith = [](const std::vector<std::string>& extra, const std::string& res) {
-        std::vector<std::string> args{"scan", kFandisk, "-o", tmpPath("cli_scan/l.off").string(), "--view", "+x",
-                                      "--resolution", res, "--json"};
+        std::vector<std::string> args{"scan",   kFandisk, "-o",           tmpPath("cli_scan/l.off").string(),
+                                      "--view", "+x",     "--resolution", res,
+                                      "--json"};
         args.insert(args.end(), extra.begin(), extra.end());
         const auto r = remesh(args);
         EXPECT_EQ(r.exitCode, 0) << r.err;

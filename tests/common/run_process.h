@@ -18,10 +18,10 @@ extern char** environ;
 namespace fss::test {
 
 struct ProcessResult {
-    int exitCode = -1;   ///< exit status when the program exited normally
-    int signal = 0;      ///< terminating signal, 0 when it exited normally
-    std::string out;     ///< everything written to stdout
-    std::string err;     ///< everything written to stderr
+    int exitCode = -1; ///< exit status when the program exited normally
+    int signal = 0;    ///< terminating signal, 0 when it exited normally
+    std::string out;   ///< everything written to stdout
+    std::string err;   ///< everything written to stderr
 };
 
 inline std::string slurp(const std::filesystem::path& p) {
@@ -36,12 +36,15 @@ inline ProcessResult runProcess(const std::filesystem::path& exe, const std::vec
                                 const std::filesystem::path& scratch) {
     static int counter = 0;
     std::filesystem::create_directories(scratch);
-    const auto outPath = scratch / ("out" + std::to_string(::getpid()) + "_" + std::to_string(counter) + ".txt");
-    const auto errPath = scratch / ("err" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + ".txt");
+    const auto outPath =
+        scratch / ("out" + std::to_string(::getpid()) + "_" + std::to_string(counter) + ".txt");
+    const auto errPath =
+        scratch / ("err" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + ".txt");
     std::vector<std::string> all{exe.string()};
     all.insert(all.end(), args.begin(), args.end());
     std::vector<char*> argv;
-    for (auto& a : all) argv.push_back(a.data());
+    for (auto& a : all)
+        argv.push_back(a.data());
     argv.push_back(nullptr);
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
@@ -70,7 +73,8 @@ inline ProcessResult runProcess(const std::filesystem::path& exe, const std::vec
 /// Number of sentences-ending lines: the error contract is one line, one sentence.
 inline int countLines(const std::string& s) {
     int n = 0;
-    for (char c : s) n += (c == '\n');
+    for (char c : s)
+        n += (c == '\n');
     return n;
 }
 

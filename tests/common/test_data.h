@@ -17,7 +17,9 @@ inline std::filesystem::path tmpPath(const std::string& name) {
 
 #ifdef FSS_REMESH_EXE
 /// The fss-remesh executable built with the tests (only when the apps are built).
-inline std::filesystem::path remeshExe() { return std::filesystem::path(FSS_REMESH_EXE); }
+inline std::filesystem::path remeshExe() {
+    return std::filesystem::path(FSS_REMESH_EXE);
+}
 #endif
 
 } // namespace fss::test

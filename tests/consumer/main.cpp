@@ -16,7 +16,8 @@ int main(int argc, char** argv) {
         const fss::Mesh mesh = fss::readMesh(argv[1]);
         std::cout << "vertices=" << mesh.number_of_vertices() << " faces=" << mesh.number_of_faces() << "\n";
         std::cout << "sha256=" << fss::sha256OfFile(argv[1]) << "\n";
-        std::cout << "self_intersections=" << fss::computeMetrics(mesh).selfIntersections.value_or(999) << "\n";
+        std::cout << "self_intersections=" << fss::computeMetrics(mesh).selfIntersections.value_or(999)
+                  << "\n";
     } catch (const fss::Error& e) {
         std::cerr << e.what() << "\n";
         return 1;

@@ -68,7 +68,8 @@ TEST(Camera, PerspectiveFrustumEdgesMapToImageBorders) {
 TEST(Camera, ParallelProjectionMapsScaleToBorders) {
     const Camera c = makeCamera(true);
     const Eigen::Matrix4d vinv = c.viewMatrix().inverse();
-    const Eigen::Vector3d p = (vinv * Eigen::Vector4d(c.parallelScale * c.aspect(), -c.parallelScale, -3, 1)).head<3>();
+    const Eigen::Vector3d p =
+        (vinv * Eigen::Vector4d(c.parallelScale * c.aspect(), -c.parallelScale, -3, 1)).head<3>();
     const Eigen::Vector3d s = c.project(p);
     EXPECT_NEAR(s.x(), c.width, 1e-9);
     EXPECT_NEAR(s.y(), c.height, 1e-9);
@@ -121,15 +122,16 @@ TEST(Camera, PixelFootprintMatchesNeighbourUnprojection) {
 
 TEST(Camera, StandardViewsSeeTheWholeBox) {
     const Eigen::AlignedBox3d box(Eigen::Vector3d(-1, 2, 0), Eigen::Vector3d(3, 4, 1));
-    for (auto view : {fss::StandardView::Iso, fss::StandardView::PosX, fss::StandardView::NegX,
-                      fss::StandardView::PosY, fss::StandardView::NegY, fss::StandardView::PosZ,
-                      fss::StandardView::NegZ}) {
+    for (auto view :
+         {fss::StandardView::Iso, fss::StandardView::PosX, fss::StandardView::NegX, fss::StandardView::PosY,
+          fss::StandardView::NegY, fss::StandardView::PosZ, fss::StandardView::NegZ}) {
         for (bool parallel : {false, true}) {
             for (auto [w, h] : {std::pair{256, 256}, std::pair{400, 100}, std::pair{100, 400}}) {
                 const Camera c = Camera::standardView(view, box, w, h, parallel);
                 EXPECT_EQ(fss::parseStandardView(fss::standardViewName(view)), view);
                 for (int i = 0; i < 8; ++i) {
-                    const Eigen::Vector3d s = c.project(box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(i)));
+                    const Eigen::Vector3d s =
+                        c.project(box.corner(static_cast<Eigen::AlignedBox3d::CornerType>(i)));
                     EXPECT_GE(s.x(), 0);
                     EXPECT_LE(s.x(), w);
                     EXPECT_GE(s.y(), 0);
@@ -190,7 +192,7 @@ TEST(Camera, FitClippingRangeIsTightAndRejectsBoxBehind) {
     EXPECT_NEAR(c.farPlane, 10.5, 1e-2);
     EXPECT_LT(c.nearPlane, 9.5);
     EXPECT_GT(c.farPlane, 10.5);
-    c.focal = {0, 0, 20};  // looking away
+    c.focal = {0, 0, 20}; // looking away
     EXPECT_THROW(c.fitClippingRange(box), fss::InvalidInputError);
 }
 

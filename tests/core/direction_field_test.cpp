@@ -11,9 +11,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <numbers>
-#include <cstdint>
 #include <optional>
 #include <string>
 #include <thread>
@@ -221,7 +221,8 @@ TEST(DirectionField, BothFieldsInOnePassEqualTwoSingleFields) {
     fss::Camera cam;
     cam.eye = {2.5, 1.0, 3.0};
     cam.width = cam.height = 96;
-    cam.fitClippingRange(Eigen::AlignedBox3d(Eigen::Vector3d(-1.4, -1.4, -0.4), Eigen::Vector3d(1.4, 1.4, 0.4)));
+    cam.fitClippingRange(
+        Eigen::AlignedBox3d(Eigen::Vector3d(-1.4, -1.4, -0.4), Eigen::Vector3d(1.4, 1.4, 0.4)));
     const fss::FrameBuffers fb = fss::test::bruteForceRaster(mesh, cam);
     const fss::DirectionFieldPair both = fss::computeDirectionFields(mesh, curv, fb);
     const DirectionField mn = fss::computeDirectionField(mesh, curv, fb, {fss::PrincipalDirection::Min});
@@ -268,8 +269,8 @@ std::vector<Eigen::Vector2d> probePositions(int w, int h) {
     return out;
 }
 
-void expectSameSample(const std::optional<fss::DirectionSample>& a, const std::optional<fss::DirectionSample>& b,
-                      const Eigen::Vector2d& p) {
+void expectSameSample(const std::optional<fss::DirectionSample>& a,
+                      const std::optional<fss::DirectionSample>& b, const Eigen::Vector2d& p) {
     ASSERT_EQ(a.has_value(), b.has_value()) << p.transpose();
     if (!a) return;
     ASSERT_EQ(a->direction, b->direction) << p.transpose();

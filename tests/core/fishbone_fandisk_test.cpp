@@ -303,13 +303,15 @@ TEST(FishboneFandisk, DrawnFishboneRemovesTheAliasingOfACurvedCrease) {
             std::size_t(p.mesh.number_of_faces()));
     };
     const Drift tracedDrift = driftOf(tracedAll), freeDrift = driftOf(tracedNoSnap);
-    std::printf("[ aliasing, fandisk ] h = 1 pixel = %.5f; backbone off the crease by at most %.3f h (drawn)\n",
-                hWorld, drift(fish));
-    std::printf("[ aliasing, fandisk ] traced backbone: %zu samples in the lasso, off the crease by at most %.3f h, "
-                "mean %.3f h, covers %.1f %% of the inner crease; without crease following: at most %.3f h, "
-                "mean %.3f h, covers %.1f %%\n",
-                tracedDrift.samples, tracedDrift.worst, tracedDrift.mean, 100 * tracedDrift.coverage,
-                freeDrift.worst, freeDrift.mean, 100 * freeDrift.coverage);
+    std::printf(
+        "[ aliasing, fandisk ] h = 1 pixel = %.5f; backbone off the crease by at most %.3f h (drawn)\n",
+        hWorld, drift(fish));
+    std::printf(
+        "[ aliasing, fandisk ] traced backbone: %zu samples in the lasso, off the crease by at most %.3f h, "
+        "mean %.3f h, covers %.1f %% of the inner crease; without crease following: at most %.3f h, "
+        "mean %.3f h, covers %.1f %%\n",
+        tracedDrift.samples, tracedDrift.worst, tracedDrift.mean, 100 * tracedDrift.coverage, freeDrift.worst,
+        freeDrift.mean, 100 * freeDrift.coverage);
     print("pixel grid", g, grid.patch);
     print("drawn backbone + key-ribs", f, fish.patch);
     print("drawn backbone, traced ribs", tr, tracedRibs.patch);
@@ -350,9 +352,11 @@ TEST(FishboneFandisk, DrawnFishboneRemovesTheAliasingOfACurvedCrease) {
     traced2.spacing = 2.0;
     traced2.seed = 2.0 * clicked[4];
     traced2.creaseSnapRadius = 2.0 * traced.creaseSnapRadius; // scan pixels: the same radius on the surface
-    const fss::FishboneScanResult half = fss::scanFishbonePatch(m, renderer, m, renderer, params2, traced2, cache);
+    const fss::FishboneScanResult half =
+        fss::scanFishbonePatch(m, renderer, m, renderer, params2, traced2, cache);
     traced2.samplingFactor = 1;
-    const fss::FishboneScanResult full = fss::scanFishbonePatch(m, renderer, m, renderer, params2, traced2, cache);
+    const fss::FishboneScanResult full =
+        fss::scanFishbonePatch(m, renderer, m, renderer, params2, traced2, cache);
     EXPECT_EQ(half.samplingFactor, 2);
     EXPECT_EQ(half.grid.camera.width, 200);
     EXPECT_EQ(full.samplingFactor, 1);
@@ -372,10 +376,11 @@ TEST(FishboneFandisk, DrawnFishboneRemovesTheAliasingOfACurvedCrease) {
     print("traced, 400², h = 2, k = 2", th, half.patch);
     print("traced, 400², h = 2, k = 1", tk, full.patch);
     const Drift halfDrift = driftOf(half), fullDrift = driftOf(full);
-    std::printf("[ aliasing, fandisk ] 400², h = 2: backbone off the crease by at most %.3f h (k = 2), %.3f h "
-                "(k = 1); covers %.1f %% / %.1f %%; rib vertices %zu / %zu\n",
-                halfDrift.worst, fullDrift.worst, 100 * halfDrift.coverage, 100 * fullDrift.coverage,
-                half.counts.ribVertices, full.counts.ribVertices);
+    std::printf(
+        "[ aliasing, fandisk ] 400², h = 2: backbone off the crease by at most %.3f h (k = 2), %.3f h "
+        "(k = 1); covers %.1f %% / %.1f %%; rib vertices %zu / %zu\n",
+        halfDrift.worst, fullDrift.worst, 100 * halfDrift.coverage, 100 * fullDrift.coverage,
+        half.counts.ribVertices, full.counts.ribVertices);
     for (const fss::FishboneScanResult* r : {&half, &full}) {
         const Drift d = driftOf(*r);
         EXPECT_GT(d.samples, 100u);

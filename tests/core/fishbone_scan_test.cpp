@@ -238,10 +238,12 @@ TEST(FishboneScan, AutomaticScanOfTheCreasedRingIsAManifoldPatch) {
         for (const fss::Sample& x : s->grid.samples)
             if (x.hit) {
                 const double k = s->samplingFactor;
-                ASSERT_NEAR(x.quality, x.footprint / k / std::max(std::cos(double(x.samplingAngle)),
-                                                                   std::cos(fss::ScanOptions{}.qualityAngleLimitDeg *
-                                                                            std::numbers::pi / 180)),
-                            1e-5 * x.quality);
+                ASSERT_NEAR(
+                    x.quality,
+                    x.footprint / k /
+                        std::max(std::cos(double(x.samplingAngle)),
+                                 std::cos(fss::ScanOptions{}.qualityAngleLimitDeg * std::numbers::pi / 180)),
+                    1e-5 * x.quality);
             }
 
     // Key-rib mode: two traced key-ribs on the backbone, blended in between.
@@ -482,8 +484,10 @@ TEST(FishboneScan, HintedRayCastOnFacesSmallerThanAPixelMatchesTheAabbTree) {
             worst = std::max(worst, (s.point - truth.point).norm());
         }
     EXPECT_GT(hits, std::size_t(grid.rows * grid.cols) / 5); // the torus covers about a quarter of the window
-    EXPECT_LT(worst, 1e-9); // the same point on the visible surface
-    std::printf("hinted ray cast on the 100k-face torus at 128²: %zu hits, %zu on the pixel's face, worst distance %.2e\n", hits, hintHits, worst);
+    EXPECT_LT(worst, 1e-9);                                  // the same point on the visible surface
+    std::printf("hinted ray cast on the 100k-face torus at 128²: %zu hits, %zu on the pixel's face, worst "
+                "distance %.2e\n",
+                hits, hintHits, worst);
     // The pixel's own face is hit by fewer than 2/3 of the rays: most of the rest needed the walk.
     EXPECT_LT(hintHits, 2 * hits / 3);
 }

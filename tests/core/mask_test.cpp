@@ -194,9 +194,10 @@ TEST(Lasso, RowsAtOnceMatchThePointTest) {
             for (int r = 0; r < rows; ++r)
                 for (int c = 0; c < cols; ++c) {
                     fss::Sample& s = g.at(r, c);
-                    if (layout == 1) s.screen.x() = double(c / 2) + 0.5; // pairs of equal x
+                    if (layout == 1) s.screen.x() = double(c / 2) + 0.5;                  // pairs of equal x
                     if (layout == 2 && r % 2 == 1) s.screen.x() = double(cols - c) - 0.5; // mirrored
-                    if (layout == 3 && r == 5 && c == 7) s.screen.x() = std::numeric_limits<double>::quiet_NaN();
+                    if (layout == 3 && r == 5 && c == 7)
+                        s.screen.x() = std::numeric_limits<double>::quiet_NaN();
                     s.admissible = s.valid = (next() % 7 != 0);
                 }
             const SampleGrid before = g;
@@ -208,8 +209,8 @@ TEST(Lasso, RowsAtOnceMatchThePointTest) {
                     const bool in = fss::insideLasso(lasso, s.screen);
                     const bool keep = s.admissible && in;
                     expectedDropped += s.admissible && !in;
-                    ASSERT_EQ(g.at(r, c).admissible, keep) << "trial " << trial << " layout " << layout << " at "
-                                                           << r << "," << c;
+                    ASSERT_EQ(g.at(r, c).admissible, keep)
+                        << "trial " << trial << " layout " << layout << " at " << r << "," << c;
                     ASSERT_EQ(g.at(r, c).valid, s.valid && keep);
                     if (in) {
                         ++insideTotal;

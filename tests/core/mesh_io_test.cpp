@@ -897,7 +897,8 @@ TEST(MeshIo, CanonicalMeshIsTheMeshAsReadBackFromItsFile) {
         CGAL::Euler::flip_edge(m.halfedge(*std::next(m.edges().begin(), 10)), m);
         const fss::Mesh canonical = fss::canonicalMesh(m);
         for (const bool binary : {true, false}) {
-            const auto path = fss::test::tmpPath(std::string("canonical_") + name + (binary ? ".ply" : ".off"));
+            const auto path =
+                fss::test::tmpPath(std::string("canonical_") + name + (binary ? ".ply" : ".off"));
             fss::WriteOptions o;
             o.binary = binary;
             fss::writeMesh(m, path, o);

@@ -19,11 +19,14 @@ namespace {
 
 fss::Mesh load(const std::string& name) {
     fss::Mesh m;
-    if (!CGAL::IO::read_polygon_mesh(fss::test::meshPath(name).string(), m)) ADD_FAILURE() << "cannot read " << name;
+    if (!CGAL::IO::read_polygon_mesh(fss::test::meshPath(name).string(), m))
+        ADD_FAILURE() << "cannot read " << name;
     return m;
 }
 
-Eigen::AlignedBox3d bbox(const fss::Mesh& m) { return fss::boundingBox(m); }
+Eigen::AlignedBox3d bbox(const fss::Mesh& m) {
+    return fss::boundingBox(m);
+}
 
 std::string messageOf(const std::function<void()>& f) {
     try {
@@ -46,8 +49,8 @@ TEST(ScanPipeline, IsoScanOfFandiskIsARegularManifoldPatch) {
 
     EXPECT_EQ(r.counts.pixels, 256u * 256u);
     EXPECT_GT(r.counts.covered, 256u * 256u / 5);
-    EXPECT_EQ(r.counts.afterLasso, r.counts.frontFacing);    // no lasso
-    EXPECT_EQ(r.counts.afterQuality, r.counts.afterLasso);   // first scan: input faces always lose
+    EXPECT_EQ(r.counts.afterLasso, r.counts.frontFacing);  // no lasso
+    EXPECT_EQ(r.counts.afterQuality, r.counts.afterLasso); // first scan: input faces always lose
     EXPECT_LE(r.counts.afterMorphology, r.counts.afterQuality);
     // Triangles across silhouettes are dropped, so a few valid samples end up in no triangle.
     EXPECT_LE(r.patch.mesh.number_of_vertices(), r.counts.afterMorphology);
@@ -89,22 +92,23 @@ TEST(ScanPipeline, BadScansAreExplainedInOneSentence) {
 
     auto scan = [&](const fss::ScanParams& p) { fss::scanPatch(sphere, renderer, sphere, renderer, p); };
     {
-        auto p = params;  // looking away from the sphere
+        auto p = params; // looking away from the sphere
         p.camera.focal = p.camera.eye + (p.camera.eye - p.camera.focal);
         EXPECT_NE(messageOf([&] { scan(p); }).find("behind"), std::string::npos);
     }
     {
-        auto p = params;  // eye at the centre of the sphere
+        auto p = params; // eye at the centre of the sphere
         p.camera.eye = {0, 0, 0};
         p.camera.focal = {0, 0, -1};
         EXPECT_NE(messageOf([&] { scan(p); }).find("inside the mesh"), std::string::npos);
     }
     {
-        auto p = params;  // looking beside the sphere
+        auto p = params; // looking beside the sphere
         p.camera.focal = p.camera.eye + Eigen::Vector3d(1, 0, 0);
         p.camera.up = {0, 0, 1};
         const std::string msg = messageOf([&] { scan(p); });
-        EXPECT_TRUE(msg.find("sees no part") != std::string::npos || msg.find("behind") != std::string::npos) << msg;
+        EXPECT_TRUE(msg.find("sees no part") != std::string::npos || msg.find("behind") != std::string::npos)
+            << msg;
     }
     {
         auto p = params;
@@ -117,7 +121,7 @@ TEST(ScanPipeline, BadScansAreExplainedInOneSentence) {
         EXPECT_NE(messageOf([&] { scan(p); }), "(no error)");
     }
     {
-        auto p = params;  // a lasso in a corner where the sphere is not
+        auto p = params; // a lasso in a corner where the sphere is not
         p.lasso = fss::Lasso{{{0, 0}, {2, 0}, {0, 2}}};
         EXPECT_NE(messageOf([&] { scan(p); }).find("lasso selects no part"), std::string::npos);
     }

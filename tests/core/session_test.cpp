@@ -313,9 +313,10 @@ TEST(Session, UndoRestoresAMeshTheStitchShrank) {
     session.scan(isoStep(session.reference(), 32));
     session.accept();
     const std::string after = fingerprint(session.current());
-    std::printf("coarse scan: %u -> %u vertices, %u -> %u faces\n", unsigned(session.reference().number_of_vertices()),
-                unsigned(session.current().number_of_vertices()), unsigned(session.reference().number_of_faces()),
-                unsigned(session.current().number_of_faces()));
+    std::printf(
+        "coarse scan: %u -> %u vertices, %u -> %u faces\n",
+        unsigned(session.reference().number_of_vertices()), unsigned(session.current().number_of_vertices()),
+        unsigned(session.reference().number_of_faces()), unsigned(session.current().number_of_faces()));
     EXPECT_LT(session.current().number_of_faces(), session.reference().number_of_faces());
     EXPECT_LT(session.current().number_of_halfedges(), session.reference().number_of_halfedges());
     EXPECT_LT(session.current().number_of_vertices(), session.reference().number_of_vertices());

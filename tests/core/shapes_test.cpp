@@ -15,7 +15,9 @@ using fss::Mesh;
 
 namespace {
 
-int valence(const Mesh& m, fss::VertexIndex v) { return int(m.degree(v)); }
+int valence(const Mesh& m, fss::VertexIndex v) {
+    return int(m.degree(v));
+}
 
 void expectClosedOutward(const Mesh& m) {
     ASSERT_TRUE(m.is_valid(false));
@@ -56,7 +58,8 @@ TEST(Shapes, IcosahedronIsRegular) {
         EXPECT_NEAR(std::sqrt(CGAL::squared_distance(m.point(v), fss::Point3(0, 0, 0))), 2.0, 1e-12);
     }
     const double edge = 2.0 / std::sin(2 * std::numbers::pi / 5);
-    for (auto e : m.edges()) EXPECT_NEAR(PMP::edge_length(e, m), edge, 1e-12);
+    for (auto e : m.edges())
+        EXPECT_NEAR(PMP::edge_length(e, m), edge, 1e-12);
 }
 
 TEST(Shapes, IcosphereCountsAndRadius) {
@@ -77,11 +80,12 @@ TEST(Shapes, UvSphereCylinderTorusCubeAreClosedAndOutward) {
     const Mesh t = fss::shapes::torus(64, 32, 2.0, 0.5);
     expectClosedOutward(t);
     EXPECT_EQ(t.number_of_vertices(), 64u * 32u);
-    for (auto v : t.vertices()) EXPECT_EQ(valence(t, v), 6);
+    for (auto v : t.vertices())
+        EXPECT_EQ(valence(t, v), 6);
     EXPECT_NEAR(PMP::volume(t), 2 * std::numbers::pi * std::numbers::pi * 2.0 * 0.25, 0.02 * 9.87);
     const Mesh k = fss::shapes::cube(3, 2.0);
     expectClosedOutward(k);
-    EXPECT_EQ(k.number_of_vertices(), 6u * 9u + 2u);  // 6n²+2 for n = 3
+    EXPECT_EQ(k.number_of_vertices(), 6u * 9u + 2u); // 6n²+2 for n = 3
     EXPECT_NEAR(PMP::volume(k), 8.0, 1e-12);
     EXPECT_NEAR(PMP::area(k), 24.0, 1e-12);
 }
@@ -91,7 +95,8 @@ TEST(Shapes, OpenCylinderHasTwoBoundaryLoops) {
     ASSERT_TRUE(c.is_valid(false));
     EXPECT_FALSE(CGAL::is_closed(c));
     std::size_t borderEdges = 0;
-    for (auto e : c.edges()) borderEdges += c.is_border(e) ? 1 : 0;
+    for (auto e : c.edges())
+        borderEdges += c.is_border(e) ? 1 : 0;
     EXPECT_EQ(borderEdges, 24u);
 }
 

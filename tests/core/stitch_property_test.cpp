@@ -158,7 +158,8 @@ ScanSetup randomSetup(std::mt19937& rng, const Eigen::AlignedBox3d& box, int max
     std::uniform_real_distribution<double> U(0, 1);
     ScanSetup s;
     // Resolution log-uniform in [32, maxRes].
-    const int res = int(std::lround(std::exp(std::log(32.0) + U(rng) * (std::log(double(maxRes)) - std::log(32.0)))));
+    const int res =
+        int(std::lround(std::exp(std::log(32.0) + U(rng) * (std::log(double(maxRes)) - std::log(32.0)))));
     const int W = std::clamp(int(res * (0.8 + 0.4 * U(rng))), 32, maxRes), H = res;
     Camera& c = s.camera;
     c.width = W;
@@ -168,7 +169,8 @@ ScanSetup randomSetup(std::mt19937& rng, const Eigen::AlignedBox3d& box, int max
     const Vec3 centre = box.center(), half = 0.5 * box.sizes();
     const double radius = half.norm();
     const double zoom = std::exp(U(rng) * std::log(2.5)); // 1: whole object; 2.5: a part of it
-    const Vec3 focal = centre + (1.0 - 1.0 / zoom) * half.cwiseProduct(Vec3(2 * U(rng) - 1, 2 * U(rng) - 1, 2 * U(rng) - 1));
+    const Vec3 focal =
+        centre + (1.0 - 1.0 / zoom) * half.cwiseProduct(Vec3(2 * U(rng) - 1, 2 * U(rng) - 1, 2 * U(rng) - 1));
     const Vec3 dir = randomDirection(rng);
     const double fit = radius / std::sin(0.5 * c.viewAngleDeg * std::numbers::pi / 180.0);
     c.focal = focal;
@@ -405,7 +407,8 @@ bool touchesFootprint(const Mesh& m, FaceIndex f, const Camera& cam, const Footp
         if (fp.at(int(std::floor(s[k].x())), int(std::floor(s[k].y())))) return true;
         ++k;
     }
-    const double area = (s[1].x() - s[0].x()) * (s[2].y() - s[0].y()) - (s[1].y() - s[0].y()) * (s[2].x() - s[0].x());
+    const double area =
+        (s[1].x() - s[0].x()) * (s[2].y() - s[0].y()) - (s[1].y() - s[0].y()) * (s[2].x() - s[0].x());
     if (area == 0) return false;
     const int x0 = std::max(0, int(std::floor(std::min({s[0].x(), s[1].x(), s[2].x()}))));
     const int x1 = std::min(fp.W - 1, int(std::ceil(std::max({s[0].x(), s[1].x(), s[2].x()}))));
@@ -479,7 +482,9 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
     std::mt19937 rng(cs.seed);
     const fss::StitchOptions options;
     using Clock = std::chrono::steady_clock;
-    auto seconds = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+    auto seconds = [](Clock::time_point t) {
+        return std::chrono::duration<double>(Clock::now() - t).count();
+    };
 
     // Bound of the distance at a point p on / nearest to face f of the current mesh: the pixel footprint
     // at p of the scan that sampled the face's surface (its scan id) and of the scan whose stitch last
@@ -507,8 +512,9 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
     auto describe = [&](const Mesh& m, FaceIndex f) {
         auto sid = m.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId);
         std::ostringstream os;
-        os << " [face " << std::uint32_t(f) << " scan id " << (sid.second ? sid.first[f] : -1) << " made by scan "
-           << (std::size_t(f) < madeBy.size() ? madeBy[std::size_t(f)] : -1) << "; corners:";
+        os << " [face " << std::uint32_t(f) << " scan id " << (sid.second ? sid.first[f] : -1)
+           << " made by scan " << (std::size_t(f) < madeBy.size() ? madeBy[std::size_t(f)] : -1)
+           << "; corners:";
         const auto c = corners(m, f);
         for (int i = 0; i < 3; ++i) {
             const Vec3 p = vec(m.point(c[std::size_t(i)])), q = vec(m.point(c[std::size_t((i + 1) % 3)]));
@@ -521,7 +527,12 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
     auto toReference = [&](const Mesh& m, FaceIndex f, double& worst, std::string& where) {
         const auto c = corners(m, f);
         const Vec3 P[3] = {vec(m.point(c[0])), vec(m.point(c[1])), vec(m.point(c[2]))};
-        const Vec3 pts[7] = {P[0], P[1], P[2], 0.5 * (P[0] + P[1]), 0.5 * (P[1] + P[2]), 0.5 * (P[2] + P[0]),
+        const Vec3 pts[7] = {P[0],
+                             P[1],
+                             P[2],
+                             0.5 * (P[0] + P[1]),
+                             0.5 * (P[1] + P[2]),
+                             0.5 * (P[2] + P[0]),
                              (P[0] + P[1] + P[2]) / 3.0};
         for (const Vec3& p : pts) {
             const double d = std::sqrt(refTree.squared_distance(Point3(p.x(), p.y(), p.z())));
@@ -543,14 +554,15 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
             // reference: the bound at p is the largest among the faces within 2d of p.
             std::vector<Primitive::Id> near;
             const double r = 2 * d;
-            tree.all_intersected_primitives(fss::Kernel::Iso_cuboid_3(p.x() - r, p.y() - r, p.z() - r, p.x() + r,
-                                                                      p.y() + r, p.z() + r),
-                                            std::back_inserter(near));
+            tree.all_intersected_primitives(
+                fss::Kernel::Iso_cuboid_3(p.x() - r, p.y() - r, p.z() - r, p.x() + r, p.y() + r, p.z() + r),
+                std::back_inserter(near));
             const Point3 P(p.x(), p.y(), p.z());
             for (FaceIndex g : near) {
                 const auto c = corners(m, g);
                 const fss::Kernel::Triangle_3 t(m.point(c[0]), m.point(c[1]), m.point(c[2]));
-                if (CGAL::squared_distance(P, t) <= r * r) bound = std::max(bound, boundAt(m, g, vec(m.point(c[0]))));
+                if (CGAL::squared_distance(P, t) <= r * r)
+                    bound = std::max(bound, boundAt(m, g, vec(m.point(c[0]))));
             }
         }
         const double r = d / bound;
@@ -567,8 +579,8 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
         ++fig.attempts;
         const ScanSetup setup = randomSetup(rng, box, cs.maxRes);
         const std::string trace = std::string(cs.file) + " seed " + std::to_string(cs.seed) + " attempt " +
-                                  std::to_string(fig.attempts) + " scan id " + std::to_string(scanId + 1) + ": " +
-                                  setup.text;
+                                  std::to_string(fig.attempts) + " scan id " + std::to_string(scanId + 1) +
+                                  ": " + setup.text;
         SCOPED_TRACE(trace);
         fss::ScanParams params;
         params.camera = setup.camera;
@@ -650,8 +662,9 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
                     if (refTree.squared_distance(p) > inputTol * inputTol && !changedBefore.empty()) {
                         std::vector<Primitive::Id> on;
                         const double r = inputTol;
-                        old.all_intersected_primitives(fss::Kernel::Iso_cuboid_3(p.x() - r, p.y() - r, p.z() - r,
-                                                                                 p.x() + r, p.y() + r, p.z() + r),
+                        old.all_intersected_primitives(fss::Kernel::Iso_cuboid_3(p.x() - r, p.y() - r,
+                                                                                 p.z() - r, p.x() + r,
+                                                                                 p.y() + r, p.z() + r),
                                                        std::back_inserter(on));
                         if (on.empty()) on.push_back(old.closest_point_and_primitive(p).second);
                         for (FaceIndex g : on)
@@ -696,8 +709,8 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
                     if (example.empty()) example = "face " + std::to_string(std::uint32_t(f));
                 }
             }
-            EXPECT_EQ(outside, 0u) << "changed faces outside the seam neighbourhood, e.g. " << example << " of "
-                                   << changedBefore.size();
+            EXPECT_EQ(outside, 0u) << "changed faces outside the seam neighbourhood, e.g. " << example
+                                   << " of " << changedBefore.size();
         }
 
         // Self-intersections.
@@ -761,12 +774,12 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
         fig.worstFromRef = std::max(fig.worstFromRef, worst2);
     }
     fig.facesEnd = current.number_of_faces();
-    std::printf("%s (seed %u): %d scan attempts, %d without a patch, %d patches stitched, %d refused; faces %zu -> "
-                "%zu; worst Hausdorff / footprint: current->reference %.3f, reference->current %.3f; "
-                "time scan %.1f s, stitch %.1f s, checks %.1f s\n",
-                cs.file, cs.seed, fig.attempts, fig.noPatch, fig.stitched, fig.refused, fig.facesStart,
-                fig.facesEnd, fig.worstToRef, fig.worstFromRef, fig.scanSeconds, fig.stitchSeconds,
-                fig.checkSeconds);
+    std::printf(
+        "%s (seed %u): %d scan attempts, %d without a patch, %d patches stitched, %d refused; faces %zu -> "
+        "%zu; worst Hausdorff / footprint: current->reference %.3f, reference->current %.3f; "
+        "time scan %.1f s, stitch %.1f s, checks %.1f s\n",
+        cs.file, cs.seed, fig.attempts, fig.noPatch, fig.stitched, fig.refused, fig.facesStart, fig.facesEnd,
+        fig.worstToRef, fig.worstFromRef, fig.scanSeconds, fig.stitchSeconds, fig.checkSeconds);
     for (const auto& [why, n] : fig.reasons)
         std::printf("  refused %d x: %s\n", n, why.c_str());
     EXPECT_GE(fig.stitched + fig.refused, cs.patches) << "too few scans produced a patch";

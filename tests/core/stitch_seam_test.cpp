@@ -18,12 +18,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdlib>
-#include <map>
-#include <set>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
+#include <map>
 #include <numbers>
+#include <set>
 
 using fss::FaceIndex;
 using fss::Mesh;
@@ -116,19 +116,26 @@ SeamFigures fandiskSeam(fss::StandardView view, const char* name) {
             }
             const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
             const Eigen::Vector3d c = (p[0] + p[1] + p[2]) / 3.0;
-            const double view = std::acos(std::clamp(n.dot((eye - c).normalized()), -1.0, 1.0)) * 180 / std::numbers::pi;
-            const std::string key = std::string(sid.first[f] == 1 ? "patch" : "old") + (a < 10 ? " <10" : " 10-25") +
-                                    (view > 70 ? " grazing>70" : view > 50 ? " view50-70" : " view<50");
+            const double view =
+                std::acos(std::clamp(n.dot((eye - c).normalized()), -1.0, 1.0)) * 180 / std::numbers::pi;
+            const std::string key = std::string(sid.first[f] == 1 ? "patch" : "old") +
+                                    (a < 10 ? " <10" : " 10-25") +
+                                    (view > 70   ? " grazing>70"
+                                     : view > 50 ? " view50-70"
+                                                 : " view<50");
             ++kinds[key];
             if (a < 10) {
-                std::printf("  bad face %u min %.2f view %.1f label %d:", std::uint32_t(f), a, view, sid.first[f]);
+                std::printf("  bad face %u min %.2f view %.1f label %d:", std::uint32_t(f), a, view,
+                            sid.first[f]);
                 for (auto v : CGAL::vertices_around_face(current.halfedge(f), current)) {
                     const bool old = std::size_t(v) < ref.num_vertices() && ref.point(v) == current.point(v);
                     const bool onSeam = std::find(seam.begin(), seam.end(), v) != seam.end();
-                    std::printf(" [%s%s deg %zu]", old ? "old" : "new", onSeam ? " seam" : "", std::size_t(current.degree(v)));
+                    std::printf(" [%s%s deg %zu]", old ? "old" : "new", onSeam ? " seam" : "",
+                                std::size_t(current.degree(v)));
                 }
                 std::printf(" edges");
-                for (int i = 0; i < 3; ++i) std::printf(" %.4f", (p[std::size_t(i)] - p[std::size_t((i + 1) % 3)]).norm());
+                for (int i = 0; i < 3; ++i)
+                    std::printf(" %.4f", (p[std::size_t(i)] - p[std::size_t((i + 1) % 3)]).norm());
                 std::printf("\n");
             }
         }

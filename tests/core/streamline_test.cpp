@@ -133,8 +133,8 @@ TEST(Streamline, SineFieldFollowsItsIntegralCurves) {
             worst = std::max(worst, std::abs(p.y() - (A * std::sin(p.x() / L) + C)));
             xmax = std::max(xmax, p.x());
         }
-        std::printf("[ sine field, %s ] x from %.1f to %.1f, worst deviation %.2e px\n", c.name, seed.x(), xmax,
-                    worst);
+        std::printf("[ sine field, %s ] x from %.1f to %.1f, worst deviation %.2e px\n", c.name, seed.x(),
+                    xmax, worst);
         EXPECT_GE(xmax - seed.x(), 200.0);
         EXPECT_LT(worst, 0.1);
     }
@@ -306,7 +306,8 @@ TEST(Streamline, AttractorKeepsTheLineOnAnAttractingCurve) {
     const fss::StreamlineHalf plain = fss::traceStreamlineHalf(f, seed, d, o);
     EXPECT_NEAR(plain.points.back().y() - 40.5, 200 * std::sin(tilt), 1e-6);
 
-    auto alongLine = [](const Eigen::Vector2d& q, const Eigen::Vector2d& heading) -> std::optional<Eigen::Vector2d> {
+    auto alongLine = [](const Eigen::Vector2d& q,
+                        const Eigen::Vector2d& heading) -> std::optional<Eigen::Vector2d> {
         if (std::abs(q.y() - 40.5) > 1.5 || std::abs(heading.x()) < std::cos(kPi / 6)) return std::nullopt;
         return Eigen::Vector2d(q.x(), 40.5);
     };
@@ -322,9 +323,11 @@ TEST(Streamline, AttractorKeepsTheLineOnAnAttractingCurve) {
     EXPECT_GT(held.points.back().x(), 200.0 + seed.x() - 0.1);
 
     // A field across the line: the attractor declines (heading check), the line crosses it unchanged.
-    const DirectionField across = makeField(300, 100, [](const Eigen::Vector2d&) { return Eigen::Vector2d(0, 1); });
+    const DirectionField across =
+        makeField(300, 100, [](const Eigen::Vector2d&) { return Eigen::Vector2d(0, 1); });
     o.maxLength = 50;
-    const fss::StreamlineHalf crossing = fss::traceStreamlineHalf(across, Eigen::Vector2d(100, 20), {0, 1}, o);
+    const fss::StreamlineHalf crossing =
+        fss::traceStreamlineHalf(across, Eigen::Vector2d(100, 20), {0, 1}, o);
     EXPECT_NEAR(crossing.points.back().y(), 70.0, 1e-9);
     EXPECT_NEAR(crossing.points.back().x(), 100.0, 1e-9);
 }

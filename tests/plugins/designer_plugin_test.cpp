@@ -71,8 +71,8 @@ private slots:
                          qPrintable(QColor(centre).name()));
             }
         }
-        for (const char* expected : {"fss::widgets::VtkView", "fss::widgets::RemeshWidget", "fss::widgets::ScanPanel",
-                                     "fss::widgets::QualityPanel"})
+        for (const char* expected : {"fss::widgets::VtkView", "fss::widgets::RemeshWidget",
+                                     "fss::widgets::ScanPanel", "fss::widgets::QualityPanel"})
             QVERIFY2(names.contains(QString::fromLatin1(expected)), qPrintable(names.join(", ")));
         qInfo("the plugin offers %lld widget(s): %s", qlonglong(names.size()), qPrintable(names.join(", ")));
     }

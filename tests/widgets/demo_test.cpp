@@ -15,9 +15,9 @@
 #include <QElapsedTimer>
 #include <QFile>
 #include <QFileInfo>
-#include <QSettings>
 #include <QImage>
 #include <QProcess>
+#include <QSettings>
 #include <QSignalSpy>
 #include <QTest>
 
@@ -42,11 +42,14 @@ RunResult runDemo(const QStringList& args) {
     return r;
 }
 
-QString tmp(const char* name) { return QString::fromStdString(fss::test::tmpPath(name).string()); }
+QString tmp(const char* name) {
+    return QString::fromStdString(fss::test::tmpPath(name).string());
+}
 
 QString badMeshFile() {
     const QString path = tmp("demo_bad.off");
-    std::ofstream(path.toStdString()) << "OFF\n3 1 0\n0 0 0\n1 0 0\n";  // truncated: a vertex and the face missing
+    std::ofstream(path.toStdString())
+        << "OFF\n3 1 0\n0 0 0\n1 0 0\n"; // truncated: a vertex and the face missing
     return path;
 }
 
@@ -97,7 +100,8 @@ private slots:
         const RunResult r = runDemo({"--screenshot", out, badMeshFile()});
         QVERIFY(r.exitCode != 0 && r.exitCode != -1);
         const QString sentence = r.err.trimmed();
-        QVERIFY2(!sentence.isEmpty() && !sentence.contains('\n') && sentence.endsWith('.'), qPrintable(r.err));
+        QVERIFY2(!sentence.isEmpty() && !sentence.contains('\n') && sentence.endsWith('.'),
+                 qPrintable(r.err));
         QVERIFY(sentence.contains("demo_bad.off"));
         QVERIFY(!QFile::exists(out));
     }
@@ -105,8 +109,8 @@ private slots:
     void screenshotAfterAScan() {
         const QString out = tmp("demo_scanned.png");
         QFile::remove(out);
-        const RunResult r = runDemo({"--screenshot", out, "--size", "800x600", "--scan", "+z", "--resolution", "96",
-                                     "--colormap", "angle",
+        const RunResult r = runDemo({"--screenshot", out, "--size", "800x600", "--scan", "+z", "--resolution",
+                                     "96", "--colormap", "angle",
                                      QString::fromStdString(fss::test::meshPath("fandisk.off").string())});
         QVERIFY2(r.exitCode == 0, qPrintable(r.err));
         QImage image;
@@ -205,7 +209,8 @@ private slots:
         remesh->accept();
         QElapsedTimer t;
         t.start();
-        while (remesh->isBusy() && t.elapsed() < 60000) QTest::qWait(10);
+        while (remesh->isBusy() && t.elapsed() < 60000)
+            QTest::qWait(10);
         QCOMPARE(changed.count(), 1);
         const std::size_t faces = window.mesh().number_of_faces();
         QVERIFY(faces != before.number_of_faces());

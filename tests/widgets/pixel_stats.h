@@ -22,7 +22,8 @@ inline double pixelFraction(const QImage& image, const std::function<bool(QRgb)>
     long long hits = 0;
     for (int y = rect.top(); y <= rect.bottom(); ++y) {
         const auto* line = reinterpret_cast<const QRgb*>(rgb.constScanLine(y));
-        for (int x = rect.left(); x <= rect.right(); ++x) hits += pred(line[x]) ? 1 : 0;
+        for (int x = rect.left(); x <= rect.right(); ++x)
+            hits += pred(line[x]) ? 1 : 0;
     }
     return double(hits) / double(rect.width()) / double(rect.height());
 }
@@ -36,10 +37,14 @@ inline bool notBackground(QRgb p) {
 }
 
 /// The shaded plain surface colour (VtkView::kSurface is a warm tan: red well above blue, lit enough).
-inline bool surfaceColored(QRgb p) { return qRed(p) > qBlue(p) + 25 && qGreen(p) > qBlue(p); }
+inline bool surfaceColored(QRgb p) {
+    return qRed(p) > qBlue(p) + 25 && qGreen(p) > qBlue(p);
+}
 
 /// Green or yellow-green of the quality colour maps (good faces), shaded: green clearly above red and blue.
 /// Neither the surface tan, nor yellow, nor the background qualifies.
-inline bool qualityGreen(QRgb p) { return qGreen(p) > qBlue(p) + 30 && qGreen(p) > qRed(p) + 20; }
+inline bool qualityGreen(QRgb p) {
+    return qGreen(p) > qBlue(p) + 30 && qGreen(p) > qRed(p) + 20;
+}
 
 } // namespace fss::test

@@ -103,7 +103,8 @@ private slots:
         QVERIFY(w->openMesh(QString::fromStdString(fandisk_.string())));
         QCOMPARE(w->meshPath(), QString::fromStdString(fandisk_.string()));
         stages_.push_back(w->mesh());
-        for (const fss::StandardView v : {fss::StandardView::Iso, fss::StandardView::PosX, fss::StandardView::NegZ}) {
+        for (const fss::StandardView v :
+             {fss::StandardView::Iso, fss::StandardView::PosX, fss::StandardView::NegZ}) {
             QVERIFY2(scanAndAccept(*w, v, 160), qPrintable(w->statusText()));
             stages_.push_back(w->mesh());
         }
@@ -172,8 +173,8 @@ private slots:
         const std::filesystem::path out = dir_ / "replayed.off";
         QProcess p;
         p.start(QString::fromStdString(fss::test::remeshExe().string()),
-                {"run", QString::fromStdString(recorded_.string()), "-o", QString::fromStdString(out.string()),
-                 "--quiet"});
+                {"run", QString::fromStdString(recorded_.string()), "-o",
+                 QString::fromStdString(out.string()), "--quiet"});
         QVERIFY(p.waitForFinished(600000));
         QVERIFY2(p.exitCode() == 0, p.readAllStandardError().constData());
         const std::string a = slurp(out), b = slurp(dir_ / "recorded_result.off");
@@ -202,8 +203,9 @@ private slots:
         for (fss::VertexIndex v : sphere.vertices())
             QVERIFY(w2->referenceMesh().point(v) == sphere.point(v));
         QVERIFY(identical(w2->referenceMesh(), w->referenceMesh()));
-        QVERIFY2(w2->mesh().number_of_faces() == result.number_of_faces(),
-                 qPrintable(QString("%1 vs %2").arg(w2->mesh().number_of_faces()).arg(result.number_of_faces())));
+        QVERIFY2(
+            w2->mesh().number_of_faces() == result.number_of_faces(),
+            qPrintable(QString("%1 vs %2").arg(w2->mesh().number_of_faces()).arg(result.number_of_faces())));
         QVERIFY(identical(w2->mesh(), result));
     }
 

@@ -62,7 +62,8 @@ private slots:
         const fss::Camera before = view->camera();
         sendMouse(view.get(), QEvent::MouseButtonPress, {300, 225}, Qt::LeftButton, Qt::LeftButton);
         for (int i = 1; i <= 10; ++i)
-            sendMouse(view.get(), QEvent::MouseMove, {300.0 + 8 * i, 225.0 + 3 * i}, Qt::NoButton, Qt::LeftButton);
+            sendMouse(view.get(), QEvent::MouseMove, {300.0 + 8 * i, 225.0 + 3 * i}, Qt::NoButton,
+                      Qt::LeftButton);
         sendMouse(view.get(), QEvent::MouseButtonRelease, {380, 255}, Qt::LeftButton, Qt::NoButton);
         QVERIFY(moved.count() > 0); // reported while dragging
         const fss::Camera after = view->camera();
@@ -95,7 +96,8 @@ private slots:
         sendWheel(view.get(), {300, 225}, 120);
         sendWheel(view.get(), {300, 225}, 120);
         const double coverageIn = fss::test::pixelFraction(view->grabImage(), fss::test::notBackground);
-        QVERIFY2(coverageIn > coverageOut * 1.2, qPrintable(QString("coverage %1 -> %2").arg(coverageOut).arg(coverageIn)));
+        QVERIFY2(coverageIn > coverageOut * 1.2,
+                 qPrintable(QString("coverage %1 -> %2").arg(coverageOut).arg(coverageIn)));
     }
 
     void exitKeysDoNotQuit() {
@@ -138,8 +140,10 @@ private slots:
         // The composed window shows both (what the user sees, not only each widget's framebuffer).
         const QImage whole = window.grab().toImage();
         const int half = whole.width() / 2;
-        QVERIFY(fss::test::pixelFraction(whole, fss::test::surfaceColored, QRect(0, 0, half, whole.height())) > 0.03);
-        QVERIFY(fss::test::pixelFraction(whole, fss::test::qualityGreen, QRect(half, 0, half, whole.height())) > 0.02);
+        QVERIFY(fss::test::pixelFraction(whole, fss::test::surfaceColored,
+                                         QRect(0, 0, half, whole.height())) > 0.03);
+        QVERIFY(fss::test::pixelFraction(whole, fss::test::qualityGreen,
+                                         QRect(half, 0, half, whole.height())) > 0.02);
     }
 
     void standardViewsLookAlongTheAxis() {
@@ -148,9 +152,12 @@ private slots:
         const struct {
             fss::StandardView view;
             Eigen::Vector3d direction;
-        } cases[] = {{fss::StandardView::PosX, {-1, 0, 0}}, {fss::StandardView::NegX, {1, 0, 0}},
-                     {fss::StandardView::PosY, {0, -1, 0}}, {fss::StandardView::NegY, {0, 1, 0}},
-                     {fss::StandardView::PosZ, {0, 0, -1}}, {fss::StandardView::NegZ, {0, 0, 1}},
+        } cases[] = {{fss::StandardView::PosX, {-1, 0, 0}},
+                     {fss::StandardView::NegX, {1, 0, 0}},
+                     {fss::StandardView::PosY, {0, -1, 0}},
+                     {fss::StandardView::NegY, {0, 1, 0}},
+                     {fss::StandardView::PosZ, {0, 0, -1}},
+                     {fss::StandardView::NegZ, {0, 0, 1}},
                      {fss::StandardView::Iso, Eigen::Vector3d(-1, -1, -1).normalized()}};
         for (const auto& c : cases) {
             view->setStandardView(c.view);
@@ -211,9 +218,12 @@ private slots:
 
         view->setColorMap(ColorMap::Valence);
         const QImage valence = view->grabImage();
-        QVERIFY(fss::test::pixelFraction(valence, fss::test::qualityGreen) > 0.02); // 80 % of fandisk is regular
+        QVERIFY(fss::test::pixelFraction(valence, fss::test::qualityGreen) >
+                0.02); // 80 % of fandisk is regular
         // Orange / red faces (a corner of valence 4 or 8 and worse) exist on fandisk too.
-        QVERIFY(fss::test::pixelFraction(valence, [](QRgb p) { return qRed(p) > qGreen(p) + 60 && qRed(p) > qBlue(p) + 60; }) > 0.001);
+        QVERIFY(fss::test::pixelFraction(valence, [](QRgb p) {
+                    return qRed(p) > qGreen(p) + 60 && qRed(p) > qBlue(p) + 60;
+                }) > 0.001);
 
         view->clearMesh();
         QVERIFY(!view->hasMesh());

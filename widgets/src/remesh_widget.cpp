@@ -117,7 +117,7 @@ struct RemeshWidget::Replay {
 
 struct RemeshWidget::Impl {
     std::unique_ptr<Session> session;
-    QString meshPath;       // the reference's file, if any
+    QString meshPath; // the reference's file, if any
     // A mesh given to setMesh without a file, as given: its file (saveSession) reads back as the
     // reference, canonicalMesh(memoryInput) (canonicalMesh is not idempotent, so the reference itself
     // would not).
@@ -125,7 +125,7 @@ struct RemeshWidget::Impl {
     bool cpuRenderer = false; // the session was made with the CPU renderer
     // Set by the session's renderer factory when the view could not give a GPU renderer.
     std::shared_ptr<std::atomic<bool>> cpuFallback = std::make_shared<std::atomic<bool>>(false);
-    CurvatureOptions curvature;        // the session's curvature options (saved in session files)
+    CurvatureOptions curvature; // the session's curvature options (saved in session files)
     std::unique_ptr<Replay> replay;
     std::shared_ptr<std::atomic<bool>> cpuFallbackPending; // the replayed session's cpuFallback
     bool syncingStack = false; // pushing / undoing commands that only mirror the session's history
@@ -385,8 +385,10 @@ void RemeshWidget::installSession(std::unique_ptr<Session> session, const QStrin
     // Mirror the session's history on the undo stack: applied steps, then the redo-able ones undone.
     const std::vector<ScanStep> steps = d_->session->steps();
     d_->syncingStack = true;
-    for (const ScanStep& step : steps) d_->undoStack->push(new AcceptCommand(this, AcceptCommand::textOf(step)));
-    for (std::size_t i = 0; i < d_->session->redoCount(); ++i) d_->undoStack->undo();
+    for (const ScanStep& step : steps)
+        d_->undoStack->push(new AcceptCommand(this, AcceptCommand::textOf(step)));
+    for (std::size_t i = 0; i < d_->session->redoCount(); ++i)
+        d_->undoStack->undo();
     d_->syncingStack = false;
     std::int32_t nextId = 0;
     for (const SessionEvent& e : d_->session->events())
@@ -441,7 +443,8 @@ bool RemeshWidget::saveSession(const QString& path) {
             writeMesh(d_->memoryInput ? *d_->memoryInput : d_->session->reference(), meshFile, exact);
         }
         const bool cpu = d_->cpuRenderer || d_->cpuFallback->load();
-        saveSessionFile(sessionFileFromSession(*d_->session, meshFile, cpu ? "cpu" : "gpu", d_->curvature), file);
+        saveSessionFile(sessionFileFromSession(*d_->session, meshFile, cpu ? "cpu" : "gpu", d_->curvature),
+                        file);
         if (d_->meshPath.isEmpty()) {
             d_->meshPath = QString::fromStdString(meshFile.string());
             d_->memoryInput.reset();

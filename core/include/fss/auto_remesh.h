@@ -44,8 +44,9 @@
 ///     stitch's maxNormalChangeDeg, or takes faces farther from the reference than they were (beyond L/20).
 ///     A stage of the relaxation (a round's flips, collapses or smoothing) after which the mesh would
 ///     intersect itself is undone and run again without touching the vertices of the intersecting faces
-///     (up to three times), then, if it still would, undone and not run again. Closedness and manifoldness are kept; only collapses
-///     lower the vertex count (towards the target: the seams have more vertices than a regular grid).
+///     (up to three times), then, if it still would, undone and not run again. Closedness and manifoldness
+///     are kept; only collapses lower the vertex count (towards the target: the seams have more vertices than
+///     a regular grid).
 ///  7. **Crease recovery.** The views' regions meet at the sharp creases of the reference, so the seams run
 ///     along them, and neither pixel grid has vertices on them: the faces there bevel the creases off by up
 ///     to half an edge length, where the largest distances to and from the reference were. The vertex

@@ -34,16 +34,16 @@ std::string standardViewName(StandardView view);
 
 /// Pinhole or parallel camera with an image size. Plain value type: copy freely.
 struct Camera {
-    Eigen::Vector3d eye{0, 0, 1};     ///< position of the eye
-    Eigen::Vector3d focal{0, 0, 0};   ///< point looked at
-    Eigen::Vector3d up{0, 1, 0};      ///< approximate up direction (orthogonalised internally)
-    bool parallel = false;            ///< parallel (orthographic) projection instead of perspective
-    double viewAngleDeg = 30.0;       ///< vertical full view angle of a perspective camera, degrees
-    double parallelScale = 1.0;       ///< half the image height in world units, parallel camera
-    double nearPlane = 0.01;          ///< distance of the near clipping plane from the eye (> 0)
-    double farPlane = 1000.0;         ///< distance of the far clipping plane from the eye (> near)
-    int width = 256;                  ///< image width in pixels
-    int height = 256;                 ///< image height in pixels
+    Eigen::Vector3d eye{0, 0, 1};   ///< position of the eye
+    Eigen::Vector3d focal{0, 0, 0}; ///< point looked at
+    Eigen::Vector3d up{0, 1, 0};    ///< approximate up direction (orthogonalised internally)
+    bool parallel = false;          ///< parallel (orthographic) projection instead of perspective
+    double viewAngleDeg = 30.0;     ///< vertical full view angle of a perspective camera, degrees
+    double parallelScale = 1.0;     ///< half the image height in world units, parallel camera
+    double nearPlane = 0.01;        ///< distance of the near clipping plane from the eye (> 0)
+    double farPlane = 1000.0;       ///< distance of the far clipping plane from the eye (> near)
+    int width = 256;                ///< image width in pixels
+    int height = 256;               ///< image height in pixels
 
     /// Largest accepted image side (larger buffers exceed what GL drivers reliably allocate).
     static constexpr int kMaxResolution = 8192;

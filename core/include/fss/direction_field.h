@@ -59,8 +59,8 @@ struct LazyDirectionTiles; // the tile cache of a lazy field (direction_field.cp
 /// The stored values of one pixel of a DirectionField.
 struct DirectionPixel {
     Eigen::Vector2d direction = Eigen::Vector2d::Zero(); ///< unit screen direction (zero where invalid)
-    float anisotropy = 0;                                 ///< in [0, 1]; 0 where invalid
-    bool valid = false;                                   ///< the pixel has a direction
+    float anisotropy = 0;                                ///< in [0, 1]; 0 where invalid
+    bool valid = false;                                  ///< the pixel has a direction
 };
 
 /// A 2D line field on the pixels of an image: per pixel a unit screen direction (defined up to sign), an
@@ -75,9 +75,10 @@ struct DirectionPixel {
 struct DirectionField {
     int width = 0;
     int height = 0;
-    std::vector<Eigen::Vector2d> direction; ///< unit screen direction per pixel (zero where invalid); empty if lazy
-    std::vector<float> anisotropy;          ///< per pixel, in [0, 1]; 0 where invalid; empty if lazy
-    std::vector<std::uint8_t> valid;        ///< 1 where the pixel has a direction; empty if lazy
+    std::vector<Eigen::Vector2d>
+        direction;                   ///< unit screen direction per pixel (zero where invalid); empty if lazy
+    std::vector<float> anisotropy;   ///< per pixel, in [0, 1]; 0 where invalid; empty if lazy
+    std::vector<std::uint8_t> valid; ///< 1 where the pixel has a direction; empty if lazy
 
     DirectionField() = default;
     /// An all-invalid stored field of the given size. \throw InvalidInputError for a negative size.
@@ -177,7 +178,7 @@ DirectionFieldPair computeDirectionFields(const Mesh& mesh, const CurvatureField
 /// the face ids when a tile is computed.
 /// \throw InvalidInputError when a precondition is violated or tileSize < 1 (a bad face id throws from
 ///        the access that computes its tile).
-DirectionField lazyDirectionField(const Mesh& mesh, const CurvatureField& curvature, const FrameBuffers& buffers,
-                                  const LazyDirectionFieldOptions& options = {});
+DirectionField lazyDirectionField(const Mesh& mesh, const CurvatureField& curvature,
+                                  const FrameBuffers& buffers, const LazyDirectionFieldOptions& options = {});
 
 } // namespace fss

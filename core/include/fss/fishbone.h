@@ -150,7 +150,8 @@ Backbone drawnBackbone(const Polyline2& points, const FishboneOptions& options =
 
 /// The ribs through backbone samples first … first + count − 1, each exactly traceRib's: their halves are
 /// traced in lockstep on the calling thread (traceHalvesInLockstep), which is faster than one by one.
-/// \pre first + count ≤ backbone.samples.size(), backbone has ≥ 2 samples. \throw InvalidInputError otherwise.
+/// \pre first + count ≤ backbone.samples.size(), backbone has ≥ 2 samples. \throw InvalidInputError
+/// otherwise.
 std::vector<Rib> traceRibs(const DirectionField& ribField, const Backbone& backbone, std::size_t first,
                            std::size_t count, const FishboneOptions& options = {});
 

@@ -82,12 +82,12 @@ private:
 /// the key-rib points, or drawn; blended ribs in between, fishbone.h keyRibFishbone); the backbone is
 /// traced through `seed` or, when `drawnBackbone` is given, the spline through its points.
 struct FishboneParams {
-    std::optional<Eigen::Vector2d> seed;          ///< picked point of a traced backbone
+    std::optional<Eigen::Vector2d> seed;                    ///< picked point of a traced backbone
     PrincipalDirection direction = PrincipalDirection::Min; ///< the backbone's direction; ribs the other
-    double spacing = 4.0;                         ///< h: sample spacing in pixels, in [0.5, min(W, H)/4]
-    std::vector<Eigen::Vector2d> keyRibs;         ///< key-rib mode: traced key-ribs at these points (≥ 2)
-    std::vector<Polyline2> drawnKeyRibs;          ///< key-rib mode: hand-drawn key-ribs (splines)
-    Polyline2 drawnBackbone;                      ///< hand-drawn backbone (≥ 2 points) instead of seed
+    double spacing = 4.0;                 ///< h: sample spacing in pixels, in [0.5, min(W, H)/4]
+    std::vector<Eigen::Vector2d> keyRibs; ///< key-rib mode: traced key-ribs at these points (≥ 2)
+    std::vector<Polyline2> drawnKeyRibs;  ///< key-rib mode: hand-drawn key-ribs (splines)
+    Polyline2 drawnBackbone;              ///< hand-drawn backbone (≥ 2 points) instead of seed
     /// Tracing options (its spacing is replaced by `spacing`): steps in pixels of the sampling image (the
     /// direction field's, see samplingFactor), a finite maxLength in pixels of the scan image. The default
     /// continues straight across isotropic regions, which CAD meshes' flat faces need. An unbounded
@@ -154,7 +154,7 @@ struct FishboneTimings {
     double rayCasting = 0;      ///< rib vertex → ray → sample
     double masks = 0;           ///< lasso + quality mask + morphology
     double triangulate = 0;
-    double total = 0;           ///< everything, including the cached stages when computed here
+    double total = 0; ///< everything, including the cached stages when computed here
 };
 
 /// Sample counts after each stage of scanFishbonePatch.
@@ -174,8 +174,8 @@ struct FishboneCounts {
 /// current mesh's buffers from the sampling camera (for the stitcher: stitch with
 /// fishboneSamplingCamera(params.camera, fishbone) and currentBuffers.faceId).
 struct FishboneScanResult {
-    FishboneGrid fishbone;       ///< the traced grid, in pixels of the scan image (camera.width × height)
-    SampleGrid grid;             ///< the samples; grid.camera is the sampling camera (fitted clipping range)
+    FishboneGrid fishbone; ///< the traced grid, in pixels of the scan image (camera.width × height)
+    SampleGrid grid;       ///< the samples; grid.camera is the sampling camera (fitted clipping range)
     Patch patch;
     FrameBuffers currentBuffers; ///< the current mesh from the sampling camera
     int samplingFactor = 1;      ///< k actually used (FishboneParams::samplingFactor)
@@ -187,11 +187,11 @@ struct FishboneScanResult {
 /// camera) onto \p reference: the face of \p referenceBuffers under the vertex's pixel is the first guess
 /// (then the faces under the 8 neighbouring pixels, nearest hit), and RayCaster::intersect with that hint
 /// (local search, AABB fallback) answers the rest. As RayCaster's hinted query, a guess is trusted to be
-/// unoccluded unless `search.verifyUnoccluded` (then every ray goes through the caster). Returns a SampleGrid of the same rows × cols whose
-/// sample (r, c) has screen = the rib vertex and the rest from setSampleOnSurface; absent vertices and
-/// misses are not hit. \p hintHits (optional) receives how many hits lie on the hint face itself.
-/// \pre \p caster holds \p reference and \p referenceBuffers were rendered from it.
-/// \throw InvalidInputError when the buffers' sizes do not match their camera.
+/// unoccluded unless `search.verifyUnoccluded` (then every ray goes through the caster). Returns a SampleGrid
+/// of the same rows × cols whose sample (r, c) has screen = the rib vertex and the rest from
+/// setSampleOnSurface; absent vertices and misses are not hit. \p hintHits (optional) receives how many hits
+/// lie on the hint face itself. \pre \p caster holds \p reference and \p referenceBuffers were rendered from
+/// it. \throw InvalidInputError when the buffers' sizes do not match their camera.
 SampleGrid rayCastFishbone(const FishboneGrid& fishbone, const FrameBuffers& referenceBuffers,
                            const Mesh& reference, const RayCaster& caster, const ScanOptions& options = {},
                            const LocalSearchOptions& search = {}, std::size_t* hintHits = nullptr);
@@ -222,9 +222,9 @@ Camera fishboneSamplingCamera(const Camera& scan, const FishboneParams& fishbone
 ///        flat / isotropic region; two key-ribs fall on one backbone sample, or one lies farther than 2h from
 ///        the backbone; the backbone has fewer than two samples; or nothing is left to triangulate.
 ///        CancelledError through \p progress.
-FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& referenceRenderer, const Mesh& current,
-                                     MeshRenderer& currentRenderer, const ScanParams& params,
-                                     const FishboneParams& fishbone, FishboneCache& cache,
-                                     const Progress& progress = {});
+FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& referenceRenderer,
+                                     const Mesh& current, MeshRenderer& currentRenderer,
+                                     const ScanParams& params, const FishboneParams& fishbone,
+                                     FishboneCache& cache, const Progress& progress = {});
 
 } // namespace fss

@@ -24,27 +24,27 @@ namespace fss {
 /// repeated corners, i.e. they describe the surface the file means. STL stores every triangle's corners
 /// separately: its identical corners are merged while reading and are not counted as duplicates.
 struct SoupStats {
-    std::size_t points = 0;               ///< points in the file
-    std::size_t polygons = 0;             ///< polygons in the file
-    std::size_t nonTriangles = 0;         ///< polygons with more than 3 corners
-    std::size_t nonManifoldEdges = 0;     ///< undirected edges shared by more than two polygons
+    std::size_t points = 0;           ///< points in the file
+    std::size_t polygons = 0;         ///< polygons in the file
+    std::size_t nonTriangles = 0;     ///< polygons with more than 3 corners
+    std::size_t nonManifoldEdges = 0; ///< undirected edges shared by more than two polygons
     /// vertices whose incident polygons form more than one fan (bow-ties); the ends of a non-manifold edge
     /// are counted in nonManifoldEdges only
     std::size_t nonManifoldVertices = 0;
     /// polygons with repeated corners or zero area (exactly collinear corners). Only those with repeated
     /// corners are removed by the repair: removing a zero-area triangle from a closed mesh would open a hole.
     std::size_t degeneratePolygons = 0;
-    std::size_t duplicatePoints = 0;      ///< points geometrically equal to an earlier point
+    std::size_t duplicatePoints = 0; ///< points geometrically equal to an earlier point
 };
 
 /// What readMesh found and what it changed.
 struct ReadReport {
-    std::string format;                ///< "off", "obj", "ply", "stl"
-    bool binary = false;               ///< binary PLY / STL
-    SoupStats soup;                    ///< the soup as read
-    std::vector<std::string> repairs;  ///< one sentence per repair made ("merged 12 duplicate points", ...)
-    bool hasFaceQuality = false;       ///< a PLY face property `quality` was restored into props::faceQuality
-    bool hasScanId = false;            ///< a PLY face property `scan_id` was restored into props::faceScanId
+    std::string format;               ///< "off", "obj", "ply", "stl"
+    bool binary = false;              ///< binary PLY / STL
+    SoupStats soup;                   ///< the soup as read
+    std::vector<std::string> repairs; ///< one sentence per repair made ("merged 12 duplicate points", ...)
+    bool hasFaceQuality = false;      ///< a PLY face property `quality` was restored into props::faceQuality
+    bool hasScanId = false;           ///< a PLY face property `scan_id` was restored into props::faceScanId
     bool repaired() const { return !repairs.empty(); }
 };
 
@@ -67,7 +67,8 @@ struct ReadOptions {
 ///        garbage, NaN/inf coordinates, faces indexing missing vertices, faces with fewer than 3 corners,
 ///        no faces, or nothing is left after repair (or needs repair while options.repair is false).
 ///        The message is one sentence that names the file and, for text formats, the line.
-Mesh readMesh(const std::filesystem::path& path, ReadReport* report = nullptr, const ReadOptions& options = {});
+Mesh readMesh(const std::filesystem::path& path, ReadReport* report = nullptr,
+              const ReadOptions& options = {});
 
 /// The mesh as readMesh (default options) builds it from a binary PLY that writeMesh made of \p mesh:
 /// garbage dropped, vertices and faces re-indexed contiguously in iteration order, the reader's halfedge
@@ -81,8 +82,8 @@ Mesh canonicalMesh(const Mesh& mesh);
 
 /// Options of writeMesh.
 struct WriteOptions {
-    bool binary = false;        ///< binary PLY / STL (ascii otherwise); binary PLY stores doubles, STL floats
-    int precision = 17;         ///< significant digits of ascii coordinates (17 round-trips doubles); 1…17
+    bool binary = false; ///< binary PLY / STL (ascii otherwise); binary PLY stores doubles, STL floats
+    int precision = 17;  ///< significant digits of ascii coordinates (17 round-trips doubles); 1…17
 };
 
 /// Writes a mesh; the format is chosen by the extension (.off .obj .ply .stl, case-insensitive). PLY files

@@ -27,7 +27,7 @@ struct Sample {
     float samplingAngle = 0;         ///< angle between the reversed view ray and the normal, radians
     float footprint = 0;             ///< world size of one pixel at the sample (Camera::pixelFootprint)
     float quality = std::numeric_limits<float>::infinity(); ///< lower is better (scan.h documents it)
-    bool hit = false;        ///< the sample lies on the reference surface
+    bool hit = false;                                       ///< the sample lies on the reference surface
     bool admissible = false; ///< hit, and passed the lasso and sampling-quality tests
     bool valid = false;      ///< currently part of the patch (admissible, and kept by erosion/dilation)
 };
@@ -37,9 +37,9 @@ struct Sample {
 struct SampleGrid {
     int rows = 0;
     int cols = 0;
-    Camera camera;                ///< the camera of the scan
-    std::int32_t scanId = -1;     ///< id given to the faces this grid becomes (props::faceScanId)
-    std::vector<Sample> samples;  ///< rows·cols entries
+    Camera camera;               ///< the camera of the scan
+    std::int32_t scanId = -1;    ///< id given to the faces this grid becomes (props::faceScanId)
+    std::vector<Sample> samples; ///< rows·cols entries
 
     SampleGrid() = default;
     /// rows_ × cols_ default samples. Large grids get transparent huge pages where the system offers them
@@ -58,7 +58,8 @@ struct SampleGrid {
 private:
     std::size_t count(bool Sample::*flag) const {
         std::size_t n = 0;
-        for (const Sample& s : samples) n += (s.*flag) ? 1 : 0;
+        for (const Sample& s : samples)
+            n += (s.*flag) ? 1 : 0;
         return n;
     }
 };

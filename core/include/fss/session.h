@@ -8,9 +8,9 @@
 /// \code
 ///   fss::Session session(fss::readMesh("part.off"));
 ///   fss::ScanStep step;
-///   step.params.camera = fss::Camera::standardView(fss::StandardView::Iso, fss::boundingBox(session.reference()), 256, 256);
-///   session.scan(step);          // preview: session.preview()->patch
-///   session.accept();            // stitches the preview into session.current()
+///   step.params.camera = fss::Camera::standardView(fss::StandardView::Iso,
+///   fss::boundingBox(session.reference()), 256, 256); session.scan(step);          // preview:
+///   session.preview()->patch session.accept();            // stitches the preview into session.current()
 ///   session.undo();              // back to the reference, exactly
 /// \endcode
 ///
@@ -31,9 +31,9 @@
 /// for an element present in one state only — plus a few hundred bytes for the ScanStep and StitchReport.
 /// A stitch adding F faces and removing R therefore costs roughly 90 × (F + R) bytes whatever the mesh size
 /// (measured: an 18k-face patch costs 1.6 MB in a 10k- and 1.7 MB in a 300k-face sphere, whose element
-/// arrays take 2.1 and 22 MB). Finding the changed records compares the two states once per accept (linear in the mesh,
-/// a few milliseconds per 100k faces); undo() and redo() write the records back in time proportional to
-/// the change.
+/// arrays take 2.1 and 22 MB). Finding the changed records compares the two states once per accept (linear in
+/// the mesh, a few milliseconds per 100k faces); undo() and redo() write the records back in time
+/// proportional to the change.
 ///
 /// A Session is not thread-safe: call it from one thread at a time (the widgets run scan() and accept()
 /// on a worker thread while the GUI only reads what it copied).

@@ -69,12 +69,13 @@ struct StitchOptions {
     int maxTrimRounds = 16;
     /// How a problem at the patch boundary is trimmed. Off: every patch vertex near it (at a fold of the mesh
     /// under the boundary, of the patch triangles within the snapping distance plus one patch edge of the
-    /// hidden face) goes, with all its faces, a band two to three edges wide per round. On (peeling): only the
-    /// patch's boundary vertices among those go (when there are any), and at a fold only the patch triangles
-    /// within the snapping distance of the hidden face count: one layer of faces per round, the boundary
-    /// moving off the problem in as many rounds as it takes. Wide bands cut thin patches apart into pieces
-    /// too small to stitch; peeling keeps them (autoRemesh: CGAL's elephant goes from 0.635 to 0.755 of its
-    /// area remeshed, bunny00 from 0.979 to 0.991). Off by default so that sessions replay to the same mesh.
+    /// hidden face) goes, with all its faces, a band two to three edges wide per round. On (peeling): only
+    /// the patch's boundary vertices among those go (when there are any), and at a fold only the patch
+    /// triangles within the snapping distance of the hidden face count: one layer of faces per round, the
+    /// boundary moving off the problem in as many rounds as it takes. Wide bands cut thin patches apart into
+    /// pieces too small to stitch; peeling keeps them (autoRemesh: CGAL's elephant goes from 0.635 to 0.755
+    /// of its area remeshed, bunny00 from 0.979 to 0.991). Off by default so that sessions replay to the same
+    /// mesh.
     bool peelTrim = false;
     /// Components (and pieces left by trimming) with fewer faces are not stitched: a few isolated triangles
     /// only add seam.

@@ -125,7 +125,8 @@ struct HalfStart {
 /// tracing them one after the other, because the halves' independent field evaluations overlap in the
 /// processor (the two halves of two neighbouring ribs, for instance).
 /// \pre and \throw as traceStreamlineHalf, for every start (checked before any tracing).
-std::vector<StreamlineHalf> traceHalvesInLockstep(const DirectionField& field, const std::vector<HalfStart>& starts,
+std::vector<StreamlineHalf> traceHalvesInLockstep(const DirectionField& field,
+                                                  const std::vector<HalfStart>& starts,
                                                   const StreamlineOptions& options = {});
 
 /// Traces a streamline both ways from \p seed (DESIGN.md §1: the backbone through the picked point, the

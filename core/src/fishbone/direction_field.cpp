@@ -192,7 +192,8 @@ public:
         const Eigen::Vector3d unit = D / coherence;
         // The derivative of the projection at p along D̂ (pixels per world unit): the clip coordinates
         // of p + t·D̂ are clip + t·VP·(D̂, 0).
-        const Eigen::Vector4d cu = projector_.viewProjection() * Eigen::Vector4d(unit.x(), unit.y(), unit.z(), 0.0);
+        const Eigen::Vector4d cu =
+            projector_.viewProjection() * Eigen::Vector4d(unit.x(), unit.y(), unit.z(), 0.0);
         const Eigen::Vector4d& c = fr.clip;
         const double w2 = c.w() * c.w();
         screen = {0.5 * width() * (cu.x() * c.w() - c.x() * cu.w()) / w2,
@@ -222,8 +223,9 @@ private:
         g.n = (g.corner[1] - g.corner[0]).cross(g.corner[2] - g.corner[0]);
         g.n2 = g.n.squaredNorm();
         for (std::size_t k = 0; k < 3; ++k)
-            g.g[k] = g.n2 > 0 ? Eigen::Vector3d(g.n.cross(g.corner[(k + 2) % 3] - g.corner[(k + 1) % 3]) / g.n2)
-                              : Eigen::Vector3d::Zero();
+            g.g[k] = g.n2 > 0
+                         ? Eigen::Vector3d(g.n.cross(g.corner[(k + 2) % 3] - g.corner[(k + 1) % 3]) / g.n2)
+                         : Eigen::Vector3d::Zero();
         for (int useMax = 0; useMax < 2; ++useMax) {
             const Eigen::Vector3d* first = nullptr;
             for (std::size_t k = 0; k < 3; ++k) {
@@ -266,7 +268,8 @@ private:
     const FrameBuffers& buffers_;
     Projector projector_;
     std::size_t faceSlots_;
-    Eigen::Vector3d ray0_, rayX_, rayY_; // perspective ray direction at pixel (sx, sy): ray0 + sx·rayX + sy·rayY
+    Eigen::Vector3d ray0_, rayX_,
+        rayY_; // perspective ray direction at pixel (sx, sy): ray0 + sx·rayX + sy·rayY
 };
 
 // One computed tile of a lazy field: the pixels [x0, x0 + w) × [y0, y0 + h), row-major.
@@ -288,7 +291,8 @@ struct LazyDirectionTiles {
     LazyDirectionTiles(const Mesh& mesh, const CurvatureField& curvature, const FrameBuffers& buffers,
                        bool max, int size)
         : source(mesh, curvature, buffers), useMax(max), tileSize(size),
-          tileShift((size & (size - 1)) == 0 ? std::countr_zero(unsigned(size)) : -1), tilesX((source.width() + size - 1) / size), tilesY((source.height() + size - 1) / size),
+          tileShift((size & (size - 1)) == 0 ? std::countr_zero(unsigned(size)) : -1),
+          tilesX((source.width() + size - 1) / size), tilesY((source.height() + size - 1) / size),
           tiles(std::size_t(tilesX) * std::size_t(tilesY)) {}
     LazyDirectionTiles(const LazyDirectionTiles&) = delete;
     LazyDirectionTiles& operator=(const LazyDirectionTiles&) = delete;
@@ -302,7 +306,8 @@ struct LazyDirectionTiles {
 
     // Tile (tx, ty), computed on first use. \pre 0 ≤ tx < tilesX, 0 ≤ ty < tilesY.
     const DirectionTile& tile(int tx, int ty) const {
-        std::atomic<const DirectionTile*>& slot = tiles[std::size_t(ty) * std::size_t(tilesX) + std::size_t(tx)];
+        std::atomic<const DirectionTile*>& slot =
+            tiles[std::size_t(ty) * std::size_t(tilesX) + std::size_t(tx)];
         if (const DirectionTile* t = slot.load(std::memory_order_acquire)) return *t;
         auto made = std::make_unique<const DirectionTile>(compute(tx * tileSize, ty * tileSize));
         const DirectionTile* expected = nullptr;
@@ -318,7 +323,8 @@ struct LazyDirectionTiles {
     std::size_t computedPixels() const {
         std::size_t n = 0;
         for (const auto& t : tiles)
-            if (const DirectionTile* p = t.load(std::memory_order_acquire)) n += std::size_t(p->w) * std::size_t(p->h);
+            if (const DirectionTile* p = t.load(std::memory_order_acquire))
+                n += std::size_t(p->w) * std::size_t(p->h);
         return n;
     }
 
@@ -342,7 +348,8 @@ private:
         for (int y = y0; y < y0 + t.h; ++y)
             for (int x = x0; x < x0 + t.w; ++x)
                 if (source.frame(x, y, fr) && source.direction(fr, useMax, screen, aniso)) {
-                    DirectionPixel& px = t.pixels[std::size_t(y - y0) * std::size_t(t.w) + std::size_t(x - x0)];
+                    DirectionPixel& px =
+                        t.pixels[std::size_t(y - y0) * std::size_t(t.w) + std::size_t(x - x0)];
                     px.valid = storePixel(px.direction, px.anisotropy, screen, aniso);
                 }
         return t;
@@ -417,7 +424,8 @@ struct TiledPixels {
         }
         for (int k = 0; k < 4; ++k) {
             const int x = x0 + (k & 1), y = y0 + (k >> 1);
-            if (x >= 0 && y >= 0 && x < width && y < height) q[std::size_t(k)] = of(tiles.tileOf(x, y).at(x, y));
+            if (x >= 0 && y >= 0 && x < width && y < height)
+                q[std::size_t(k)] = of(tiles.tileOf(x, y).at(x, y));
         }
     }
 };
@@ -521,7 +529,9 @@ std::size_t DirectionField::computedPixels() const {
 std::optional<DirectionSample> DirectionField::sample(const Eigen::Vector2d& pos,
                                                       const Eigen::Vector2d& reference,
                                                       double straightBelow) const {
-    if (lazy_) return bilinearSample(TiledPixels{*lazy_, width, height}, width, height, pos, reference, straightBelow);
+    if (lazy_)
+        return bilinearSample(TiledPixels{*lazy_, width, height}, width, height, pos, reference,
+                              straightBelow);
     return bilinearSample(StoredPixels{*this}, width, height, pos, reference, straightBelow);
 }
 
@@ -569,8 +579,8 @@ DirectionFieldPair computeDirectionFields(const Mesh& mesh, const CurvatureField
     return pair;
 }
 
-DirectionField lazyDirectionField(const Mesh& mesh, const CurvatureField& curvature, const FrameBuffers& buffers,
-                                  const LazyDirectionFieldOptions& options) {
+DirectionField lazyDirectionField(const Mesh& mesh, const CurvatureField& curvature,
+                                  const FrameBuffers& buffers, const LazyDirectionFieldOptions& options) {
     if (options.tileSize < 1)
         throw InvalidInputError("The tile size of a lazy direction field must be at least 1 pixel, not " +
                                 std::to_string(options.tileSize) + ".");

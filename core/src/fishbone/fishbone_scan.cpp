@@ -64,8 +64,8 @@ struct RayFactory {
 /// (a silhouette: the visible sheet ends there), a face the ray runs parallel to, or \p maxSteps faces.
 /// On meshes whose faces are smaller than a pixel the face under the rib vertex's pixel is often a
 /// neighbour of the hit face: the walk reaches it in a few steps, where a ring search tests dozens.
-std::optional<std::pair<FaceIndex, Eigen::Vector3d>> walkToHit(const Mesh& mesh, FaceIndex start, const Ray& ray,
-                                                              int maxSteps) {
+std::optional<std::pair<FaceIndex, Eigen::Vector3d>> walkToHit(const Mesh& mesh, FaceIndex start,
+                                                               const Ray& ray, int maxSteps) {
     FaceIndex f = start;
     double startSign = 0;
     for (int step = 0; step <= maxSteps; ++step) {
@@ -127,7 +127,8 @@ std::vector<CreaseSegment> visibleCreases(const Mesh& mesh, const std::vector<Ed
         const HalfedgeIndex he = mesh.halfedge(e);
         const std::uint32_t f0 = std::uint32_t(mesh.face(he).idx()),
                             f1 = std::uint32_t(mesh.face(mesh.opposite(he)).idx());
-        const Eigen::Vector2d a = project(mesh.point(mesh.source(he))), b = project(mesh.point(mesh.target(he)));
+        const Eigen::Vector2d a = project(mesh.point(mesh.source(he))),
+                              b = project(mesh.point(mesh.target(he)));
         if (!a.allFinite() || !b.allFinite()) continue;
         const Eigen::Vector2d m = 0.5 * (a + b);
         const int mx = int(std::floor(m.x())), my = int(std::floor(m.y()));
@@ -151,8 +152,8 @@ std::vector<CreaseSegment> visibleCreases(const Mesh& mesh, const std::vector<Ed
 class CreaseIndex {
 public:
     CreaseIndex(std::vector<CreaseSegment> segments, double radius, int width, int height)
-        : segments_(std::move(segments)), radius_(radius),
-          cellsX_(std::max(1, (width + kCell - 1) / kCell)), cellsY_(std::max(1, (height + kCell - 1) / kCell)),
+        : segments_(std::move(segments)), radius_(radius), cellsX_(std::max(1, (width + kCell - 1) / kCell)),
+          cellsY_(std::max(1, (height + kCell - 1) / kCell)),
           cells_(std::size_t(cellsX_) * std::size_t(cellsY_)) {
         const double grow = radius + 1.0;
         for (std::size_t i = 0; i < segments_.size(); ++i) {
@@ -171,13 +172,15 @@ public:
 
     /// The point nearest to \p q on a crease segment within the radius that runs along \p heading (within
     /// 30°), if any; of equally near segments the last in segment order.
-    std::optional<Eigen::Vector2d> nearestAlong(const Eigen::Vector2d& q, const Eigen::Vector2d& heading) const {
+    std::optional<Eigen::Vector2d> nearestAlong(const Eigen::Vector2d& q,
+                                                const Eigen::Vector2d& heading) const {
         if (!q.allFinite()) return std::nullopt;
         const double cosMax = std::cos(30.0 * std::numbers::pi / 180.0);
         std::optional<Eigen::Vector2d> best;
         double bestDistance = radius_;
         const std::vector<std::size_t>& cell =
-            cells_[std::size_t(cellOf(q.y(), cellsY_)) * std::size_t(cellsX_) + std::size_t(cellOf(q.x(), cellsX_))];
+            cells_[std::size_t(cellOf(q.y(), cellsY_)) * std::size_t(cellsX_) +
+                   std::size_t(cellOf(q.x(), cellsX_))];
         for (std::size_t i : cell) {
             const CreaseSegment& s = segments_[i];
             const Eigen::Vector2d d = s.b - s.a;
@@ -387,8 +390,9 @@ namespace {
 // the sampling factor, only for the positions in error messages (which the user gave in scan pixels).
 FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& referenceRenderer,
                                        const Mesh& current, MeshRenderer& currentRenderer,
-                                       const ScanParams& params, const FishboneParams& fb, FishboneCache& cache,
-                                       const Progress& progress, int k, Clock::time_point start) {
+                                       const ScanParams& params, const FishboneParams& fb,
+                                       FishboneCache& cache, const Progress& progress, int k,
+                                       Clock::time_point start) {
     auto shown = [k](const Eigen::Vector2d& p) { return point(double(k) * p); };
     const double h = fb.spacing;
     const bool drawnBackbone = !fb.drawnBackbone.empty();
@@ -449,8 +453,7 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
     }
     // Lazy fields: a tile of pixels is computed when the backbone or a rib first comes near it, so the cost
     // follows the area the fishbone covers (the backbone's field is needed only along the backbone).
-    if (tracedBackbone)
-        backboneField = lazyDirectionField(reference, *curvature, buffers, {fb.direction});
+    if (tracedBackbone) backboneField = lazyDirectionField(reference, *curvature, buffers, {fb.direction});
     if (tracedRibs)
         ribField = lazyDirectionField(reference, *curvature, buffers, {otherDirection(fb.direction)});
     result.timings.directionField = secondsSince(t);
@@ -500,7 +503,8 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
             const double d = (backbone.samples[row] - p).norm();
             if (d > 2 * h)
                 throw InvalidInputError("The key-rib point " + shown(p) + " lies " + fmt(k * d) +
-                                        " pixels from the backbone, farther than 2h = " + fmt(2 * k * h) + ".");
+                                        " pixels from the backbone, farther than 2h = " + fmt(2 * k * h) +
+                                        ".");
             claim(row, shown(p));
             keys.push_back(KeyRib{row, traceRib(ribField, backbone, row, options)});
         }
@@ -592,8 +596,8 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
     const int k = fishboneSamplingFactor(params.camera, fb);
     FishboneScanResult result;
     if (k == 1) {
-        result = scanOnSamplingImage(reference, referenceRenderer, current, currentRenderer, params, fb, cache,
-                                     progress, 1, start);
+        result = scanOnSamplingImage(reference, referenceRenderer, current, currentRenderer, params, fb,
+                                     cache, progress, 1, start);
     } else {
         // Everything the user gave in pixels of the scan image, in pixels of the sampling image.
         const double s = 1.0 / k;
@@ -620,16 +624,19 @@ FishboneScanResult scanFishbonePatch(const Mesh& reference, MeshRenderer& refere
         for (StreamlineOptions* o : {&f.tracing.backboneTracing, &f.tracing.ribTracing}) {
             o->maxLength *= s;
             if (o->insideRegion)
-                o->insideRegion = [inside = o->insideRegion, k](const Eigen::Vector2d& q) { return inside(k * q); };
+                o->insideRegion = [inside = o->insideRegion, k](const Eigen::Vector2d& q) {
+                    return inside(k * q);
+                };
             if (o->attractor)
-                o->attractor = [attract = o->attractor, k, s](const Eigen::Vector2d& q, const Eigen::Vector2d& d)
-                    -> std::optional<Eigen::Vector2d> {
+                o->attractor = [attract = o->attractor, k,
+                                s](const Eigen::Vector2d& q,
+                                   const Eigen::Vector2d& d) -> std::optional<Eigen::Vector2d> {
                     if (const std::optional<Eigen::Vector2d> a = attract(k * q, d)) return s * *a;
                     return std::nullopt;
                 };
         }
-        result = scanOnSamplingImage(reference, referenceRenderer, current, currentRenderer, sp, f, cache, progress,
-                                     k, start);
+        result = scanOnSamplingImage(reference, referenceRenderer, current, currentRenderer, sp, f, cache,
+                                     progress, k, start);
         // The traced grid back in pixels of the scan image (the widget draws it over the view).
         for (Eigen::Vector2d& q : result.fishbone.screen)
             q *= double(k);

@@ -81,8 +81,8 @@ namespace {
 // loads, square roots and divisions; each half's result is exactly the same as traced alone.
 class HalfTracer {
 public:
-    HalfTracer(const DirectionField& field, const Eigen::Vector2d& seed, const Eigen::Vector2d& initialDirection,
-               const StreamlineOptions& options)
+    HalfTracer(const DirectionField& field, const Eigen::Vector2d& seed,
+               const Eigen::Vector2d& initialDirection, const StreamlineOptions& options)
         : tracer_(field, options), o_(options), seed_(seed),
           cosMaxTurn_(std::cos(options.maxTurnDeg * std::numbers::pi / 180.0)), step_(options.step) {
         options.validate();
@@ -225,7 +225,8 @@ StreamlineHalf traceStreamlineHalf(const DirectionField& field, const Eigen::Vec
     return t.take();
 }
 
-std::vector<StreamlineHalf> traceHalvesInLockstep(const DirectionField& field, const std::vector<HalfStart>& starts,
+std::vector<StreamlineHalf> traceHalvesInLockstep(const DirectionField& field,
+                                                  const std::vector<HalfStart>& starts,
                                                   const StreamlineOptions& options) {
     std::vector<HalfTracer> tracers;
     tracers.reserve(starts.size());

@@ -1,5 +1,5 @@
-#include "base/disjoint_sets.h"
 #include "fss/metrics.h"
+#include "base/disjoint_sets.h"
 
 #include "fss/error.h"
 

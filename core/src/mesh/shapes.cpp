@@ -29,8 +29,10 @@ Mesh fromTriangles(const std::vector<Point3>& pts, const std::vector<std::array<
     Mesh m;
     std::vector<VertexIndex> v;
     v.reserve(pts.size());
-    for (const Point3& p : pts) v.push_back(m.add_vertex(p));
-    for (const auto& t : tris) addTriangle(m, v[t[0]], v[t[1]], v[t[2]]);
+    for (const Point3& p : pts)
+        v.push_back(m.add_vertex(p));
+    for (const auto& t : tris)
+        addTriangle(m, v[t[0]], v[t[1]], v[t[2]]);
     return m;
 }
 
@@ -42,13 +44,14 @@ struct IcoData {
 IcoData icosahedronData() {
     const double t = (1.0 + std::sqrt(5.0)) / 2.0;
     IcoData d;
-    const double raw[12][3] = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                               {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    const double raw[12][3] = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                               {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
     const double n = std::sqrt(1 + t * t);
-    for (const auto& r : raw) d.points.emplace_back(r[0] / n, r[1] / n, r[2] / n);
-    d.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-                   {11, 10, 2}, {10, 7, 6}, {7, 1, 8},   {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                   {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+    for (const auto& r : raw)
+        d.points.emplace_back(r[0] / n, r[1] / n, r[2] / n);
+    d.triangles = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+                   {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+                   {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
     return d;
 }
 
@@ -63,7 +66,8 @@ Mesh grid(int nx, int ny, double h) {
     require(nx >= 1 && ny >= 1 && h > 0, "A grid needs at least one quad per side and a positive spacing.");
     std::vector<Point3> pts;
     for (int j = 0; j <= ny; ++j)
-        for (int i = 0; i <= nx; ++i) pts.emplace_back(i * h, j * h, 0.0);
+        for (int i = 0; i <= nx; ++i)
+            pts.emplace_back(i * h, j * h, 0.0);
     std::vector<std::array<int, 3>> tris;
     auto id = [nx](int i, int j) { return j * (nx + 1) + i; };
     for (int j = 0; j < ny; ++j)
@@ -75,7 +79,9 @@ Mesh grid(int nx, int ny, double h) {
     return fromTriangles(pts, tris);
 }
 
-Mesh icosahedron(double radius) { return icosphere(0, radius); }
+Mesh icosahedron(double radius) {
+    return icosphere(0, radius);
+}
 
 Mesh icosphere(int levels, double radius) {
     require(levels >= 0 && levels <= 10, "The icosphere subdivision level must be between 0 and 10.");
@@ -102,33 +108,36 @@ Mesh icosphere(int levels, double radius) {
         }
         d.triangles = std::move(next);
     }
-    for (Point3& p : d.points) p = scaled(p, radius);
+    for (Point3& p : d.points)
+        p = scaled(p, radius);
     return fromTriangles(d.points, d.triangles);
 }
 
 Mesh uvSphere(int nu, int nv, double radius) {
     require(nu >= 3 && nv >= 2 && radius > 0, "A UV sphere needs nu >= 3, nv >= 2 and a positive radius.");
     std::vector<Point3> pts;
-    pts.emplace_back(0, 0, radius);  // north pole
+    pts.emplace_back(0, 0, radius); // north pole
     for (int j = 1; j < nv; ++j) {
         const double theta = kPi * j / nv;
         for (int i = 0; i < nu; ++i) {
             const double phi = 2 * kPi * i / nu;
-            pts.emplace_back(radius * std::sin(theta) * std::cos(phi), radius * std::sin(theta) * std::sin(phi),
-                             radius * std::cos(theta));
+            pts.emplace_back(radius * std::sin(theta) * std::cos(phi),
+                             radius * std::sin(theta) * std::sin(phi), radius * std::cos(theta));
         }
     }
-    pts.emplace_back(0, 0, -radius);  // south pole
+    pts.emplace_back(0, 0, -radius); // south pole
     const int south = int(pts.size()) - 1;
     auto id = [nu](int ring, int i) { return 1 + (ring - 1) * nu + ((i % nu) + nu) % nu; };
     std::vector<std::array<int, 3>> tris;
-    for (int i = 0; i < nu; ++i) tris.push_back({0, id(1, i), id(1, i + 1)});
+    for (int i = 0; i < nu; ++i)
+        tris.push_back({0, id(1, i), id(1, i + 1)});
     for (int j = 1; j < nv - 1; ++j)
         for (int i = 0; i < nu; ++i) {
             tris.push_back({id(j, i), id(j + 1, i), id(j + 1, i + 1)});
             tris.push_back({id(j, i), id(j + 1, i + 1), id(j, i + 1)});
         }
-    for (int i = 0; i < nu; ++i) tris.push_back({south, id(nv - 1, i + 1), id(nv - 1, i)});
+    for (int i = 0; i < nu; ++i)
+        tris.push_back({south, id(nv - 1, i + 1), id(nv - 1, i)});
     return fromTriangles(pts, tris);
 }
 
@@ -186,12 +195,13 @@ Mesh torus(int nu, int nv, double majorRadius, double minorRadius) {
 Mesh cube(int n, double side) {
     require(n >= 1 && side > 0, "A cube needs at least one quad per side and a positive side length.");
     std::vector<Point3> pts;
-    std::map<std::array<int, 3>, int> index;  // integer lattice coordinates → vertex
+    std::map<std::array<int, 3>, int> index; // integer lattice coordinates → vertex
     auto vertex = [&](int a, int b, int c) {
         const std::array<int, 3> key{a, b, c};
         auto it = index.find(key);
         if (it != index.end()) return it->second;
-        pts.emplace_back(side * (double(a) / n - 0.5), side * (double(b) / n - 0.5), side * (double(c) / n - 0.5));
+        pts.emplace_back(side * (double(a) / n - 0.5), side * (double(b) / n - 0.5),
+                         side * (double(c) / n - 0.5));
         return index[key] = int(pts.size()) - 1;
     };
     std::vector<std::array<int, 3>> tris;
@@ -208,7 +218,8 @@ Mesh cube(int n, double side) {
                         c[(axis + 2) % 3] = v;
                         return vertex(c[0], c[1], c[2]);
                     };
-                    const int a = lattice(i, j), b = lattice(i + 1, j), c = lattice(i + 1, j + 1), d = lattice(i, j + 1);
+                    const int a = lattice(i, j), b = lattice(i + 1, j), c = lattice(i + 1, j + 1),
+                              d = lattice(i, j + 1);
                     // (u, v) = (axis+1, axis+2) is right-handed with the axis: u × v = +axis.
                     if (sideSign) {
                         tris.push_back({a, b, c});

@@ -104,8 +104,10 @@ public:
                 std::size_t lo = 0, hi = n;
                 while (lo < hi) {
                     const std::size_t mid = lo + (hi - lo) / 2;
-                    if (pred(orient(mid))) hi = mid;
-                    else lo = mid + 1;
+                    if (pred(orient(mid)))
+                        hi = mid;
+                    else
+                        lo = mid + 1;
                 }
                 return lo;
             };

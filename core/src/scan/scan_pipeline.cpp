@@ -12,7 +12,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double secondsSince(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double secondsSince(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 void reportAt(const Progress& progress, const ProgressMark& mark) {
     if (!mark.stage.empty()) progress.report(mark.fraction, mark.stage);
@@ -108,7 +110,8 @@ ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, con
     result.counts.covered = result.grid.hitCount();
     result.counts.frontFacing = result.grid.admissibleCount();
     if (result.counts.frontFacing == 0)
-        throw InvalidInputError("The scan camera sees only the back of the surface; it is probably inside the mesh.");
+        throw InvalidInputError(
+            "The scan camera sees only the back of the surface; it is probably inside the mesh.");
 
     MaskStages stages;
     if (params.lasso) stages.lasso = &*params.lasso;

@@ -7,8 +7,8 @@
 // 100k faces); the record itself, and undo / redo, are O(change).
 #include "fss/session.h"
 
-#include "session/mesh_delta.h"
 #include "fss/error.h"
+#include "session/mesh_delta.h"
 
 #include <chrono>
 #include <deque>
@@ -26,11 +26,13 @@ struct HistoryItem {
 // Heap bytes of the parts of a step that are not the mesh delta.
 std::size_t stepBytes(const ScanStep& step, const StitchReport& report) {
     std::size_t bytes = 0;
-    if (step.params.lasso) bytes += step.params.lasso->points.capacity() * sizeof(step.params.lasso->points[0]);
+    if (step.params.lasso)
+        bytes += step.params.lasso->points.capacity() * sizeof(step.params.lasso->points[0]);
     if (step.fishbone)
         bytes += (step.fishbone->keyRibs.capacity() + step.fishbone->drawnBackbone.capacity()) *
                  sizeof(Eigen::Vector2d);
-    for (const std::string& s : report.skipped) bytes += sizeof(std::string) + s.capacity();
+    for (const std::string& s : report.skipped)
+        bytes += sizeof(std::string) + s.capacity();
     return bytes;
 }
 
@@ -81,7 +83,8 @@ Session::Session(Mesh reference, SessionOptions options) : impl_(std::make_uniqu
     if (reference.number_of_faces() == 0) throw InvalidInputError("The session's input mesh has no faces.");
     if (!CGAL::is_triangle_mesh(reference))
         throw InvalidInputError("The session's input mesh is not a triangle mesh.");
-    if (!reference.is_valid(false)) throw InvalidInputError("The session's input mesh is not a valid halfedge mesh.");
+    if (!reference.is_valid(false))
+        throw InvalidInputError("The session's input mesh is not a valid halfedge mesh.");
     options.curvature.validate();
     if (options.maxUndoSteps < 50) options.maxUndoSteps = 50;
     impl_->options = std::move(options);
@@ -99,8 +102,12 @@ Session::~Session() = default;
 Session::Session(Session&&) noexcept = default;
 Session& Session::operator=(Session&&) noexcept = default;
 
-const Mesh& Session::reference() const { return impl_->reference; }
-const Mesh& Session::current() const { return impl_->current; }
+const Mesh& Session::reference() const {
+    return impl_->reference;
+}
+const Mesh& Session::current() const {
+    return impl_->current;
+}
 
 const ScanPreview& Session::scan(const ScanStep& step, const Progress& progress) {
     Impl& d = *impl_;
@@ -115,8 +122,9 @@ const ScanPreview& Session::scan(const ScanStep& step, const Progress& progress)
     ScanPreview preview;
     preview.step = step;
     if (step.fishbone) {
-        FishboneScanResult result = scanFishbonePatch(d.reference, *d.referenceRenderer, current, currentRenderer,
-                                                      step.params, *step.fishbone, d.fishboneCache, progress);
+        FishboneScanResult result =
+            scanFishbonePatch(d.reference, *d.referenceRenderer, current, currentRenderer, step.params,
+                              *step.fishbone, d.fishboneCache, progress);
         preview.grid = std::move(result.grid);
         preview.patch = std::move(result.patch);
         preview.fishbone = std::move(result.fishbone);
@@ -134,7 +142,9 @@ const ScanPreview& Session::scan(const ScanStep& step, const Progress& progress)
     return *d.preview;
 }
 
-const ScanPreview* Session::preview() const { return impl_->preview ? &*impl_->preview : nullptr; }
+const ScanPreview* Session::preview() const {
+    return impl_->preview ? &*impl_->preview : nullptr;
+}
 
 void Session::reject() {
     impl_->dropPreview();
@@ -158,7 +168,8 @@ const StitchReport& Session::accept(const Progress& progress) {
     // A fishbone scan samples (and rendered the current mesh) with its sampling camera.
     const Camera camera = p.step.fishbone ? fishboneSamplingCamera(p.step.params.camera, *p.step.fishbone)
                                           : p.step.params.camera;
-    StitchReport report = stitchPatch(next, p.patch.mesh, camera, options, p.currentBuffers.faceId, stitchProgress);
+    StitchReport report =
+        stitchPatch(next, p.patch.mesh, camera, options, p.currentBuffers.faceId, stitchProgress);
     if (next.has_garbage()) next.collect_garbage();
     progress.report(0.9, "record");
     HistoryItem item{p.step, std::move(report), detail::MeshDelta::between(d.current, next)};
@@ -180,10 +191,18 @@ const StitchReport& Session::accept(const Progress& progress) {
     return d.history.back().report;
 }
 
-bool Session::canUndo() const { return impl_->applied > 0; }
-bool Session::canRedo() const { return impl_->applied < impl_->history.size(); }
-std::size_t Session::undoCount() const { return impl_->applied; }
-std::size_t Session::redoCount() const { return impl_->history.size() - impl_->applied; }
+bool Session::canUndo() const {
+    return impl_->applied > 0;
+}
+bool Session::canRedo() const {
+    return impl_->applied < impl_->history.size();
+}
+std::size_t Session::undoCount() const {
+    return impl_->applied;
+}
+std::size_t Session::redoCount() const {
+    return impl_->history.size() - impl_->applied;
+}
 
 void Session::undo() {
     Impl& d = *impl_;
@@ -209,24 +228,31 @@ void Session::redo() {
 
 std::vector<ScanStep> Session::steps() const {
     std::vector<ScanStep> out;
-    for (const HistoryItem& item : impl_->history) out.push_back(item.step);
+    for (const HistoryItem& item : impl_->history)
+        out.push_back(item.step);
     return out;
 }
 
 const StitchReport& Session::report(std::size_t i) const {
-    if (i >= impl_->history.size()) throw InvalidInputError("There is no history step " + std::to_string(i) + ".");
+    if (i >= impl_->history.size())
+        throw InvalidInputError("There is no history step " + std::to_string(i) + ".");
     return impl_->history[i].report;
 }
 
 std::size_t Session::historyBytes() const {
     std::size_t bytes = 0;
     for (const HistoryItem& item : impl_->history)
-        bytes += sizeof(HistoryItem) - sizeof(detail::MeshDelta) + item.delta.bytes() + stepBytes(item.step, item.report);
+        bytes += sizeof(HistoryItem) - sizeof(detail::MeshDelta) + item.delta.bytes() +
+                 stepBytes(item.step, item.report);
     return bytes;
 }
 
-const std::vector<SessionEvent>& Session::events() const { return impl_->events; }
+const std::vector<SessionEvent>& Session::events() const {
+    return impl_->events;
+}
 
-FishboneCache& Session::fishboneCache() { return impl_->fishboneCache; }
+FishboneCache& Session::fishboneCache() {
+    return impl_->fishboneCache;
+}
 
 } // namespace fss

@@ -1460,7 +1460,8 @@ private:
                     // The fan's pieces must pass the final check's angle floor in 3D: a mesh vertex in line
                     // with the patch triangle's other corners (a patch vertex snapped onto a mesh edge
                     // through it) would leave a needle no triangulation of that triangle avoids.
-                    const Vec3& prev3 = pos == taken.begin() ? A3 : L_[std::size_t(std::prev(pos)->second)].pos;
+                    const Vec3& prev3 =
+                        pos == taken.begin() ? A3 : L_[std::size_t(std::prev(pos)->second)].pos;
                     const Vec3& next3 = pos == taken.end() ? B3 : L_[std::size_t(pos->second)].pos;
                     const Vec3& v3 = L_[std::size_t(c.lid)].pos;
                     if (minAngle(prev3, v3, C3) < floor || minAngle(v3, next3, C3) < floor) continue;
@@ -2297,8 +2298,8 @@ private:
             score = newMin;
             return true;
         };
-        // Collapses the candidate edges (a, b), by increasing key, each in the direction that leaves the larger
-        // smallest angle around (edges gone or changed by earlier collapses are skipped).
+        // Collapses the candidate edges (a, b), by increasing key, each in the direction that leaves the
+        // larger smallest angle around (edges gone or changed by earlier collapses are skipped).
         using Candidates = std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>>;
         auto collapseEach = [&](Candidates& cands) {
             std::sort(cands.begin(), cands.end());
@@ -2370,8 +2371,8 @@ private:
             flipPass(loc, plan);
         }
         valencePass(loc, plan);
-        // -- last smoothing: the free vertices near the seam whose smallest angle around is still small search
-        // for a better place (smoothOutside with search; no flips after it, so the valences stay).
+        // -- last smoothing: the free vertices near the seam whose smallest angle around is still small
+        // search for a better place (smoothOutside with search; no flips after it, so the valences stay).
         for (int pass = 0; pass < 2; ++pass)
             if (smoothOutside(loc, true) == 0) break;
     }
@@ -2432,7 +2433,9 @@ private:
         for (const auto& [p, q] : ring)
             oldMin = std::min(oldMin, minAngle(p0, pt(S, p), pt(S, q)));
         // The smallest angle around v moved to U + t (W - U), or -1 where a check fails.
-        auto score = [&](double t, Point2& uv) { return ringScore(loc, ring, faces, p0, U + t * (W - U), true, uv); };
+        auto score = [&](double t, Point2& uv) {
+            return ringScore(loc, ring, faces, p0, U + t * (W - U), true, uv);
+        };
         double bestMin = oldMin, bestT = -1;
         Point2 bestUv;
         auto consider = [&](double t) {
@@ -2483,8 +2486,8 @@ private:
                 continue;
             }
             const bool withPatch = loc.lid[v] >= 0;
-            // All faces around: pieces of one mesh face (a Steiner point inside it, not on a mesh edge), or of
-            // two (a point on the mesh edge between them: it moves along that edge's line).
+            // All faces around: pieces of one mesh face (a Steiner point inside it, not on a mesh edge), or
+            // of two (a point on the mesh edge between them: it moves along that edge's line).
             std::vector<Vec3> planes;
             bool outside = true;
             std::vector<std::pair<VertexIndex, VertexIndex>> ring; // (p, q): faces (v, p, q)
@@ -2496,8 +2499,9 @@ private:
                     outside = false;
                     break;
                 }
-                const Vec3 n = loc.patchSide[f] ? normalOf(pt(S, v), pt(S, S.target(S.next(g))), pt(S, S.source(g)))
-                                                : loc.planeNormal[f];
+                const Vec3 n = loc.patchSide[f]
+                                   ? normalOf(pt(S, v), pt(S, S.target(S.next(g))), pt(S, S.source(g)))
+                                   : loc.planeNormal[f];
                 if (std::none_of(planes.begin(), planes.end(),
                                  [&](const Vec3& m) { return angleBetween(n, m) <= kCoplanar; }))
                     planes.push_back(n);
@@ -2527,7 +2531,8 @@ private:
                     dirs.push_back(std::cos(t) * e1 + std::sin(t) * e2);
                 }
             }
-            if (planes.size() == 2 && !withPatch) { // (the patch's planes are not exact: no line between them)
+            if (planes.size() == 2 &&
+                !withPatch) { // (the patch's planes are not exact: no line between them)
                 const Vec3 d = planes[0].cross(planes[1]).normalized();
                 if (d.allFinite()) {
                     dirs.push_back(d);
@@ -2678,11 +2683,11 @@ private:
         loc.offView[to] = loc.offView[from];
     }
 
-    // A flip of the edge of halfedge h (x → y, faces (x, y, z1) and (y, x, z2) → (x, z2, z1), (z2, y, z1)) that
-    // the seam optimisation may make: both faces new and near the seam, not a seam edge, no vertex left with
-    // fewer than three edges, no edge doubled, every new face oriented as its kind must be (in the view, or
-    // in 3D for pieces the view does not see) and not degenerate (exact); on the patch side no normal turns
-    // more than maxNormalChangeDeg, outside it the surface stays (see below). Sets the smallest angles
+    // A flip of the edge of halfedge h (x → y, faces (x, y, z1) and (y, x, z2) → (x, z2, z1), (z2, y, z1))
+    // that the seam optimisation may make: both faces new and near the seam, not a seam edge, no vertex left
+    // with fewer than three edges, no edge doubled, every new face oriented as its kind must be (in the view,
+    // or in 3D for pieces the view does not see) and not degenerate (exact); on the patch side no normal
+    // turns more than maxNormalChangeDeg, outside it the surface stays (see below). Sets the smallest angles
     // before and after, and `nearPlanar` when the flip joins pieces of two nearly coplanar mesh faces.
     bool flipAllowed(const Local& loc, HalfedgeIndex h, const std::unordered_set<std::uint32_t>& near,
                      double& oldMin, double& newMin, bool& nearPlanar) const {
@@ -2691,7 +2696,8 @@ private:
         auto isNewFace = [&](FaceIndex f) { return f != Mesh::null_face() && !loc.star.kept[f]; };
         const HalfedgeIndex o = S.opposite(h);
         if (!isNewFace(S.face(h)) || !isNewFace(S.face(o))) return false;
-        const VertexIndex x = S.source(h), y = S.target(h), z1 = S.target(S.next(h)), z2 = S.target(S.next(o));
+        const VertexIndex x = S.source(h), y = S.target(h), z1 = S.target(S.next(h)),
+                          z2 = S.target(S.next(o));
         if (!near.count(std::uint32_t(x)) || !near.count(std::uint32_t(y))) return false;
         if (loc.seam.count(seamKey(x, y)) || !detail::canFlip(S, h)) return false;
         // New faces (x, z2, z1) and (z2, y, z1).
@@ -2826,8 +2832,8 @@ private:
             seamVs.insert(a);
             seamVs.insert(b);
         }
-        // Flips the candidate (flipAllowed) with the largest smallest angle after, above `above` and, when the
-        // smallest angle before was larger, at least `floor`; none that raises a seam vertex above
+        // Flips the candidate (flipAllowed) with the largest smallest angle after, above `above` and, when
+        // the smallest angle before was larger, at least `floor`; none that raises a seam vertex above
         // kMaxSeamValence. Returns whether it flipped.
         std::size_t flips = 0;
         auto flipBest = [&](const std::vector<HalfedgeIndex>& candidates, double above, double floor) {
@@ -2858,7 +2864,8 @@ private:
             const VertexIndex v(vi);
             for (int guard = 0; guard < 4; ++guard) {
                 progress_.tick();
-                if (S.is_removed(v) || S.halfedge(v) == Mesh::null_halfedge() || S.degree(v) <= kMaxSeamValence)
+                if (S.is_removed(v) || S.halfedge(v) == Mesh::null_halfedge() ||
+                    S.degree(v) <= kMaxSeamValence)
                     break;
                 const auto around = CGAL::halfedges_around_target(S.halfedge(v), S);
                 if (!flipBest({around.begin(), around.end()}, -1.0, kValenceFlipMinDeg * kDeg)) break;
@@ -2878,7 +2885,8 @@ private:
                 const HalfedgeIndex h = S.next(S.next(g)); // the side of g's face across from v
                 bool keeps = !S.is_border(S.opposite(h));
                 for (VertexIndex end : {S.source(h), S.target(h)})
-                    keeps = keeps && S.degree(end) > (seamVs.count(std::uint32_t(end)) ? kMinSeamValence : 3u);
+                    keeps =
+                        keeps && S.degree(end) > (seamVs.count(std::uint32_t(end)) ? kMinSeamValence : 3u);
                 if (keeps) opposite.push_back(h);
             }
             flipBest(opposite, -1.0, kValenceFlipMinDeg * kDeg);
@@ -2889,8 +2897,8 @@ private:
             progress_.tick();
             if (S.is_removed(f)) continue;
             const HalfedgeIndex h0 = S.halfedge(f);
-            if (std::abs(minAngle(pt(S, S.source(h0)), pt(S, S.target(h0)), pt(S, S.target(S.next(h0)))) - ang) >
-                1e-12)
+            if (std::abs(minAngle(pt(S, S.source(h0)), pt(S, S.target(h0)), pt(S, S.target(S.next(h0)))) -
+                         ang) > 1e-12)
                 continue; // changed by an earlier flip
             const auto sides = CGAL::halfedges_around_face(h0, S);
             flipBest({sides.begin(), sides.end()}, ang + 0.5 * kDeg, 0.0);

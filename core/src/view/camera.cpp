@@ -15,7 +15,9 @@ namespace {
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 
-bool allFinite(const Eigen::Vector3d& v) { return v.allFinite(); }
+bool allFinite(const Eigen::Vector3d& v) {
+    return v.allFinite();
+}
 
 // Orthonormal camera frame (s = right, u = up, f = forward).
 struct Frame {
@@ -51,13 +53,20 @@ std::optional<StandardView> parseStandardView(std::string_view name) {
 
 std::string standardViewName(StandardView view) {
     switch (view) {
-    case StandardView::Iso: return "iso";
-    case StandardView::PosX: return "+x";
-    case StandardView::NegX: return "-x";
-    case StandardView::PosY: return "+y";
-    case StandardView::NegY: return "-y";
-    case StandardView::PosZ: return "+z";
-    case StandardView::NegZ: return "-z";
+    case StandardView::Iso:
+        return "iso";
+    case StandardView::PosX:
+        return "+x";
+    case StandardView::NegX:
+        return "-x";
+    case StandardView::PosY:
+        return "+y";
+    case StandardView::NegY:
+        return "-y";
+    case StandardView::PosZ:
+        return "+z";
+    case StandardView::NegZ:
+        return "-z";
     }
     return "iso";
 }
@@ -71,9 +80,9 @@ void Camera::validate() const {
     if (up.norm() == 0 || d.normalized().cross(up.normalized()).norm() < 1e-9)
         throw InvalidInputError("The camera's up vector is zero or parallel to its viewing direction.");
     if (width < 1 || height < 1 || width > kMaxResolution || height > kMaxResolution)
-        throw InvalidInputError("The scan resolution " + std::to_string(width) + "x" + std::to_string(height) +
-                                " is outside the supported range 1 to " + std::to_string(kMaxResolution) +
-                                " pixels per side.");
+        throw InvalidInputError("The scan resolution " + std::to_string(width) + "x" +
+                                std::to_string(height) + " is outside the supported range 1 to " +
+                                std::to_string(kMaxResolution) + " pixels per side.");
     if (!parallel && !(viewAngleDeg > 0 && viewAngleDeg < 180))
         throw InvalidInputError("The camera's view angle " + fmt(viewAngleDeg) +
                                 " degrees is outside the open range 0 to 180.");
@@ -84,7 +93,9 @@ void Camera::validate() const {
                                 "] is not a positive increasing range.");
 }
 
-Eigen::Vector3d Camera::viewDirection() const { return (focal - eye).normalized(); }
+Eigen::Vector3d Camera::viewDirection() const {
+    return (focal - eye).normalized();
+}
 
 Eigen::Matrix4d Camera::viewMatrix() const {
     const Frame fr = frameOf(*this);
@@ -119,7 +130,9 @@ Eigen::Matrix4d Camera::projectionMatrix() const {
     return p;
 }
 
-Eigen::Matrix4d Camera::viewProjectionMatrix() const { return projectionMatrix() * viewMatrix(); }
+Eigen::Matrix4d Camera::viewProjectionMatrix() const {
+    return projectionMatrix() * viewMatrix();
+}
 
 Eigen::Vector3d Camera::project(const Eigen::Vector3d& world) const {
     const Eigen::Vector4d clip = viewProjectionMatrix() * world.homogeneous();
@@ -175,7 +188,9 @@ CameraProjector::PixelCentre CameraProjector::unprojectPixelCentreWithRay(int px
     return out;
 }
 
-double Camera::viewDepth(const Eigen::Vector3d& p) const { return (p - eye).dot(viewDirection()); }
+double Camera::viewDepth(const Eigen::Vector3d& p) const {
+    return (p - eye).dot(viewDirection());
+}
 
 double Camera::pixelFootprint(const Eigen::Vector3d& p) const {
     if (parallel) return 2.0 * parallelScale / height;
@@ -201,7 +216,7 @@ void Camera::fitClippingRange(const Eigen::AlignedBox3d& box) {
 void Camera::zoom(double factor) {
     if (!(factor > 0) || !std::isfinite(factor))
         throw InvalidInputError("The zoom factor " + fmt(factor) + " is not a finite positive number.");
-    if (factor == 1.0) return;  // exactly: no rounding of the view angle
+    if (factor == 1.0) return; // exactly: no rounding of the view angle
     if (parallel)
         parallelScale /= factor;
     else
@@ -212,16 +227,32 @@ Camera Camera::standardView(StandardView view, const Eigen::AlignedBox3d& box, i
                             bool parallel, double viewAngleDeg) {
     if (box.isEmpty() || !box.min().allFinite() || !box.max().allFinite())
         throw InvalidInputError("Cannot place a camera around an empty or non-finite bounding box.");
-    Eigen::Vector3d from;  // direction from the centre towards the eye
+    Eigen::Vector3d from; // direction from the centre towards the eye
     Eigen::Vector3d up(0, 0, 1);
     switch (view) {
-    case StandardView::Iso: from = Eigen::Vector3d(1, 1, 1).normalized(); break;
-    case StandardView::PosX: from = {1, 0, 0}; break;
-    case StandardView::NegX: from = {-1, 0, 0}; break;
-    case StandardView::PosY: from = {0, 1, 0}; break;
-    case StandardView::NegY: from = {0, -1, 0}; break;
-    case StandardView::PosZ: from = {0, 0, 1}; up = {0, 1, 0}; break;
-    case StandardView::NegZ: from = {0, 0, -1}; up = {0, 1, 0}; break;
+    case StandardView::Iso:
+        from = Eigen::Vector3d(1, 1, 1).normalized();
+        break;
+    case StandardView::PosX:
+        from = {1, 0, 0};
+        break;
+    case StandardView::NegX:
+        from = {-1, 0, 0};
+        break;
+    case StandardView::PosY:
+        from = {0, 1, 0};
+        break;
+    case StandardView::NegY:
+        from = {0, -1, 0};
+        break;
+    case StandardView::PosZ:
+        from = {0, 0, 1};
+        up = {0, 1, 0};
+        break;
+    case StandardView::NegZ:
+        from = {0, 0, -1};
+        up = {0, 1, 0};
+        break;
     }
     Camera c;
     c.width = width;

@@ -2,8 +2,8 @@
 /// \file gpu_mesh_renderer.h
 /// fss::MeshRenderer on the GPU: the scan pipeline (scan_pipeline.h) rendering through a Rasterizer.
 
-#include "fss/render/rasterizer.h"
 #include "fss/mesh_renderer.h"
+#include "fss/render/rasterizer.h"
 
 namespace fss::render {
 
