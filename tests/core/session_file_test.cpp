@@ -374,10 +374,8 @@ TEST_F(BadSessionFile, GoodFileLoads) {
 
 TEST_F(BadSessionFile, WrongFormatOrVersion) {
     Json j = good_;
-    j["version"] = 3;
-    EXPECT_EQ(load(j), ": version is 3, but this FSS reads versions 1 to 2 only.");
-    j["version"] = 1; // version 1 files (stitch v1) still load; they replay with the current stitch
-    EXPECT_EQ(load(j), "(no error)");
+    j["version"] = 2;
+    EXPECT_EQ(load(j), ": version is 2, but this FSS reads version 1 only.");
     j["version"] = "1";
     EXPECT_EQ(load(j), ": version must be a positive integer.");
     j = good_;

@@ -41,8 +41,8 @@
 ///                     "max_gap_ratio": 0.25, "max_trim_rounds": 16, "min_component_faces": 8,
 ///                     "collect_garbage": false, "peel_trim": true (optional: written only when true,
 ///                     absent = false), "outside_min_angle_floor_deg": 10 (optional: written only when
-///                     not 0, absent = 0), "refill_seam": false (optional: written only when false,
-///                     absent = true, stitch v2's seam refill; version 1 files replay with it) } } },
+///                     not 0, absent = 0), "refill_seam": true (optional: written only when true,
+///                     absent = false; stitch v2's seam refill, DESIGN.md §6.2) } } },
 ///     { "kind": "undo" }, { "kind": "redo" } ] }
 /// STREAMLINE = { "step": 0.25, "min_step": 0.015625, "max_length": null (unbounded) | L,
 ///                "min_anisotropy": 0.05,
@@ -67,11 +67,8 @@
 
 namespace fss {
 
-/// The session file format version this FSS writes; it reads every version from 1 up to this one. Version 2
-/// (issue 19): the stitch's seam is refilled (stitch v2, DESIGN.md §6.2), so a session recorded with it
-/// replays to different bytes than with version 1's stitch. Version 1 files have the same fields and still
-/// load; they replay with the current stitch (so not to the mesh recorded with version 1).
-inline constexpr int kSessionFileVersion = 2;
+/// The session file format version this FSS writes and reads.
+inline constexpr int kSessionFileVersion = 1;
 
 /// A session file in memory.
 struct SessionFile {

@@ -41,8 +41,10 @@ struct StitchOptions {
     /// the seam or next to it) are replaced by a constrained Delaunay triangulation of their region in the
     /// view, refined for quality (CGAL's 2D mesher, 25 deg in the view, no boundary edge split) and smoothed
     /// (CGAL's 2D Lloyd), with the strip's border and creases kept; new vertices lie on the glued surface
-    /// (ray cast from the scan camera). Session files write it only when off ("refill_seam": false).
-    bool refillSeam = true;
+    /// (ray cast from the scan camera). Off by default: on fandisk's +y 256² scan it measured worse than
+    /// version 1's repair (smallest seam angle 3.7 vs ≥ 10 deg; issue 19). Session files write it only when
+    /// on ("refill_seam": true), so files without it replay as before.
+    bool refillSeam = false;
     /// Seam edges shorter than this × the patch's median edge length are collapsed. The same fraction of
     /// the local patch edge length (in pixels) is the distance within which a patch boundary vertex is
     /// snapped onto a mesh vertex or edge, and a mesh vertex onto a patch boundary edge.
