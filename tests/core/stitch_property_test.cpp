@@ -494,7 +494,13 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
     Figures fig;
     fig.facesStart = ref.number_of_faces();
     std::mt19937 rng(cs.seed);
-    const fss::StitchOptions options;
+    // FSS_STITCH_REFILL=1 measures stitch v2's seam refill (StitchOptions::refillSeam, off by default).
+    const fss::StitchOptions options = [] {
+        fss::StitchOptions o;
+        const char* refill = std::getenv("FSS_STITCH_REFILL");
+        o.refillSeam = refill && std::string(refill) == "1";
+        return o;
+    }();
     using Clock = std::chrono::steady_clock;
     auto seconds = [](Clock::time_point t) {
         return std::chrono::duration<double>(Clock::now() - t).count();
