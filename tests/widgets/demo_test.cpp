@@ -10,6 +10,7 @@
 #include <fss/widgets/scan_panel.h>
 #include <fss/widgets/vtk_view.h>
 
+#include <QAbstractButton>
 #include <QAction>
 #include <QApplication>
 #include <QElapsedTimer>

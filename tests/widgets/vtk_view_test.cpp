@@ -15,6 +15,7 @@
 #include <QTest>
 #include <QWheelEvent>
 
+#include <algorithm>
 #include <memory>
 
 using fss::widgets::ColorMap;

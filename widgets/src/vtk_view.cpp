@@ -748,7 +748,7 @@ VtkView::UpAxis VtkView::upAxis() const {
 void VtkView::frameMesh() {
     Eigen::AlignedBox3d box = impl_->bounds;
     if (box.isEmpty()) return setStandardView(impl_->initialView);
-    const double b[6] = {box.min().x(), box.max().x(), box.min().y(),
+    double b[6] = {box.min().x(), box.max().x(), box.min().y(),
                          box.max().y(), box.min().z(), box.max().z()};
     impl_->renderer->ResetCamera(b);
     vtkCamera* c = impl_->renderer->GetActiveCamera();
