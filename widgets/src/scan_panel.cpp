@@ -108,6 +108,9 @@ ScanPanel::ScanPanel(QWidget* parent) : QWidget(parent) {
     });
     resolution_->installEventFilter(this);
     target_->installEventFilter(this);
+    // Fields never squeezed below their natural height (RemeshWidget scrolls the panel instead).
+    for (QAbstractSpinBox* box : findChildren<QAbstractSpinBox*>())
+        box->setMinimumHeight(box->sizeHint().height());
     connect(erode_, &QSpinBox::valueChanged, this, changed);
     connect(dilate_, &QSpinBox::valueChanged, this, changed);
     connect(maxEdge_, &QDoubleSpinBox::valueChanged, this, changed);
