@@ -73,6 +73,7 @@ private:
 bool scanAndAccept(fss::demo::MainWindow& window) {
     fss::widgets::RemeshWidget* remesh = window.remeshWidget();
     remesh->scanPanel()->setResolution(64);
+    remesh->scanPanel()->setForceReplace(true); // a second scan of the same view replaces faces too
     const int steps = remesh->undoStack()->count();
     if (!remesh->scan()) return false;
     remesh->accept();
@@ -283,7 +284,7 @@ private slots:
         QVERIFY2(seen.startsWith("Save changes?|") && seen.contains("1 accepted scan"), qPrintable(seen));
         QVERIFY(window.isVisible());
         QCOMPARE(window.remeshWidget()->undoStack()->count(), 1);
-        // Saved work closes without asking.
+        // Saving makes the work clean; a new accept makes it unsaved again.
         QVERIFY(window.saveMesh(tmp("demo_unsaved.ply")));
         QVERIFY(!window.hasUnsavedChanges());
         QVERIFY(scanAndAccept(window));
