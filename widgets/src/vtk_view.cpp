@@ -527,6 +527,7 @@ VtkView::VtkView(QWidget* parent) : QOpenGLWidget(parent), impl_(std::make_uniqu
     d.legend->SetLabelFormat("%.0f");
     d.legend->DrawAnnotationsOn();
     d.legend->SetTextPositionToSucceedScalarBar();
+    d.legend->UnconstrainedFontSizeOn(); // the font sizes below, not scaled to the bar's height
     for (vtkTextProperty* text : {d.legend->GetTitleTextProperty(), d.legend->GetLabelTextProperty(),
                                   d.legend->GetAnnotationTextProperty()}) {
         text->SetColor(1, 1, 1);
@@ -748,8 +749,7 @@ VtkView::UpAxis VtkView::upAxis() const {
 void VtkView::frameMesh() {
     Eigen::AlignedBox3d box = impl_->bounds;
     if (box.isEmpty()) return setStandardView(impl_->initialView);
-    double b[6] = {box.min().x(), box.max().x(), box.min().y(),
-                         box.max().y(), box.min().z(), box.max().z()};
+    double b[6] = {box.min().x(), box.max().x(), box.min().y(), box.max().y(), box.min().z(), box.max().z()};
     impl_->renderer->ResetCamera(b);
     vtkCamera* c = impl_->renderer->GetActiveCamera();
     c->Modified();

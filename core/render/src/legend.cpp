@@ -97,6 +97,7 @@ Image renderMinAngleLegend(int width, int height, const Rgb& background) {
         bar->SetWidth(0.9);
         bar->SetHeight(0.8);
         bar->SetBarRatio(0.3);
+        bar->UnconstrainedFontSizeOn(); // the font sizes below, not scaled to the bar's height
         // Dark text on a light background, light text on a dark one.
         const double luminance = (0.3 * background[0] + 0.59 * background[1] + 0.11 * background[2]) / 255;
         const double ink = luminance > 0.5 ? 0.1 : 0.95;
