@@ -94,9 +94,11 @@ void chainTwoScans(const std::string& name, const std::string& view1, const std:
     EXPECT_EQ(j1.at("scan_id"), 0);
     EXPECT_GT(j1.at("stitch").at("faces_added").get<int>(), 1000);
     EXPECT_GE(j1.at("stitch").at("components_stitched").get<int>(), 1);
-    for (const char* key : {"faces_removed", "seam_edges", "seam_length", "seam_min_angle_deg", "seam_faces",
-                            "components_skipped", "pieces_stitched", "patch_faces_trimmed", "collapses",
-                            "flips", "skipped", "seconds", "seam_frac_min_angle_above_25"})
+    for (const char* key :
+         {"faces_removed", "seam_edges", "seam_length", "seam_min_angle_deg", "seam_faces",
+          "components_skipped", "pieces_stitched", "patch_faces_trimmed", "collapses", "flips", "skipped",
+          "seconds", "seam_frac_min_angle_above_25", "seam_frac_min_angle_above_30", "seam_vertices",
+          "seam_valence_histogram", "seam_frac_valence_5_to_7"})
         EXPECT_TRUE(j1.at("stitch").contains(key)) << key;
     EXPECT_GT(j1.at("counts").at("patch_faces").get<int>(), 0); // the patch counts are still there
     EXPECT_GE(j1.at("timings_s").at("stitch").get<double>(), 0.0);

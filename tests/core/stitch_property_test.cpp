@@ -442,7 +442,21 @@ struct Figures {
     std::size_t facesStart = 0, facesEnd = 0;
     double stitchSeconds = 0, scanSeconds = 0, checkSeconds = 0;
     std::map<std::string, int> reasons; // why patches were refused
+    // Seam figures over all stitches (see the loop).
+    double seamMinAngle = 180;
+    std::size_t seamFaces = 0, seamFacesAbove30 = 0, seamVertices = 0, seamValence5To7 = 0;
+    int stitchesSeamAbove20 = 0;
 };
+
+double seamAngleDeg(const Vec3& a, const Vec3& b, const Vec3& c) {
+    const std::array<Vec3, 3> p{a, b, c};
+    double best = 180;
+    for (std::size_t i = 0; i < 3; ++i) {
+        const Vec3 u = p[(i + 1) % 3] - p[i], w = p[(i + 2) % 3] - p[i];
+        best = std::min(best, std::atan2(u.cross(w).norm(), u.dot(w)) * 180.0 / std::numbers::pi);
+    }
+    return best;
+}
 
 class StitchProperty : public ::testing::TestWithParam<Case> {};
 
@@ -480,7 +494,13 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
     Figures fig;
     fig.facesStart = ref.number_of_faces();
     std::mt19937 rng(cs.seed);
-    const fss::StitchOptions options;
+    // FSS_STITCH_REFILL=1 measures stitch v2's seam refill (StitchOptions::refillSeam, off by default).
+    const fss::StitchOptions options = [] {
+        fss::StitchOptions o;
+        const char* refill = std::getenv("FSS_STITCH_REFILL");
+        o.refillSeam = refill && std::string(refill) == "1";
+        return o;
+    }();
     using Clock = std::chrono::steady_clock;
     auto seconds = [](Clock::time_point t) {
         return std::chrono::duration<double>(Clock::now() - t).count();
@@ -679,6 +699,46 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
         for (FaceIndex f : changedAfter)
             madeBy[std::size_t(f)] = scanId;
 
+        // Seam figures (issue 19), from the mesh alone: seam vertices are the vertices of changed faces
+        // that also touch an unchanged face or a face of another scan id (where the patch meets the old
+        // mesh, and the rim of the changed region); seam faces are the changed faces with a seam vertex.
+        {
+            auto sid = current.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId);
+            std::unordered_set<std::uint32_t> changed;
+            for (FaceIndex f : changedAfter)
+                changed.insert(std::uint32_t(f));
+            std::unordered_set<std::uint32_t> seamVertices;
+            for (FaceIndex f : changedAfter)
+                for (auto v : CGAL::vertices_around_face(current.halfedge(f), current)) {
+                    bool otherScan = false, unchanged = false;
+                    for (auto g : CGAL::faces_around_target(current.halfedge(v), current)) {
+                        if (g == Mesh::null_face()) continue;
+                        unchanged = unchanged || !changed.count(std::uint32_t(g));
+                        otherScan = otherScan || (sid.second && sid.first[g] != scanId);
+                    }
+                    if (unchanged || otherScan) seamVertices.insert(std::uint32_t(v));
+                }
+            double smallest = 180;
+            for (FaceIndex f : changedAfter) {
+                const auto c = corners(current, f);
+                if (!seamVertices.count(std::uint32_t(c[0])) && !seamVertices.count(std::uint32_t(c[1])) &&
+                    !seamVertices.count(std::uint32_t(c[2])))
+                    continue;
+                const double a = seamAngleDeg(vec(current.point(c[0])), vec(current.point(c[1])),
+                                              vec(current.point(c[2])));
+                smallest = std::min(smallest, a);
+                ++fig.seamFaces;
+                fig.seamFacesAbove30 += a >= 30;
+            }
+            for (std::uint32_t v : seamVertices) {
+                const auto d = current.degree(VertexIndex(v));
+                ++fig.seamVertices;
+                fig.seamValence5To7 += d >= 5 && d <= 7;
+            }
+            fig.seamMinAngle = std::min(fig.seamMinAngle, smallest);
+            fig.stitchesSeamAbove20 += smallest >= 20;
+        }
+
         // Seam neighbourhood: every changed face of `before` within seamRings vertex rings of a face that
         // touches the patch's footprint.
         {
@@ -782,6 +842,12 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
         fig.worstToRef, fig.worstFromRef, fig.scanSeconds, fig.stitchSeconds, fig.checkSeconds);
     for (const auto& [why, n] : fig.reasons)
         std::printf("  refused %d x: %s\n", n, why.c_str());
+    std::printf(
+        "  seam: smallest angle %.2f deg; stitches with every seam angle >= 20 deg: %d of %d; seam faces "
+        ">= 30 deg: %.4f of %zu; seam vertices of valence 5-7: %.4f of %zu\n",
+        fig.seamMinAngle, fig.stitchesSeamAbove20, fig.stitched,
+        fig.seamFaces ? double(fig.seamFacesAbove30) / double(fig.seamFaces) : 1.0, fig.seamFaces,
+        fig.seamVertices ? double(fig.seamValence5To7) / double(fig.seamVertices) : 1.0, fig.seamVertices);
     EXPECT_GE(fig.stitched + fig.refused, cs.patches) << "too few scans produced a patch";
     // Most patches stitch (a majority); the refused ones are listed above with their reasons.
     EXPECT_GT(fig.stitched, fig.refused) << "too many patches could not be stitched";

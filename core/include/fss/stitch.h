@@ -34,8 +34,17 @@ struct StitchOptions {
     /// Rings of vertices around the seam that the seam optimisation may change; the seamRings − 1 rings of
     /// mesh faces around the faces cut by the seam are opened to it too.
     int seamRings = 2;
-    /// Collapse short seam edges and flip edges for quality after gluing.
+    /// Improve the seam after gluing: by the strip refill when refillSeam is set, else (or where the refill
+    /// cannot be made or fails the checks) by collapsing short seam edges and flipping edges for quality.
     bool optimiseSeam = true;
+    /// Version 2 of the seam (DESIGN.md §6.2): the faces along the glued seam (the new faces with a vertex on
+    /// the seam or next to it) are replaced by a constrained Delaunay triangulation of their region in the
+    /// view, refined for quality (CGAL's 2D mesher, 25 deg in the view, no boundary edge split) and smoothed
+    /// (CGAL's 2D Lloyd), with the strip's border and creases kept; new vertices lie on the glued surface
+    /// (ray cast from the scan camera). Off by default: on fandisk's +y 256² scan it measured worse than
+    /// version 1's repair (smallest seam angle 3.7 vs ≥ 10 deg; issue 19). Session files write it only when
+    /// on ("refill_seam": true), so files without it replay as before.
+    bool refillSeam = false;
     /// Seam edges shorter than this × the patch's median edge length are collapsed. The same fraction of
     /// the local patch edge length (in pixels) is the distance within which a patch boundary vertex is
     /// snapped onto a mesh vertex or edge, and a mesh vertex onto a patch boundary edge.
@@ -97,14 +106,27 @@ struct StitchOptions {
 
 /// What stitchPatch did.
 struct StitchReport {
-    std::size_t facesRemoved = 0; ///< faces of the current mesh replaced
-    std::size_t facesAdded = 0;   ///< faces added (patch faces, re-triangulated pieces around the seam)
-    std::size_t seamEdges = 0;    ///< edges of the final seam (patch boundary ↔ old mesh)
-    double seamLength = 0;        ///< 3D length of the seam
-    double seamMinAngleDeg = 180; ///< smallest angle of the faces touching the seam (180 when none)
+    std::size_t facesRemoved =
+        0;                      ///< faces of the current mesh replaced ("faces replaced" of the seam report)
+    std::size_t facesAdded = 0; ///< faces added (patch faces, re-triangulated pieces around the seam)
+    std::size_t seamEdges = 0;  ///< edges of the final seam (patch boundary ↔ old mesh)
+    double seamLength = 0;      ///< 3D length of the seam
+    /// Smallest angle (degrees) of the new faces touching the seam (180 when none). After a strip refill the
+    /// faces touching the seam are the new faces with a vertex in the refilled strip.
+    double seamMinAngleDeg = 180;
     /// Fraction of the faces touching the seam whose smallest angle is ≥ 25°.
     double seamFracMinAngleAbove25 = 1;
+    /// Fraction of the faces touching the seam whose smallest angle is ≥ 30° (issue 19's target: ≥ 0.98).
+    double seamFracMinAngleAbove30 = 1;
     std::size_t seamFaces = 0; ///< number of faces touching the seam
+    /// Seam vertices (after a strip refill: every vertex of the refilled strip, its border included; else
+    /// the vertices of the seam line), counted once per stitched piece.
+    std::size_t seamVertices = 0;
+    /// Valence histogram of the seam vertices: seamValenceHistogram[k] of them have k edges (empty when
+    /// there are none; the last entry is the largest valence).
+    std::vector<std::size_t> seamValenceHistogram;
+    /// Fraction of the seam vertices of valence 5, 6 or 7 (1 when none; issue 19's target: ≥ 0.9).
+    double seamFracValence5To7 = 1;
     /// Patch components glued in (wholly or the part left by trimming).
     int componentsStitched = 0;
     /// Patch components left out entirely, each with a sentence in `skipped`.

@@ -32,6 +32,9 @@
 
 #include "base/disjoint_sets.h"
 #include "mesh/local_ops.h"
+#include "stitch/lift.h"
+#include "stitch/seam_quality.h"
+#include "stitch/strip_refill.h"
 
 #include "fss/error.h"
 
@@ -380,6 +383,7 @@ struct Plan {
     std::size_t seamEdges = 0;
     double seamLength = 0;
     std::vector<double> seamFaceMinAngles; // degrees, one per face touching the seam
+    std::vector<std::size_t> seamValences; // one per seam vertex
     std::size_t collapses = 0, flips = 0;
 };
 
@@ -2014,6 +2018,10 @@ private:
         Mesh::Property_map<FaceIndex, bool> offView;      // piece of a mesh face the view does not see
         std::set<std::pair<std::uint32_t, std::uint32_t>> seam;
         Star pristine; // the star as copied from the current mesh, for the rehearsal
+        // After a strip refill (v2): `seam` holds the fill's edges; the seam line's figures as glued.
+        bool refilled = false;
+        std::size_t seamLineEdges = 0;
+        double seamLineLength = 0;
     };
     static std::pair<std::uint32_t, std::uint32_t> seamKey(VertexIndex a, VertexIndex b) {
         return std::minmax(std::uint32_t(a), std::uint32_t(b));
@@ -2159,11 +2167,108 @@ private:
                 loc.seam.insert(seamKey(sv[std::size_t(pe.line[j])], sv[std::size_t(pe.line[j + 1])]));
 
         progress_.step(6, 8);
-        if (O_.optimiseSeam) optimise(loc, a.plan);
+        if (O_.optimiseSeam) {
+            const Refill refill = refill_ ? refillSeam(loc) : Refill::NotDone;
+            if (refill == Refill::Broken) return retryWithoutRefill(a);
+            if (refill == Refill::NotDone) optimise(loc, a.plan);
+        }
         progress_.step(7, 8);
-        if (!validate(loc, bordersBefore, a)) return false;
+        if (!validate(loc, bordersBefore, a)) return loc.refilled ? retryWithoutRefill(a) : false;
         const bool ok = extractPlan(loc, a);
         return ok;
+    }
+
+    // ---- v2: the seam strip filled anew by construction (strip_refill.h, DESIGN.md §6.2)
+    enum class Refill { NotDone, Applied, Broken };
+    // Where the refill cannot be made (or its result fails the checks), version 1's seam optimisation
+    // runs on a fresh build of the component instead.
+    bool retryWithoutRefill(Attempt& a) {
+        refill_ = false;
+        a = Attempt{};
+        const bool ok = buildAndOptimise(a);
+        refill_ = true;
+        return ok;
+    }
+    Refill refillSeam(Local& loc) {
+        Mesh& S = loc.star.S;
+        // The strip: new faces the view sees with a vertex on the seam or next to it (over new faces).
+        std::unordered_set<std::uint32_t> near;
+        for (const auto& [p, q] : loc.seam) {
+            near.insert(p);
+            near.insert(q);
+            loc.seamLineLength += (pt(S, VertexIndex(p)) - pt(S, VertexIndex(q))).norm();
+        }
+        loc.seamLineEdges = loc.seam.size();
+        std::vector<std::uint32_t> line(near.begin(), near.end());
+        std::sort(line.begin(), line.end());
+        for (std::uint32_t v : line)
+            for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(VertexIndex(v)), S))
+                if (!S.is_border(h) && !loc.star.kept[S.face(h)]) near.insert(std::uint32_t(S.source(h)));
+        std::vector<FaceIndex> strip;
+        for (FaceIndex f : S.faces()) {
+            if (loc.star.kept[f] || loc.offView[f]) continue;
+            for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(f), S))
+                if (near.count(std::uint32_t(v))) {
+                    strip.push_back(f);
+                    break;
+                }
+        }
+        if (strip.empty()) return Refill::NotDone;
+        stitch::StripRefillInput in;
+        in.mesh = &S;
+        in.strip = strip;
+        in.uv = [&](VertexIndex v) { return Eigen::Vector2d(loc.uv[v].x(), loc.uv[v].y()); };
+        in.keep = [&](VertexIndex v) { return bool(loc.locked[v]); };
+        in.camera = &V_.camera();
+        const stitch::StripRefill fill = stitch::refillStrip(in);
+        progress_.tick(strip.size());
+        if (!fill.ok) return Refill::NotDone;
+        // Edit the local mesh: the strip goes, the fill comes (grown from the hole's border).
+        struct Inherited {
+            float quality;
+            std::int32_t scanId;
+            bool patchSide;
+            Vec3 planeNormal;
+            double minAllowed;
+        };
+        std::vector<Inherited> inherited;
+        for (FaceIndex f : fill.parent)
+            inherited.push_back(
+                {loc.quality[f], loc.scanId[f], loc.patchSide[f], loc.planeNormal[f], loc.minAllowed[f]});
+        std::unordered_set<std::uint32_t> keep;
+        for (VertexIndex v : fill.kept)
+            keep.insert(std::uint32_t(v));
+        for (FaceIndex f : strip)
+            removeFaceKeeping(S, f, [&](VertexIndex v) { return keep.count(std::uint32_t(v)) > 0; });
+        std::vector<VertexIndex> vertexOf(fill.kept);
+        for (std::size_t i = 0; i < fill.fresh.size(); ++i) {
+            const VertexIndex v = S.add_vertex(toPoint(fill.fresh[i]));
+            loc.uv[v] = Point2(fill.freshUv[i].x(), fill.freshUv[i].y());
+            loc.lid[v] = -1;
+            loc.locked[v] = false;
+            loc.star.cur[v] = kNone;
+            vertexOf.push_back(v);
+        }
+        std::vector<std::array<VertexIndex, 3>> faceVs;
+        for (const auto& t : fill.triangles)
+            faceVs.push_back(
+                {vertexOf[std::size_t(t[0])], vertexOf[std::size_t(t[1])], vertexOf[std::size_t(t[2])]});
+        loc.seam.clear();
+        loc.refilled = true;
+        for (std::size_t i : growthOrder(faceVs, S)) {
+            const FaceIndex g = S.add_face(faceVs[i][0], faceVs[i][1], faceVs[i][2]);
+            if (g == Mesh::null_face()) return Refill::Broken;
+            loc.star.kept[g] = false;
+            loc.quality[g] = inherited[i].quality;
+            loc.scanId[g] = inherited[i].scanId;
+            loc.patchSide[g] = inherited[i].patchSide;
+            loc.planeNormal[g] = inherited[i].planeNormal;
+            loc.minAllowed[g] = inherited[i].minAllowed;
+            loc.offView[g] = false;
+            for (int k = 0; k < 3; ++k)
+                loc.seam.insert(seamKey(faceVs[i][std::size_t(k)], faceVs[i][std::size_t((k + 1) % 3)]));
+        }
+        return Refill::Applied;
     }
 
     // Border edges (pairs of current-mesh vertices) incident to the vertices of the replaced faces.
@@ -3208,7 +3313,7 @@ private:
             plan.quality.push_back(loc.quality[sfaces[i]]);
             plan.scanId.push_back(loc.scanId[sfaces[i]]);
         }
-        // Seam figures.
+        // Seam figures (after a refill, the seam's faces and vertices are the fill's).
         plan.seamEdges = loc.seam.size();
         std::unordered_set<std::uint32_t> seamVerts;
         for (const auto& [p, q] : loc.seam) {
@@ -3216,6 +3321,12 @@ private:
             seamVerts.insert(p);
             seamVerts.insert(q);
         }
+        if (loc.refilled) {
+            plan.seamEdges = loc.seamLineEdges;
+            plan.seamLength = loc.seamLineLength;
+        }
+        for (std::uint32_t v : seamVerts)
+            if (loc.star.isFull(VertexIndex(v))) plan.seamValences.push_back(S.degree(VertexIndex(v)));
         for (std::size_t i = 0; i < faces.size(); ++i) {
             const auto& fv = faces[i];
             if (!seamVerts.count(std::uint32_t(fv[0])) && !seamVerts.count(std::uint32_t(fv[1])) &&
@@ -3235,6 +3346,7 @@ private:
     const std::vector<int>& faces_;
     bool curHasQuality_, curHasScanId_;
     ComponentProgress& progress_;
+    bool refill_ = O_.refillSeam; // v2 strip refill (off for the retry after a failed refill)
     Mesh::Property_map<FaceIndex, float> curQuality_;
     Mesh::Property_map<FaceIndex, std::int32_t> curScanId_;
 
@@ -3393,7 +3505,7 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
     };
 
     bool propsReady = false;
-    std::size_t seamFacesAbove25 = 0;
+    std::size_t seamFacesAbove25 = 0, seamFacesAbove30 = 0, seamValence5To7 = 0;
     const double totalFaces = double(std::max<std::size_t>(P.tri.size(), 1));
     std::size_t facesDone = dropped; // faces stitched, trimmed or dropped so far
     double lastFraction = 0;         // reported fractions never go back
@@ -3471,7 +3583,14 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
         for (double ang : plan.seamFaceMinAngles) {
             report.seamMinAngleDeg = std::min(report.seamMinAngleDeg, ang);
             seamFacesAbove25 += ang >= 25.0;
+            seamFacesAbove30 += ang >= 30.0;
         }
+        for (std::size_t k : plan.seamValences) {
+            if (report.seamValenceHistogram.size() <= k) report.seamValenceHistogram.resize(k + 1, 0);
+            ++report.seamValenceHistogram[k];
+            seamValence5To7 += k >= 5 && k <= 7;
+        }
+        report.seamVertices += plan.seamValences.size();
         report.seamFaces += plan.seamFaceMinAngles.size();
     }
     report.componentsStitched = int(stitched.size());
@@ -3484,6 +3603,10 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
     }
     report.seamFracMinAngleAbove25 =
         report.seamFaces ? double(seamFacesAbove25) / double(report.seamFaces) : 1.0;
+    report.seamFracMinAngleAbove30 =
+        report.seamFaces ? double(seamFacesAbove30) / double(report.seamFaces) : 1.0;
+    report.seamFracValence5To7 =
+        report.seamVertices ? double(seamValence5To7) / double(report.seamVertices) : 1.0;
     if (report.componentsStitched == 0)
         throw InvalidInputError(
             "No part of the patch could be stitched" +
