@@ -508,7 +508,9 @@ TEST(Fishbone, TrimRibsStopsConvergingAndTurningRibs) {
         for (const int side : {1, -1}) { // prefixes: nothing present beyond an absent vertex
             bool ended = false;
             for (int c = g.backboneColumn; c >= 0 && c < g.cols; c += side) {
-                if (ended) EXPECT_FALSE(g.isPresent(r, c)) << r << " " << c;
+                if (ended) {
+                    EXPECT_FALSE(g.isPresent(r, c)) << r << " " << c;
+                }
                 ended = ended || !g.isPresent(r, c);
             }
         }

@@ -225,11 +225,14 @@ TEST(Scan, TriangularLatticeIsEquilateralOnAFrontalPlane) {
                 inside += onScreen;
                 ASSERT_EQ(s.hit, onScreen); // the plane fills the view
                 // The lattice: unit steps along a row, to (r+1, c) and to (r+1, c+1), on the screen.
-                if (c + 1 < g.cols) EXPECT_NEAR((g.at(r, c + 1).screen - s.screen).norm(), 1.0, 1e-12);
+                if (c + 1 < g.cols) {
+                    EXPECT_NEAR((g.at(r, c + 1).screen - s.screen).norm(), 1.0, 1e-12);
+                }
                 if (r + 1 < g.rows) {
                     EXPECT_NEAR((g.at(r + 1, c).screen - s.screen).norm(), 1.0, 1e-12);
-                    if (c + 1 < g.cols)
+                    if (c + 1 < g.cols) {
                         EXPECT_NEAR((g.at(r + 1, c + 1).screen - s.screen).norm(), 1.0, 1e-12);
+                    }
                 }
                 if (!s.hit) continue;
                 EXPECT_LE(std::abs(s.point.z()), 1e-12 * (1 + s.point.norm())); // on the analytic plane
@@ -291,9 +294,12 @@ TEST(Scan, SquareLatticeOfOnePixelIsTheRegularGrid) {
             const fss::Sample& t = b.at(2 * r, 2 * col);
             ASSERT_TRUE(s.valid);
             EXPECT_EQ(s.screen, Eigen::Vector2d(2 * col + 1.0, 2 * r + 1.0));
-            // The pixel-centre sample (t) sits half a pixel off in x and y (y foreshortened by cos 30°).
-            const double expected = t.footprint * std::sqrt(0.25 + 0.25 / (0.75));
-            EXPECT_NEAR((s.point - t.point).norm(), expected, 0.05 * t.footprint);
+            // Exactly where the viewing ray through its screen position meets the analytic plane z = 0.
+            const fss::Ray ray = cam.ray(s.screen.x(), s.screen.y());
+            const Eigen::Vector3d expected =
+                ray.origin - (ray.origin.z() / ray.direction.z()) * ray.direction;
+            EXPECT_LE((s.point - expected).norm(), 1e-9 * (1 + expected.norm()));
+            EXPECT_GT((s.point - t.point).norm(), 0.5 * t.footprint); // not the pixel centre's sample
             EXPECT_NEAR(s.quality, 2.0 * fss::sampleQuality(s.footprint, s.samplingAngle), 1e-5 * s.quality);
         }
 }
@@ -310,8 +316,12 @@ TEST(Scan, LatticeSpacingInWorldUnits) {
     for (int r = 0; r + 1 < g.rows; ++r)
         for (int c = 0; c + 1 < g.cols; ++c) {
             const fss::Sample &s = g.at(r, c), &t = g.at(r + 1, c + 1), &u = g.at(r, c + 1);
-            if (s.hit && t.hit) EXPECT_NEAR((s.point - t.point).norm(), 3.0 / 64, 1e-9);
-            if (s.hit && u.hit) EXPECT_NEAR((s.point - u.point).norm(), 3.0 / 64, 1e-9);
+            if (s.hit && t.hit) {
+                EXPECT_NEAR((s.point - t.point).norm(), 3.0 / 64, 1e-9);
+            }
+            if (s.hit && u.hit) {
+                EXPECT_NEAR((s.point - u.point).norm(), 3.0 / 64, 1e-9);
+            }
         }
     o.spacingWorld = 1000; // 64 000 px
     EXPECT_THROW(fss::latticeSpacingPixels(cam, o), fss::InvalidInputError);

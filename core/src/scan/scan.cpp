@@ -107,10 +107,15 @@ std::optional<std::pair<FaceIndex, Eigen::Vector3d>> walkToHit(const Mesh& mesh,
 }
 
 void checkBuffers(const FrameBuffers& referenceBuffers) {
-    checkBuffers(referenceBuffers);
     const Camera& camera = referenceBuffers.camera;
+    camera.validate();
     const int w = camera.width, h = camera.height;
     const std::size_t n = std::size_t(w) * std::size_t(h);
+    if (referenceBuffers.depth.size() != n || referenceBuffers.faceId.size() != n)
+        throw InvalidInputError("The scan buffers hold " + std::to_string(referenceBuffers.depth.size()) +
+                                " depth and " + std::to_string(referenceBuffers.faceId.size()) +
+                                " face-id values instead of " + std::to_string(n) + " for a " +
+                                std::to_string(w) + "x" + std::to_string(h) + " camera.");
 }
 
 } // namespace
