@@ -16,7 +16,7 @@ namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-Eigen::Vector3d faceNormal(const Mesh& m, FaceIndex f) {
+Eigen::Vector3d unitFaceNormal(const Mesh& m, FaceIndex f) {
     const HalfedgeIndex h = m.halfedge(f);
     return unitNormal(pos(m, m.source(h)), pos(m, m.target(h)), pos(m, m.target(m.next(h))));
 }
@@ -29,11 +29,11 @@ struct CreaseLine {
 // The sharp edge of face \p f (dihedral angle beyond \p cosCrease) that \p p lies on, within \p tolerance.
 std::optional<CreaseLine> creaseUnder(const Mesh& ref, FaceIndex f, const Eigen::Vector3d& p,
                                       double cosCrease, double tolerance) {
-    const Eigen::Vector3d n = faceNormal(ref, f);
+    const Eigen::Vector3d n = unitFaceNormal(ref, f);
     for (HalfedgeIndex h : CGAL::halfedges_around_face(ref.halfedge(f), ref)) {
         const FaceIndex g = ref.face(ref.opposite(h));
         if (g == Mesh::null_face()) continue;
-        const Eigen::Vector3d m = faceNormal(ref, g);
+        const Eigen::Vector3d m = unitFaceNormal(ref, g);
         if (!(n.squaredNorm() > 0 && m.squaredNorm() > 0) || n.dot(m) >= cosCrease) continue;
         const Eigen::Vector3d a = pos(ref, ref.source(h)), b = pos(ref, ref.target(h));
         const Eigen::Vector3d ab = b - a;
@@ -90,7 +90,7 @@ RelaxReport relaxOnReference(Mesh& mesh, const Mesh& reference, const std::vecto
     std::vector<Eigen::Vector3d> firstNormal(vertices.size());
     std::vector<std::optional<CreaseLine>> crease(vertices.size());
     for (std::size_t k = 0; k < vertices.size(); ++k) {
-        firstNormal[k] = faceNormal(reference, hints[k]);
+        firstNormal[k] = unitFaceNormal(reference, hints[k]);
         crease[k] = creaseUnder(reference, hints[k], pos(mesh, vertices[k]), cosCrease, 1e-6 * footprints[k]);
         report.onCrease += crease[k].has_value();
     }
@@ -115,11 +115,11 @@ RelaxReport relaxOnReference(Mesh& mesh, const Mesh& reference, const std::vecto
                     std::clamp((p + options.step * d - crease[k]->a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
                 target = crease[k]->a + t * ab;
             } else {
-                const Eigen::Vector3d normal = faceNormal(reference, hints[k]);
+                const Eigen::Vector3d normal = unitFaceNormal(reference, hints[k]);
                 const Eigen::Vector3d moved = p + options.step * (d - d.dot(normal) * normal);
                 const SurfacePoint onRef = closestPointNear(reference, moved, hints[k], search);
                 if (!onRef || onRef.distance > options.maxOffFootprints * footprints[k] ||
-                    faceNormal(reference, onRef.face).dot(firstNormal[k]) < cosCrease) {
+                    unitFaceNormal(reference, onRef.face).dot(firstNormal[k]) < cosCrease) {
                     ++report.refused;
                     continue;
                 }
