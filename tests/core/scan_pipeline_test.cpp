@@ -274,8 +274,9 @@ TEST(ScanPipeline, TriangularLatticeMakesRounderTrianglesThanThePixelGrid) {
                 tri.meanMinAngle, 100 * tri.below30, tri.valence6, tri.hausdorff, tri.faces, sq.meanMinAngle,
                 100 * sq.below30, sq.valence6, sq.hausdorff, sq.faces);
     // Measured (issue #20 report): 36.2° against 29.9°, 3.4 % against 63.7 % below 30°, Hausdorff 2.43e-3
-    // against 2.16e-3 — 12 % larger (the relaxation's share, see the next test): the issue's "no worse"
-    // is not met yet, and this bound records where it stands.
+    // against 2.16e-3 — 12 % larger (the lattice's: without the relaxation it is the same 2.43e-3 here;
+    // over 28 scans of four meshes the triangular lattice's Hausdorff was lower in 19): the issue's "no
+    // worse" is not met on this view, and this bound records where it stands.
     EXPECT_GE(tri.meanMinAngle, sq.meanMinAngle + 5);
     EXPECT_LE(tri.below30, 0.1 * sq.below30);
     EXPECT_GE(tri.valence6, 0.98);
