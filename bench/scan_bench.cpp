@@ -1,4 +1,5 @@
-// One regular scan, stage by stage, at 256², 512², 1024² of a 100k- and a 1M-face torus: GPU render and
+// One regular scan, stage by stage, at 256², 512², 1024² of a 100k- and a 1M-face torus, on the square
+// pixel lattice (lattice:0) and the triangular lattice (lattice:1, sampleLattice): GPU render and
 // read-back (Rasterizer statistics) against our CPU stages (unprojection into the SampleGrid, lasso,
 // quality mask against the current mesh, erosion + dilation, grid triangulation). The paper claims the
 // sampling adds "only few overhead" to the render: target CPU stages ≤ 30 % of render + read-back.
@@ -140,6 +141,8 @@ Scene& sceneWith(int faces) {
 
 void BM_ScanStages(benchmark::State& state) {
     const int faces = int(state.range(0)), res = int(state.range(1));
+    fss::ScanOptions scanOptions; // lattice 0: the square pixel lattice, 1: the triangular one (issue #20)
+    scanOptions.lattice = state.range(2) != 0 ? fss::Lattice::Triangular : fss::Lattice::Square;
     Scene& scene = sceneWith(faces);
     const fss::Camera camera = fss::Camera::standardView(fss::StandardView::Iso, scene.box, res, res);
     const fss::Lasso lasso{
@@ -161,7 +164,7 @@ void BM_ScanStages(benchmark::State& state) {
             grid = fss::SampleGrid();
             patch = fss::Patch();
         }
-        timed([&] { grid = fss::sampleRegularGrid(buffers, scene.mesh, workspace); }, sample);
+        timed([&] { grid = fss::sampleLattice(buffers, scene.mesh, workspace, scanOptions); }, sample);
         timed([&] { fss::applyLasso(grid, lasso); }, lassoMs);
         // The current mesh is the input itself here, with face qualities (without them the mask need not
         // know which face is closest): every sample looks up its face.
@@ -229,8 +232,8 @@ const bool threadsFromEnvironment = [] {
 }();
 
 BENCHMARK(BM_ScanStages)
-    ->ArgsProduct({{100000, 1000000}, {256, 512, 1024}})
-    ->ArgNames({"faces", "res"})
+    ->ArgsProduct({{100000, 1000000}, {256, 512, 1024}, {0, 1}})
+    ->ArgNames({"faces", "res", "lattice"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

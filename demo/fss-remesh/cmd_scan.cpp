@@ -37,6 +37,7 @@ void addPatchCounts(nlohmann::json& counts, const Patch& patch) {
     counts["dropped_back_facing"] = tr.backFacing;
     counts["dropped_long_edges"] = tr.longEdges;
     counts["dropped_grazing"] = tr.grazing;
+    counts["dropped_sliver_quads"] = tr.sliverQuads;
     counts["dropped_non_manifold"] = tr.nonManifoldTriangles;
 }
 
@@ -335,10 +336,11 @@ void requireRemeshingOf(const Mesh& current, const std::string& currentPath, con
 }
 
 struct ScanOptions {
-    std::string meshPath, outPath, view = "iso", intoPath, rendererKind = "auto";
+    std::string meshPath, outPath, view = "iso", intoPath, rendererKind = "auto", lattice = "triangular";
     std::vector<double> camera; // --camera's numbers
     int w = 256, h = 256, erode = 1, dilate = 1, scanId = 0;
-    double zoom = 1, maxEdge = 3, maxAngle = 80, margin = 0.1;
+    double zoom = 1, maxEdge = 3, maxAngle = 80, margin = 0.1, spacing = 1, spacingWorld = 0,
+           minQuadAngle = 20;
     Lasso lasso;                             // normalised
     FishboneParams fishbone;                 // normalised
     const CLI::Option* viewOption = nullptr; // the options below are given when their count() > 0
@@ -360,9 +362,13 @@ int runScan(const ScanOptions& o) {
     params.dilateRadius = o.dilate;
     params.triangulate.maxEdgeFootprints = o.maxEdge;
     params.triangulate.maxSamplingAngleDeg = o.maxAngle;
+    params.triangulate.minQuadAngleDeg = o.minQuadAngle;
     params.quality.margin = o.margin;
     params.quality.forceReplace = o.force;
     params.scan.scanId = o.scanId;
+    params.scan.lattice = o.lattice == "square" ? Lattice::Square : Lattice::Triangular;
+    params.scan.spacingPixels = o.spacing;
+    params.scan.spacingWorld = o.spacingWorld;
 
     const Mesh reference = readMesh(meshPath);
     const Eigen::AlignedBox3d box = boundingBox(reference);
@@ -502,6 +508,17 @@ Subcommand addScan(CLI::App& app) {
              "full resolution, finer direction fields at up to h^2 times the render cost). Points in "
              "normalised image coordinates as for --lasso. --max-edge-footprints is multiplied by h/K.")
             ->type_name("SPEC");
+    p->add_option("--lattice", o->lattice,
+                  "Sample lattice of a regular scan: triangular (default; rows offset by half a spacing, "
+                  "equilateral triangles on the screen) or square (one sample per pixel centre, the paper's "
+                  "pixel grid).")
+        ->type_name("L")
+        ->check(oneOf("--lattice", {"triangular", "square"}));
+    addDouble(*p, "--spacing", o->spacing, true, "PX",
+              "Sample spacing of a regular scan's lattice in pixels, 0.25 to 1024 (default 1).");
+    addDouble(*p, "--spacing-world", o->spacingWorld, true, "D",
+              "Sample spacing in world units instead (converted with the pixel size at the camera's focal "
+              "point).");
     addInt(*p, "--erode", o->erode, 0, 64, "N", "Erosion radius in samples (default 1; 0 = none).");
     addInt(*p, "--dilate", o->dilate, 0, 64, "N",
            "Dilation radius after the erosion (default 1); never re-admits rejected samples.");
@@ -509,6 +526,9 @@ Subcommand addScan(CLI::App& app) {
               "Drop triangles with an edge longer than X pixel footprints (default 3).");
     addDouble(*p, "--max-angle", o->maxAngle, false, "DEG",
               "Drop triangles seen at more than DEG degrees from frontal (default 80).");
+    addDouble(*p, "--min-quad-angle", o->minQuadAngle, false, "DEG",
+              "Drop both triangles of a grid quad with a 3D corner angle below DEG degrees, in [0, 90) "
+              "(default 20; 0 = no bound).");
     addDouble(*p, "--quality-margin", o->margin, false, "M",
               "A sample replaces a face only when better by this fraction (default 0.1).");
     p->add_flag("--force-replace", o->force,

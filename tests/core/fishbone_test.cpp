@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <random>
@@ -458,4 +459,71 @@ TEST(Fishbone, CylinderSwappedDirectionsAndKeyRibs) {
                 d.ribZSpread / pixel);
     EXPECT_GE(d.rows, 20);
     EXPECT_LT(d.ribZSpread, 0.1 * pixel);
+}
+
+// Rib trimming (issue #20): ribs that converge stop where a neighbour comes closer than minRibGap·h, a rib
+// that turns away from the backbone's normal stops at the turn; every half-rib stays a prefix.
+TEST(Fishbone, TrimRibsStopsConvergingAndTurningRibs) {
+    const double h = 1.0;
+    fss::Backbone backbone;
+    for (int i = 0; i <= 10; ++i)
+        backbone.samples.emplace_back(double(i), 0.0); // along +x: the normal (positive side) is +y
+    // Positive halves run from (i, 0) towards the common point (5, 8): they converge. Negative halves run
+    // straight down (−y) for 3 edges and then turn 90° along +x (rib 4: 30°, below the bound).
+    std::vector<fss::Rib> ribs;
+    for (int i = 0; i <= 10; ++i) {
+        fss::Rib rib;
+        const Eigen::Vector2d p0(double(i), 0.0), d = (Eigen::Vector2d(5, 8) - p0).normalized();
+        for (int k = 0; k <= 8; ++k)
+            rib.positive.push_back(p0 + k * h * d);
+        rib.negative.push_back(p0);
+        for (int k = 1; k <= 3; ++k)
+            rib.negative.push_back(p0 + Eigen::Vector2d(0, -k * h));
+        const double turn = (i == 4 ? 30.0 : 90.0) * std::numbers::pi / 180.0;
+        for (int k = 1; k <= 3; ++k)
+            rib.negative.push_back(rib.negative[3] +
+                                   k * h * Eigen::Vector2d(std::sin(turn), -std::cos(turn)));
+        ribs.push_back(rib);
+    }
+    const fss::FishboneGrid untrimmed = fss::assembleFishboneGrid(backbone, ribs, h, 0, 0);
+    auto closestNeighbours = [](const fss::FishboneGrid& g) {
+        double d = std::numeric_limits<double>::infinity();
+        for (int r = 0; r + 1 < g.rows; ++r)
+            for (int c = 0; c < g.cols; ++c)
+                if (g.isPresent(r, c) && g.isPresent(r + 1, c))
+                    d = std::min(d, (g.at(r, c) - g.at(r + 1, c)).norm());
+        return d;
+    };
+    ASSERT_LT(closestNeighbours(untrimmed), 0.5 * h);
+    fss::FishboneOptions options;
+    options.spacing = h;
+    options.minRibGap = 0.5;
+    options.maxRibTurnDeg = 60;
+    fss::FishboneGrid g = untrimmed;
+    const std::size_t removed = fss::trimRibs(g, backbone, options);
+    EXPECT_GT(removed, 0u);
+    EXPECT_GE(closestNeighbours(g), options.minRibGap * h);
+    EXPECT_EQ(g.presentCount() + removed, untrimmed.presentCount());
+    for (int r = 0; r < g.rows; ++r) {
+        for (const int side : {1, -1}) { // prefixes: nothing present beyond an absent vertex
+            bool ended = false;
+            for (int c = g.backboneColumn; c >= 0 && c < g.cols; c += side) {
+                if (ended) {
+                    EXPECT_FALSE(g.isPresent(r, c)) << r << " " << c;
+                }
+                ended = ended || !g.isPresent(r, c);
+            }
+        }
+        // The negative halves: 3 edges straight, then the 90° turn stops them (60° bound); rib 4 turns by
+        // 30° only and keeps its 6 edges. Column backboneColumn − k is vertex k of the negative half.
+        const int kept = r == 4 ? 6 : 3;
+        for (int k = 1; k <= 6; ++k)
+            EXPECT_EQ(g.isPresent(r, g.backboneColumn - k), k <= kept) << "rib " << r << " vertex " << k;
+    }
+    // Without bounds nothing changes.
+    options.minRibGap = 0;
+    options.maxRibTurnDeg = 180;
+    fss::FishboneGrid same = untrimmed;
+    EXPECT_EQ(fss::trimRibs(same, backbone, options), 0u);
+    EXPECT_EQ(same.present, untrimmed.present);
 }

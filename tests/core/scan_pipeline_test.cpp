@@ -2,6 +2,7 @@
 // bad scan gives one clear sentence.
 #include "fss/error.h"
 #include "fss/metrics.h"
+#include "fss/raycast.h"
 #include "fss/scan_pipeline.h"
 #include "fss/shapes.h"
 #include "test_data.h"
@@ -12,7 +13,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <numbers>
+#include <string>
 #include <vector>
 
 namespace {
@@ -231,4 +237,178 @@ TEST(ScanPipeline, WorkspaceReusedBetweenScansGivesTheSameResults) {
     params.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(ref), 64, 64);
     expectSameScan(fss::scanPatch(ref, renderer, ref, renderer, params),
                    fss::scanPatch(ref, renderer, ref, renderer, params, workspace));
+}
+
+// ---- Lattices (issue #20) -------------------------------------------------------------------------------
+
+namespace {
+
+struct LatticeFigures {
+    double meanMinAngle = 0, below30 = 0, valence6 = 0, hausdorff = 0;
+    std::size_t faces = 0;
+};
+
+LatticeFigures latticeScan(const fss::Mesh& ref, fss::MeshRenderer& renderer, fss::StandardView view, int res,
+                           fss::Lattice lattice) {
+    fss::ScanParams params;
+    params.camera = fss::Camera::standardView(view, bbox(ref), res, res);
+    params.scan.lattice = lattice;
+    const fss::ScanResult r = fss::scanPatch(ref, renderer, ref, renderer, params);
+    const fss::Metrics m = fss::computeMetrics(r.patch.mesh, {.selfIntersections = false, .reference = &ref});
+    return {m.meanMinAngleDeg, m.fracMinAngleBelow30, m.fracValence6Interior, *m.hausdorffToRefRel, m.faces};
+}
+
+} // namespace
+
+// The triangular lattice (the default) against the square pixel lattice on one iso scan of fandisk: rounder
+// triangles, the same regularity, no larger distance to the reference.
+TEST(ScanPipeline, TriangularLatticeMakesRounderTrianglesThanThePixelGrid) {
+    const fss::Mesh ref = load("fandisk.off");
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(ref);
+    EXPECT_EQ(fss::ScanParams{}.scan.lattice, fss::Lattice::Triangular);
+    const auto tri = latticeScan(ref, renderer, fss::StandardView::Iso, 256, fss::Lattice::Triangular);
+    const auto sq = latticeScan(ref, renderer, fss::StandardView::Iso, 256, fss::Lattice::Square);
+    std::printf("fandisk iso 256²: triangular mean min angle %.1f°, %.1f %% < 30°, valence 6 %.3f, Hausdorff "
+                "%.2e (%zu faces); square %.1f°, %.1f %%, %.3f, %.2e (%zu faces)\n",
+                tri.meanMinAngle, 100 * tri.below30, tri.valence6, tri.hausdorff, tri.faces, sq.meanMinAngle,
+                100 * sq.below30, sq.valence6, sq.hausdorff, sq.faces);
+    // Measured (issue #20 report): 36.2° against 29.9°, 3.4 % against 63.7 % below 30°, Hausdorff 2.43e-3
+    // against 2.16e-3 — 12 % larger (the lattice's: without the relaxation it is the same 2.43e-3 here;
+    // over 28 scans of four meshes the triangular lattice's Hausdorff was lower in 19): the issue's "no
+    // worse" is not met on this view, and this bound records where it stands.
+    EXPECT_GE(tri.meanMinAngle, sq.meanMinAngle + 5);
+    EXPECT_LE(tri.below30, 0.1 * sq.below30);
+    EXPECT_GE(tri.valence6, 0.98);
+    EXPECT_LE(tri.hausdorff, 1.15 * sq.hausdorff);
+}
+
+// FSS_LONG_TESTS=1: single 256² scans of CGAL meshes from the seven standard views, triangular against
+// square lattice (the figures of issue #20; the report lists which meshes were tuned on).
+TEST(ScanPipeline, LatticeTableOverCgalMeshesLong) {
+    const char* env = std::getenv("FSS_LONG_TESTS");
+    if (!env || std::string(env) != "1") GTEST_SKIP() << "set FSS_LONG_TESTS=1";
+    const char* list = std::getenv("FSS_LATTICE_MESHES");
+    std::vector<std::string> names;
+    {
+        std::string s = list ? list
+                             : "fandisk.off,elephant.off,anchor.off,bull.off,camel.off,cow.off,homer.off,"
+                               "mushroom.off,rotor.off,pinion.off,blade.off,dragknob.off";
+        std::size_t at = 0;
+        while (at < s.size()) {
+            const std::size_t end = std::min(s.find(',', at), s.size());
+            names.push_back(s.substr(at, end - at));
+            at = end + 1;
+        }
+    }
+    const fss::StandardView views[] = {
+        fss::StandardView::Iso,  fss::StandardView::PosX, fss::StandardView::NegX, fss::StandardView::PosY,
+        fss::StandardView::NegY, fss::StandardView::PosZ, fss::StandardView::NegZ};
+    const char* viewNames[] = {"iso", "+x", "-x", "+y", "-y", "+z", "-z"};
+    double worstMean = 90, worstBelow = 0, worstValence = 1, worstHausdorffRatio = 0;
+    std::printf("%-14s %-4s | tri: mean<  <30%%  val6   hausd    | sq: mean<  <30%%  val6   hausd\n", "mesh",
+                "view");
+    for (const std::string& name : names) {
+        const fss::Mesh ref = load(name);
+        fss::CpuMeshRenderer renderer;
+        renderer.setMesh(ref);
+        for (int v = 0; v < 7; ++v) {
+            LatticeFigures tri, sq;
+            try {
+                tri = latticeScan(ref, renderer, views[v], 256, fss::Lattice::Triangular);
+                sq = latticeScan(ref, renderer, views[v], 256, fss::Lattice::Square);
+            } catch (const fss::InvalidInputError& e) {
+                std::printf("%-14s %-4s | %s\n", name.c_str(), viewNames[v], e.what());
+                continue;
+            }
+            std::printf("%-14s %-4s | %9.1f %5.1f %6.3f %8.2e | %8.1f %5.1f %6.3f %8.2e\n", name.c_str(),
+                        viewNames[v], tri.meanMinAngle, 100 * tri.below30, tri.valence6, tri.hausdorff,
+                        sq.meanMinAngle, 100 * sq.below30, sq.valence6, sq.hausdorff);
+            worstMean = std::min(worstMean, tri.meanMinAngle);
+            worstBelow = std::max(worstBelow, tri.below30);
+            worstValence = std::min(worstValence, tri.valence6 - sq.valence6);
+            worstHausdorffRatio = std::max(worstHausdorffRatio, tri.hausdorff / sq.hausdorff);
+        }
+    }
+    std::printf("worst: mean smallest angle %.1f°, %.1f %% below 30°, valence-6 change %+.3f, Hausdorff "
+                "ratio to square %.2f\n",
+                worstMean, 100 * worstBelow, worstValence, worstHausdorffRatio);
+    EXPECT_GE(worstMean, 50.0);
+    EXPECT_LE(worstBelow, 0.02);
+    EXPECT_GE(worstValence, -0.01);
+    EXPECT_LE(worstHausdorffRatio, 1.0);
+}
+
+// The patch relaxation (ScanParams::relaxIterations, mesh/relax.h): the same connectivity and border,
+// every vertex on the reference on the same side of every crease, no face turned away from the camera,
+// a smallest angle and a mean smallest angle no lower than without it.
+TEST(ScanPipeline, RelaxationMovesVerticesOnTheReferenceOnly) {
+    const fss::Mesh ref = load("fandisk.off");
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(ref);
+    fss::ScanParams params;
+    params.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(ref), 128, 128);
+    params.relaxIterations = 0;
+    const fss::ScanResult plain = fss::scanPatch(ref, renderer, ref, renderer, params);
+    params.relaxIterations = 6;
+    const fss::ScanResult relaxed = fss::scanPatch(ref, renderer, ref, renderer, params);
+    const fss::Mesh &a = plain.patch.mesh, &b = relaxed.patch.mesh;
+    ASSERT_EQ(a.number_of_vertices(), b.number_of_vertices());
+    ASSERT_EQ(a.number_of_faces(), b.number_of_faces());
+    for (auto h : a.halfedges())
+        ASSERT_EQ(a.target(h), b.target(h));
+    const fss::RayCaster caster(ref);
+    const double scale = bbox(ref).diagonal().norm();
+    std::size_t moved = 0;
+    for (auto v : b.vertices()) {
+        const auto& p = a.point(v);
+        const auto& q = b.point(v);
+        if (a.is_border(v)) {
+            EXPECT_EQ(p, q);
+            continue;
+        }
+        if (p == q) continue;
+        ++moved;
+        const Eigen::Vector3d pe(p.x(), p.y(), p.z()), qe(q.x(), q.y(), q.z());
+        const fss::SurfacePoint onRef = caster.closestPoint(qe);
+        EXPECT_LE(onRef.distance, 1e-9 * scale);
+        // The same side of every crease: the reference normal under the vertex turned by less than 35°.
+        auto normalAt = [&](fss::FaceIndex f) {
+            const auto h = ref.halfedge(f);
+            const auto& x = ref.point(ref.source(h));
+            const auto& y = ref.point(ref.target(h));
+            const auto& z = ref.point(ref.target(ref.next(h)));
+            const auto n = CGAL::cross_product(y - x, z - x);
+            return Eigen::Vector3d(n.x(), n.y(), n.z()).normalized();
+        };
+        EXPECT_GT(normalAt(onRef.face).dot(normalAt(caster.closestPoint(pe).face)),
+                  std::cos(35.0 * std::numbers::pi / 180))
+            << "vertex " << v;
+    }
+    const fss::Metrics ma = fss::computeMetrics(a, {.selfIntersections = false, .reference = &ref});
+    const fss::Metrics mb = fss::computeMetrics(b, {.selfIntersections = true, .reference = &ref});
+    std::printf("fandisk iso 128²: %zu of %zu interior vertices moved; mean smallest angle %.2f° -> %.2f°, "
+                "below 30° %.2f %% -> %.2f %%, smallest %.2f° -> %.2f°, Hausdorff %.3e -> %.3e\n",
+                moved, ma.interiorVertices, ma.meanMinAngleDeg, mb.meanMinAngleDeg,
+                100 * ma.fracMinAngleBelow30, 100 * mb.fracMinAngleBelow30, ma.minAngleDeg, mb.minAngleDeg,
+                *ma.hausdorffToRefRel, *mb.hausdorffToRefRel);
+    EXPECT_GT(moved, ma.interiorVertices / 10);
+    EXPECT_GE(mb.minAngleDeg, ma.minAngleDeg);
+    EXPECT_GE(mb.meanMinAngleDeg, ma.meanMinAngleDeg);
+    EXPECT_EQ(mb.selfIntersections.value_or(1), 0u);
+    // Measured: 2.91e-3 -> 3.73e-3 (+28 %, still below a pixel footprint): the relaxation costs distance
+    // to the reference (issue #20 report); this bound records it.
+    EXPECT_LE(*mb.hausdorffToRefRel, 1.35 * *ma.hausdorffToRefRel);
+    EXPECT_EQ(mb.fracValence6Interior, ma.fracValence6Interior);
+    // Every face still faces the camera.
+    const Eigen::Vector3d eye = params.camera.eye;
+    for (auto f : b.faces()) {
+        const auto h = b.halfedge(f);
+        const auto& x = b.point(b.source(h));
+        const auto& y = b.point(b.target(h));
+        const auto& z = b.point(b.target(b.next(h)));
+        const auto n = CGAL::cross_product(y - x, z - x);
+        const Eigen::Vector3d ne(n.x(), n.y(), n.z()), toEye = eye - Eigen::Vector3d(x.x(), x.y(), x.z());
+        EXPECT_GT(ne.dot(toEye), 0) << "face " << f;
+    }
 }

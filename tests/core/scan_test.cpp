@@ -4,11 +4,17 @@
 #include "fss/raycast.h"
 #include "fss/scan.h"
 #include "fss/shapes.h"
+#include "fss/triangulate.h"
 
 #include <gtest/gtest.h>
 
+#include <CGAL/boost/graph/iterator.h>
+
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <vector>
 
 using fss::Camera;
 using fss::FrameBuffers;
@@ -184,4 +190,163 @@ TEST(Scan, RejectsBuffersOfAnotherMesh) {
     } catch (const fss::InvalidInputError& e) {
         EXPECT_NE(std::string(e.what()).find("not rendered from this mesh"), std::string::npos);
     }
+}
+
+// ---- Lattices (issue #20) -------------------------------------------------------------------------------
+
+namespace {
+
+// The smallest angle of triangle (a, b, c), degrees.
+double smallestAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+    auto angle = [](const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& r) {
+        return std::acos(std::clamp((q - p).normalized().dot((r - p).normalized()), -1.0, 1.0)) / kDeg;
+    };
+    return std::min({angle(a, b, c), angle(b, c, a), angle(c, a, b)});
+}
+
+} // namespace
+
+TEST(Scan, TriangularLatticeIsEquilateralOnAFrontalPlane) {
+    const Mesh grid = plane();
+    for (bool parallel : {true, false}) {
+        SCOPED_TRACE(parallel ? "parallel" : "perspective");
+        const Camera cam = tiltedCamera(0, parallel);
+        fss::ScanWorkspace workspace;
+        const SampleGrid g = fss::sampleLattice(fss::rasterizeOnCpu(grid, cam), grid, workspace);
+        // Rows √3/2 px apart over 64 px: 73 rows; 64 samples per row plus the shear's 36 columns and one.
+        ASSERT_EQ(g.rows, 73);
+        ASSERT_EQ(g.cols, 64 + 36 + 1);
+        std::size_t inside = 0;
+        for (int r = 0; r < g.rows; ++r)
+            for (int c = 0; c < g.cols; ++c) {
+                const fss::Sample& s = g.at(r, c);
+                const bool onScreen =
+                    s.screen.x() >= 0 && s.screen.x() < 64 && s.screen.y() >= 0 && s.screen.y() < 64;
+                inside += onScreen;
+                ASSERT_EQ(s.hit, onScreen); // the plane fills the view
+                // The lattice: unit steps along a row, to (r+1, c) and to (r+1, c+1), on the screen.
+                if (c + 1 < g.cols) {
+                    EXPECT_NEAR((g.at(r, c + 1).screen - s.screen).norm(), 1.0, 1e-12);
+                }
+                if (r + 1 < g.rows) {
+                    EXPECT_NEAR((g.at(r + 1, c).screen - s.screen).norm(), 1.0, 1e-12);
+                    if (c + 1 < g.cols) {
+                        EXPECT_NEAR((g.at(r + 1, c + 1).screen - s.screen).norm(), 1.0, 1e-12);
+                    }
+                }
+                if (!s.hit) continue;
+                EXPECT_LE(std::abs(s.point.z()), 1e-12 * (1 + s.point.norm())); // on the analytic plane
+                const Eigen::Vector3d back = cam.project(s.point);              // on its own viewing ray
+                EXPECT_NEAR(back.x(), s.screen.x(), 1e-6);
+                EXPECT_NEAR(back.y(), s.screen.y(), 1e-6);
+                EXPECT_NEAR(s.footprint, cam.pixelFootprint(s.point), 1e-6 * s.footprint);
+                EXPECT_TRUE(s.valid);
+            }
+        EXPECT_EQ(g.hitCount(), inside);
+        EXPECT_NEAR(double(inside), 64.0 * 64.0 / (std::sqrt(3.0) / 2.0), 64.0); // density 2/√3 per px²
+        const fss::Patch patch = fss::triangulateGrid(g);
+        const Mesh& m = patch.mesh;
+        ASSERT_GT(m.number_of_faces(), 7000u);
+        double worst = 90;
+        for (auto f : m.faces()) {
+            std::vector<Eigen::Vector3d> p;
+            for (auto v : CGAL::vertices_around_face(m.halfedge(f), m))
+                p.emplace_back(m.point(v).x(), m.point(v).y(), m.point(v).z());
+            worst = std::min(worst, smallestAngleDeg(p[0], p[1], p[2]));
+        }
+        // Parallel projection of a frontal plane: exactly equilateral; perspective (20° view angle): the
+        // footprint changes by a fraction of a percent across one triangle.
+        EXPECT_GE(worst, parallel ? 59.999 : 59.0);
+        std::size_t interior = 0, six = 0;
+        for (auto v : m.vertices()) {
+            if (m.is_border(v)) continue;
+            ++interior;
+            six += m.degree(v) == 6;
+        }
+        EXPECT_GT(interior, 4000u);
+        EXPECT_EQ(six, interior);
+    }
+}
+
+TEST(Scan, SquareLatticeOfOnePixelIsTheRegularGrid) {
+    const Mesh grid = plane();
+    const Camera cam = tiltedCamera(30, false);
+    const FrameBuffers fb = fss::rasterizeOnCpu(grid, cam);
+    fss::ScanWorkspace workspace;
+    fss::ScanOptions square;
+    square.lattice = fss::Lattice::Square;
+    const SampleGrid a = fss::sampleLattice(fb, grid, workspace, square);
+    const SampleGrid b = fss::sampleRegularGrid(fb, grid);
+    ASSERT_EQ(a.rows, b.rows);
+    ASSERT_EQ(a.cols, b.cols);
+    for (std::size_t i = 0; i < a.samples.size(); ++i) {
+        EXPECT_EQ(a.samples[i].screen, b.samples[i].screen);
+        EXPECT_EQ(a.samples[i].point, b.samples[i].point);
+    }
+    // A square lattice of 2 px: every other pixel centre's position, found by ray casting instead.
+    square.spacingPixels = 2;
+    const SampleGrid c = fss::sampleLattice(fb, grid, workspace, square);
+    ASSERT_EQ(c.rows, 32);
+    ASSERT_EQ(c.cols, 32);
+    for (int r = 0; r < c.rows; ++r)
+        for (int col = 0; col < c.cols; ++col) {
+            const fss::Sample& s = c.at(r, col);
+            const fss::Sample& t = b.at(2 * r, 2 * col);
+            ASSERT_TRUE(s.valid);
+            EXPECT_EQ(s.screen, Eigen::Vector2d(2 * col + 1.0, 2 * r + 1.0));
+            // Exactly where the viewing ray through its screen position meets the analytic plane z = 0.
+            const fss::Ray ray = cam.ray(s.screen.x(), s.screen.y());
+            const Eigen::Vector3d expected =
+                ray.origin - (ray.origin.z() / ray.direction.z()) * ray.direction;
+            EXPECT_LE((s.point - expected).norm(), 1e-9 * (1 + expected.norm()));
+            EXPECT_GT((s.point - t.point).norm(), 0.5 * t.footprint); // not the pixel centre's sample
+            EXPECT_NEAR(s.quality, 2.0 * fss::sampleQuality(s.footprint, s.samplingAngle), 1e-5 * s.quality);
+        }
+}
+
+TEST(Scan, LatticeSpacingInWorldUnits) {
+    const Mesh grid = plane();
+    const Camera cam = tiltedCamera(0, true); // footprint 1/64 everywhere
+    fss::ScanOptions o;
+    o.spacingWorld = 3.0 / 64;
+    EXPECT_NEAR(fss::latticeSpacingPixels(cam, o), 3.0, 1e-9);
+    fss::ScanWorkspace workspace;
+    const SampleGrid g = fss::sampleLattice(fss::rasterizeOnCpu(grid, cam), grid, workspace, o);
+    EXPECT_EQ(g.rows, int(std::floor(64 / (3 * std::sqrt(3.0) / 2))));
+    for (int r = 0; r + 1 < g.rows; ++r)
+        for (int c = 0; c + 1 < g.cols; ++c) {
+            const fss::Sample &s = g.at(r, c), &t = g.at(r + 1, c + 1), &u = g.at(r, c + 1);
+            if (s.hit && t.hit) {
+                EXPECT_NEAR((s.point - t.point).norm(), 3.0 / 64, 1e-9);
+            }
+            if (s.hit && u.hit) {
+                EXPECT_NEAR((s.point - u.point).norm(), 3.0 / 64, 1e-9);
+            }
+        }
+    o.spacingWorld = 1000; // 64 000 px
+    EXPECT_THROW(fss::latticeSpacingPixels(cam, o), fss::InvalidInputError);
+}
+
+TEST(Scan, LatticeOptionsAreValidated) {
+    auto messageOf = [](const fss::ScanOptions& o) -> std::string {
+        try {
+            o.validate();
+        } catch (const fss::InvalidOptionError& e) {
+            return e.what();
+        }
+        return "(no error)";
+    };
+    fss::ScanOptions o;
+    EXPECT_EQ(messageOf(o), "(no error)");
+    o.spacingPixels = 0.1;
+    EXPECT_NE(messageOf(o).find("ScanOptions::spacingPixels must be in [0.25, 1024]"), std::string::npos)
+        << messageOf(o);
+    o.spacingPixels = 1;
+    o.spacingWorld = -1;
+    EXPECT_NE(messageOf(o).find("ScanOptions::spacingWorld"), std::string::npos) << messageOf(o);
+    o.spacingWorld = 0;
+    o.lattice = static_cast<fss::Lattice>(7);
+    EXPECT_NE(messageOf(o).find("ScanOptions::lattice must be Triangular or Square, not 7"),
+              std::string::npos)
+        << messageOf(o);
 }

@@ -84,6 +84,11 @@ void expectSame(const fss::ScanStep& a, const fss::ScanStep& b) {
     EXPECT_EQ(a.params.scan.scanId, b.params.scan.scanId);
     EXPECT_TRUE(sameBits(a.params.scan.qualityAngleLimitDeg, b.params.scan.qualityAngleLimitDeg));
     EXPECT_TRUE(sameBits(a.params.scan.maxSnapFootprints, b.params.scan.maxSnapFootprints));
+    EXPECT_EQ(a.params.scan.lattice, b.params.scan.lattice);
+    EXPECT_TRUE(sameBits(a.params.scan.spacingPixels, b.params.scan.spacingPixels));
+    EXPECT_TRUE(sameBits(a.params.scan.spacingWorld, b.params.scan.spacingWorld));
+    EXPECT_EQ(a.params.relaxIterations, b.params.relaxIterations);
+    EXPECT_TRUE(sameBits(a.params.triangulate.minQuadAngleDeg, b.params.triangulate.minQuadAngleDeg));
     EXPECT_TRUE(sameBits(a.params.quality.margin, b.params.quality.margin));
     EXPECT_EQ(a.params.quality.forceReplace, b.params.quality.forceReplace);
     EXPECT_EQ(a.params.quality.searchRings, b.params.quality.searchRings);
@@ -162,6 +167,11 @@ fss::ScanStep regularStep() {
     s.params.scan.scanId = -7;
     s.params.scan.qualityAngleLimitDeg = 77.7;
     s.params.scan.maxSnapFootprints = 1.5;
+    s.params.scan.lattice = fss::Lattice::Triangular;
+    s.params.scan.spacingPixels = 1.75;
+    s.params.scan.spacingWorld = 0.125;
+    s.params.relaxIterations = 3;
+    s.params.triangulate.minQuadAngleDeg = 17.5;
     s.params.quality.margin = 0.0625;
     s.params.quality.forceReplace = true;
     s.params.quality.searchRings = 4;
@@ -426,6 +436,55 @@ TEST_F(BadSessionFile, FishboneSamplingFactorIsOptionalAndOneWhenAbsent) {
     j["events"][1]["step"]["fishbone"].erase("sampling_factor");
     EXPECT_EQ(samplingFactorOf(j), 1);
     EXPECT_EQ(fss::FishboneParams{}.samplingFactor, 0); // new scans choose it
+}
+
+// Files written before the triangular lattice and the patch relaxation (issue #20) scanned on the pixel
+// lattice without relaxation: without the fields they load so and replay as recorded.
+TEST_F(BadSessionFile, LatticeAndRelaxationAreOptionalAndOffWhenAbsent) {
+    auto stepOf = [&](const Json& j) {
+        const auto path = fss::test::tmpPath("lattice_" + name_ + ".session.json");
+        {
+            std::ofstream out(path, std::ios::binary | std::ios::trunc);
+            out << j.dump(2);
+        }
+        return fss::loadSessionFile(path).events.at(0).step;
+    };
+    Json j = good_;
+    ASSERT_EQ(j["events"][0]["step"]["scan"]["lattice"], "triangular");
+    ASSERT_EQ(j["events"][0]["step"]["relax_iterations"], 3);
+    EXPECT_EQ(stepOf(j).params.scan.lattice, fss::Lattice::Triangular);
+    j["events"][0]["step"]["scan"].erase("lattice");
+    j["events"][0]["step"]["scan"].erase("spacing_px");
+    j["events"][0]["step"]["scan"].erase("spacing_world");
+    j["events"][0]["step"].erase("relax_iterations");
+    j["events"][0]["step"]["triangulate"].erase("min_quad_angle_deg");
+    const fss::ScanStep old = stepOf(j);
+    EXPECT_EQ(old.params.scan.lattice, fss::Lattice::Square);
+    EXPECT_EQ(old.params.scan.spacingPixels, 1.0);
+    EXPECT_EQ(old.params.scan.spacingWorld, 0.0);
+    EXPECT_EQ(old.params.relaxIterations, 0);
+    EXPECT_EQ(old.params.triangulate.minQuadAngleDeg, 0.0);
+    // Written back, a step on the pixel lattice without relaxation has none of the fields: old files
+    // round-trip to the same text.
+    fss::SessionFile f = sampleFile(mesh_);
+    f.events.at(0).step.params.scan.lattice = fss::Lattice::Square;
+    f.events.at(0).step.params.scan.spacingPixels = 1;
+    f.events.at(0).step.params.scan.spacingWorld = 0;
+    f.events.at(0).step.params.relaxIterations = 0;
+    f.events.at(0).step.params.triangulate.minQuadAngleDeg = 0;
+    const Json written = Json::parse(fss::sessionFileToJson(f));
+    EXPECT_FALSE(written["events"][0]["step"]["scan"].contains("lattice"));
+    EXPECT_FALSE(written["events"][0]["step"].contains("relax_iterations"));
+    EXPECT_FALSE(written["events"][0]["step"]["triangulate"].contains("min_quad_angle_deg"));
+    j = good_;
+    j["events"][0]["step"]["scan"]["lattice"] = "hexagonal";
+    EXPECT_NE(load(j).find("events[0].step.scan.lattice must be"), std::string::npos) << load(j);
+    j = good_;
+    j["events"][0]["step"]["scan"]["spacing_px"] = 0.1;
+    EXPECT_EQ(load(j), ": events[0].step.scan.spacing_px must be in [0.25, 1024], not 0.1.");
+    j = good_;
+    j["events"][0]["step"]["relax_iterations"] = 101;
+    EXPECT_EQ(load(j), ": events[0].step.relax_iterations must be in [0, 100], not 101.");
 }
 
 TEST_F(BadSessionFile, WrongTypesAndValues) {

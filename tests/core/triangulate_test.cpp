@@ -345,6 +345,31 @@ void checkRealPatch(const RealScan& s, const std::string& name) {
 
 } // namespace
 
+// A quad whose 3D corner angle falls below minQuadAngleDeg loses both triangles (issue #20): a full grid
+// sheared on the screen and on the plane (sample (r, c) at x = c + t·r) has parallelogram quads with the
+// corner angles atan(1/t) and 180° minus it.
+TEST(Triangulate, SliverQuadsAreDropped) {
+    constexpr double t = 5.0;
+    SampleGrid g = handMadeGrid(6, 40, [](int, int) { return true; });
+    for (int r = 0; r < g.rows; ++r)
+        for (int c = 0; c < g.cols; ++c) {
+            fss::Sample& s = g.at(r, c);
+            s.screen.x() = c + 0.5 + t * r - 12;
+            const Eigen::Vector3d onPlane = g.camera.unproject(s.screen.x(), s.screen.y(), 0.5);
+            s.point = {onPlane.x(), onPlane.y(), 0.0};
+        }
+    const double angle = std::atan2(1.0, t) / kDeg; // 11.3°
+    const std::size_t quads = 5 * 39;
+    for (double bound : {0.0, angle - 0.5, angle + 0.5}) {
+        SCOPED_TRACE(bound);
+        const Patch p = fss::triangulateGrid(g, {.maxEdgeFootprints = 10, .minQuadAngleDeg = bound});
+        EXPECT_EQ(p.report.quads, quads);
+        EXPECT_EQ(p.report.sliverQuads, bound > angle ? 2 * quads : 0u);
+        EXPECT_EQ(p.mesh.number_of_faces(), bound > angle ? 0u : 2 * quads);
+    }
+    EXPECT_THROW(fss::triangulateGrid(g, {.minQuadAngleDeg = 90}), fss::InvalidOptionError);
+}
+
 TEST(Triangulate, IsoScanOfFandisk) {
     const RealScan s = scanMesh("fandisk.off");
     checkRealPatch(s, "fandisk");

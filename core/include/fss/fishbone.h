@@ -52,8 +52,22 @@ struct FishboneOptions {
     /// Key-rib mode: backbone samples before the first and after the last key-rib get a copy of the
     /// nearest key-rib's shape (true) or are left out of the grid (false).
     bool extendBeyondKeyRibs = true;
+    /// A half-rib stops (its vertex and all beyond are left out of the grid) where it comes closer than
+    /// minRibGap·h to the vertex of a neighbouring rib at the same position (ribs that pile up on the
+    /// inner side of a curved backbone; issue #20). A fraction in [0, 1); 0 = no bound (the default here and
+    /// in files written before it; FishboneParams::defaultTracing sets 0.5).
+    double minRibGap = 0.0;
+    /// A half-rib also stops where its edge turns more than this from the backbone's normal at its row
+    /// (a rib that bends to follow the backbone makes slivers). Degrees in (0, 180]; 180 = no bound (the
+    /// default here; FishboneParams::defaultTracing sets 60).
+    double maxRibTurnDeg = 180.0;
+    /// The fishbone scan stops a half-rib where an edge after its first crosses a visible crease of the
+    /// reference (FishboneParams::creaseAngleDeg > 0; a rib running onto a neighbouring face of a CAD part).
+    /// false here and in files written before it; FishboneParams::defaultTracing sets true.
+    bool stopRibsAtCreases = false;
 
-    /// Checks the ranges: spacing finite and > 0, and both tracings (StreamlineOptions::validate, named
+    /// Checks the ranges: spacing finite and > 0, minRibGap in [0, 1), maxRibTurnDeg in (0, 180], and both
+    /// tracings (StreamlineOptions::validate, named
     /// "FishboneOptions::backboneTracing.step" ...).
     /// \throw InvalidOptionError naming the field.
     void validate() const;
@@ -108,6 +122,13 @@ struct FishboneGrid {
     const Eigen::Vector2d& at(int r, int c) const { return screen[index(r, c)]; }
     std::size_t presentCount() const;
 };
+
+/// Stops the half-ribs of \p grid (rows = the samples of \p backbone) where \p options' minRibGap or
+/// maxRibTurnDeg says (FishboneOptions): rows in order, each half outwards from the backbone; a vertex and
+/// every one beyond it on its half-rib become absent. Of two ribs that converge the one of the lower row
+/// stops first, so the other goes on. Returns the number of vertices removed.
+/// \pre grid.rows == backbone.samples.size() ≥ 2.
+std::size_t trimRibs(FishboneGrid& grid, const Backbone& backbone, const FishboneOptions& options);
 
 /// [E0, {αᵢ}] of one rib half whose first vertex lies on the backbone (the paper's key-rib representation).
 /// Any polyline is accepted: fewer than two points give an empty shape. The turning angles are exact

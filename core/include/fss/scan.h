@@ -30,10 +30,20 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <optional>
 
 namespace fss {
 
-/// Options of sampleRegularGrid (and setSampleOnSurface).
+/// The lattice of sample positions on the screen of a regular scan (sampleLattice, DESIGN.md §1).
+enum class Lattice {
+    /// Rows √3/2 of a spacing apart, each row shifted by half a spacing against the one before: the
+    /// triangulation's grid triangles are equilateral on the screen (and on a surface facing the camera).
+    Triangular,
+    /// The pixel lattice of the paper: one sample per pixel centre (right isosceles triangles).
+    Square,
+};
+
+/// Options of sampleRegularGrid / sampleLattice (and setSampleOnSurface).
 struct ScanOptions {
     /// Id given to the grid (SampleGrid::scanId), later to the faces it becomes (props::faceScanId).
     std::int32_t scanId = -1;
@@ -43,12 +53,25 @@ struct ScanOptions {
     /// point by at most this many pixel footprints; a larger move means the face id and the depth disagree
     /// (a corrupted ID buffer), and the unprojected point is kept.
     double maxSnapFootprints = 2.0;
+    /// The lattice of sampleLattice (scanPatch). sampleRegularGrid always samples the pixel centres.
+    Lattice lattice = Lattice::Triangular;
+    /// Distance between neighbouring samples of sampleLattice, in pixels of the scan image; ≥ 0.25.
+    double spacingPixels = 1.0;
+    /// When > 0: the spacing in world units instead, converted to pixels with the pixel footprint at the
+    /// camera's focal point (latticeSpacingPixels).
+    double spacingWorld = 0.0;
 
-    /// Checks the ranges: qualityAngleLimitDeg in (0, 90), maxSnapFootprints finite and ≥ 0.
+    /// Checks the ranges: qualityAngleLimitDeg in (0, 90), maxSnapFootprints finite and ≥ 0, lattice one of
+    /// the enumerators, spacingPixels finite and in [0.25, 1024], spacingWorld finite and ≥ 0.
     /// \throw InvalidOptionError naming the field ("ScanOptions::qualityAngleLimitDeg must be in (0, 90), not
     ///        90.").
     void validate() const;
 };
+
+/// The spacing of \p options' lattice in pixels of \p camera's image: spacingWorld divided by the pixel
+/// footprint at the camera's focal point when spacingWorld > 0, else spacingPixels.
+/// \throw InvalidInputError when the world spacing gives less than 0.25 or more than 1024 pixels.
+double latticeSpacingPixels(const Camera& camera, const ScanOptions& options);
 
 /// The sampling quality q = footprint / max(cos(samplingAngle), cos(qualityAngleLimitDeg)) (see the file
 /// comment). \p samplingAngle in radians.
@@ -97,5 +120,45 @@ SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& r
 SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& reference,
                              ScanWorkspace& workspace, const ScanOptions& options = {},
                              const Progress& progress = {});
+
+/// The scan of scanPatch: the samples of \p options' lattice (ScanOptions::lattice, spacing).
+///  - Lattice::Square with a spacing of 1 pixel: sampleRegularGrid (the pixel centres, bit for bit).
+///  - Otherwise a lattice of screen positions, spacing s = latticeSpacingPixels: sample (r, c) at
+///    x = x0 + (c − r/2)·s, y = y0 + r·(√3/2)·s for Lattice::Triangular (x = x0 + c·s, y = y0 + r·s for
+///    Lattice::Square), centred in the image. The triangular lattice is stored *sheared*: its rows shift by
+///    half a spacing each, so the triangulation's fixed diagonal (r, c)–(r+1, c+1) (triangulate.h) is the
+///    lattice's short diagonal and every grid triangle is equilateral on the screen, with interior
+///    valence 6; the grid has about rows/2 more columns than fit across the image, and the samples
+///    outside it miss (hit = false). Masks work on it unchanged (their square windows in (row, column)
+///    become rhombi on the screen).
+///    Each sample is found as fishbone samples are (hitFromIdBuffer): the face the ID buffer shows under
+///    the sample's pixel is the first guess, the viewing ray through the exact screen position is
+///    intersected with it or with the faces a walk over the surface reaches. A sample whose pixel shows no
+///    surface, or whose ray the walk cannot place, misses.
+///    The sampling quality is multiplied by s (a coarser lattice makes longer edges, scan.h).
+/// \throw as sampleRegularGrid; InvalidInputError when the world spacing is out of range.
+SampleGrid sampleLattice(const FrameBuffers& referenceBuffers, const Mesh& reference,
+                         ScanWorkspace& workspace, const ScanOptions& options = {},
+                         const Progress& progress = {});
+
+/// Where the viewing ray \p ray through screen position \p screen meets the reference, found from the
+/// ID buffer (DESIGN.md §1, shared by sampleLattice and the fishbone scan).
+struct IdBufferHit {
+    FaceIndex face;        ///< the face hit
+    Eigen::Vector3d point; ///< the hit point
+    bool onHint = false;   ///< the face is the one under the sample's pixel (the first guess)
+};
+
+/// The face the ID buffer shows under the pixel of \p screen (clamped into the image), or
+/// Mesh::null_face() when it shows none or a face id beyond \p reference's faces.
+FaceIndex idBufferHint(const FrameBuffers& buffers, const Mesh& reference, const Eigen::Vector2d& screen);
+
+/// The hit of \p ray with the surface near \p hint (idBufferHint of \p screen): a walk over the
+/// surface from the hint towards the ray (at most \p maxWalkSteps faces; on meshes with faces smaller
+/// than a pixel the hit face is often a neighbour of the hint), else the nearest hit among the faces the
+/// ID buffer shows at the 8 pixels around. Nothing when neither finds one (a border or a silhouette).
+/// \pre \p hint is a face of \p reference.
+std::optional<IdBufferHit> hitFromIdBuffer(const FrameBuffers& buffers, const Mesh& reference, FaceIndex hint,
+                                           const Ray& ray, const Eigen::Vector2d& screen, int maxWalkSteps);
 
 } // namespace fss

@@ -32,12 +32,16 @@ struct ScanParams {
     ScanOptions scan;               ///< sampling options (scan id, quality angle limit)
     QualityMaskOptions quality;     ///< quality mask (margin, forceReplace)
     TriangulateOptions triangulate; ///< triangulation thresholds
+    /// Sweeps of tangential relaxation of the patch's interior vertices on the reference (connectivity and
+    /// border unchanged, moves that would cross a crease, turn a face or lower the local smallest angle are
+    /// refused; core/src/mesh/relax.h); 0 = none. In [0, 100].
+    int relaxIterations = 6;
 
     /// Checks everything a scan needs before it renders: the camera (Camera::validate), the erosion and
-    /// dilation radii (in [0, 1024]), the lasso (validateLasso) when there is one, and the scan,
-    /// quality-mask and triangulation options (their validate()). scanPatch, scanFishbonePatch and the
-    /// session-file reader call it.
-    /// \throw InvalidInputError with one sentence naming the problem; InvalidOptionError for an option out of
+    /// dilation radii (in [0, 1024]), relaxIterations (in [0, 100]), the lasso (validateLasso) when there is
+    /// one, and the scan, quality-mask and triangulation options (their validate()). scanPatch,
+    /// scanFishbonePatch and the session-file reader call it. \throw InvalidInputError with one sentence
+    /// naming the problem; InvalidOptionError for an option out of
     ///        range, named as a field of ScanParams ("ScanParams::quality.margin must be in [0, 1),
     ///        not 1.5.").
     void validate() const;
@@ -52,6 +56,7 @@ struct ScanTimings {
     double qualityMask = 0;
     double morphology = 0;
     double triangulate = 0;
+    double relax = 0; ///< tangential relaxation of the patch (ScanParams::relaxIterations)
     double total = 0;
 };
 

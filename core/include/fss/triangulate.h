@@ -10,7 +10,9 @@
 ///    normal and the viewing ray, exceeds `maxSamplingAngleDeg`;
 ///  - is flipped on the screen: its screen orientation (exact 2D orientation predicate on the samples'
 ///    screen positions) is not the grid's orientation, or it is degenerate (crossing fishbone ribs);
-///  - is back-facing: its 3D normal or a corner's reference normal points away from the viewer.
+///  - is back-facing: its 3D normal or a corner's reference normal points away from the viewer;
+///  - belongs to a quad with a 3D corner angle below `minQuadAngleDeg` (both triangles are dropped: a
+///    sliver of a fishbone grid whose ribs converge, issue #20).
 /// Vertices where the kept triangles meet in more than one fan (e.g. two quads touching only at a
 /// corner) are made manifold by removing the triangles of all but the largest fan (repeated until no
 /// such vertex is left). The result is a valid, edge-manifold, consistently oriented Surface_mesh whose
@@ -53,8 +55,12 @@ struct TriangulateOptions {
     /// A triangle with a corner sample, or a normal, at a larger angle to the viewing ray is a grazing
     /// sliver and is dropped. Degrees, in (0, 90].
     double maxSamplingAngleDeg = 80.0;
+    /// Both triangles of a quad are dropped when one of the quad's four corner angles in 3D is smaller.
+    /// Degrees, in [0, 90); 0 = no bound (session files written before it).
+    double minQuadAngleDeg = 20.0;
 
-    /// Checks the ranges: maxEdgeFootprints finite and > 0, maxSamplingAngleDeg in (0, 90].
+    /// Checks the ranges: maxEdgeFootprints finite and > 0, maxSamplingAngleDeg in (0, 90],
+    /// minQuadAngleDeg in [0, 90).
     /// \throw InvalidOptionError naming the field ("TriangulateOptions::maxEdgeFootprints must be a positive
     ///        finite number, not 0.").
     void validate() const;
@@ -65,6 +71,7 @@ struct TriangulateOptions {
 struct TriangulateReport {
     std::size_t quads = 0;                ///< grid quads with four valid samples (2 candidate triangles each)
     std::size_t flipped = 0;              ///< dropped: screen orientation against the grid's, or degenerate
+    std::size_t sliverQuads = 0;          ///< dropped: in a quad with a 3D angle below minQuadAngleDeg
     std::size_t backFacing = 0;           ///< dropped: 3D or reference normal facing away from the viewer
     std::size_t longEdges = 0;            ///< dropped: an edge longer than maxEdgeFootprints footprints
     std::size_t grazing = 0;              ///< dropped: sampling angle beyond maxSamplingAngleDeg

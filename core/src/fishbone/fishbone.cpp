@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <string>
 
@@ -338,6 +339,43 @@ FishboneGrid assembleFishboneGrid(const Backbone& backbone, const std::vector<Ri
     return g;
 }
 
+std::size_t trimRibs(FishboneGrid& grid, const Backbone& backbone, const FishboneOptions& options) {
+    if (grid.rows < 2 || std::size_t(grid.rows) != backbone.samples.size()) return 0;
+    const double minGap = options.minRibGap * grid.spacing;
+    const double cosTurn = std::cos(options.maxRibTurnDeg * std::numbers::pi / 180.0);
+    const bool turnBound = options.maxRibTurnDeg < 180.0;
+    if (!(minGap > 0) && !turnBound) return 0;
+    std::size_t removed = 0;
+    for (int r = 0; r < grid.rows; ++r) {
+        const Eigen::Vector2d normal = backbone.normal(std::size_t(r));
+        for (const int side : {1, -1}) {
+            bool stopped = false;
+            for (int c = grid.backboneColumn + side; c >= 0 && c < grid.cols; c += side) {
+                const std::size_t i = grid.index(r, c);
+                if (!grid.present[i]) {
+                    stopped = true; // a half-rib that has ended stays ended
+                    continue;
+                }
+                if (!stopped && grid.isPresent(r, c - side)) {
+                    const Eigen::Vector2d edge = grid.at(r, c) - grid.at(r, c - side);
+                    const double len = edge.norm();
+                    if (turnBound && len > 0 && (double(side) * edge).dot(normal) < cosTurn * len)
+                        stopped = true;
+                }
+                for (const int dr : {-1, 1})
+                    if (!stopped && minGap > 0 && grid.isPresent(r + dr, c) &&
+                        (grid.at(r + dr, c) - grid.at(r, c)).norm() < minGap)
+                        stopped = true;
+                if (stopped) {
+                    grid.present[i] = 0;
+                    ++removed;
+                }
+            }
+        }
+    }
+    return removed;
+}
+
 std::vector<Rib> traceAllRibs(const DirectionField& ribField, const Backbone& backbone,
                               const FishboneOptions& options) {
     requireBackbone(backbone);
@@ -362,7 +400,10 @@ FishboneGrid automaticFishbone(const DirectionField& backboneField, const Direct
     requireBackbone(backbone);
     // The ribs are independent streamlines: traced on several threads, each into its own slot (parallel.h).
     const std::vector<Rib> ribs = traceAllRibs(ribField, backbone, options);
-    return assembleFishboneGrid(backbone, ribs, options.spacing, ribField.width, ribField.height);
+    FishboneGrid grid =
+        assembleFishboneGrid(backbone, ribs, options.spacing, ribField.width, ribField.height);
+    trimRibs(grid, backbone, options);
+    return grid;
 }
 
 FishboneGrid keyRibFishbone(const Backbone& backbone, std::vector<KeyRib> keyRibs,
@@ -414,7 +455,9 @@ FishboneGrid keyRibFishbone(const Backbone& backbone, std::vector<KeyRib> keyRib
             ribs.push_back(blendRibs(a.rib, b.rib, p0, t, h));
         }
     }
-    return assembleFishboneGrid(part, ribs, h, width, height);
+    FishboneGrid grid = assembleFishboneGrid(part, ribs, h, width, height);
+    trimRibs(grid, part, options);
+    return grid;
 }
 
 } // namespace fss

@@ -62,6 +62,8 @@ void FishboneOptions::validate() const {
     const char* owner = "FishboneOptions";
     const detail::OptionCheck check(owner);
     check.positive("spacing", spacing);
+    check.inRange("minRibGap", minRibGap, 0, 1, false, true);
+    check.inRange("maxRibTurnDeg", maxRibTurnDeg, 0, 180, true, false);
     detail::nestedOptions(owner, "backboneTracing.", [&] { backboneTracing.validate(); });
     detail::nestedOptions(owner, "ribTracing.", [&] { ribTracing.validate(); });
 }

@@ -57,53 +57,6 @@ struct RayFactory {
     }
 };
 
-/// Walks over the mesh from face \p start towards the ray (a visibility walk in the ray's barycentric
-/// coordinates): in each face the ray's intersection with the face's plane has barycentric coordinates;
-/// when one is negative the walk crosses the edge opposite the most negative one. Returns the face the
-/// ray hits and the hit point, or nothing when the walk reaches a border, a face seen from its other side
-/// (a silhouette: the visible sheet ends there), a face the ray runs parallel to, or \p maxSteps faces.
-/// On meshes whose faces are smaller than a pixel the face under the rib vertex's pixel is often a
-/// neighbour of the hit face: the walk reaches it in a few steps, where a ring search tests dozens.
-std::optional<std::pair<FaceIndex, Eigen::Vector3d>> walkToHit(const Mesh& mesh, FaceIndex start,
-                                                               const Ray& ray, int maxSteps) {
-    FaceIndex f = start;
-    double startSign = 0;
-    for (int step = 0; step <= maxSteps; ++step) {
-        const HalfedgeIndex h0 = mesh.halfedge(f), h1 = mesh.next(h0), h2 = mesh.next(h1);
-        auto P = [&](VertexIndex v) {
-            const Point3& p = mesh.point(v);
-            return Eigen::Vector3d(p.x(), p.y(), p.z());
-        };
-        const Eigen::Vector3d a = P(mesh.source(h0)), b = P(mesh.target(h0)), c = P(mesh.target(h1));
-        const Eigen::Vector3d e1 = b - a, e2 = c - a, pv = ray.direction.cross(e2);
-        const double det = e1.dot(pv);
-        if (!(std::abs(det) >= 1e-14 * e1.norm() * e2.norm())) return std::nullopt;
-        if (step == 0) startSign = det;
-        if ((det > 0) != (startSign > 0)) return std::nullopt;
-        const Eigen::Vector3d tv = ray.origin - a, qv = tv.cross(e1);
-        const double u = tv.dot(pv) / det, v = ray.direction.dot(qv) / det, w = 1.0 - u - v; // of b, c, a
-        constexpr double eps = 1e-12;
-        if (u >= -eps && v >= -eps && w >= -eps) {
-            const double t = e2.dot(qv) / det;
-            if (t < 0) return std::nullopt;
-            return std::make_pair(f, Eigen::Vector3d(ray.origin + t * ray.direction));
-        }
-        // The edge opposite the most negative coordinate: a's is b→c (h1), b's is c→a (h2), c's is a→b (h0).
-        const HalfedgeIndex exit = (w <= u && w <= v) ? h1 : (u <= v ? h2 : h0);
-        const FaceIndex next = mesh.face(mesh.opposite(exit));
-        if (next == Mesh::null_face()) return std::nullopt;
-        f = next;
-    }
-    return std::nullopt;
-}
-
-/// The ray's hit on face \p f alone (the walk's test of one face: Möller–Trumbore, inclusive edges with a
-/// tiny tolerance), if any.
-std::optional<Eigen::Vector3d> hitOnFace(const Mesh& mesh, FaceIndex f, const Ray& ray) {
-    const auto hit = walkToHit(mesh, f, ray, 0);
-    return hit ? std::optional<Eigen::Vector3d>(hit->second) : std::nullopt;
-}
-
 /// A sharp edge of the reference as seen from the scan camera (screen positions of its end points).
 struct CreaseSegment {
     Eigen::Vector2d a, b;
@@ -195,6 +148,52 @@ public:
             }
         }
         return best;
+    }
+
+    /// Whether the segment \p a – \p b crosses a crease segment (proper crossing: each segment's end
+    /// points strictly on both sides of the other's line).
+    bool crosses(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const {
+        if (!a.allFinite() || !b.allFinite()) return false;
+        auto side = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
+            const double v = (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x();
+            return v > 0 ? 1 : (v < 0 ? -1 : 0);
+        };
+        const int x0 = cellOf(std::min(a.x(), b.x()), cellsX_), x1 = cellOf(std::max(a.x(), b.x()), cellsX_),
+                  y0 = cellOf(std::min(a.y(), b.y()), cellsY_), y1 = cellOf(std::max(a.y(), b.y()), cellsY_);
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x)
+                for (std::size_t i : cells_[std::size_t(y) * std::size_t(cellsX_) + std::size_t(x)]) {
+                    const CreaseSegment& s = segments_[i];
+                    if (side(a, b, s.a) * side(a, b, s.b) < 0 && side(s.a, s.b, a) * side(s.a, s.b, b) < 0)
+                        return true;
+                }
+        return false;
+    }
+
+    /// Stops the half-ribs of \p grid where an edge after the first (which starts on the backbone, maybe
+    /// on the crease it follows) crosses a crease: that edge's outer vertex and every one beyond become
+    /// absent. Returns the number of vertices removed.
+    std::size_t stopRibsAtCreases(FishboneGrid& grid) const {
+        std::size_t removed = 0;
+        for (int r = 0; r < grid.rows; ++r)
+            for (const int side : {1, -1}) {
+                bool stopped = false;
+                for (int c = grid.backboneColumn + 2 * side; c >= 0 && c < grid.cols; c += side) {
+                    const std::size_t i = grid.index(r, c);
+                    if (!grid.present[i]) {
+                        stopped = true;
+                        continue;
+                    }
+                    if (!stopped && grid.isPresent(r, c - side) &&
+                        crosses(grid.at(r, c - side), grid.at(r, c)))
+                        stopped = true;
+                    if (stopped) {
+                        grid.present[i] = 0;
+                        ++removed;
+                    }
+                }
+            }
+        return removed;
     }
 
 private:
@@ -300,6 +299,10 @@ FishboneOptions FishboneParams::defaultTracing() {
     // patch faces against 11 764 and 8 136).
     o.ribTracing.step = 1.0;
     o.ribTracing.maxTurnDeg = 12.0;
+    // Ribs that pile up, bend away from the backbone's normal or cross a crease stop (issue #20).
+    o.minRibGap = 0.5;
+    o.maxRibTurnDeg = 60.0;
+    o.stopRibsAtCreases = true;
     return o;
 }
 
@@ -322,7 +325,6 @@ SampleGrid rayCastFishbone(const FishboneGrid& fishbone, const FrameBuffers& ref
     grid.scanId = options.scanId;
     const RayFactory rays(camera);
     const CameraProjector projector(camera);
-    const std::size_t faceCount = reference.number_of_faces() + reference.number_of_removed_faces();
     // Rows (ribs) in blocks, one per thread (parallel.h): every rib vertex is cast on its own.
     const int blocks = detail::rowBlocks(fishbone.rows, 8);
     std::vector<std::size_t> localHits(static_cast<std::size_t>(blocks), 0);
@@ -334,40 +336,14 @@ SampleGrid rayCastFishbone(const FishboneGrid& fishbone, const FrameBuffers& ref
                 if (!fishbone.isPresent(r, c)) continue;
                 const Eigen::Vector2d& p = fishbone.at(r, c);
                 s.screen = p;
-                const int px = std::clamp(int(std::floor(p.x())), 0, w - 1);
-                const int py = std::clamp(int(std::floor(p.y())), 0, h - 1);
-                const std::uint32_t id = referenceBuffers.faceAt(px, py);
-                const FaceIndex hint =
-                    (id != FrameBuffers::kNoFace && id < faceCount) ? FaceIndex(id) : Mesh::null_face();
+                const FaceIndex hint = idBufferHint(referenceBuffers, reference, p);
                 const Ray ray = rays(p.x(), p.y());
                 if (hint != Mesh::null_face() && !search.verifyUnoccluded) {
-                    // Most rays hit the hint face (a rib vertex lies in the pixel whose centre shows it); the
-                    // walk tests it first, then moves over the surface towards the ray (faces smaller than a
-                    // pixel).
-                    if (const auto walked = walkToHit(reference, hint, ray, kMaxWalkSteps)) {
-                        if (walked->first == hint) ++local;
-                        setSampleOnSurface(s, reference, projector, walked->first, walked->second, options);
-                        continue;
-                    }
-                    // The faces under the 8 neighbouring pixels (the walk met a border or a silhouette):
-                    // nearest hit among them.
-                    std::optional<Eigen::Vector3d> best;
-                    FaceIndex bestFace;
-                    for (int dy = -1; dy <= 1; ++dy)
-                        for (int dx = -1; dx <= 1; ++dx) {
-                            const int x = px + dx, y = py + dy;
-                            if ((dx == 0 && dy == 0) || x < 0 || y < 0 || x >= w || y >= h) continue;
-                            const std::uint32_t nid = referenceBuffers.faceAt(x, y);
-                            if (nid == FrameBuffers::kNoFace || nid >= faceCount || nid == id) continue;
-                            if (const auto q = hitOnFace(reference, FaceIndex(nid), ray);
-                                q && (!best ||
-                                      (*q - ray.origin).squaredNorm() < (*best - ray.origin).squaredNorm())) {
-                                best = q;
-                                bestFace = FaceIndex(nid);
-                            }
-                        }
-                    if (best) {
-                        setSampleOnSurface(s, reference, projector, bestFace, *best, options);
+                    // The ID buffer's first guess, as a triangular-lattice scan finds its samples (scan.h).
+                    if (const auto found =
+                            hitFromIdBuffer(referenceBuffers, reference, hint, ray, p, kMaxWalkSteps)) {
+                        if (found->onHint) ++local;
+                        setSampleOnSurface(s, reference, projector, found->face, found->point, options);
                         continue;
                     }
                 }
@@ -460,6 +436,17 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
 
     progress.report(0.4, "tracing");
     t = Clock::now();
+    // The visible creases (crease following of the backbone, ribs stopped at creases), made once when needed.
+    std::optional<CreaseIndex> creaseIndex;
+    auto visible = [&]() -> const CreaseIndex& {
+        if (!creaseIndex)
+            creaseIndex.emplace(
+                fb.creaseAngleDeg > 0
+                    ? visibleCreases(reference, cache.creaseEdges(reference, fb.creaseAngleDeg), buffers)
+                    : std::vector<CreaseSegment>{},
+                fb.creaseSnapRadius, W, H);
+        return *creaseIndex;
+    };
     Backbone backbone;
     if (drawnBackbone) {
         backbone = fss::drawnBackbone(fb.drawnBackbone, options);
@@ -469,11 +456,7 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
             throw InvalidInputError("The fishbone seed " + shown(*fb.seed) +
                                     " lies on a flat or isotropic region where no principal direction is "
                                     "defined; pick a point on a curved feature.");
-        const CreaseIndex creases(
-            fb.creaseAngleDeg > 0
-                ? visibleCreases(reference, cache.creaseEdges(reference, fb.creaseAngleDeg), buffers)
-                : std::vector<CreaseSegment>{},
-            fb.creaseSnapRadius, W, H);
+        const CreaseIndex& creases = visible();
         FishboneOptions backboneOptions = options;
         if (!creases.empty())
             backboneOptions.backboneTracing.attractor = [&](const Eigen::Vector2d& q,
@@ -489,6 +472,7 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
         // The ribs are independent streamlines, traced on the scan threads (the grid is the same for any
         // thread count).
         result.fishbone = assembleFishboneGrid(backbone, traceAllRibs(ribField, backbone, options), h, W, H);
+        trimRibs(result.fishbone, backbone, options); // as automaticFishbone (fishbone.h)
     } else {
         std::vector<KeyRib> keys;
         std::vector<std::uint8_t> used(backbone.samples.size(), 0);
@@ -515,6 +499,7 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
         }
         result.fishbone = keyRibFishbone(backbone, std::move(keys), options, W, H);
     }
+    if (options.stopRibsAtCreases && fb.creaseAngleDeg > 0) visible().stopRibsAtCreases(result.fishbone);
     result.timings.tracing = secondsSince(t);
     result.counts.directionPixels = backboneField.computedPixels() + ribField.computedPixels();
     result.counts.rows = result.fishbone.rows;

@@ -7,12 +7,18 @@
 
 #include "base/option_check.h"
 
+#include <string>
+
 namespace fss {
 
 void ScanOptions::validate() const {
     const detail::OptionCheck check("ScanOptions");
     check.inRange("qualityAngleLimitDeg", qualityAngleLimitDeg, 0, 90, true, true);
     check.nonNegative("maxSnapFootprints", maxSnapFootprints);
+    if (lattice != Lattice::Triangular && lattice != Lattice::Square)
+        check.fail("lattice", "must be Triangular or Square, not " + std::to_string(int(lattice)));
+    check.inRange("spacingPixels", spacingPixels, 0.25, 1024, false, false);
+    check.nonNegative("spacingWorld", spacingWorld);
 }
 
 void QualityMaskOptions::validate() const {
@@ -25,6 +31,7 @@ void TriangulateOptions::validate() const {
     const detail::OptionCheck check("TriangulateOptions");
     check.positive("maxEdgeFootprints", maxEdgeFootprints);
     check.inRange("maxSamplingAngleDeg", maxSamplingAngleDeg, 0, 90, true, false);
+    check.inRange("minQuadAngleDeg", minQuadAngleDeg, 0, 90, false, true);
 }
 
 void ScanParams::validate() const {
@@ -33,6 +40,7 @@ void ScanParams::validate() const {
     const detail::OptionCheck check(owner);
     check.intRange("erodeRadius", erodeRadius, 0, 1024);
     check.intRange("dilateRadius", dilateRadius, 0, 1024);
+    check.intRange("relaxIterations", relaxIterations, 0, 100);
     if (lasso) validateLasso(*lasso);
     detail::nestedOptions(owner, "scan.", [&] { scan.validate(); });
     detail::nestedOptions(owner, "quality.", [&] { quality.validate(); });

@@ -3,9 +3,13 @@
 #include "fss/error.h"
 #include "fss/mask_triangulate.h"
 
+#include "mesh/relax.h"
+
+#include <algorithm>
 #include <chrono>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace fss {
 namespace {
@@ -18,6 +22,29 @@ double secondsSince(Clock::time_point t0) {
 
 void reportAt(const Progress& progress, const ProgressMark& mark) {
     if (!mark.stage.empty()) progress.report(mark.fraction, mark.stage);
+}
+
+// The patch's interior vertices relaxed on the reference (mesh/relax.h), each starting from its sample's
+// reference face and footprint.
+void relaxPatch(Patch& patch, const SampleGrid& grid, const Mesh& reference, const ScanParams& params) {
+    Mesh& mesh = patch.mesh;
+    const auto [gridIndex, found] = mesh.property_map<VertexIndex, GridIndex>(props::vertexGridIndex);
+    if (!found) return;
+    std::vector<VertexIndex> vertices;
+    std::vector<FaceIndex> hints;
+    std::vector<double> footprints;
+    for (VertexIndex v : mesh.vertices()) {
+        if (mesh.is_border(v)) continue;
+        const GridIndex g = gridIndex[v];
+        const Sample& s = grid.at(g.row, g.col);
+        if (s.face == Sample::kNoFace) continue;
+        vertices.push_back(v);
+        hints.push_back(FaceIndex(s.face));
+        footprints.push_back(double(s.footprint));
+    }
+    detail::RelaxOptions options;
+    options.iterations = params.relaxIterations;
+    detail::relaxOnReference(mesh, reference, vertices, hints, footprints, options, &grid.camera);
 }
 
 } // namespace
@@ -105,7 +132,7 @@ ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, con
 
     progress.report(0.4, "sample");
     t = Clock::now();
-    result.grid = sampleRegularGrid(referenceBuffers, reference, workspace, params.scan);
+    result.grid = sampleLattice(referenceBuffers, reference, workspace, params.scan);
     result.timings.sample = secondsSince(t);
     result.counts.covered = result.grid.hitCount();
     result.counts.frontFacing = result.grid.admissibleCount();
@@ -122,6 +149,8 @@ ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, con
     stages.quality = params.quality;
     stages.morphology = {.radius = params.erodeRadius, .dilateRadius = params.dilateRadius};
     stages.triangulate = params.triangulate;
+    // The edge limit is in pixel footprints; the lattice's edges are `spacing` pixels long.
+    stages.triangulate.maxEdgeFootprints *= std::max(1.0, latticeSpacingPixels(params.camera, params.scan));
     MaskedPatch masked = maskAndTriangulate(result.grid, stages, workspace, progress);
     result.patch = std::move(masked.patch);
     result.counts.afterLasso = masked.counts.afterLasso;
@@ -131,6 +160,11 @@ ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, con
     result.timings.qualityMask = masked.timings.qualityMask;
     result.timings.morphology = masked.timings.morphology;
     result.timings.triangulate = masked.timings.triangulate;
+    if (params.relaxIterations > 0) {
+        t = Clock::now();
+        relaxPatch(result.patch, result.grid, reference, params);
+        result.timings.relax = secondsSince(t);
+    }
     result.timings.total = secondsSince(start);
     progress.report(1.0, "done");
     return result;

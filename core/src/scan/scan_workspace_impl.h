@@ -27,7 +27,7 @@ struct ScanWorkspace::Impl {
         std::vector<std::uint8_t> keptIf; // of each candidate: kept if the grid is not mirrored, or if it is
         std::vector<std::uint8_t> top, bottom; // sample flags of the two rows of the quad row at hand
         std::size_t quads = 0, rightTurns = 0, leftTurns = 0;
-        std::array<std::array<std::size_t, 5>, 2> verdicts{}; // per verdict, if not mirrored / if mirrored
+        std::array<std::array<std::size_t, 6>, 2> verdicts{}; // per verdict, if not mirrored / if mirrored
     };
     std::vector<float> sampleQuality;
     std::vector<Block> blocks;

@@ -45,13 +45,27 @@ CGAL::Orientation screenOrientation(const SampleGrid& grid, const Triangle& t) {
     return CGAL::orientation(Point2(a.x(), a.y()), Point2(b.x(), b.y()), Point2(c.x(), c.y()));
 }
 
-enum class Verdict { Keep, Flipped, BackFacing, LongEdge, Grazing };
+enum class Verdict { Keep, Flipped, BackFacing, LongEdge, Grazing, SliverQuad };
 
 struct JudgeLimits {
     double maxEdgeFootprints;
     double maxAngle;    // radians
     double cosMaxAngle; // cos(maxAngle)
+    double cosMinQuad;  // cos(minQuadAngleDeg); > 1 when there is no bound
 };
+
+// A quad (corners in order around it) with a 3D corner angle below the bound (cos above cosMinQuad).
+bool sliverQuad(const SampleGrid& grid, std::array<std::uint32_t, 4> q, double cosMinQuad) {
+    if (!(cosMinQuad < 1)) return false;
+    for (std::size_t k = 0; k < 4; ++k) {
+        const Eigen::Vector3d& p = grid.samples[q[k]].point;
+        const Eigen::Vector3d u = grid.samples[q[(k + 1) % 4]].point - p,
+                              v = grid.samples[q[(k + 3) % 4]].point - p;
+        const double lu = u.norm(), lv = v.norm();
+        if (!(lu > 0 && lv > 0) || u.dot(v) > cosMinQuad * lu * lv) return true;
+    }
+    return false;
+}
 
 // Per-sample flags of usableSample (one byte per sample): the tests of judge() that depend on one sample
 // only, computed once per sample instead of once per triangle (a sample is a corner of up to six).
@@ -258,7 +272,9 @@ std::vector<Triangle>& judgeQuadTriangles(const SampleGrid& grid, const Triangul
                                           ScanWorkspace::Impl& w, TriangulateReport& report, bool& mirrored) {
     const Viewer viewer(grid.camera);
     const double maxAngle = options.maxSamplingAngleDeg * std::numbers::pi / 180.0;
-    const JudgeLimits limits{options.maxEdgeFootprints, maxAngle, std::cos(maxAngle)};
+    const JudgeLimits limits{
+        options.maxEdgeFootprints, maxAngle, std::cos(maxAngle),
+        options.minQuadAngleDeg > 0 ? std::cos(options.minQuadAngleDeg * std::numbers::pi / 180.0) : 2.0};
 
     // One pass over the quad rows, in blocks, one per thread (parallel.h), with the samples of a quad row
     // in cache: their own tests (sampleFlags, one byte per sample of the two rows at hand: every sample is
@@ -313,6 +329,7 @@ std::vector<Triangle>& judgeQuadTriangles(const SampleGrid& grid, const Triangul
                            i10 = std::uint32_t(grid.index(r + 1, c)),
                            i11 = std::uint32_t(grid.index(r + 1, c + 1));
                 ++out.quads;
+                const bool sliver = sliverQuad(grid, {i00, i01, i11, i10}, limits.cosMinQuad);
                 const std::uint8_t lower = top[c] | bottom[c] | bottom[c + 1],
                                    upper = top[c] | bottom[c + 1] | top[c + 1];
                 for (const auto& [t, corners] :
@@ -322,13 +339,16 @@ std::vector<Triangle>& judgeQuadTriangles(const SampleGrid& grid, const Triangul
                     out.leftTurns += (o == CGAL::LEFT_TURN);
                     // [0]: the verdicts if the grid is not mirrored, [1]: if it is.
                     if (o == CGAL::RIGHT_TURN) {
-                        const Verdict v = judge(grid, corners, t, viewer, limits);
+                        const Verdict v =
+                            sliver ? Verdict::SliverQuad : judge(grid, corners, t, viewer, limits);
                         ++out.verdicts[0][std::size_t(v)];
                         ++out.verdicts[1][std::size_t(Verdict::Flipped)];
                         if (v == Verdict::Keep)
                             out.candidates.push_back(t), out.keptIf.push_back(kKeptIfNotMirrored);
                     } else if (o == CGAL::LEFT_TURN) {
-                        const Verdict v = judge(grid, corners, Triangle{t[0], t[2], t[1]}, viewer, limits);
+                        const Verdict v =
+                            sliver ? Verdict::SliverQuad
+                                   : judge(grid, corners, Triangle{t[0], t[2], t[1]}, viewer, limits);
                         ++out.verdicts[0][std::size_t(Verdict::Flipped)];
                         ++out.verdicts[1][std::size_t(v)];
                         if (v == Verdict::Keep)
@@ -373,6 +393,7 @@ std::vector<Triangle>& judgeQuadTriangles(const SampleGrid& grid, const Triangul
         report.backFacing += v[std::size_t(Verdict::BackFacing)];
         report.longEdges += v[std::size_t(Verdict::LongEdge)];
         report.grazing += v[std::size_t(Verdict::Grazing)];
+        report.sliverQuads += v[std::size_t(Verdict::SliverQuad)];
     }
 
     return triangles;

@@ -111,6 +111,12 @@ struct Writer {
         Json t;
         t["spacing"] = number(p.tracing.spacing, f + ".tracing.spacing");
         t["extend_beyond_key_ribs"] = p.tracing.extendBeyondKeyRibs;
+        // The rib bounds only when set (absent: off, as in files written before them, issue #20).
+        if (p.tracing.minRibGap != 0)
+            t["min_rib_gap"] = number(p.tracing.minRibGap, f + ".tracing.min_rib_gap");
+        if (p.tracing.stopRibsAtCreases) t["stop_ribs_at_creases"] = true;
+        if (p.tracing.maxRibTurnDeg != 180)
+            t["max_rib_turn_deg"] = number(p.tracing.maxRibTurnDeg, f + ".tracing.max_rib_turn_deg");
         t["backbone"] = streamline(p.tracing.backboneTracing, f + ".tracing.backbone");
         t["ribs"] = streamline(p.tracing.ribTracing, f + ".tracing.ribs");
         j["tracing"] = std::move(t);
@@ -152,11 +158,18 @@ struct Writer {
         j["lasso"] = p.lasso ? points(p.lasso->points, f + ".lasso") : Json(nullptr);
         j["erode_radius"] = p.erodeRadius;
         j["dilate_radius"] = p.dilateRadius;
+        if (p.relaxIterations != 0) j["relax_iterations"] = p.relaxIterations; // absent: 0 (issue #20)
         j["scan"] = {
             {"scan_id", p.scan.scanId},
             {"quality_angle_limit_deg",
              number(p.scan.qualityAngleLimitDeg, f + ".scan.quality_angle_limit_deg")},
             {"max_snap_footprints", number(p.scan.maxSnapFootprints, f + ".scan.max_snap_footprints")}};
+        // The lattice only when it is not the pixel lattice, which files without it mean (issue #20).
+        if (p.scan.lattice != Lattice::Square || p.scan.spacingPixels != 1.0 || p.scan.spacingWorld != 0.0) {
+            j["scan"]["lattice"] = p.scan.lattice == Lattice::Triangular ? "triangular" : "square";
+            j["scan"]["spacing_px"] = number(p.scan.spacingPixels, f + ".scan.spacing_px");
+            j["scan"]["spacing_world"] = number(p.scan.spacingWorld, f + ".scan.spacing_world");
+        }
         j["quality_mask"] = {{"margin", number(p.quality.margin, f + ".quality_mask.margin")},
                              {"force_replace", p.quality.forceReplace},
                              {"search_rings", p.quality.searchRings}};
@@ -164,6 +177,9 @@ struct Writer {
                              number(p.triangulate.maxEdgeFootprints, f + ".triangulate.max_edge_footprints")},
                             {"max_sampling_angle_deg", number(p.triangulate.maxSamplingAngleDeg,
                                                               f + ".triangulate.max_sampling_angle_deg")}};
+        if (p.triangulate.minQuadAngleDeg != 0) // absent: 0, as files written before it (issue #20)
+            j["triangulate"]["min_quad_angle_deg"] =
+                number(p.triangulate.minQuadAngleDeg, f + ".triangulate.min_quad_angle_deg");
         j["grid"] = s.fishbone ? "fishbone" : "regular";
         if (s.fishbone) j["fishbone"] = fishbone(*s.fishbone, f + ".fishbone");
         j["stitch"] = stitch(s.stitch, f + ".stitch");
@@ -436,9 +452,13 @@ FishboneParams readFishbone(const Node& n) {
         p.drawnKeyRibs.push_back(drawn.element(i).points());
     p.drawnBackbone = n.at("drawn_backbone").points();
     const Node t = n.at("tracing");
-    t.onlyKeys({"spacing", "extend_beyond_key_ribs", "backbone", "ribs"});
+    t.onlyKeys({"spacing", "extend_beyond_key_ribs", "backbone", "ribs", "min_rib_gap", "max_rib_turn_deg",
+                "stop_ribs_at_creases"});
     p.tracing.spacing = t.at("spacing").number();
     p.tracing.extendBeyondKeyRibs = t.at("extend_beyond_key_ribs").boolean();
+    p.tracing.minRibGap = t.has("min_rib_gap") ? t.at("min_rib_gap").number() : 0.0;
+    p.tracing.maxRibTurnDeg = t.has("max_rib_turn_deg") ? t.at("max_rib_turn_deg").number() : 180.0;
+    p.tracing.stopRibsAtCreases = t.has("stop_ribs_at_creases") && t.at("stop_ribs_at_creases").boolean();
     p.tracing.backboneTracing = readStreamline(t.at("backbone"));
     p.tracing.ribTracing = readStreamline(t.at("ribs"));
     p.minSeedAnisotropy = n.at("min_seed_anisotropy").number();
@@ -484,8 +504,8 @@ StitchOptions readStitch(const Node& n) {
 }
 
 ScanStep readStep(const Node& n) {
-    n.onlyKeys({"camera", "lasso", "erode_radius", "dilate_radius", "scan", "quality_mask", "triangulate",
-                "grid", "fishbone", "stitch"});
+    n.onlyKeys({"camera", "lasso", "erode_radius", "dilate_radius", "relax_iterations", "scan",
+                "quality_mask", "triangulate", "grid", "fishbone", "stitch"});
     ScanStep step;
     ScanParams& p = step.params;
     p.camera = readCamera(n.at("camera"));
@@ -500,23 +520,36 @@ ScanStep readStep(const Node& n) {
     }
     p.erodeRadius = intField(n.at("erode_radius"));
     p.dilateRadius = intField(n.at("dilate_radius"));
+    // Files written before the patch relaxation (issue #20) did not relax.
+    p.relaxIterations = n.has("relax_iterations") ? intField(n.at("relax_iterations")) : 0;
     const Node scan = n.at("scan");
-    scan.onlyKeys({"scan_id", "quality_angle_limit_deg", "max_snap_footprints"});
+    scan.onlyKeys({"scan_id", "quality_angle_limit_deg", "max_snap_footprints", "lattice", "spacing_px",
+                   "spacing_world"});
     p.scan.scanId = std::int32_t(scan.at("scan_id").integer(std::numeric_limits<std::int32_t>::min(),
                                                             std::numeric_limits<std::int32_t>::max(),
                                                             "a 32-bit integer"));
     p.scan.qualityAngleLimitDeg = scan.at("quality_angle_limit_deg").number();
     p.scan.maxSnapFootprints = scan.at("max_snap_footprints").number();
+    // Files written before the triangular lattice (issue #20) scanned on the pixel lattice.
+    p.scan.lattice =
+        scan.has("lattice") && scan.at("lattice").choice({"triangular", "square"}) == "triangular"
+            ? Lattice::Triangular
+            : Lattice::Square;
+    p.scan.spacingPixels = scan.has("spacing_px") ? scan.at("spacing_px").number() : 1.0;
+    p.scan.spacingWorld = scan.has("spacing_world") ? scan.at("spacing_world").number() : 0.0;
     const Node quality = n.at("quality_mask");
     quality.onlyKeys({"margin", "force_replace", "search_rings"});
     p.quality.margin = quality.at("margin").number();
     p.quality.forceReplace = quality.at("force_replace").boolean();
     p.quality.searchRings = intField(quality.at("search_rings"));
     const Node tri = n.at("triangulate");
-    tri.onlyKeys({"max_edge_footprints", "max_sampling_angle_deg"});
+    tri.onlyKeys({"max_edge_footprints", "max_sampling_angle_deg", "min_quad_angle_deg"});
     p.triangulate.maxEdgeFootprints = tri.at("max_edge_footprints").number();
     p.triangulate.maxSamplingAngleDeg = tri.at("max_sampling_angle_deg").number();
-    validated(n, [&] { p.validate(); }, {{"quality.", "quality_mask."}});
+    p.triangulate.minQuadAngleDeg =
+        tri.has("min_quad_angle_deg") ? tri.at("min_quad_angle_deg").number() : 0.0;
+    validated(n, [&] { p.validate(); },
+              {{"quality.", "quality_mask."}, {"scan.spacingPixels", "scan.spacing_px"}});
     const bool fishbone = n.at("grid").choice({"regular", "fishbone"}) == "fishbone";
     if (fishbone) {
         const Node fb = n.at("fishbone");

@@ -1,0 +1,144 @@
+#include "mesh/relax.h"
+
+#include "fss/raycast.h"
+
+#include "mesh/triangle_geometry.h"
+
+#include <CGAL/boost/graph/iterator.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <optional>
+
+namespace fss::detail {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+Eigen::Vector3d unitFaceNormal(const Mesh& m, FaceIndex f) {
+    const HalfedgeIndex h = m.halfedge(f);
+    return unitNormal(pos(m, m.source(h)), pos(m, m.target(h)), pos(m, m.target(m.next(h))));
+}
+
+// A crease edge of the reference that \p p lies on: its end points.
+struct CreaseLine {
+    Eigen::Vector3d a, b;
+};
+
+// The sharp edge of face \p f (dihedral angle beyond \p cosCrease) that \p p lies on, within \p tolerance.
+std::optional<CreaseLine> creaseUnder(const Mesh& ref, FaceIndex f, const Eigen::Vector3d& p,
+                                      double cosCrease, double tolerance) {
+    const Eigen::Vector3d n = unitFaceNormal(ref, f);
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(ref.halfedge(f), ref)) {
+        const FaceIndex g = ref.face(ref.opposite(h));
+        if (g == Mesh::null_face()) continue;
+        const Eigen::Vector3d m = unitFaceNormal(ref, g);
+        if (!(n.squaredNorm() > 0 && m.squaredNorm() > 0) || n.dot(m) >= cosCrease) continue;
+        const Eigen::Vector3d a = pos(ref, ref.source(h)), b = pos(ref, ref.target(h));
+        const Eigen::Vector3d ab = b - a;
+        const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+        if ((a + t * ab - p).norm() <= tolerance) return CreaseLine{a, b};
+    }
+    return std::nullopt;
+}
+
+// The smallest angle of the faces around \p v, and whether each is acceptable after a move (normal turned
+// by less than the bound from \p before, not degenerate, facing the camera).
+struct Ring {
+    std::vector<Eigen::Vector3d> normals; // by incident face, in circulation order
+    double minAngle = 0;
+    bool ok = true;
+};
+
+Ring ringOf(const Mesh& m, VertexIndex v, const Eigen::Vector3d& at, const Ring* before, double cosTurn,
+            const Camera* facing) {
+    Ring ring;
+    ring.minAngle = std::numbers::pi;
+    std::size_t k = 0;
+    for (HalfedgeIndex h : CGAL::halfedges_around_target(m.halfedge(v), m)) {
+        if (m.is_border(h)) continue;
+        const Eigen::Vector3d b = pos(m, m.source(h)), c = pos(m, m.target(m.next(h)));
+        const Eigen::Vector3d n = unitNormal(b, at, c); // the face (source, v, next's target) in its order
+        ring.minAngle = std::min(ring.minAngle, minAngle(b, at, c));
+        ring.normals.push_back(n);
+        if (!(n.squaredNorm() > 0)) ring.ok = false;
+        if (before && k < before->normals.size() && before->normals[k].dot(n) < cosTurn) ring.ok = false;
+        if (facing && ring.ok) {
+            const Eigen::Vector3d centroid = (b + at + c) / 3.0;
+            const Eigen::Vector3d toViewer = facing->parallel ? Eigen::Vector3d(-facing->viewDirection())
+                                                              : Eigen::Vector3d(facing->eye - centroid);
+            if (!(n.dot(toViewer) > 0)) ring.ok = false;
+        }
+        ++k;
+    }
+    return ring;
+}
+
+} // namespace
+
+RelaxReport relaxOnReference(Mesh& mesh, const Mesh& reference, const std::vector<VertexIndex>& vertices,
+                             std::vector<FaceIndex>& hints, const std::vector<double>& footprints,
+                             const RelaxOptions& options, const Camera* facing) {
+    RelaxReport report;
+    report.vertices = vertices.size();
+    if (options.iterations <= 0 || vertices.empty()) return report;
+    const double cosCrease = std::cos(options.creaseAngleDeg * kDeg);
+    const double cosTurn = std::cos(options.maxNormalTurnDeg * kDeg);
+    // Per vertex: its first reference face's normal (moves may not cross a crease away from it) and the
+    // crease it lies on, if any.
+    std::vector<Eigen::Vector3d> firstNormal(vertices.size());
+    std::vector<std::optional<CreaseLine>> crease(vertices.size());
+    for (std::size_t k = 0; k < vertices.size(); ++k) {
+        firstNormal[k] = unitFaceNormal(reference, hints[k]);
+        crease[k] = creaseUnder(reference, hints[k], pos(mesh, vertices[k]), cosCrease, 1e-6 * footprints[k]);
+        report.onCrease += crease[k].has_value();
+    }
+    const LocalSearchOptions search{.rings = 1};
+    for (int sweep = 0; sweep < options.iterations; ++sweep) {
+        for (std::size_t k = 0; k < vertices.size(); ++k) {
+            const VertexIndex v = vertices[k];
+            const Eigen::Vector3d p = pos(mesh, v);
+            Eigen::Vector3d centroid(0, 0, 0);
+            int n = 0;
+            for (VertexIndex w : CGAL::vertices_around_target(mesh.halfedge(v), mesh)) {
+                centroid += pos(mesh, w);
+                ++n;
+            }
+            if (n < 3) continue;
+            const Eigen::Vector3d d = centroid / double(n) - p;
+            Eigen::Vector3d target;
+            FaceIndex face = hints[k];
+            if (crease[k]) { // along the crease edge only, kept within it
+                const Eigen::Vector3d ab = crease[k]->b - crease[k]->a;
+                const double t =
+                    std::clamp((p + options.step * d - crease[k]->a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+                target = crease[k]->a + t * ab;
+            } else {
+                const Eigen::Vector3d normal = unitFaceNormal(reference, hints[k]);
+                const Eigen::Vector3d moved = p + options.step * (d - d.dot(normal) * normal);
+                const SurfacePoint onRef = closestPointNear(reference, moved, hints[k], search);
+                if (!onRef || onRef.distance > options.maxOffFootprints * footprints[k] ||
+                    unitFaceNormal(reference, onRef.face).dot(firstNormal[k]) < cosCrease) {
+                    ++report.refused;
+                    continue;
+                }
+                target = onRef.point;
+                face = onRef.face;
+            }
+            if ((target - p).squaredNorm() == 0) continue;
+            const Ring before = ringOf(mesh, v, p, nullptr, cosTurn, facing);
+            const Ring after = ringOf(mesh, v, target, &before, cosTurn, facing);
+            if (!after.ok || after.minAngle < before.minAngle) {
+                ++report.refused;
+                continue;
+            }
+            mesh.point(v) = Point3(target.x(), target.y(), target.z());
+            hints[k] = face;
+            ++report.moves;
+        }
+    }
+    return report;
+}
+
+} // namespace fss::detail
