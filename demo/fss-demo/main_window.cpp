@@ -1,8 +1,10 @@
 #include "main_window.h"
 
 #include <fss/error.h>
+#include <fss/face_groups.h>
 #include <fss/mesh_io.h>
 #include <fss/metrics.h>
+#include <fss/render/fem_io.h>
 
 #include <QActionGroup>
 #include <QApplication>
@@ -133,7 +135,7 @@ void MainWindow::setColorMap(widgets::ColorMap map) {
 bool MainWindow::openMesh(const QString& path) {
     Mesh mesh;
     try {
-        mesh = readMesh(path.toStdString());
+        mesh = render::readMeshFile(path.toStdString());
     } catch (const std::exception& e) {
         reportError(tr("Open mesh"), QString::fromStdString(e.what()));
         return false;
@@ -154,7 +156,9 @@ bool MainWindow::openMesh(const QString& path) {
 
 bool MainWindow::saveMesh(const QString& path) {
     try {
-        writeMesh(mesh(), path.toStdString());
+        Mesh out = mesh();
+        if (hasFaceGroups(remesh_->referenceMesh())) transferFaceGroups(remesh_->referenceMesh(), out);
+        render::writeMeshFile(out, path.toStdString());
     } catch (const std::exception& e) {
         reportError(tr("Save mesh"), QString::fromStdString(e.what()));
         return false;
@@ -236,16 +240,20 @@ void MainWindow::updateStatistics() {
 }
 
 void MainWindow::openDialog() {
-    const QString path = QFileDialog::getOpenFileName(this, tr("Open mesh"), QFileInfo(meshPath_).path(),
-                                                      tr("Meshes (*.off *.obj *.ply *.stl);;OFF (*.off);;OBJ "
-                                                         "(*.obj);;PLY (*.ply);;STL (*.stl);;All files (*)"));
+    const QString path =
+        QFileDialog::getOpenFileName(this, tr("Open mesh"), QFileInfo(meshPath_).path(),
+                                     tr("Meshes (*.off *.obj *.ply *.stl *.msh *.vtu *.vtp *.vtk);;OFF "
+                                        "(*.off);;OBJ (*.obj);;PLY (*.ply);;STL (*.stl);;gmsh MSH "
+                                        "(*.msh);;VTK (*.vtu *.vtp *.vtk);;All files (*)"));
     if (!path.isEmpty()) openMesh(path);
 }
 
 void MainWindow::saveDialog() {
     const QString path = QFileDialog::getSaveFileName(
         this, tr("Save mesh"), meshPath_,
-        tr("PLY, keeps scan ids and quality (*.ply);;OFF (*.off);;OBJ (*.obj);;STL (*.stl)"));
+        tr("PLY, keeps scan ids and quality (*.ply);;OFF (*.off);;OBJ (*.obj);;STL (*.stl);;gmsh MSH 4.1, "
+           "groups as physical surfaces (*.msh);;Abaqus INP (*.inp);;Nastran BDF (*.bdf *.nas);;I-deas UNV "
+           "(*.unv);;VTK unstructured grid (*.vtu);;VTK poly data (*.vtp)"));
     if (!path.isEmpty()) saveMesh(path);
 }
 
