@@ -1,6 +1,8 @@
 // Everything that talks to VTK for the FEM hand-off (fss/render/fem_io.h): VTU / VTP written by VTK's XML
-// writers with the groups as integer cell data `group` and their names as field data `group_names`; VTU,
-// VTP and legacy VTK files read by VTK's readers.
+// writers with the groups as integer cell data `group` and each group's name as a one-value integer field
+// data array "group:<name>" holding its value (the convention meshio uses for names; a vtkStringArray would
+// be the obvious choice, but meshio 5 refuses VTU files with String arrays, measured); VTU, VTP and legacy
+// VTK files read by VTK's readers.
 #include "fem_detail.h"
 
 #include "fss/face_groups.h"
@@ -16,11 +18,12 @@
 #include <vtkIdList.h>
 #include <vtkIntArray.h>
 #include <vtkNew.h>
+#include <vtkObjectFactory.h>
+#include <vtkOutputWindow.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataReader.h>
 #include <vtkSmartPointer.h>
-#include <vtkStringArray.h>
 #include <vtkType.h>
 #include <vtkUnstructuredGrid.h>
 #include <vtkUnstructuredGridReader.h>
@@ -33,6 +36,7 @@
 #include <cctype>
 #include <cmath>
 #include <map>
+#include <string_view>
 
 namespace fs = std::filesystem;
 
@@ -46,13 +50,62 @@ std::string lowerExtension(const fs::path& path) {
     return ext;
 }
 
-/// Points, the triangles' and edges' connectivity, cell data `group`, field data `group_names`.
+constexpr std::string_view kNamePrefix = "group:";
+
+/// Collects VTK's error and warning texts instead of printing them (a bad file must give one sentence).
+class QuietOutputWindow : public vtkOutputWindow {
+public:
+    static QuietOutputWindow* New();
+    vtkTypeMacro(QuietOutputWindow, vtkOutputWindow);
+    std::string firstError;
+    void DisplayErrorText(const char* text) override {
+        if (firstError.empty() && text) firstError = text;
+    }
+    void DisplayWarningText(const char*) override {}
+    void DisplayGenericWarningText(const char*) override {}
+    void DisplayText(const char*) override {}
+
+protected:
+    QuietOutputWindow() = default;
+    ~QuietOutputWindow() override = default;
+};
+vtkStandardNewMacro(QuietOutputWindow);
+
+/// VTK's process-wide output window replaced by a QuietOutputWindow for the lifetime of the object.
+class ScopedQuietVtk {
+public:
+    ScopedQuietVtk() : previous_(vtkOutputWindow::GetInstance()) { vtkOutputWindow::SetInstance(quiet_); }
+    ~ScopedQuietVtk() { vtkOutputWindow::SetInstance(previous_); }
+    ScopedQuietVtk(const ScopedQuietVtk&) = delete;
+    ScopedQuietVtk& operator=(const ScopedQuietVtk&) = delete;
+    /// The last line of VTK's first error (the line that names the problem), or "".
+    std::string error() const {
+        std::string e = quiet_->firstError;
+        while (!e.empty() && (e.back() == '\n' || e.back() == ' '))
+            e.pop_back();
+        const std::size_t nl = e.rfind('\n');
+        return nl == std::string::npos ? e : e.substr(nl + 1);
+    }
+
+private:
+    vtkSmartPointer<vtkOutputWindow> previous_;
+    vtkNew<QuietOutputWindow> quiet_;
+};
+
+/// Points, the triangles' and edges' connectivity, cell data `group`, field data "group:<name>".
 struct VtkParts {
     vtkNew<vtkPoints> points;
     vtkNew<vtkCellArray> triangles, lines;
     vtkNew<vtkIntArray> group;
-    vtkNew<vtkStringArray> names;
+    std::vector<vtkSmartPointer<vtkIntArray>> names;
 };
+
+void addName(VtkParts& v, const std::string& name, int value) {
+    auto array = vtkSmartPointer<vtkIntArray>::New();
+    array->SetName((std::string(kNamePrefix) + name).c_str());
+    array->InsertNextValue(value);
+    v.names.push_back(array);
+}
 
 void fill(const FemMesh& m, VtkParts& v) {
     v.points->SetDataTypeToDouble();
@@ -68,10 +121,9 @@ void fill(const FemMesh& m, VtkParts& v) {
         v.lines->InsertNextCell(2, ids);
     }
     v.group->SetName("group");
-    v.names->SetName("group_names");
-    for (const std::string& n : m.groupNames)
-        v.names->InsertNextValue(n);
-    if (!m.edges.empty()) v.names->InsertNextValue(m.edgeGroup);
+    for (std::size_t g = 0; g < m.groupNames.size(); ++g)
+        addName(v, m.groupNames[g], int(g));
+    if (!m.edges.empty()) addName(v, m.edgeGroup, int(m.groupNames.size()));
 }
 
 template <class Writer>
@@ -114,9 +166,16 @@ PolygonSoup toSoup(vtkDataSet* data, const fs::path& path) {
     }
     vtkDataArray* group = groupArray(data, path);
     std::map<long long, std::string> names;
-    if (auto* table = vtkStringArray::SafeDownCast(data->GetFieldData()->GetAbstractArray("group_names")))
-        for (vtkIdType i = 0; i < table->GetNumberOfValues(); ++i)
-            names[i] = table->GetValue(i);
+    vtkFieldData* field = data->GetFieldData();
+    for (int i = 0; field && i < field->GetNumberOfArrays(); ++i) {
+        vtkDataArray* a = field->GetArray(i);
+        const char* n = field->GetArrayName(i);
+        if (!a || !n || a->GetNumberOfTuples() != 1 || a->GetNumberOfComponents() != 1) continue;
+        const std::string_view name(n);
+        if (name.substr(0, kNamePrefix.size()) == kNamePrefix && name.size() > kNamePrefix.size())
+            names[static_cast<long long>(a->GetComponent(0, 0))] =
+                std::string(name.substr(kNamePrefix.size()));
+    }
     std::map<long long, std::int32_t> indexOfValue;
     vtkNew<vtkIdList> ids;
     const vtkIdType nc = data->GetNumberOfCells();
@@ -204,7 +263,8 @@ void writeVtk(const FemMesh& m, const fs::path& path, const FemWriteOptions& opt
             parts.group->InsertNextValue(edgeGroup);
         }
         grid->GetCellData()->AddArray(parts.group);
-        grid->GetFieldData()->AddArray(parts.names);
+        for (const auto& a : parts.names)
+            grid->GetFieldData()->AddArray(a);
         vtkNew<vtkXMLUnstructuredGridWriter> writer;
         writer->SetInputData(grid);
         finishWrite(writer.Get(), path, options);
@@ -220,7 +280,8 @@ void writeVtk(const FemMesh& m, const fs::path& path, const FemWriteOptions& opt
     for (std::int32_t g : m.group)
         parts.group->InsertNextValue(g);
     poly->GetCellData()->AddArray(parts.group);
-    poly->GetFieldData()->AddArray(parts.names);
+    for (const auto& a : parts.names)
+        poly->GetFieldData()->AddArray(a);
     vtkNew<vtkXMLPolyDataWriter> writer;
     writer->SetInputData(poly);
     finishWrite(writer.Get(), path, options);
@@ -228,6 +289,7 @@ void writeVtk(const FemMesh& m, const fs::path& path, const FemWriteOptions& opt
 
 PolygonSoup readVtk(const fs::path& path) {
     const std::string ext = lowerExtension(path);
+    const ScopedQuietVtk quiet;
     vtkSmartPointer<vtkDataSet> data;
     if (ext == ".vtu") {
         vtkNew<vtkXMLUnstructuredGridReader> reader;
@@ -250,6 +312,7 @@ PolygonSoup readVtk(const fs::path& path) {
         else
             failRead(path, "it is not a legacy VTK file of an unstructured grid or poly data");
     }
+    if (!quiet.error().empty()) failRead(path, "VTK's reader reports: " + quiet.error());
     if (!data) failRead(path, "VTK's reader could not read it");
     return toSoup(data, path);
 }

@@ -15,7 +15,9 @@ Soup readObj(const Source& src, ReadReport& report) {
     Soup soup;
     std::vector<std::size_t> faceLine;
     std::string_view line, t;
-    std::int32_t group = kNoGroup; // the group of the last `g` or `o` statement
+    // The group of the last `g` or `o` statement; a name enters the table with its first face.
+    std::string groupName;
+    std::int32_t group = kNoGroup;
     bool grouped = false;
     while (lines.next(line)) {
         Tokens tok(line);
@@ -58,6 +60,7 @@ Soup readObj(const Source& src, ReadReport& report) {
                 src.fail(where + face + " has " + std::to_string(poly.size()) +
                          " corners, but a face needs at least 3");
             soup.polygons.push_back(std::move(poly));
+            if (grouped && group == kNoGroup) group = groupIndex(soup, groupName);
             soup.group.push_back(group);
             faceLine.push_back(lines.number());
         } else if (t == "g" || t == "o") {
@@ -67,7 +70,8 @@ Soup readObj(const Source& src, ReadReport& report) {
             if (tok.next(extra))
                 src.fail(where + "the group statement names more than one group (" + quoteToken(name) +
                          " and " + quoteToken(extra) + "), but FSS holds one group per face");
-            group = groupIndex(soup, name);
+            groupName = std::string(name);
+            group = kNoGroup;
             grouped = true;
         } else if (std::find(std::begin(ignored), std::end(ignored), t) == std::end(ignored)) {
             src.fail(where + "unknown OBJ statement " + quoteToken(t));
