@@ -81,7 +81,7 @@ public:
     /// The last line of VTK's first error (the line that names the problem), or "".
     std::string error() const {
         std::string e = quiet_->firstError;
-        while (!e.empty() && (e.back() == '\n' || e.back() == ' '))
+        while (!e.empty() && (e.back() == '\n' || e.back() == ' ' || e.back() == '.'))
             e.pop_back();
         const std::size_t nl = e.rfind('\n');
         return nl == std::string::npos ? e : e.substr(nl + 1);
