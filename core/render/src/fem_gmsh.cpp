@@ -75,7 +75,8 @@ void writeGmsh(const FemMesh& m, const fs::path& path, const FemWriteOptions& op
                 coords.insert(coords.end(), m.nodes[i].begin(), m.nodes[i].end());
             }
             gmsh::model::mesh::addNodes(2, 1, nodeTags, coords);
-            std::vector<std::vector<std::size_t>> tags(std::size_t(groups)), nodes(std::size_t(groups));
+            std::vector<std::vector<std::size_t>> tags(static_cast<std::size_t>(groups)),
+                nodes(static_cast<std::size_t>(groups));
             for (std::size_t t = 0; t < m.triangles.size(); ++t) {
                 const auto g = std::size_t(m.group[t]);
                 tags[g].push_back(t + 1);
