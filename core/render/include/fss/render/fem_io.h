@@ -64,10 +64,10 @@ void writeMeshFile(const Mesh& mesh, const std::filesystem::path& path, const Fe
                    const WriteOptions& coreOptions = {});
 
 /// Reads a mesh: .vtu .vtp .vtk by VTK's readers and .msh by gmsh (triangles and quads of the file; groups
-/// from the integer cell data `group` (names from field data "group:<name>" arrays, else "group_<value>") or from
-/// MSH physical surfaces), then checked and repaired as fss::readMesh does (fss::meshFromPolygons); every
-/// other extension by fss::readMesh.
-/// \throw IoError (one sentence naming the file) when the file is missing or unreadable, has no triangles,
+/// from the integer cell data `group` (names from field data "group:<name>" arrays, else "group_<value>") or
+/// from MSH physical surfaces), then checked and repaired as fss::readMesh does (fss::meshFromPolygons);
+/// every other extension by fss::readMesh. \throw IoError (one sentence naming the file) when the file is
+/// missing or unreadable, has no triangles,
 ///        has cells other than vertices, lines, triangles, quads and polygons, or a `group` array that is not
 ///        one integer per cell.
 Mesh readMeshFile(const std::filesystem::path& path, ReadReport* report = nullptr,
