@@ -226,7 +226,8 @@ std::map<std::string, std::pair<std::size_t, double>> infoGroups(const std::stri
     EXPECT_EQ(r.exitCode, 0) << r.err;
     std::map<std::string, std::pair<std::size_t, double>> out;
     if (r.exitCode != 0) return out;
-    for (const auto& g : nlohmann::json::parse(r.out).at("groups"))
+    const nlohmann::json report = nlohmann::json::parse(r.out); // a named object: the loop must not dangle
+    for (const auto& g : report.at("groups"))
         out[g.at("name").get<std::string>()] = {g.at("faces").get<std::size_t>(), g.at("area").get<double>()};
     return out;
 }
