@@ -44,3 +44,39 @@ function(fss_target_warnings target)
     endif()
   endif()
 endfunction()
+
+# Unity builds (FSS_UNITY_BUILD, ON by default): the sources of a library or program compile as few
+# translation units, so CGAL's, Qt's, VTK's and the standard library's headers are parsed, and their
+# templates instantiated, once per unit instead of once per file — most of a clean build's CPU time on two
+# cores. Consequence for the code: the .cpp files of one unit must not define the same name in their
+# anonymous namespaces. Developers who edit one file over and over may prefer -DFSS_UNITY_BUILD=OFF.
+option(FSS_UNITY_BUILD "Compile each library's and program's sources as few translation units" ON)
+
+# fss_unity_build(target [GROUPS_UNDER <dir>]): a unity build of target (when FSS_UNITY_BUILD is on); with
+# GROUPS_UNDER, one unit per first-level folder under <dir> (core's modules), else one unit for all.
+function(fss_unity_build target)
+  cmake_parse_arguments(ARG "" "GROUPS_UNDER" "" ${ARGN})
+  if(NOT FSS_UNITY_BUILD)
+    return()
+  endif()
+  if(ARG_GROUPS_UNDER)
+    set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_MODE GROUP)
+    get_target_property(sources ${target} SOURCES)
+    foreach(src ${sources})
+      get_filename_component(abs "${src}" ABSOLUTE BASE_DIR "${CMAKE_CURRENT_SOURCE_DIR}")
+      if(abs MATCHES "\\.cpp$" AND abs MATCHES "^${ARG_GROUPS_UNDER}/")
+        file(RELATIVE_PATH rel "${ARG_GROUPS_UNDER}" "${abs}")
+        string(REGEX REPLACE "/.*" "" group "${rel}")
+        set_source_files_properties(${src} TARGET_DIRECTORY ${target} PROPERTIES UNITY_GROUP "${target}_${group}")
+      endif()
+    endforeach()
+  else()
+    set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_MODE BATCH UNITY_BUILD_BATCH_SIZE 0)
+  endif()
+  # GCC warns when a type of a named namespace holds one of an anonymous namespace in an included file,
+  # because a header so included by two translation units would break the one-definition rule; in a unity
+  # build the "included file" is a .cpp included exactly once, so the warning does not apply.
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    target_compile_options(${target} PRIVATE -Wno-subobject-linkage)
+  endif()
+endfunction()

@@ -12,18 +12,10 @@ if(NOT CLANG_FORMAT)
   message(FATAL_ERROR "FormatCheck: clang-format was not found (scripts/setup.sh installs it)")
 endif()
 
-set(globs "")
-foreach(dir core widgets plugins demo tests bench examples)
-  list(APPEND globs "${ROOT}/${dir}/*.h" "${ROOT}/${dir}/*.cpp")
-endforeach()
-file(GLOB_RECURSE sources ${globs})
-# Fixtures that must stay unformatted, and generated files, are not ours to format.
-string(REGEX REPLACE "([][+.*()^$?|\\\\])" "\\\\\\1" root_regex "${ROOT}")
-list(FILTER sources EXCLUDE REGEX "^${root_regex}/tests/format/")
+include("${CMAKE_CURRENT_LIST_DIR}/FSSReadLines.cmake")
+# Fixtures that must stay unformatted are not ours to format.
+fss_cpp_sources(sources ROOT "${ROOT}" DIRS core widgets plugins demo tests bench examples EXCLUDE "tests/format/")
 list(LENGTH sources count)
-if(count EQUAL 0)
-  message(FATAL_ERROR "FormatCheck: no C++ source found under ${ROOT}")
-endif()
 
 set(unformatted "")
 # clang-format takes many files at once; batches keep the command line short.

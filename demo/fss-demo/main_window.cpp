@@ -8,6 +8,7 @@
 
 #include <QActionGroup>
 #include <QApplication>
+#include <QCloseEvent>
 #include <QElapsedTimer>
 #include <QFileDialog>
 #include <QFileInfo>
@@ -15,12 +16,16 @@
 #include <QLabel>
 #include <QMenuBar>
 #include <QMessageBox>
+#include <QPushButton>
+#include <QRegularExpression>
 #include <QSettings>
 #include <QStatusBar>
 #include <QThread>
 #include <QTimer>
+#include <QUndoStack>
 #include <QWindow>
 
+#include <tuple>
 #include <utility>
 
 namespace fss::demo {
@@ -34,8 +39,10 @@ MainWindow::MainWindow(std::unique_ptr<MessagePresenter> presenter, QWidget* par
     if (!presenter_) presenter_ = std::make_unique<MessageBoxPresenter>();
     remesh_ = new widgets::RemeshWidget(this);
     setCentralWidget(remesh_);
+    // At the right, without stretch: the status messages keep the rest of the bar.
     statistics_ = new QLabel(this);
-    statusBar()->addPermanentWidget(statistics_, 1);
+    statistics_->setObjectName(QStringLiteral("statistics"));
+    statusBar()->addPermanentWidget(statistics_, 0);
     connect(remesh_, &widgets::RemeshWidget::meshChanged, this, [this] {
         updateStatistics();
         emit meshChanged();
@@ -52,6 +59,7 @@ MainWindow::MainWindow(std::unique_ptr<MessagePresenter> presenter, QWidget* par
     });
     connect(remesh_, &widgets::RemeshWidget::sessionLoaded, this, [this](const QString& path) {
         sessionPending_ = false;
+        remesh_->undoStack()->setClean(); // as in its file
         meshPath_ = remesh_->meshPath();
         meshName_ = QFileInfo(path).fileName();
         addRecentFile(path);
@@ -75,8 +83,14 @@ MainWindow::~MainWindow() = default;
 
 void MainWindow::createMenus() {
     QMenu* file = menuBar()->addMenu(tr("&File"));
-    file->addAction(tr("&Open…"), QKeySequence::Open, this, &MainWindow::openDialog);
-    file->addAction(tr("&Save As…"), QKeySequence::SaveAs, this, &MainWindow::saveDialog);
+    file->addAction(tr("&Open…"), QKeySequence(Qt::CTRL | Qt::Key_O), this, &MainWindow::openDialog)
+        ->setObjectName(QStringLiteral("open"));
+    // Explicit keys: QKeySequence::SaveAs has no binding on some platforms (xcb without a desktop).
+    file->addAction(tr("&Save"), QKeySequence(Qt::CTRL | Qt::Key_S), this, &MainWindow::save)
+        ->setObjectName(QStringLiteral("save"));
+    file->addAction(tr("Save &As…"), QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_S), this,
+                    &MainWindow::saveDialog)
+        ->setObjectName(QStringLiteral("saveAs"));
     file->addSeparator();
     file->addAction(tr("Open Sess&ion…"), QKeySequence(tr("Ctrl+Shift+O")), this,
                     &MainWindow::openSessionDialog);
@@ -86,7 +100,8 @@ void MainWindow::createMenus() {
     recentMenu_ = file->addMenu(tr("Open &Recent"));
     updateRecentMenu();
     file->addSeparator();
-    file->addAction(tr("&Quit"), QKeySequence::Quit, this, &QWidget::close);
+    file->addAction(tr("&Quit"), QKeySequence(Qt::CTRL | Qt::Key_Q), this, &QWidget::close)
+        ->setObjectName(QStringLiteral("quit"));
 
     QMenu* edit = menuBar()->addMenu(tr("&Edit"));
     edit->addAction(remesh_->undoAction());
@@ -96,26 +111,90 @@ void MainWindow::createMenus() {
     edit->addAction(remesh_->acceptAction());
     edit->addAction(remesh_->rejectAction());
 
+    // Standard views on the number keys as in FreeCAD (0 iso, 1 front, 2 top, 3 right, 4 rear, 5 bottom,
+    // 6 left; front looks along +y at the −y side).
     QMenu* viewMenu = menuBar()->addMenu(tr("&View"));
-    const std::pair<StandardView, const char*> views[] = {
-        {StandardView::Iso, "&Iso"},      {StandardView::PosX, "From +&X"}, {StandardView::NegX, "From −X"},
-        {StandardView::PosY, "From +&Y"}, {StandardView::NegY, "From −Y"},  {StandardView::PosZ, "From +&Z"},
-        {StandardView::NegZ, "From −Z"}};
-    for (const auto& [v, label] : views)
-        viewMenu->addAction(tr(label), this, [this, v = v] { view()->setStandardView(v); });
+    const std::tuple<StandardView, const char*, Qt::Key> views[] = {
+        {StandardView::Iso, "&Iso", Qt::Key_0},
+        {StandardView::NegY, "&Front (from −Y)", Qt::Key_1},
+        {StandardView::PosZ, "&Top (from +Z)", Qt::Key_2},
+        {StandardView::PosX, "&Right (from +X)", Qt::Key_3},
+        {StandardView::PosY, "R&ear (from +Y)", Qt::Key_4},
+        {StandardView::NegZ, "&Bottom (from −Z)", Qt::Key_5},
+        {StandardView::NegX, "&Left (from −X)", Qt::Key_6}};
+    for (const auto& [v, label, key] : views)
+        viewMenu->addAction(tr(label), QKeySequence(key), this, [this, v = v] { view()->setStandardView(v); })
+            ->setObjectName(QStringLiteral("view-") + QString::fromStdString(standardViewName(v)));
+    viewMenu->addAction(tr("F&rame the mesh"), QKeySequence(Qt::Key_R), this, [this] { view()->frameMesh(); })
+        ->setObjectName(QStringLiteral("frame"));
+    viewMenu->addSeparator();
+    QAction* edges =
+        viewMenu->addAction(tr("Show &edges"), this, [this](bool on) { view()->setEdgesVisible(on); });
+    edges->setObjectName(QStringLiteral("edges"));
+    edges->setCheckable(true);
+    edges->setChecked(view()->edgesVisible());
+    edges->setToolTip(tr("Draw the triangle edges (dense meshes look dark with them)"));
+    QAction* axes =
+        viewMenu->addAction(tr("Axis &triad"), this, [this](bool on) { view()->setAxesVisible(on); });
+    axes->setObjectName(QStringLiteral("axes"));
+    axes->setCheckable(true);
+    axes->setChecked(view()->axesVisible());
+    QMenu* up = viewMenu->addMenu(tr("&Up axis"));
+    auto* upGroup = new QActionGroup(this);
+    for (const auto& [axis, label] :
+         {std::pair{widgets::VtkView::UpAxis::Z, "&Z up"}, std::pair{widgets::VtkView::UpAxis::Y, "&Y up"}}) {
+        QAction* a = up->addAction(tr(label), this, [this, axis = axis] {
+            view()->setUpAxis(axis);
+            view()->setStandardView(StandardView::Iso);
+        });
+        a->setObjectName(axis == widgets::VtkView::UpAxis::Z ? QStringLiteral("up-z")
+                                                             : QStringLiteral("up-y"));
+        a->setCheckable(true);
+        a->setChecked(view()->upAxis() == axis);
+        upGroup->addAction(a);
+    }
 
     QMenu* colors = menuBar()->addMenu(tr("&Colour"));
     auto* group = new QActionGroup(this);
     const std::pair<widgets::ColorMap, const char*> maps[] = {{widgets::ColorMap::None, "&Plain"},
                                                               {widgets::ColorMap::MinAngle, "&Minimum angle"},
-                                                              {widgets::ColorMap::Valence, "&Valence"}};
+                                                              {widgets::ColorMap::Valence, "&Valence"},
+                                                              {widgets::ColorMap::ScanId, "&Scan id"}};
     for (const auto& [m, label] : maps) {
         QAction* action = colors->addAction(tr(label), this, [this, m = m] { view()->setColorMap(m); });
         action->setCheckable(true);
         action->setChecked(m == view()->colorMap());
         group->addAction(action);
         colorActions_.emplace_back(m, action);
+        action->setObjectName(QStringLiteral("colour-") + widgets::colorMapName(m));
     }
+    colors->addSeparator();
+    QAction* legend =
+        colors->addAction(tr("&Legend"), this, [this](bool on) { view()->setLegendVisible(on); });
+    legend->setObjectName(QStringLiteral("legend"));
+    legend->setCheckable(true);
+    legend->setChecked(view()->legendVisible());
+
+    QMenu* help = menuBar()->addMenu(tr("&Help"));
+    help->addAction(tr("&Navigation keys"), QKeySequence::HelpContents, this,
+                    [this] { QMessageBox::information(this, tr("Navigation keys"), navigationHelp()); })
+        ->setObjectName(QStringLiteral("navigationHelp"));
+    help->addAction(tr("&About FSS demo"), this, [this] {
+        QMessageBox::about(this, tr("About FSS demo"),
+                           tr("FSS %1: feature-sensitive remeshing by virtual range scanning.")
+                               .arg(QApplication::applicationVersion()));
+    });
+}
+
+QString MainWindow::navigationHelp() {
+    return tr("<b>Mouse</b> (in the view): left drag rotates, middle drag or Shift + left drag pans, right "
+              "drag or the wheel zooms.<br>"
+              "<b>Keys</b>: R frames the mesh; 0 iso view, 1 front (−Y), 2 top (+Z), 3 right (+X), 4 rear "
+              "(+Y), 5 bottom (−Z), 6 left (−X).<br>"
+              "<b>Scanning</b>: Enter takes a scan (Scan tool, or in the Resolution / Target edge fields), "
+              "Enter again accepts it, Esc rejects it or clears the lasso. Fishbone: D switches the "
+              "curvature direction, K key-ribs.<br>"
+              "<b>Edit</b>: Ctrl+Z undo, Ctrl+Shift+Z or Ctrl+Y redo; Ctrl+S save, Ctrl+Shift+S save as.");
 }
 
 widgets::VtkView* MainWindow::view() const {
@@ -165,9 +244,65 @@ bool MainWindow::saveMesh(const QString& path) {
     }
     meshPath_ = path;
     meshName_ = QFileInfo(path).fileName();
+    savePath_ = path;
+    if (!remesh_->isBusy()) remesh_->undoStack()->setClean();
     addRecentFile(path);
     updateStatistics();
+    statusBar()->showMessage(tr("Saved %1 (%2 faces).").arg(meshName_).arg(mesh().number_of_faces()), 8000);
     return true;
+}
+
+bool MainWindow::save() {
+    if (savePath_.isEmpty()) {
+        saveDialog();
+        return !savePath_.isEmpty() && !hasUnsavedChanges();
+    }
+    return saveMesh(savePath_);
+}
+
+QString MainWindow::withFilterSuffix(const QString& path, const QString& filter) {
+    static const QStringList known = {"off", "obj", "ply", "stl", "msh", "inp",
+                                      "bdf", "nas", "unv", "vtu", "vtp"};
+    if (known.contains(QFileInfo(path).suffix().toLower())) return path;
+    const QRegularExpressionMatch m = QRegularExpression(QStringLiteral("\\*\\.(\\w+)")).match(filter);
+    return m.hasMatch() ? path + QLatin1Char('.') + m.captured(1) : path;
+}
+
+bool MainWindow::hasUnsavedChanges() const {
+    return remesh_->isBusy() || !remesh_->undoStack()->isClean();
+}
+
+bool MainWindow::maybeSave() {
+    if (!hasUnsavedChanges()) return true;
+    const int steps = remesh_->undoStack()->index();
+    QString text = remesh_->isBusy() ? tr("A scan is being stitched in") : QString();
+    if (!remesh_->undoStack()->isClean())
+        text += (text.isEmpty() ? QString() : tr(", and ")) +
+                (steps == 1 ? tr("1 accepted scan of %1 is not saved")
+                            : tr("%1 accepted scans of %2 are not saved").arg(steps))
+                    .arg(meshName_.isEmpty() ? tr("the mesh") : meshName_);
+    QMessageBox box(QMessageBox::Warning, tr("Save changes?"), text + QLatin1Char('.'),
+                    QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel, this);
+    box.setObjectName(QStringLiteral("saveChanges"));
+    box.setInformativeText(tr("Save the remeshed mesh before going on?"));
+    box.setDefaultButton(QMessageBox::Save);
+    switch (box.exec()) {
+    case QMessageBox::Save:
+        if (remesh_->isBusy()) return false; // the stitch must finish before its result can be saved
+        return save();
+    case QMessageBox::Discard:
+        if (remesh_->isBusy()) remesh_->cancel(); // the widget waits for the worker when it goes
+        return true;
+    default:
+        return false;
+    }
+}
+
+void MainWindow::closeEvent(QCloseEvent* event) {
+    if (maybeSave())
+        event->accept();
+    else
+        event->ignore();
 }
 
 void MainWindow::setMesh(Mesh mesh, const QString& name) {
@@ -199,6 +334,7 @@ void MainWindow::updateRecentMenu() {
         recentMenu_
             ->addAction(QStringLiteral("&%1 %2").arg(i + 1).arg(QFileInfo(path).fileName()), this,
                         [this, path] {
+                            if (!maybeSave()) return;
                             if (path.endsWith(QLatin1String(".json"), Qt::CaseInsensitive))
                                 openSession(path);
                             else
@@ -240,6 +376,7 @@ void MainWindow::updateStatistics() {
 }
 
 void MainWindow::openDialog() {
+    if (!maybeSave()) return;
     const QString path =
         QFileDialog::getOpenFileName(this, tr("Open mesh"), QFileInfo(meshPath_).path(),
                                      tr("Meshes (*.off *.obj *.ply *.stl *.msh *.vtu *.vtp *.vtk);;OFF "
@@ -249,12 +386,14 @@ void MainWindow::openDialog() {
 }
 
 void MainWindow::saveDialog() {
+    QString filter;
     const QString path = QFileDialog::getSaveFileName(
-        this, tr("Save mesh"), meshPath_,
+        this, tr("Save mesh"), savePath_.isEmpty() ? QFileInfo(meshPath_).path() : savePath_,
         tr("PLY, keeps scan ids and quality (*.ply);;OFF (*.off);;OBJ (*.obj);;STL (*.stl);;gmsh MSH 4.1, "
            "groups as physical surfaces (*.msh);;Abaqus INP (*.inp);;Nastran BDF (*.bdf *.nas);;I-deas UNV "
-           "(*.unv);;VTK unstructured grid (*.vtu);;VTK poly data (*.vtp)"));
-    if (!path.isEmpty()) saveMesh(path);
+           "(*.unv);;VTK unstructured grid (*.vtu);;VTK poly data (*.vtp)"),
+        &filter);
+    if (!path.isEmpty()) saveMesh(withFilterSuffix(path, filter));
 }
 
 bool MainWindow::reportWidgetFailure(const QString& title, const std::function<bool()>& call) {
@@ -275,12 +414,14 @@ bool MainWindow::openSession(const QString& path) {
 
 bool MainWindow::saveSession(const QString& path) {
     if (!reportWidgetFailure(tr("Save session"), [&] { return remesh_->saveSession(path); })) return false;
+    remesh_->undoStack()->setClean();
     addRecentFile(path);
     statusBar()->showMessage(tr("Session saved to %1.").arg(QFileInfo(path).fileName()), 5000);
     return true;
 }
 
 void MainWindow::openSessionDialog() {
+    if (!maybeSave()) return;
     const QString path = QFileDialog::getOpenFileName(this, tr("Open session"), QFileInfo(meshPath_).path(),
                                                       tr("FSS sessions (*.json);;All files (*)"));
     if (!path.isEmpty()) openSession(path);

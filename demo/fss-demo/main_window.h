@@ -1,8 +1,11 @@
 #pragma once
 /// \file main_window.h
 /// The main window of fss-demo: a RemeshWidget (view, tools, panels, history) with File (open, save,
-/// recent files), Edit (undo, redo), View and Colour menus and mesh statistics in the status bar. Errors
-/// go through a MessagePresenter so that tests can open bad files without a modal box.
+/// save as, sessions, recent files, quit), Edit (undo, redo), View (standard views with keys 0–6, frame
+/// with R, edges, axis triad, up axis), Colour (maps, legend) and Help (navigation keys) menus and mesh
+/// statistics at the right of the status bar. Errors go through a MessagePresenter so that tests can open
+/// bad files without a modal box. Closing the window or opening another mesh with unsaved accepted scans
+/// (or a stitch running) asks "Save changes?" (Save / Discard / Cancel).
 
 #include <fss/camera.h>
 #include <fss/mesh.h>
@@ -19,6 +22,7 @@
 #include <vector>
 
 class QAction;
+class QCloseEvent;
 class QLabel;
 class QMenu;
 
@@ -54,8 +58,22 @@ public:
     /// sentence) is shown through the presenter and errorOccurred() is emitted. On success the file
     /// heads the recent files. \return success
     bool openMesh(const QString& path);
-    /// Writes the current mesh to \p path (format by extension). On failure reports like openMesh.
+    /// Writes the current mesh to \p path (format by extension). On success the status bar says so, the
+    /// work counts as saved and File › Save writes there again. On failure reports like openMesh.
     bool saveMesh(const QString& path);
+    /// File › Save (Ctrl+S): writes the mesh to the file of the last Save As; without one, Save As.
+    /// \return whether the mesh was written
+    bool save();
+    /// \p path with the suffix of the file dialog's name filter \p filter (e.g. "OFF (*.off)") appended
+    /// when \p path has no suffix of a mesh format; unchanged otherwise.
+    static QString withFilterSuffix(const QString& path, const QString& filter);
+    /// Whether accepted scans are not saved yet (mesh or session) or a stitch is running.
+    bool hasUnsavedChanges() const;
+    /// Asks "Save changes?" with Save / Discard / Cancel when hasUnsavedChanges() (Save runs save()).
+    /// \return true when the caller may go on (nothing unsaved, saved, or discarded)
+    bool maybeSave();
+    /// The text of Help › Navigation keys.
+    static QString navigationHelp();
     /// Loads the session file \p path (RemeshWidget::loadSession): validates it and replays it with progress
     /// and Cancel; the result and its history replace the current session when the replay has finished
     /// (sessionLoaded()). A bad file or a failed replay is reported like openMesh's errors, and the previous
@@ -87,6 +105,9 @@ public:
     /// extension). \return an empty string on success, else one sentence saying why it failed.
     QString saveScreenshot(const QString& path);
 
+protected:
+    void closeEvent(QCloseEvent* event) override;
+
 signals:
     /// An operation failed; \p message is the sentence shown to the user.
     void errorOccurred(const QString& message);
@@ -116,6 +137,7 @@ private:
     std::vector<std::pair<widgets::ColorMap, QAction*>> colorActions_;
     QString meshPath_;
     QString meshName_;
+    QString savePath_;            // the last Save As target: File › Save writes there
     bool sessionPending_ = false; // openSession started a replay whose errors go to the presenter
 };
 

@@ -1,5 +1,6 @@
 // fss-remesh run SESSION.json -o OUT [--report R.json] [--json] [--snapshot S.png] [--snapshot-size WxH]
-//                [--snapshot-view V] [--renderer session|auto|gpu|cpu] [--no-self-intersections]
+//                [--snapshot-view V] [--snapshot-legend] [--renderer session|auto|gpu|cpu]
+//                [--no-self-intersections]
 // Replays a session file head-less (session_file.h) and reports what it made.
 #include "command_line.h"
 #include "commands.h"
@@ -45,7 +46,7 @@ struct RunOptions {
     double zoom = 1;
     const CLI::Option* report = nullptr;   // given when count() > 0
     const CLI::Option* snapshot = nullptr; // given when count() > 0
-    bool json = false, noSelf = false, quiet = false;
+    bool json = false, noSelf = false, quiet = false, legend = false;
     OutputFileOptions file;
 };
 
@@ -107,6 +108,7 @@ int runRun(const RunOptions& o) {
         camera.zoom(o.zoom);
         render::SnapshotOptions options;
         if (o.rendererKind == "cpu") options.renderer = render::SnapshotOptions::Renderer::Cpu;
+        options.legend = o.legend;
         shot = render::renderSnapshot(result, camera, options);
         render::writePng(shot.image, o.snapshotPath);
         snapshotSeconds = since(t);
@@ -256,6 +258,8 @@ Subcommand addRun(CLI::App& app) {
                   "View of the snapshot: iso, +x, -x, +y, -y, +z, -z (default iso).")
         ->type_name("V")
         ->check(standardViewName("--snapshot-view"));
+    p->add_flag("--snapshot-legend", o->legend,
+                "Append the colour legend (a VTK scalar bar, 0 to 60 degrees) at the right of the snapshot.");
     addDouble(*p, "--snapshot-zoom", o->zoom, true, "F",
               "Zoom factor of the snapshot camera (> 0, default 1: the whole mesh).");
     addRenderer(*p, o->rendererKind, {"session"},

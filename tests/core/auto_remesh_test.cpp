@@ -9,6 +9,7 @@
 #include "fss/metrics.h"
 #include "fss/raycast.h"
 #include "fss/shapes.h"
+#include "test_math.h"
 
 #include "expect_valid_mesh.h"
 #include "test_data.h"
@@ -21,6 +22,8 @@
 #include <random>
 
 namespace {
+
+using fss::test::metricsAgainst;
 
 // Coverage recomputed from the result's face property, independently of the report.
 double scannedAreaFraction(const fss::Mesh& m) {
@@ -201,15 +204,7 @@ TEST(AutoRemesh, SphereIsCoveredAndStaysClose) {
     EXPECT_NEAR(double(m.vertices), double(sphere.number_of_vertices()), 0.25 * sphere.number_of_vertices());
 }
 
-namespace {
-
-fss::Metrics metricsAgainst(const fss::Mesh& mesh, const fss::Mesh& reference) {
-    fss::MetricsOptions mo;
-    mo.reference = &reference;
-    return fss::computeMetrics(mesh, mo);
-}
-
-} // namespace
+namespace {} // namespace
 
 namespace {
 

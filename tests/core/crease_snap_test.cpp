@@ -3,6 +3,7 @@
 // the stitches do (a corner cut off, a vertex standing off a face, a fold) and checks that snapToCreases
 // repairs exactly that: the result is measured against the cube itself, never against the code's own view.
 #include "remesh/crease_snap.h"
+#include "test_math.h"
 
 #include "fss/metrics.h"
 #include "fss/shapes.h"
@@ -19,18 +20,15 @@
 
 namespace {
 
+using fss::test::metricsAgainst;
+
 constexpr int kN = 8;         // quads per side of the cube
 constexpr double kSide = 1.0; // side of the cube
 constexpr double kL = kSide / kN;
 
-Eigen::Vector3d at(const fss::Mesh& m, fss::VertexIndex v) {
-    const auto& p = m.point(v);
-    return {p.x(), p.y(), p.z()};
-}
-
 fss::VertexIndex vertexAt(const fss::Mesh& m, const Eigen::Vector3d& p) {
     for (fss::VertexIndex v : m.vertices())
-        if ((at(m, v) - p).norm() < 1e-12) return v;
+        if ((fss::test::position(m, v) - p).norm() < 1e-12) return v;
     return fss::Mesh::null_vertex();
 }
 
@@ -39,12 +37,6 @@ double distanceToCube(const Eigen::Vector3d& p) {
     const Eigen::Vector3d q = p.cwiseAbs() - Eigen::Vector3d::Constant(kSide / 2);
     const double outside = q.cwiseMax(0.0).norm();
     return outside > 0 ? outside : -q.maxCoeff();
-}
-
-fss::Metrics metricsAgainst(const fss::Mesh& mesh, const fss::Mesh& reference) {
-    fss::MetricsOptions mo;
-    mo.reference = &reference;
-    return fss::computeMetrics(mesh, mo);
 }
 
 fss::detail::CreaseSnapOptions options() {
@@ -58,7 +50,9 @@ std::size_t facesTurnedOver(const fss::Mesh& m) {
     std::size_t n = 0;
     for (fss::FaceIndex f : m.faces()) {
         const auto h = m.halfedge(f);
-        const Eigen::Vector3d a = at(m, m.source(h)), b = at(m, m.target(h)), c = at(m, m.target(m.next(h)));
+        const Eigen::Vector3d a = fss::test::position(m, m.source(h)),
+                              b = fss::test::position(m, m.target(h)),
+                              c = fss::test::position(m, m.target(m.next(h)));
         const Eigen::Vector3d centroid = (a + b + c) / 3.0;
         int axis = 0;
         centroid.cwiseAbs().maxCoeff(&axis);
@@ -90,7 +84,7 @@ TEST(CreaseSnap, MovesTheVertexNearACornerOntoTheCorner) {
     EXPECT_NE(vertexAt(m, corner), fss::Mesh::null_vertex()) << "no vertex on the corner";
     // Every vertex is back on the cube, the vertex count is the cube's, and the corner is no longer cut.
     for (fss::VertexIndex w : m.vertices())
-        EXPECT_LT(distanceToCube(at(m, w)), 1e-12);
+        EXPECT_LT(distanceToCube(fss::test::position(m, w)), 1e-12);
     EXPECT_EQ(m.number_of_vertices(), cube.number_of_vertices());
     const fss::Metrics after = metricsAgainst(m, cube);
     fss::test::expectClosedValidMesh(after);
@@ -110,13 +104,13 @@ TEST(CreaseSnap, RemovesAVertexOfValenceThreeStandingOffTheSurface) {
     for (fss::FaceIndex f : m.faces()) {
         Eigen::Vector3d c = Eigen::Vector3d::Zero();
         for (fss::VertexIndex w : CGAL::vertices_around_face(m.halfedge(f), m))
-            c += at(m, w) / 3.0;
+            c += fss::test::position(m, w) / 3.0;
         if (std::abs(c.z() - 0.5) < 1e-12 && c.head<2>().norm() < kL) target = f;
     }
     ASSERT_NE(target, fss::Mesh::null_face());
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
     for (fss::VertexIndex w : CGAL::vertices_around_face(m.halfedge(target), m))
-        c += at(m, w) / 3.0;
+        c += fss::test::position(m, w) / 3.0;
     const fss::HalfedgeIndex h = CGAL::Euler::add_center_vertex(m.halfedge(target), m);
     const fss::VertexIndex apex = m.target(h);
     m.point(apex) = fss::Point3(c.x(), c.y(), c.z() + 0.3 * kL);
@@ -128,7 +122,7 @@ TEST(CreaseSnap, RemovesAVertexOfValenceThreeStandingOffTheSurface) {
     EXPECT_EQ(m.number_of_vertices(), cube.number_of_vertices());
     EXPECT_EQ(m.number_of_faces(), cube.number_of_faces());
     for (fss::VertexIndex w : m.vertices())
-        EXPECT_LT(distanceToCube(at(m, w)), 1e-12);
+        EXPECT_LT(distanceToCube(fss::test::position(m, w)), 1e-12);
     const fss::Metrics after = metricsAgainst(m, cube);
     fss::test::expectClosedValidMesh(after);
     ASSERT_TRUE(before.hausdorffToRef && after.hausdorffToRef);
@@ -157,7 +151,7 @@ TEST(CreaseSnap, RepairsAFoldNextToACrease) {
     EXPECT_GE(r.repairs, 1u);
     EXPECT_EQ(facesTurnedOver(m), 0u);
     for (fss::VertexIndex w : m.vertices())
-        EXPECT_LT(distanceToCube(at(m, w)), 1e-12);
+        EXPECT_LT(distanceToCube(fss::test::position(m, w)), 1e-12);
     const fss::Metrics after = metricsAgainst(m, cube);
     fss::test::expectClosedValidMesh(after); // includes no self-intersection
     EXPECT_NEAR(after.area, 6.0 * kSide * kSide, 1e-9);
@@ -176,7 +170,7 @@ TEST(CreaseSnap, BringsABevelledCreaseBackOntoTheCube) {
     // y = 1/2, beyond the snap radius L/2): the faces between them and the +z side's next row bevel the
     // crease by 0.51 L.
     for (fss::VertexIndex w : m.vertices()) {
-        const Eigen::Vector3d p = at(m, w);
+        const Eigen::Vector3d p = fss::test::position(m, w);
         if (std::abs(p.y() - 0.5) < 1e-12 && std::abs(p.z() - 0.5) < 1e-12 && std::abs(p.x()) < 0.5 - 1e-9)
             m.point(w) = fss::Point3(p.x(), p.y(), p.z() - 0.6 * kL);
     }
@@ -187,7 +181,7 @@ TEST(CreaseSnap, BringsABevelledCreaseBackOntoTheCube) {
     const fss::detail::CreaseSnapReport r = fss::detail::snapToCreases(m, cube, options());
     EXPECT_GT(r.splits + r.snaps + r.repairs, 0u);
     for (fss::VertexIndex w : m.vertices())
-        EXPECT_LT(distanceToCube(at(m, w)), 1e-12);
+        EXPECT_LT(distanceToCube(fss::test::position(m, w)), 1e-12);
     const fss::Metrics after = metricsAgainst(m, cube);
     fss::test::expectClosedValidMesh(after);
     ASSERT_TRUE(after.hausdorffFromRef && after.hausdorffToRef);
@@ -223,7 +217,7 @@ TEST(CreaseSnap, CollapsesAShortEdgeBetweenTwoVerticesOnACrease) {
     EXPECT_GE(r.repairs, 1u);
     EXPECT_EQ(m.number_of_vertices(), cube.number_of_vertices());
     for (fss::VertexIndex w : m.vertices())
-        EXPECT_LT(distanceToCube(at(m, w)), 1e-12);
+        EXPECT_LT(distanceToCube(fss::test::position(m, w)), 1e-12);
     const fss::Metrics after = metricsAgainst(m, cube);
     fss::test::expectClosedValidMesh(after);
     EXPECT_NEAR(after.minAngleDeg, 45.0, 1e-9);

@@ -3,6 +3,7 @@
 #include "fss/curvature.h"
 #include "fss/error.h"
 #include "fss/shapes.h"
+#include "test_math.h"
 
 #include <gtest/gtest.h>
 
@@ -19,23 +20,14 @@ using fss::VertexIndex;
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = 180.0 / kPi;
-
-Eigen::Vector3d point(const Mesh& m, VertexIndex v) {
-    const auto& p = m.point(v);
-    return {p.x(), p.y(), p.z()};
-}
+using fss::test::kDeg;
+using fss::test::kPi;
+using fss::test::median;
 
 // Angle between two lines (direction sign ignored), degrees.
 double lineAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
     const double c = std::min(1.0, std::abs(a.normalized().dot(b.normalized())));
     return std::acos(c) * kDeg;
-}
-
-double median(std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
-    return v[v.size() / 2];
 }
 
 double quantile(std::vector<double> v, double q) {
@@ -70,7 +62,7 @@ Errors torusErrors(const Mesh& m, const CurvatureField& c, double R, double r) {
     Errors e;
     for (VertexIndex v : m.vertices()) {
         EXPECT_TRUE(c.isDefined(v));
-        const TorusFrame f = torusFrame(point(m, v), R, r);
+        const TorusFrame f = torusFrame(fss::test::position(m, v), R, r);
         e.d1Deg.push_back(lineAngleDeg(c.d1[v.idx()], f.d1));
         e.d2Deg.push_back(lineAngleDeg(c.d2[v.idx()], f.d2));
         e.k1Rel.push_back(std::abs(c.k1[v.idx()] - f.k1) / f.k1);
@@ -107,7 +99,7 @@ TEST(Curvature, TorusPrincipalDirectionsAndCurvatures) {
         EXPECT_NEAR(c.d1[v.idx()].dot(c.d2[v.idx()]), 0.0, 1e-9);
         EXPECT_NEAR(c.d1[v.idx()].dot(c.normal[v.idx()]), 0.0, 0.05);
         // Outward normal: away from the tube's centre circle.
-        const Eigen::Vector3d p = point(m, v);
+        const Eigen::Vector3d p = fss::test::position(m, v);
         const Eigen::Vector3d centre = Eigen::Vector3d(p.x(), p.y(), 0).normalized() * R;
         EXPECT_GT(c.normal[v.idx()].dot(p - centre), 0.0);
     }
@@ -119,7 +111,7 @@ TEST(Curvature, TorusOuterAndInnerRegions) {
     const Mesh m = fss::shapes::torus(200, 100, R, r);
     const CurvatureField c = fss::estimateCurvature(m);
     for (VertexIndex v : m.vertices()) {
-        const Eigen::Vector3d p = point(m, v);
+        const Eigen::Vector3d p = fss::test::position(m, v);
         if (std::abs(p.z()) > 1e-9) continue;
         const double rho = std::hypot(p.x(), p.y());
         const double k2Exact = rho > R ? 1.0 / (R + r) : -1.0 / (R - r);
@@ -142,7 +134,7 @@ TEST(Curvature, IrregularlySampledTorusStaysAccurate) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> jitter(-0.35, 0.35);
     for (VertexIndex v : m.vertices()) {
-        const Eigen::Vector3d p = point(m, v);
+        const Eigen::Vector3d p = fss::test::position(m, v);
         const double u = std::atan2(p.y(), p.x()) + jitter(rng) * 2 * kPi / nu;
         const double w = std::atan2(p.z(), std::hypot(p.x(), p.y()) - R) + jitter(rng) * 2 * kPi / nv;
         const double rho = R + r * std::cos(w);
@@ -170,7 +162,7 @@ TEST(Curvature, OpenCylinder) {
     std::vector<double> d1Err, d2Err, k1Err, k2Err, boundaryD1Err;
     for (VertexIndex v : m.vertices()) {
         ASSERT_TRUE(c.isDefined(v));
-        const Eigen::Vector3d p = point(m, v);
+        const Eigen::Vector3d p = fss::test::position(m, v);
         const Eigen::Vector3d around(-p.y(), p.x(), 0), axis(0, 0, 1);
         d1Err.push_back(lineAngleDeg(c.d1[v.idx()], around));
         d2Err.push_back(lineAngleDeg(c.d2[v.idx()], axis));

@@ -4,6 +4,7 @@
 #include "fss/direction_field.h"
 #include "fss/error.h"
 #include "fss/shapes.h"
+#include "test_math.h"
 
 #include "brute_force_raster.h"
 
@@ -24,15 +25,11 @@ using fss::PrincipalDirection;
 
 namespace {
 
-constexpr double kDeg = 180.0 / std::numbers::pi;
+using fss::test::kDeg;
+using fss::test::median;
 
 double lineAngleDeg(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) * kDeg;
-}
-
-double median(std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
-    return v[v.size() / 2];
 }
 
 fss::Camera sideCamera(bool parallel) {

@@ -3,6 +3,7 @@
 // chains, the crease recovery's crease index, the fishbone cache's crease edges, the seam relaxation's
 // feature edges), which must classify every edge alike at the angles FSS uses.
 #include "mesh/features.h"
+#include "test_math.h"
 
 #include "fss/mesh_io.h"
 #include "fss/shapes.h"
@@ -90,10 +91,6 @@ TEST(Features, BorderEdgesAreNotSharp) {
 // ---------------------------------------------------------------------------------------------------------
 // The predicates the features unit replaces, as they were written (issue 18).
 
-Eigen::Vector3d at(const fss::Mesh& m, fss::VertexIndex v) {
-    const auto& p = m.point(v);
-    return {p.x(), p.y(), p.z()};
-}
 Eigen::Vector3d unit(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
     const Eigen::Vector3d n = (b - a).cross(c - a);
     const double len = n.norm();
@@ -101,7 +98,8 @@ Eigen::Vector3d unit(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const E
 }
 Eigen::Vector3d faceUnit(const fss::Mesh& m, fss::FaceIndex f) {
     const auto h = m.halfedge(f);
-    return unit(at(m, m.source(h)), at(m, m.target(h)), at(m, m.target(m.next(h))));
+    return unit(fss::test::position(m, m.source(h)), fss::test::position(m, m.target(h)),
+                fss::test::position(m, m.target(m.next(h))));
 }
 
 // auto_remesh.cpp featureChains
@@ -113,17 +111,18 @@ bool autoChains(const fss::Mesh& m, fss::EdgeIndex e, double deg) {
 // crease_snap.cpp CreaseIndex
 bool creaseSnap(const fss::Mesh& m, fss::EdgeIndex e, double deg) {
     const auto h = m.halfedge(e), o = m.opposite(h);
-    const Eigen::Vector3d a = at(m, m.source(h)), b = at(m, m.target(h));
-    const Eigen::Vector3d n1 = unit(a, b, at(m, m.target(m.next(h))));
-    const Eigen::Vector3d n2 = unit(b, a, at(m, m.target(m.next(o))));
+    const Eigen::Vector3d a = fss::test::position(m, m.source(h)), b = fss::test::position(m, m.target(h));
+    const Eigen::Vector3d n1 = unit(a, b, fss::test::position(m, m.target(m.next(h))));
+    const Eigen::Vector3d n2 = unit(b, a, fss::test::position(m, m.target(m.next(o))));
     return !(n1.isZero() || n2.isZero() || n1.dot(n2) >= std::cos(deg * std::numbers::pi / 180.0));
 }
 // fishbone_scan.cpp FishboneCache::creaseEdges
 bool fishboneCache(const fss::Mesh& m, fss::EdgeIndex e, double deg) {
     auto normal = [&](fss::FaceIndex f) {
         const auto h = m.halfedge(f);
-        const Eigen::Vector3d a = at(m, m.source(h));
-        return Eigen::Vector3d((at(m, m.target(h)) - a).cross(at(m, m.target(m.next(h))) - a));
+        const Eigen::Vector3d a = fss::test::position(m, m.source(h));
+        return Eigen::Vector3d(
+            (fss::test::position(m, m.target(h)) - a).cross(fss::test::position(m, m.target(m.next(h))) - a));
     };
     const auto h = m.halfedge(e);
     const Eigen::Vector3d n0 = normal(m.face(h)), n1 = normal(m.face(m.opposite(h)));

@@ -7,6 +7,7 @@
 #include "fss/scan.h"
 #include "fss/shapes.h"
 #include "fss/triangulate.h"
+#include "test_math.h"
 
 #include <CGAL/boost/graph/iterator.h>
 
@@ -27,7 +28,7 @@ using fss::SampleGrid;
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using fss::test::kPi;
 
 // rows × cols samples on their pixel centres, all hit, admissible and valid.
 SampleGrid flatGrid(int rows, int cols) {

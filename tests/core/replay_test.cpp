@@ -21,7 +21,7 @@ namespace {
 
 // The mesh as text in index order (points bit-exact via hexfloat, faces' vertices, f:quality and
 // f:scan_id): equal strings = equal meshes.
-std::string fingerprint(const fss::Mesh& mesh) {
+std::string replayFingerprint(const fss::Mesh& mesh) {
     std::ostringstream out;
     out << std::hexfloat;
     for (auto v : mesh.vertices())
@@ -53,7 +53,7 @@ TEST(SessionReplay, SteppingThroughTheExampleSessionGivesReplaySessionsMesh) {
     EXPECT_FALSE(replay.done());
     EXPECT_EQ(replay.fraction(), 0.0);
     EXPECT_GT(replay.readSeconds(), 0.0);
-    EXPECT_EQ(fingerprint(replay.current()), fingerprint(replay.session().reference()));
+    EXPECT_EQ(replayFingerprint(replay.current()), replayFingerprint(replay.session().reference()));
     std::vector<double> fractions;
     const fss::Progress progress([&](double f, std::string_view) {
         fractions.push_back(f);
@@ -84,8 +84,8 @@ TEST(SessionReplay, SteppingThroughTheExampleSessionGivesReplaySessionsMesh) {
         EXPECT_GE(fractions[i], fractions[i - 1]);
     EXPECT_LE(fractions.back(), 1.0);
 
-    EXPECT_NE(fingerprint(whole.session.current()), fingerprint(whole.session.reference()));
-    EXPECT_EQ(fingerprint(replay.current()), fingerprint(whole.session.current()));
+    EXPECT_NE(replayFingerprint(whole.session.current()), replayFingerprint(whole.session.reference()));
+    EXPECT_EQ(replayFingerprint(replay.current()), replayFingerprint(whole.session.current()));
     ASSERT_EQ(replay.events().size(), whole.events.size());
     for (std::size_t i = 0; i < whole.events.size(); ++i) {
         EXPECT_EQ(replay.events()[i].patchFaces, whole.events[i].patchFaces) << i;
@@ -99,7 +99,7 @@ TEST(SessionReplay, SteppingThroughTheExampleSessionGivesReplaySessionsMesh) {
     EXPECT_THROW(replay.step(), fss::InvalidInputError);
     const std::unique_ptr<fss::Session> session = replay.takeSession();
     ASSERT_TRUE(session);
-    EXPECT_EQ(fingerprint(session->current()), fingerprint(whole.session.current()));
+    EXPECT_EQ(replayFingerprint(session->current()), replayFingerprint(whole.session.current()));
 }
 
 fss::ScanStep viewStep(const fss::Mesh& mesh, fss::StandardView view, int resolution) {
@@ -151,8 +151,9 @@ TEST(SessionReplay, PartsOfStepsGiveTheSameMesh) {
         EXPECT_EQ(done.stitch.has_value(), e.kind == fss::SessionEvent::Kind::Accept);
     }
     EXPECT_EQ(cacheBuilds, 1u);
-    EXPECT_EQ(fingerprint(replay.current()), fingerprint(recorded.current()));
-    EXPECT_EQ(fingerprint(replay.current()), fingerprint(fss::replaySession(file).session.current()));
+    EXPECT_EQ(replayFingerprint(replay.current()), replayFingerprint(recorded.current()));
+    EXPECT_EQ(replayFingerprint(replay.current()),
+              replayFingerprint(fss::replaySession(file).session.current()));
     EXPECT_EQ(replay.session().undoCount(), recorded.undoCount());
     EXPECT_EQ(replay.session().redoCount(), recorded.redoCount());
 

@@ -3,6 +3,7 @@
 #include "fss/direction_field.h"
 #include "fss/error.h"
 #include "fss/streamline.h"
+#include "test_math.h"
 
 #include <gtest/gtest.h>
 
@@ -21,7 +22,7 @@ using fss::StreamlineStop;
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using fss::test::kPi;
 
 // A field whose pixel centres carry dir(centre), each with a random sign (a line field, not a vector field).
 DirectionField makeField(int w, int h, const std::function<Eigen::Vector2d(const Eigen::Vector2d&)>& dir,

@@ -95,6 +95,50 @@ TEST(Snapshot, GpuCoverageMatchesCpuRayCasting) {
     fss::render::writePng(gpu.image, fss::test::tmpPath("snapshot_fandisk.png"));
 }
 
+// Issue #21: the legend (a VTK scalar bar) is appended at the right; the mesh's picture is unchanged; the
+// bar shows the map's red (0°) below its green (60°), and text in the ink colour.
+TEST(Snapshot, LegendIsAppendedAtTheRight) {
+    const fss::Mesh sphere = fss::shapes::icosphere(3);
+    const fss::Camera camera =
+        fss::Camera::standardView(fss::StandardView::Iso, fss::boundingBox(sphere), 320, 240);
+    fss::render::SnapshotOptions options;
+    options.renderer = fss::render::SnapshotOptions::Renderer::Cpu; // the same pixels with and without
+    const fss::render::Snapshot plain = fss::render::renderSnapshot(sphere, camera, options);
+    options.legend = true;
+    const fss::render::Snapshot shot = fss::render::renderSnapshot(sphere, camera, options);
+    const int lw = fss::render::legendWidth(240);
+    ASSERT_EQ(shot.image.width, 320 + lw);
+    ASSERT_EQ(shot.image.height, 240);
+    for (int y = 0; y < 240; ++y)
+        for (int x = 0; x < 320; ++x)
+            ASSERT_EQ(shot.image.pixel(x, y), plain.image.pixel(x, y));
+    // Rows of the legend's red (minAngleColor(0)) and green (minAngleColor(60)) pixels, and dark text.
+    const Rgb red = fss::render::minAngleColor(0), green = fss::render::minAngleColor(60);
+    auto near = [](const Rgb& p, const Rgb& q) {
+        return std::abs(p[0] - q[0]) + std::abs(p[1] - q[1]) + std::abs(p[2] - q[2]) < 30;
+    };
+    long redRows = 0, greenRows = 0, reds = 0, greens = 0, dark = 0;
+    for (int y = 0; y < 240; ++y)
+        for (int x = 320; x < 320 + lw; ++x) {
+            const Rgb p = shot.image.pixel(x, y);
+            if (near(p, red)) {
+                ++reds;
+                redRows += y;
+            }
+            if (near(p, green)) {
+                ++greens;
+                greenRows += y;
+            }
+            dark += p[0] < 80 && p[1] < 80 && p[2] < 80;
+        }
+    EXPECT_GT(reds, 50);
+    EXPECT_GT(greens, 50);
+    EXPECT_GT(double(redRows) / double(reds), double(greenRows) / double(greens)); // red lower (y down)
+    EXPECT_GT(dark, 30);                                                           // title and labels
+    fss::render::writePng(shot.image, fss::test::tmpPath("snapshot_legend.png"));
+    EXPECT_THROW(fss::render::renderMinAngleLegend(8, 8, {255, 255, 255}), fss::InvalidInputError);
+}
+
 // Flat shading of a hand-made buffer: a frontal face gets exactly its colour inside, darker on its border.
 TEST(Snapshot, ShadeFacesIsFlatAndOutlined) {
     fss::Mesh mesh;

@@ -24,14 +24,19 @@
 #include <CGAL/Polygon_mesh_processing/shape_predicates.h>
 #include <CGAL/boost/graph/helpers.h>
 
+#include <QAbstractSpinBox>
 #include <QApplication>
 #include <QElapsedTimer>
 #include <QLineF>
 #include <QMouseEvent>
 #include <QPushButton>
+#include <QScrollArea>
+#include <QScrollBar>
 #include <QSignalSpy>
+#include <QSpinBox>
 #include <QTest>
 #include <QTimer>
+#include <QToolBar>
 #include <QUndoStack>
 #include <QUndoView>
 
@@ -60,6 +65,12 @@ void click(QWidget* w, QPointF pos, Qt::KeyboardModifiers modifiers = Qt::NoModi
     sendMouse(w, QEvent::MouseButtonRelease, pos, Qt::LeftButton, Qt::NoButton, modifiers);
 }
 
+void sendWheel(QWidget* w, QPointF pos, int angle) {
+    QWheelEvent event(pos, w->mapToGlobal(pos), QPoint(), QPoint(0, angle), Qt::NoButton, Qt::NoModifier,
+                      Qt::NoScrollPhase, false);
+    QApplication::sendEvent(w, &event);
+}
+
 // A lasso drawn with the mouse: a circle of \p radius DIP around \p centre in \p steps moves.
 QPolygonF drawLasso(QWidget* view, QPointF centre, double radius, int steps = 48) {
     QPolygonF drawn;
@@ -84,6 +95,38 @@ std::unique_ptr<RemeshWidget> shownWidget(const fss::Mesh& mesh, QSize size = {1
     if (!w->setMesh(mesh)) return nullptr;
     QTest::qWait(20);
     return w;
+}
+
+// Independent whole-mesh figures: the share of interior vertices of valence 6 (halfedges pointing at each
+// vertex) and the smallest corner angle (law of cosines), for the accept summary.
+std::pair<double, double> valence6AndMinAngle(const fss::Mesh& m) {
+    std::map<fss::VertexIndex, int> in;
+    std::set<fss::VertexIndex> onBorder;
+    for (fss::HalfedgeIndex h : m.halfedges()) {
+        ++in[m.target(h)];
+        if (m.is_border(h)) onBorder.insert(m.target(h));
+    }
+    std::size_t interior = 0, six = 0;
+    for (const auto& [v, count] : in)
+        if (!onBorder.count(v)) {
+            ++interior;
+            six += count == 6 ? 1 : 0;
+        }
+    double smallest = 180;
+    for (fss::FaceIndex f : m.faces()) {
+        std::vector<fss::Point3> p;
+        for (fss::VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m))
+            p.push_back(m.point(v));
+        for (int i = 0; i < 3; ++i) {
+            const double a = std::sqrt(CGAL::squared_distance(p[(i + 1) % 3], p[(i + 2) % 3]));
+            const double b = std::sqrt(CGAL::squared_distance(p[i], p[(i + 1) % 3]));
+            const double c = std::sqrt(CGAL::squared_distance(p[i], p[(i + 2) % 3]));
+            smallest =
+                std::min(smallest, std::acos(std::clamp((b * b + c * c - a * a) / (2 * b * c), -1.0, 1.0)) *
+                                       180 / std::numbers::pi);
+        }
+    }
+    return {interior ? double(six) / double(interior) : 0.0, smallest};
 }
 
 bool waitIdle(RemeshWidget& w, int timeoutMs = 120000) {
@@ -563,6 +606,183 @@ private slots:
         QVERIFY(!w->fishboneTool()->hasInput());
         QVERIFY2(w->statusText().contains("cancelled"), qPrintable(w->statusText()));
         QVERIFY(w->fishboneTool()->isEnabled());
+    }
+
+    // Issue #21 item 1: camera changes keep the previews (fishbone and regular) and say what was dropped.
+    void zoomAfterSeedingKeepsTheFishbonePreview() {
+        auto w = shownWidget(fss::shapes::cylinder(96, 48, 1.0, 2.0, true));
+        QVERIFY(w);
+        w->view()->setStandardView(fss::StandardView::PosX);
+        w->scanPanel()->setResolution(128);
+        w->scanPanel()->setFishboneSpacing(3.0);
+        w->setActiveTool(w->fishboneTool());
+        QWidget* view = w->view();
+        const QPointF centre(view->width() / 2.0, view->height() / 2.0);
+        click(view, centre); // the seed; automatic ribs give a grid preview
+        QVERIFY(waitIdle(*w));
+        QTRY_VERIFY_WITH_TIMEOUT(w->hasPreview(), 30000);
+        QVERIFY(w->session()->preview()->step.fishbone.has_value());
+        const std::size_t faces = w->session()->preview()->patch.mesh.number_of_faces();
+        const fss::Camera before = w->view()->camera();
+        sendWheel(view, centre, 120); // zoom
+        QVERIFY((w->view()->camera().eye - before.eye).norm() > 1e-6);
+        QVERIFY(w->hasPreview());
+        QVERIFY(w->view()->hasPreviewMesh());
+        QCOMPARE(w->session()->preview()->patch.mesh.number_of_faces(), faces);
+        QVERIFY(w->session()->preview()->step.fishbone.has_value());
+        QVERIFY(!w->fishboneTool()->hasInput()); // the screen strokes are gone
+        QVERIFY2(w->statusText().contains("fishbone strokes") && w->statusText().contains("preview is kept"),
+                 qPrintable(w->statusText()));
+
+        // A lasso scan, then a pan: the preview stays, the lasso goes, the status line says so.
+        w->reject();
+        w->setActiveTool(w->lassoTool());
+        drawLasso(view, centre, 60);
+        QVERIFY(w->scan());
+        QVERIFY(w->lassoTool()->hasLasso());
+        sendMouse(view, QEvent::MouseButtonPress, centre, Qt::MiddleButton, Qt::MiddleButton);
+        for (int i = 1; i <= 5; ++i)
+            sendMouse(view, QEvent::MouseMove, centre + QPointF(6 * i, 0), Qt::NoButton, Qt::MiddleButton);
+        sendMouse(view, QEvent::MouseButtonRelease, centre + QPointF(30, 0), Qt::MiddleButton, Qt::NoButton);
+        QVERIFY(w->hasPreview());
+        QVERIFY(!w->lassoTool()->hasLasso());
+        QVERIFY2(w->statusText().contains("the lasso") && w->statusText().contains("preview is kept"),
+                 qPrintable(w->statusText()));
+        w->reject(); // the next action clears the note
+        QVERIFY2(!w->statusText().contains("dropped"), qPrintable(w->statusText()));
+    }
+
+    // Issue #21 items 2 and 6: History numbers accepted steps from 1 (rejected previews do not count) and
+    // names view, resolution and grid; the entry and the status line give faces replaced, valence 6 and
+    // the smallest angle before → after (checked against independent counts).
+    void historyNamesStepsFromOneWithTheirFigures() {
+        auto w = shownWidget(fss::shapes::icosphere(3));
+        QVERIFY(w);
+        w->view()->setStandardView(fss::StandardView::PosZ);
+        w->scanPanel()->setResolution(96);
+        w->scanPanel()->setForceReplace(true);
+        QVERIFY(w->scan());
+        w->reject(); // not a step
+        QVERIFY(w->scan());
+        const fss::Camera cam = w->session()->preview()->step.params.camera;
+        const auto before = valence6AndMinAngle(w->mesh());
+        QSignalSpy accepted(w.get(), &RemeshWidget::scanAccepted);
+        w->accept();
+        QVERIFY(waitIdle(*w));
+        QCOMPARE(accepted.count(), 1);
+        const auto report = accepted.at(0).at(0).value<fss::StitchReport>();
+        const auto after = valence6AndMinAngle(w->mesh());
+        QCOMPARE(w->undoStack()->count(), 1);
+        const QString name = w->undoStack()->text(0);
+        const QString prefix =
+            QString("1. Scan from +Z, %1×%2 px, regular grid — ").arg(cam.width).arg(cam.height);
+        QVERIFY2(name.startsWith(prefix), qPrintable(name));
+        const QString figures[] = {
+            QString("%1 faces replaced").arg(report.facesRemoved),
+            QString("valence 6 %1 % → %2 %")
+                .arg(100 * before.first, 0, 'f', 1)
+                .arg(100 * after.first, 0, 'f', 1),
+            QString("min angle %1° → %2°").arg(before.second, 0, 'f', 1).arg(after.second, 0, 'f', 1)};
+        QVERIFY(report.facesRemoved > 0);
+        for (const QString& f : figures) {
+            QVERIFY2(name.contains(f), qPrintable(name + " lacks " + f));
+            QVERIFY2(w->statusText().contains(f), qPrintable(w->statusText() + " lacks " + f));
+        }
+        QVERIFY(w->statusText().startsWith("Accepted: "));
+        // Undo, then a new step: numbered 1 again (the undone one is gone).
+        w->undoStack()->undo();
+        QVERIFY(!w->statusText().startsWith("Accepted: ")); // stale texts go
+        QVERIFY(w->scan());
+        w->accept();
+        QVERIFY(waitIdle(*w));
+        QCOMPARE(w->undoStack()->count(), 1);
+        QVERIFY(w->undoStack()->text(0).startsWith("1. Scan from +Z"));
+    }
+
+    // Issue #21 item 5: the side panel scrolls instead of collapsing; spin boxes keep their height.
+    void sidePanelStaysUsableInSmallWindows() {
+        for (const QSize size : {QSize(800, 500), QSize(640, 420)}) {
+            auto w = shownWidget(fss::shapes::icosphere(2), size);
+            QVERIFY(w);
+            const auto boxes = w->scanPanel()->findChildren<QAbstractSpinBox*>();
+            QVERIFY(boxes.size() >= 8);
+            for (QAbstractSpinBox* b : boxes)
+                QVERIFY2(b->height() >= b->sizeHint().height(), qPrintable(QString("%1 px high at %2×%3")
+                                                                               .arg(b->height())
+                                                                               .arg(size.width())
+                                                                               .arg(size.height())));
+            QVERIFY(w->scanPanel()->width() >= w->scanPanel()->minimumSizeHint().width());
+            auto* scroll = w->findChild<QScrollArea*>();
+            QVERIFY(scroll && scroll->isVisible());
+            QVERIFY(scroll->verticalScrollBar()->maximum() > 0); // the rest is reachable by scrolling
+            QVERIFY(w->historyView()->height() >= 100);
+            QVERIFY(w->view()->width() >= 200);
+        }
+    }
+
+    // Issue #21 items 7 and 8: a target edge length in world units (default: the input's mean edge
+    // length) sets the resolution for the view; a typed resolution is held; Enter in it scans.
+    void targetEdgeLengthSetsTheResolutionAndEnterScans() {
+        const fss::Mesh sphere = fss::shapes::icosphere(3);
+        auto w = shownWidget(sphere);
+        QVERIFY(w);
+        fss::widgets::ScanPanel* panel = w->scanPanel();
+        double sum = 0;
+        for (fss::HalfedgeIndex h : sphere.halfedges())
+            sum += std::sqrt(
+                CGAL::squared_distance(sphere.point(sphere.source(h)), sphere.point(sphere.target(h))));
+        const double mean = sum / double(sphere.number_of_halfedges());
+        QVERIFY(std::abs(panel->inputEdgeLength() - mean) < 1e-9 * mean);
+        QVERIFY(std::abs(panel->targetEdgeLength() - mean) < 1e-3 * mean);
+        QVERIFY(panel->followsTargetEdgeLength());
+
+        const double target = mean / 8;
+        panel->setTargetEdgeLength(target);
+        const int r1 = panel->resolution();
+        QVERIFY2(r1 > 32 && r1 < 4096, qPrintable(QString::number(r1)));
+        const Eigen::Vector3d centre = fss::boundingBox(sphere).center();
+        auto footprint = [&] { return panel->scanCamera(w->view()->camera()).pixelFootprint(centre); };
+        QVERIFY2(std::abs(footprint() - target) < 0.01 * target,
+                 qPrintable(QString("%1 vs %2").arg(footprint()).arg(target)));
+        QVERIFY(std::abs(panel->edgeLength() - footprint()) < 1e-12 * target);
+        // Twice as close: half the resolution for the same edge length.
+        fss::Camera c = w->view()->camera();
+        const fss::Camera far = c;
+        c.eye = c.focal + 0.5 * (c.eye - c.focal);
+        w->view()->setCamera(c);
+        QVERIFY2(std::abs(panel->resolution() - r1 / 2.0) <= 1.5,
+                 qPrintable(QString("%1 then %2").arg(r1).arg(panel->resolution())));
+        QVERIFY(std::abs(footprint() - target) < 0.02 * target);
+        // A typed resolution is held when the view changes.
+        panel->setResolution(100);
+        QVERIFY(!panel->followsTargetEdgeLength());
+        w->view()->setCamera(far);
+        QCOMPARE(panel->resolution(), 100);
+
+        auto* box = panel->findChild<QSpinBox*>("resolution");
+        QVERIFY(box);
+        box->setFocus();
+        QTest::keyClick(box, Qt::Key_Return);
+        QVERIFY(w->hasPreview());
+        const fss::Camera scanned = w->session()->preview()->step.params.camera;
+        QCOMPARE(std::max(scanned.width, scanned.height), 100);
+    }
+
+    // Issue #21 item 10: every tool-bar action has a tooltip that says more than its label.
+    void toolBarActionsExplainThemselves() {
+        RemeshWidget w;
+        auto* bar = w.findChild<QToolBar*>();
+        QVERIFY(bar);
+        int checked = 0;
+        for (QAction* a : bar->actions()) {
+            if (a->isSeparator()) continue;
+            const QString label = QString(a->text()).remove('&');
+            QVERIFY2(a->toolTip().size() > label.size() + 15, qPrintable(label + ": " + a->toolTip()));
+            ++checked;
+        }
+        QVERIFY(checked >= 12);
+        QVERIFY(w.redoAction()->shortcuts().contains(QKeySequence(Qt::CTRL | Qt::Key_Y)));
+        QVERIFY(w.redoAction()->shortcuts().contains(QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_Z)));
     }
 
     void destroyingTheWidgetWhileItStitchesWaits() {

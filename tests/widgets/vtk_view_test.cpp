@@ -15,6 +15,7 @@
 #include <QTest>
 #include <QWheelEvent>
 
+#include <algorithm>
 #include <memory>
 
 using fss::widgets::ColorMap;
@@ -98,6 +99,57 @@ private slots:
         const double coverageIn = fss::test::pixelFraction(view->grabImage(), fss::test::notBackground);
         QVERIFY2(coverageIn > coverageOut * 1.2,
                  qPrintable(QString("coverage %1 -> %2").arg(coverageOut).arg(coverageIn)));
+    }
+
+    // Issue #21 item 9: edges on/off (dense meshes turn dark), the axis triad in the lower-left corner,
+    // Y-up standard views, framing.
+    void edgesTriadUpAxisAndFraming() {
+        auto view = shownView();
+        QVERIFY(view);
+        auto dark = [](QRgb p) { return std::max({qRed(p), qGreen(p), qBlue(p)}) < 70; };
+        QVERIFY(view->edgesVisible());
+        const double darkWith = fss::test::pixelFraction(view->grabImage(), dark);
+        view->setEdgesVisible(false);
+        const double darkWithout = fss::test::pixelFraction(view->grabImage(), dark);
+        QVERIFY2(darkWith > 2 * darkWithout + 0.01,
+                 qPrintable(QString("dark pixels %1 with edges, %2 without").arg(darkWith).arg(darkWithout)));
+
+        // The triad: the lower-left 16 % is background but for it (the mesh is framed in the middle).
+        QImage image = view->grabImage();
+        const QRect corner(0, image.height() * 84 / 100, image.width() * 16 / 100, image.height() * 16 / 100);
+        QVERIFY(!view->axesVisible()); // hidden in a bare view
+        view->setAxesVisible(true);
+        image = view->grabImage();
+        const double triad = fss::test::pixelFraction(image, fss::test::notBackground, corner);
+        view->setAxesVisible(false);
+        image = view->grabImage();
+        const double none = fss::test::pixelFraction(image, fss::test::notBackground, corner);
+        QVERIFY2(triad > 0.01 && none < 0.002,
+                 qPrintable(QString("corner %1 with the triad, %2 without").arg(triad).arg(none)));
+
+        QCOMPARE(view->upAxis(), VtkView::UpAxis::Z);
+        view->setStandardView(fss::StandardView::PosX);
+        QVERIFY(view->camera().up.dot(Eigen::Vector3d::UnitZ()) > 1 - 1e-9);
+        view->setUpAxis(VtkView::UpAxis::Y);
+        view->setStandardView(fss::StandardView::PosX);
+        QVERIFY(view->camera().up.dot(Eigen::Vector3d::UnitY()) > 1 - 1e-9);
+        view->setStandardView(fss::StandardView::Iso);
+        QVERIFY(view->camera().up.y() > 0.8 && view->camera().up.z() < 0);
+
+        // Framing after a zoom: the same direction, the whole mesh back in view.
+        const fss::Camera framed = view->camera();
+        for (int i = 0; i < 5; ++i)
+            sendWheel(view.get(), {300, 225}, 120);
+        QVERIFY((view->camera().eye - framed.focal).norm() < 0.8 * (framed.eye - framed.focal).norm());
+        view->frameMesh();
+        const fss::Camera c = view->camera();
+        QVERIFY(c.viewDirection().dot(framed.viewDirection()) > 1 - 1e-9);
+        const Eigen::AlignedBox3d box = fss::boundingBox(fandisk());
+        for (int k = 0; k < 8; ++k) {
+            const Eigen::Vector3d p = c.project(box.corner(Eigen::AlignedBox3d::CornerType(k)));
+            QVERIFY2(p.x() >= 0 && p.x() <= c.width && p.y() >= 0 && p.y() <= c.height,
+                     qPrintable(QString("corner %1 at %2, %3").arg(k).arg(p.x()).arg(p.y())));
+        }
     }
 
     void exitKeysDoNotQuit() {

@@ -3,6 +3,7 @@
 #include "fss/error.h"
 #include "fss/face_groups.h"
 #include "fss/mesh_io.h"
+#include "fss/metrics.h"
 #include "fss/render/fem_io.h"
 #include "fss/replay.h"
 #include "fss/session_file.h"
@@ -25,6 +26,7 @@
 #include <QLabel>
 #include <QProgressBar>
 #include <QPushButton>
+#include <QScrollArea>
 #include <QSplitter>
 #include <QThread>
 #include <QTimer>
@@ -83,17 +85,72 @@ QString sentence(const std::exception& e) {
     return QString::fromStdString(e.what());
 }
 
+// The standard view whose direction the camera looks along (within ~2.5°), else "custom view".
+QString viewName(const Camera& camera) {
+    const Eigen::Vector3d from = (camera.eye - camera.focal).normalized();
+    const std::pair<Eigen::Vector3d, const char*> views[] = {{Eigen::Vector3d(1, 1, 1).normalized(), "iso"},
+                                                             {{1, 0, 0}, "+X"},
+                                                             {{-1, 0, 0}, "-X"},
+                                                             {{0, 1, 0}, "+Y"},
+                                                             {{0, -1, 0}, "-Y"},
+                                                             {{0, 0, 1}, "+Z"},
+                                                             {{0, 0, -1}, "-Z"}};
+    for (const auto& [direction, name] : views)
+        if (from.dot(direction) > 0.999) return RemeshWidget::tr("from %1").arg(QLatin1String(name));
+    return RemeshWidget::tr("custom view");
+}
+
+// Mean length of the edges of \p mesh (0 without edges).
+double meanEdgeLength(const Mesh& mesh) {
+    double sum = 0;
+    for (EdgeIndex e : mesh.edges())
+        sum +=
+            std::sqrt((mesh.point(mesh.source(mesh.halfedge(e))) - mesh.point(mesh.target(mesh.halfedge(e))))
+                          .squared_length());
+    return mesh.number_of_edges() > 0 ? sum / double(mesh.number_of_edges()) : 0;
+}
+
+// Whole-mesh figures shown before → after an accept (computeMetrics without self-intersections).
+struct MeshFigures {
+    double valence6 = 0; // fraction of interior vertices with valence 6
+    double minAngle = 0; // smallest corner angle, degrees
+};
+
+MeshFigures figuresOf(const Mesh& mesh) {
+    MetricsOptions options;
+    options.selfIntersections = false;
+    const Metrics m = computeMetrics(mesh, options);
+    return {m.fracValence6Interior, m.minAngleDeg};
+}
+
 } // namespace
+
+QString RemeshWidget::stepName(int number, const ScanStep& step) {
+    const Camera& c = step.params.camera;
+    const QString grid = step.fishbone       ? tr("fishbone grid")
+                         : step.params.lasso ? tr("regular grid in a lasso")
+                                             : tr("regular grid");
+    return tr("%1. Scan %2, %3×%4 px, %5").arg(number).arg(viewName(c)).arg(c.width).arg(c.height).arg(grid);
+}
+
+QString RemeshWidget::acceptSummary(const StitchReport& report, double valence6Before, double valence6After,
+                                    double minAngleBefore, double minAngleAfter) {
+    // One entry per figure: a new StitchReport field is one more line here.
+    QStringList parts;
+    parts << tr("%1 faces replaced by %2").arg(report.facesRemoved).arg(report.facesAdded);
+    parts << tr("valence 6 %1 % → %2 %")
+                 .arg(100 * valence6Before, 0, 'f', 1)
+                 .arg(100 * valence6After, 0, 'f', 1);
+    parts << tr("min angle %1° → %2°").arg(minAngleBefore, 0, 'f', 1).arg(minAngleAfter, 0, 'f', 1);
+    if (report.seamFaces > 0) parts << tr("seam min angle %1°").arg(report.seamMinAngleDeg, 0, 'f', 1);
+    return parts.join(QStringLiteral("; "));
+}
 
 /// One accepted scan on the undo stack. The scan was already applied by Session::accept when the command
 /// is pushed, so its first redo() (QUndoStack::push calls it) does nothing.
 class AcceptCommand final : public QUndoCommand {
 public:
     AcceptCommand(RemeshWidget* widget, const QString& text) : QUndoCommand(text), widget_(widget) {}
-    static QString textOf(const ScanStep& step) {
-        return step.fishbone ? RemeshWidget::tr("Fishbone scan %1").arg(step.params.scan.scanId)
-                             : RemeshWidget::tr("Scan %1").arg(step.params.scan.scanId);
-    }
     void undo() override { widget_->undoStep(); }
     void redo() override {
         if (first_) {
@@ -131,6 +188,10 @@ struct RemeshWidget::Impl {
     std::unique_ptr<Replay> replay;
     std::shared_ptr<std::atomic<bool>> cpuFallbackPending; // the replayed session's cpuFallback
     bool syncingStack = false; // pushing / undoing commands that only mirror the session's history
+    // A message for the user (an error, what an accept did, what a camera change dropped) shown in the
+    // status line until the next action (scan, accept, reject, tool, settings, undo / redo).
+    QString note;
+    QScrollArea* sideScroll = nullptr;
     Mesh empty;
     // The GUI thread's copy of the session's current mesh: the worker may be replacing the session's
     // own while the GUI reads this one.
@@ -170,6 +231,7 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     Impl& d = *d_;
     d.view = new VtkView(this);
     d.view->setMinimumSize(200, 200);
+    d.view->setAxesVisible(true);
     d.view->setFocusPolicy(Qt::StrongFocus);
     d.scanPanel = new ScanPanel(this);
     d.qualityPanel = new QualityPanel(this);
@@ -182,70 +244,17 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     d.scanTool = new ScanTool(d.view, d.scanPanel, d.lasso, this);
     d.fishbone = new FishboneTool(d.view, this);
 
-    // Tool bar: tools (exclusive), scan actions, fishbone options, ghost.
-    d.toolBar = new QToolBar(this);
-    d.toolBar->setToolButtonStyle(Qt::ToolButtonTextOnly);
-    auto* tools = new QActionGroup(this);
-    auto addTool = [&](Tool* tool) {
-        QAction* a = d.toolBar->addAction(tool->name());
-        a->setCheckable(true);
-        tools->addAction(a);
-        connect(a, &QAction::triggered, this, [this, tool] { setActiveTool(tool); });
-        return a;
-    };
-    d.navigateAction = addTool(d.navigate);
-    d.lassoAction = addTool(d.lasso);
-    d.scanModeAction = addTool(d.scanTool);
-    d.fishboneAction = addTool(d.fishbone);
-    d.toolBar->addSeparator();
-    d.scanAction = d.toolBar->addAction(tr("Take scan"), this, [this] { scan(); });
-    d.scanAction->setToolTip(tr("Scan the view at the panel's resolution (inside the lasso, if any)"));
-    d.acceptAction = d.toolBar->addAction(tr("Accept"), this, [this] { accept(); });
-    d.rejectAction = d.toolBar->addAction(tr("Reject"), this, [this] { reject(); });
-    d.toolBar->addSeparator();
-    d.directionAction = d.toolBar->addAction(tr("Max direction"));
-    d.directionAction->setCheckable(true);
-    d.directionAction->setToolTip(
-        tr("Fishbone backbone along the maximal (checked) or minimal curvature (D)"));
-    connect(d.directionAction, &QAction::toggled, this, [this](bool max) {
-        d_->fishbone->setDirection(max ? PrincipalDirection::Max : PrincipalDirection::Min);
-    });
-    d.keyRibAction = d.toolBar->addAction(tr("Key-ribs"));
-    d.keyRibAction->setCheckable(true);
-    d.keyRibAction->setToolTip(tr("Place key-ribs on the backbone instead of automatic ribs (K)"));
-    connect(d.keyRibAction, &QAction::toggled, this, [this](bool on) {
-        d_->fishbone->setRibMode(on ? FishboneTool::RibMode::KeyRibs : FishboneTool::RibMode::Automatic);
-    });
-    d.drawBackboneAction = d.toolBar->addAction(tr("Draw backbone"));
-    d.drawBackboneAction->setCheckable(true);
-    d.drawRibAction = d.toolBar->addAction(tr("Draw rib"));
-    d.drawRibAction->setCheckable(true);
-    auto inputChanged = [this] {
-        FishboneTool::InputMode mode = FishboneTool::InputMode::Pick;
-        if (d_->drawBackboneAction->isChecked())
-            mode = FishboneTool::InputMode::DrawBackbone;
-        else if (d_->drawRibAction->isChecked())
-            mode = FishboneTool::InputMode::DrawRib;
-        d_->fishbone->setInputMode(mode);
-    };
-    connect(d.drawBackboneAction, &QAction::toggled, this, [this, inputChanged](bool on) {
-        if (on) d_->drawRibAction->setChecked(false);
-        inputChanged();
-    });
-    connect(d.drawRibAction, &QAction::toggled, this, [this, inputChanged](bool on) {
-        if (on) d_->drawBackboneAction->setChecked(false);
-        inputChanged();
-    });
-    d.toolBar->addSeparator();
-    d.ghostAction = d.toolBar->addAction(tr("Ghost"));
-    d.ghostAction->setCheckable(true);
-    d.ghostAction->setToolTip(tr("Show the input mesh as a translucent ghost"));
-    connect(d.ghostAction, &QAction::toggled, this, &RemeshWidget::setGhostVisible);
+    createToolBar();
 
     d.undoAction = d.undoStack->createUndoAction(this, tr("&Undo"));
     d.undoAction->setShortcut(QKeySequence::Undo);
     d.redoAction = d.undoStack->createRedoAction(this, tr("&Redo"));
-    d.redoAction->setShortcut(QKeySequence::Redo);
+    // The platform's redo keys, and both of the common ones (Ctrl+Shift+Z, Ctrl+Y) wherever missing.
+    QList<QKeySequence> redoKeys = QKeySequence::keyBindings(QKeySequence::Redo);
+    for (const QKeySequence& k :
+         {QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_Z), QKeySequence(Qt::CTRL | Qt::Key_Y)})
+        if (!redoKeys.contains(k)) redoKeys << k;
+    d.redoAction->setShortcuts(redoKeys);
 
     // Layout: tool bar; view | panels; status line with progress and Cancel.
     auto* side = new QWidget(this);
@@ -261,15 +270,26 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     group(tr("Scan"), d.scanPanel, 0);
     group(tr("Quality"), d.qualityPanel, 2);
     group(tr("History"), d.historyView, 1);
+    // Sensible minimum sizes: below them the side panel scrolls instead of squeezing its parts.
+    d.qualityPanel->setMinimumHeight(std::max(160, d.qualityPanel->minimumSizeHint().height()));
+    d.historyView->setMinimumHeight(110);
+    d.sideScroll = new QScrollArea(this);
+    d.sideScroll->setWidget(side);
+    d.sideScroll->setWidgetResizable(true);
+    d.sideScroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+    d.sideScroll->setFrameShape(QFrame::NoFrame);
+    d.sideScroll->setMinimumWidth(side->minimumSizeHint().width() + 20); // room for the vertical bar
     auto* splitter = new QSplitter(Qt::Horizontal, this);
     splitter->addWidget(d.view);
-    splitter->addWidget(side);
+    splitter->addWidget(d.sideScroll);
     splitter->setStretchFactor(0, 1);
     splitter->setStretchFactor(1, 0);
     splitter->setChildrenCollapsible(false);
 
     d.status = new QLabel(this);
     d.status->setWordWrap(true);
+    d.status->setObjectName(QStringLiteral("status"));
+    d.view->installEventFilter(this); // a resize changes the scan size the status line tells
     d.progress = new QProgressBar(this);
     d.progress->setMaximumWidth(220);
     d.progress->setRange(0, 1000);
@@ -320,17 +340,36 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     connect(d.lasso, &LassoTool::lassoChanged, this,
             [this] { d_->scanTool->setPreviewPending(hasPreview()); });
     connect(d.scanPanel, &ScanPanel::settingsChanged, this, [this] {
+        d_->note.clear();
         if (d_->fishbone->hasInput() && !isBusy()) runFishbone();
         updateStatus();
     });
+    connect(d.scanPanel, &ScanPanel::scanRequested, this, [this] {
+        if (d_->active == d_->fishbone) return; // the fishbone scans by itself
+        scan();
+    });
     connect(d.view, &VtkView::cameraChanged, this, [this] {
         if (d_->updatingView) return;
-        // Lasso and fishbone positions are screen positions of the old camera: they no longer apply.
+        // Lasso and fishbone strokes are screen positions of the old camera: they no longer apply and are
+        // dropped. A preview (regular or fishbone) lies on the surface in world space: it stays, and the
+        // status line says what was dropped.
+        QStringList dropped;
+        if (d_->lasso->hasLasso()) dropped << tr("the lasso");
+        if (d_->fishbone->hasInput()) dropped << tr("the fishbone strokes");
+        {
+            const QSignalBlocker blocker(d_->fishbone); // no new fishbone scan: the preview is kept
+            if (d_->fishbone->hasInput()) d_->fishbone->clear();
+        }
         d_->lasso->clear();
-        if (d_->fishbone->hasInput()) d_->fishbone->clear();
-        if (d_->session)
+        if (d_->session) // first: with a target edge length the resolution changes (settingsChanged)
             d_->scanPanel->updateEdgeLength(d_->view->camera(),
                                             boundingBox(d_->session->reference()).center());
+        if (!dropped.isEmpty())
+            setNote(hasPreview() ? tr("The view moved: %1 (drawn on the screen) dropped; the preview is kept "
+                                      "— Accept or Reject it.")
+                                       .arg(dropped.join(tr(" and ")))
+                                 : tr("The view moved: %1 (drawn on the screen) dropped — draw again.")
+                                       .arg(dropped.join(tr(" and "))));
     });
 
     d.navigateAction->setChecked(true);
@@ -338,7 +377,87 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     setBusy(false);
 }
 
+// Tool bar: tools (exclusive), scan actions, fishbone options, ghost; every action with a tooltip.
+void RemeshWidget::createToolBar() {
+    Impl& d = *d_;
+    d.toolBar = new QToolBar(this);
+    d.toolBar->setToolButtonStyle(Qt::ToolButtonTextOnly);
+    auto* tools = new QActionGroup(this);
+    auto addTool = [&](Tool* tool) {
+        QAction* a = d.toolBar->addAction(tool->name());
+        a->setCheckable(true);
+        tools->addAction(a);
+        connect(a, &QAction::triggered, this, [this, tool] { setActiveTool(tool); });
+        return a;
+    };
+    d.navigateAction = addTool(d.navigate);
+    d.navigateAction->setToolTip(tr("Navigate: left drag rotates, middle or Shift+left drag pans, right "
+                                    "drag or the wheel zooms, R frames the mesh"));
+    d.lassoAction = addTool(d.lasso);
+    d.lassoAction->setToolTip(tr("Lasso: drag around the region the next scan samples (Esc clears it); "
+                                 "other buttons still navigate"));
+    d.scanModeAction = addTool(d.scanTool);
+    d.scanModeAction->setToolTip(tr("Scan mode: Enter takes a regular scan of the view, Enter again "
+                                    "accepts it, Esc rejects it"));
+    d.fishboneAction = addTool(d.fishbone);
+    d.fishboneAction->setToolTip(tr("Fishbone: click a seed on a feature; the backbone follows a "
+                                    "principal curvature direction and the ribs cross it, giving a grid "
+                                    "aligned with the feature"));
+    d.toolBar->addSeparator();
+    d.scanAction = d.toolBar->addAction(tr("Take scan"), this, [this] { scan(); });
+    d.scanAction->setToolTip(tr("Scan the view at the panel's resolution (inside the lasso, if any)"));
+    d.acceptAction = d.toolBar->addAction(tr("Accept"), this, [this] { accept(); });
+    d.acceptAction->setToolTip(tr("Stitch the blue preview into the mesh, replacing the faces under it "
+                                  "where the scan is better (one undo step)"));
+    d.rejectAction = d.toolBar->addAction(tr("Reject"), this, [this] { reject(); });
+    d.rejectAction->setToolTip(tr("Drop the preview; the mesh stays as it is"));
+    d.toolBar->addSeparator();
+    d.directionAction = d.toolBar->addAction(tr("Max direction"));
+    d.directionAction->setCheckable(true);
+    d.directionAction->setToolTip(
+        tr("Fishbone backbone along the maximal (checked) or minimal curvature (D)"));
+    connect(d.directionAction, &QAction::toggled, this, [this](bool max) {
+        d_->fishbone->setDirection(max ? PrincipalDirection::Max : PrincipalDirection::Min);
+    });
+    d.keyRibAction = d.toolBar->addAction(tr("Key-ribs"));
+    d.keyRibAction->setCheckable(true);
+    d.keyRibAction->setToolTip(tr("Place key-ribs on the backbone instead of automatic ribs (K)"));
+    connect(d.keyRibAction, &QAction::toggled, this, [this](bool on) {
+        d_->fishbone->setRibMode(on ? FishboneTool::RibMode::KeyRibs : FishboneTool::RibMode::Automatic);
+    });
+    d.drawBackboneAction = d.toolBar->addAction(tr("Draw backbone"));
+    d.drawBackboneAction->setCheckable(true);
+    d.drawBackboneAction->setToolTip(tr("Drag the fishbone's backbone by hand instead of tracing it "
+                                        "from a seed along the curvature"));
+    d.drawRibAction = d.toolBar->addAction(tr("Draw rib"));
+    d.drawRibAction->setCheckable(true);
+    d.drawRibAction->setToolTip(tr("Drag a rib across the backbone by hand; drawn ribs replace the "
+                                   "automatic ones"));
+    auto inputChanged = [this] {
+        FishboneTool::InputMode mode = FishboneTool::InputMode::Pick;
+        if (d_->drawBackboneAction->isChecked())
+            mode = FishboneTool::InputMode::DrawBackbone;
+        else if (d_->drawRibAction->isChecked())
+            mode = FishboneTool::InputMode::DrawRib;
+        d_->fishbone->setInputMode(mode);
+    };
+    connect(d.drawBackboneAction, &QAction::toggled, this, [this, inputChanged](bool on) {
+        if (on) d_->drawRibAction->setChecked(false);
+        inputChanged();
+    });
+    connect(d.drawRibAction, &QAction::toggled, this, [this, inputChanged](bool on) {
+        if (on) d_->drawBackboneAction->setChecked(false);
+        inputChanged();
+    });
+    d.toolBar->addSeparator();
+    d.ghostAction = d.toolBar->addAction(tr("Ghost"));
+    d.ghostAction->setCheckable(true);
+    d.ghostAction->setToolTip(tr("Show the input mesh as a translucent ghost"));
+    connect(d.ghostAction, &QAction::toggled, this, &RemeshWidget::setGhostVisible);
+}
+
 RemeshWidget::~RemeshWidget() {
+    d_->view->removeEventFilter(this); // the view outlives d_
     if (d_->job) d_->job->cancel = true;
     if (d_->thread) {
         d_->thread->wait();
@@ -387,8 +506,8 @@ void RemeshWidget::installSession(std::unique_ptr<Session> session, const QStrin
     // Mirror the session's history on the undo stack: applied steps, then the redo-able ones undone.
     const std::vector<ScanStep> steps = d_->session->steps();
     d_->syncingStack = true;
-    for (const ScanStep& step : steps)
-        d_->undoStack->push(new AcceptCommand(this, AcceptCommand::textOf(step)));
+    for (std::size_t i = 0; i < steps.size(); ++i)
+        d_->undoStack->push(new AcceptCommand(this, stepName(int(i) + 1, steps[i])));
     for (std::size_t i = 0; i < d_->session->redoCount(); ++i)
         d_->undoStack->undo();
     d_->syncingStack = false;
@@ -405,6 +524,7 @@ void RemeshWidget::installSession(std::unique_ptr<Session> session, const QStrin
     setGhostVisible(ghost_);
     d_->qualityPanel->setMesh(d_->mesh);
     d_->scanPanel->updateEdgeLength(d_->view->camera(), boundingBox(d_->session->reference()).center());
+    d_->scanPanel->setInputEdgeLength(meanEdgeLength(d_->session->reference()));
     d_->scanTool->setPreviewPending(false);
     d_->undoAction->setEnabled(!isBusy() && d_->undoStack->canUndo());
     d_->redoAction->setEnabled(!isBusy() && d_->undoStack->canRedo());
@@ -493,7 +613,7 @@ void RemeshWidget::failReplay(const QString& message) {
     d_->cpuFallbackPending.reset();
     setBusy(false);
     if (message.isEmpty())
-        d_->status->setText(tr("Loading the session was cancelled; the previous mesh is kept."));
+        setNote(tr("Loading the session was cancelled; the previous mesh is kept."));
     else
         reportError(message);
 }
@@ -552,8 +672,8 @@ void RemeshWidget::finishReplay() {
     const CurvatureOptions curvature = r->engine->file().curvature;
     installSession(r->engine->takeSession(), r->meshPath, r->cpuRenderer, curvature);
     if (fellBack)
-        d_->status->setText(tr("The session was recorded with the GPU renderer, which this view cannot "
-                               "give; it was replayed with the CPU renderer and may differ slightly."));
+        setNote(tr("The session was recorded with the GPU renderer, which this view cannot give; it was "
+                   "replayed with the CPU renderer and may differ slightly."));
     emit sessionLoaded(r->path);
 }
 
@@ -629,6 +749,17 @@ const Session* RemeshWidget::session() const {
 bool RemeshWidget::hasPreview() const {
     return d_->session && !isBusy() && d_->session->preview();
 }
+bool RemeshWidget::eventFilter(QObject* watched, QEvent* event) {
+    if (d_ && watched == d_->view && event->type() == QEvent::Resize) {
+        // The scan size and the edge length follow the view's size.
+        if (d_->session)
+            d_->scanPanel->updateEdgeLength(d_->view->camera(),
+                                            boundingBox(d_->session->reference()).center());
+        updateStatus();
+    }
+    return QWidget::eventFilter(watched, event);
+}
+
 bool RemeshWidget::isBusy() const {
     return d_->thread != nullptr || d_->replay != nullptr;
 }
@@ -638,6 +769,7 @@ QString RemeshWidget::statusText() const {
 
 void RemeshWidget::setActiveTool(Tool* tool) {
     if (!tool || tool == d_->active) return;
+    d_->note.clear();
     if (d_->active) d_->active->deactivate();
     d_->active = tool;
     tool->activate();
@@ -657,6 +789,7 @@ void RemeshWidget::setActiveTool(Tool* tool) {
 
 bool RemeshWidget::scan() {
     if (isBusy()) return false;
+    d_->note.clear();
     if (!d_->session) {
         reportError(tr("There is no mesh to scan: open a mesh first."));
         return false;
@@ -712,7 +845,7 @@ void RemeshWidget::runFishbone() {
             } else if (job->cancelled) {
                 d_->fishbonePending = false;
                 d_->fishbone->clear();
-                d_->status->setText(tr("The curvature estimate was cancelled."));
+                setNote(tr("The curvature estimate was cancelled."));
             } else if (d_->fishbonePending) {
                 runFishbone();
             }
@@ -740,35 +873,45 @@ void RemeshWidget::runFishbone() {
 
 void RemeshWidget::accept() {
     if (isBusy()) return;
+    d_->note.clear();
     if (!d_->session || !d_->session->preview()) {
         reportError(tr("There is no scan to accept: take a scan first."));
         return;
     }
     Session* s = d_->session.get();
-    const QString text = AcceptCommand::textOf(s->preview()->step);
+    const QString name = stepName(d_->undoStack->index() + 1, s->preview()->step);
     auto report = std::make_shared<StitchReport>();
+    auto figures = std::make_shared<std::pair<MeshFigures, MeshFigures>>();
     setBusy(true, tr("Stitching the scan into the mesh"));
-    startWork([s, report](const Progress& progress) { *report = s->accept(progress); },
-              [this, report, text] {
-                  const std::shared_ptr<Job> job = d_->job;
-                  setBusy(false);
-                  if (!job->error.empty()) {
-                      reportError(QString::fromStdString(job->error));
-                      return;
-                  }
-                  if (job->cancelled) {
-                      d_->status->setText(tr("Stitching was cancelled; the preview is kept."));
-                      return;
-                  }
-                  d_->undoStack->push(new AcceptCommand(this, text));
-                  if (d_->fishbone->hasInput()) {
-                      const QSignalBlocker blocker(d_->fishbone); // the accepted grid is done: no rescan
-                      d_->fishbone->clear();
-                  }
-                  d_->lasso->clear();
-                  afterMeshChange();
-                  emit scanAccepted(*report);
-              });
+    startWork(
+        [s, report, figures](const Progress& progress) {
+            figures->first = figuresOf(s->current());
+            *report = s->accept(progress);
+            figures->second = figuresOf(s->current());
+        },
+        [this, report, name, figures] {
+            const std::shared_ptr<Job> job = d_->job;
+            setBusy(false);
+            if (!job->error.empty()) {
+                reportError(QString::fromStdString(job->error));
+                return;
+            }
+            if (job->cancelled) {
+                setNote(tr("Stitching was cancelled; the preview is kept."));
+                return;
+            }
+            const QString summary = acceptSummary(*report, figures->first.valence6, figures->second.valence6,
+                                                  figures->first.minAngle, figures->second.minAngle);
+            d_->undoStack->push(new AcceptCommand(this, name + QStringLiteral(" — ") + summary));
+            if (d_->fishbone->hasInput()) {
+                const QSignalBlocker blocker(d_->fishbone); // the accepted grid is done: no rescan
+                d_->fishbone->clear();
+            }
+            d_->lasso->clear();
+            afterMeshChange();
+            setNote(tr("Accepted: %1.").arg(summary));
+            emit scanAccepted(*report);
+        });
 }
 
 void RemeshWidget::startWork(std::function<void(const Progress&)> work, std::function<void()> done) {
@@ -802,6 +945,7 @@ void RemeshWidget::startWork(std::function<void(const Progress&)> work, std::fun
 
 void RemeshWidget::reject() {
     if (isBusy() || !d_->session) return;
+    d_->note.clear();
     d_->session->reject();
     if (d_->fishbone->hasInput()) {
         const QSignalBlocker blocker(d_->fishbone);
@@ -830,6 +974,7 @@ void RemeshWidget::setGhostVisible(bool visible) {
 void RemeshWidget::undoStep() {
     if (d_->syncingStack) return; // the stack only mirrors the session's history
     waitForWork();
+    d_->note.clear();
     try {
         d_->session->undo();
     } catch (const std::exception& e) {
@@ -842,6 +987,7 @@ void RemeshWidget::undoStep() {
 void RemeshWidget::redoStep() {
     if (d_->syncingStack) return;
     waitForWork();
+    d_->note.clear();
     try {
         d_->session->redo();
     } catch (const std::exception& e) {
@@ -875,8 +1021,13 @@ void RemeshWidget::showPreview() {
 }
 
 void RemeshWidget::reportError(const QString& message) {
-    d_->status->setText(message);
+    setNote(message);
     emit errorOccurred(message);
+}
+
+void RemeshWidget::setNote(const QString& text) {
+    d_->note = text;
+    updateStatus();
 }
 
 void RemeshWidget::setBusy(bool busy, const QString& what) {
@@ -916,8 +1067,12 @@ void RemeshWidget::updateStatus() {
     QString text;
     if (isBusy() || !d_->busyWhat.isEmpty())
         text = d_->busyWhat + tr("… (Cancel stops it)");
+    else if (!d_->note.isEmpty())
+        text = d_->note;
     else if (!d_->session)
         text = tr("Open a mesh to start.");
+    else if (hasPreview() && d_->active != d_->fishbone)
+        text = d_->scanTool->statusText(); // what to do with the preview, whichever tool is active
     else if (d_->active)
         text = d_->active->statusText();
     if (text == d_->status->text()) return;

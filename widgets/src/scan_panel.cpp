@@ -3,6 +3,7 @@
 #include <QCheckBox>
 #include <QDoubleSpinBox>
 #include <QFormLayout>
+#include <QKeyEvent>
 #include <QLabel>
 #include <QSpinBox>
 
@@ -29,18 +30,35 @@ ScanPanel::ScanPanel(QWidget* parent) : QWidget(parent) {
     resolution_->setValue(256);
     resolution_->setSingleStep(32);
     resolution_->setSuffix(tr(" px"));
-    resolution_->setToolTip(tr("Samples along the longer side of the scan image"));
+    resolution_->setToolTip(tr("Samples along the longer side of the scan image (Enter scans). Typing "
+                               "it holds the resolution as the view changes."));
+    resolution_->setObjectName(QStringLiteral("resolution"));
+    target_ = doubleSpin(this, 1e-9, 1e12, 1, 0.1, 4);
+    target_->setObjectName(QStringLiteral("targetEdgeLength"));
+    target_->setToolTip(tr("Wanted edge length of the scanned triangles in world units (Enter scans); the "
+                           "resolution follows it as you zoom. Defaults to the input's mean edge length."));
+    form->addRow(tr("Target edge"), target_);
+    follow_ = new QCheckBox(tr("Keep edge length"), this);
+    follow_->setToolTip(tr("Checked: zooming changes the resolution so that the edge length stays. "
+                           "Unchecked: the resolution stays and the edge length changes."));
+    form->addRow(QString(), follow_);
     form->addRow(tr("Resolution"), resolution_);
     edgeLabel_ = new QLabel(this);
     edgeLabel_->setWordWrap(true);
     form->addRow(tr("Edge length"), edgeLabel_);
+    inputLabel_ = new QLabel(tr("(no mesh)"), this);
+    inputLabel_->setWordWrap(true);
+    inputLabel_->setToolTip(tr("Mean edge length of the input mesh"));
+    form->addRow(tr("Input edges"), inputLabel_);
     erode_ = new QSpinBox(this);
     erode_->setRange(0, 8);
     erode_->setValue(1);
+    erode_->setToolTip(tr("Samples within this many grid steps of a hole or silhouette are dropped"));
     form->addRow(tr("Erosion"), erode_);
     dilate_ = new QSpinBox(this);
     dilate_->setRange(0, 8);
     dilate_->setValue(1);
+    dilate_->setToolTip(tr("Grows the kept region again by this many grid steps after the erosion"));
     form->addRow(tr("Dilation"), dilate_);
     maxEdge_ = doubleSpin(this, 1, 20, 3, 0.5, 1);
     maxEdge_->setToolTip(tr("Triangles with a longer edge (in pixel footprints) span a depth step"));
@@ -69,7 +87,30 @@ ScanPanel::ScanPanel(QWidget* parent) : QWidget(parent) {
         refreshEdgeLength();
         emit settingsChanged();
     };
-    connect(resolution_, &QSpinBox::valueChanged, this, changed);
+    connect(resolution_, &QSpinBox::valueChanged, this, [this, changed] {
+        if (!applying_) {
+            const QSignalBlocker blocker(follow_);
+            follow_->setChecked(false); // a typed resolution is held
+        }
+        changed();
+    });
+    connect(target_, &QDoubleSpinBox::valueChanged, this, [this] {
+        {
+            const QSignalBlocker blocker(follow_);
+            follow_->setChecked(true);
+        }
+        applyTarget();
+        emit settingsChanged();
+    });
+    connect(follow_, &QCheckBox::toggled, this, [this] {
+        applyTarget();
+        emit settingsChanged();
+    });
+    resolution_->installEventFilter(this);
+    target_->installEventFilter(this);
+    // Fields never squeezed below their natural height (RemeshWidget scrolls the panel instead).
+    for (QAbstractSpinBox* box : findChildren<QAbstractSpinBox*>())
+        box->setMinimumHeight(box->sizeHint().height());
     connect(erode_, &QSpinBox::valueChanged, this, changed);
     connect(dilate_, &QSpinBox::valueChanged, this, changed);
     connect(maxEdge_, &QDoubleSpinBox::valueChanged, this, changed);
@@ -83,6 +124,86 @@ ScanPanel::ScanPanel(QWidget* parent) : QWidget(parent) {
 
 ScanPanel::~ScanPanel() = default;
 
+bool ScanPanel::eventFilter(QObject* watched, QEvent* event) {
+    if ((watched == resolution_ || watched == target_) && event->type() == QEvent::KeyPress) {
+        const int key = static_cast<QKeyEvent*>(event)->key();
+        if (key == Qt::Key_Return || key == Qt::Key_Enter) {
+            static_cast<QAbstractSpinBox*>(watched)->interpretText(); // the typed value first
+            emit scanRequested();
+            return true;
+        }
+    }
+    return QWidget::eventFilter(watched, event);
+}
+
+double ScanPanel::targetEdgeLength() const {
+    return target_->value();
+}
+
+void ScanPanel::setTargetEdgeLength(double length) {
+    target_->setValue(length);
+    if (!follow_->isChecked()) follow_->setChecked(true); // the same value again still makes it follow
+}
+
+bool ScanPanel::followsTargetEdgeLength() const {
+    return follow_->isChecked();
+}
+
+void ScanPanel::setFollowsTargetEdgeLength(bool follow) {
+    follow_->setChecked(follow);
+}
+
+void ScanPanel::setInputEdgeLength(double meanEdge) {
+    inputEdge_ = meanEdge > 0 && std::isfinite(meanEdge) ? meanEdge : 0;
+    if (inputEdge_ == 0) {
+        inputLabel_->setText(tr("(no mesh)"));
+        return;
+    }
+    inputLabel_->setText(tr("mean %1").arg(inputEdge_, 0, 'g', 3));
+    // Four significant digits at the input's scale.
+    const int decimals = std::clamp(3 - int(std::floor(std::log10(inputEdge_))), 0, 12);
+    {
+        const QSignalBlocker blocker(target_);
+        target_->setDecimals(decimals);
+        target_->setRange(std::pow(10.0, -decimals), inputEdge_ * 1e4);
+        target_->setSingleStep(std::pow(10.0, std::floor(std::log10(inputEdge_))) / 2);
+    }
+    setTargetEdgeLength(inputEdge_);
+}
+
+double ScanPanel::footprintAt(int pixels) const {
+    if (!viewCamera_) return 0;
+    Camera camera = *viewCamera_;
+    const QSizeF view(camera.width, camera.height);
+    if (view.width() >= view.height()) {
+        camera.width = pixels;
+        camera.height = std::max(1, int(std::lround(pixels * view.height() / view.width())));
+    } else {
+        camera.width = std::max(1, int(std::lround(pixels * view.width() / view.height())));
+        camera.height = pixels;
+    }
+    if (camera.viewDepth(at_) <= 0) return 0;
+    return camera.pixelFootprint(at_);
+}
+
+void ScanPanel::applyTarget() {
+    const double target = target_->value();
+    if (follow_->isChecked() && target > 0) {
+        const double unit = footprintAt(1024) * 1024; // footprint × pixels: about constant
+        if (unit > 0) {
+            int best = std::clamp(int(std::lround(unit / target)), 16, 4096);
+            // The shorter side is rounded: take the neighbour whose footprint is closest to the target.
+            for (int r : {best - 1, best + 1})
+                if (r >= 16 && r <= 4096 &&
+                    std::abs(footprintAt(r) - target) < std::abs(footprintAt(best) - target))
+                    best = r;
+            applying_ = true;
+            resolution_->setValue(best);
+            applying_ = false;
+        }
+    }
+    refreshEdgeLength(); // a changed resolution has emitted settingsChanged
+}
 int ScanPanel::resolution() const {
     return resolution_->value();
 }
@@ -169,7 +290,7 @@ ScanParams ScanPanel::scanParams(const Camera& viewCamera) const {
 void ScanPanel::updateEdgeLength(const std::optional<Camera>& viewCamera, const Eigen::Vector3d& at) {
     viewCamera_ = viewCamera;
     at_ = at;
-    refreshEdgeLength();
+    applyTarget(); // following the target: the resolution for the new view
 }
 
 QString ScanPanel::edgeLengthText() const {

@@ -7,6 +7,7 @@
 // GL constants come from Qt's qopengl.h (through QOpenGLWidget); vtk_glew.h cannot be combined with it
 // and is not needed: every GL call goes through VTK (vtkOpenGLState, the render window).
 #include <vtkActor.h>
+#include <vtkAxesActor.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
@@ -14,17 +15,22 @@
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkGenericRenderWindowInteractor.h>
 #include <vtkInteractorStyleTrackballCamera.h>
+#include <vtkLookupTable.h>
 #include <vtkNew.h>
 #include <vtkObjectFactory.h>
 #include <vtkOpenGLShaderCache.h>
 #include <vtkOpenGLState.h>
+#include <vtkOrientationMarkerWidget.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
 #include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
 #include <vtkSmartPointer.h>
+#include <vtkTextProperty.h>
 #include <vtkUnsignedCharArray.h>
+#include <vtkVariant.h>
 
 #include <QKeyEvent>
 #include <QMouseEvent>
@@ -266,10 +272,67 @@ struct VtkView::Impl {
     Eigen::AlignedBox3d bounds;
     ColorMap colorMap = ColorMap::None;
     StandardView initialView = StandardView::Iso;
+    UpAxis upAxis = UpAxis::Z;
     vtkMTimeType cameraTime = 0;
+
+    // The colour legend and the axis triad.
+    vtkNew<vtkScalarBarActor> legend;
+    vtkNew<vtkLookupTable> legendTable;
+    bool legendEnabled = true;
+    vtkNew<vtkAxesActor> axes;
+    vtkNew<vtkOrientationMarkerWidget> axesWidget;
+
+    // The legend of the active colour map: the render layer's colours (colour_maps.h) in a lookup table.
+    void updateLegend() {
+        const bool show = legendEnabled && colorMap != ColorMap::None && polyData->GetNumberOfCells() > 0;
+        legend->SetVisibility(show);
+        if (!show) return;
+        vtkLookupTable* t = legendTable;
+        t->ResetAnnotations();
+        auto set = [t](vtkIdType i, const render::Rgb& c) {
+            t->SetTableValue(i, c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
+        };
+        if (colorMap == ColorMap::MinAngle) {
+            t->IndexedLookupOff();
+            t->SetNumberOfTableValues(61);
+            for (int a = 0; a <= 60; ++a)
+                set(a, render::minAngleColor(a));
+            t->SetTableRange(0, 60);
+            legend->SetTitle("Min angle (deg)");
+            legend->SetNumberOfLabels(5);
+        } else {
+            // Categories: one swatch per annotation, in the table's order.
+            std::vector<std::pair<int, std::string>> entries;
+            if (colorMap == ColorMap::Valence) {
+                entries = {{0, "0 (regular)"}, {1, "1"}, {2, "2"}, {3, ">= 3"}, {-1, "boundary"}};
+                legend->SetTitle("|valence - 6|");
+            } else {
+                std::vector<std::int32_t> ids = faceScanId;
+                std::sort(ids.begin(), ids.end());
+                ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+                for (std::int32_t id : ids) {
+                    if (int(entries.size()) == kMaxLegendScans) break;
+                    entries.emplace_back(id, id < 0 ? std::string("input") : "scan " + std::to_string(id));
+                }
+                legend->SetTitle("Made by");
+            }
+            t->IndexedLookupOn();
+            t->SetNumberOfTableValues(vtkIdType(entries.size()));
+            for (std::size_t i = 0; i < entries.size(); ++i) {
+                const int v = entries[i].first;
+                set(vtkIdType(i),
+                    colorMap == ColorMap::Valence ? render::valenceColor(v) : render::scanIdColor(v));
+                t->SetAnnotation(vtkVariant(v), entries[i].second);
+            }
+        }
+        t->Build();
+        legend->SetLookupTable(t);
+        legend->Modified();
+    }
 
     void applyColorMap() {
         vtkProperty* property = actor->GetProperty();
+        updateLegend();
         if (colorMap == ColorMap::None || polyData->GetNumberOfCells() == 0) {
             polyData->GetCellData()->SetScalars(nullptr);
             mapper->ScalarVisibilityOff();
@@ -453,6 +516,38 @@ VtkView::VtkView(QWidget* parent) : QOpenGLWidget(parent), impl_(std::make_uniqu
     d.previewActor->VisibilityOff();
     d.previewActor->PickableOff();
     d.renderer->AddActor(d.previewActor);
+
+    // Legend: at the right edge, white text with a shadow (readable on the background and on the mesh).
+    d.legend->SetOrientationToVertical();
+    d.legend->SetPosition(0.86, 0.12);
+    d.legend->SetWidth(0.12);
+    d.legend->SetHeight(0.76);
+    d.legend->SetMaximumWidthInPixels(130);
+    d.legend->SetBarRatio(0.3);
+    d.legend->SetLabelFormat("%.0f");
+    d.legend->DrawAnnotationsOn();
+    d.legend->SetTextPositionToSucceedScalarBar();
+    d.legend->UnconstrainedFontSizeOn(); // the font sizes below, not scaled to the bar's height
+    for (vtkTextProperty* text : {d.legend->GetTitleTextProperty(), d.legend->GetLabelTextProperty(),
+                                  d.legend->GetAnnotationTextProperty()}) {
+        text->SetColor(1, 1, 1);
+        text->ShadowOn();
+        text->ItalicOff();
+        text->SetFontSize(14);
+    }
+    d.legend->SetLookupTable(d.legendTable);
+    d.legend->VisibilityOff();
+    d.legend->PickableOff();
+    d.renderer->AddViewProp(d.legend);
+
+    // Axis triad in the lower-left corner (its own renderer layer, following the camera); hidden until
+    // setAxesVisible(true).
+    d.axes->SetTotalLength(1, 1, 1);
+    d.axes->SetShaftTypeToCylinder();
+    d.axesWidget->SetOrientationMarker(d.axes);
+    d.axesWidget->SetInteractor(d.interactor);
+    d.axesWidget->SetCurrentRenderer(d.renderer);
+    d.axesWidget->SetViewport(0.0, 0.0, 0.16, 0.16); // enabled by setAxesVisible
     setStandardView(d.initialView);
 }
 
@@ -610,6 +705,59 @@ ColorMap VtkView::colorMap() const {
     return impl_->colorMap;
 }
 
+void VtkView::setLegendVisible(bool visible) {
+    impl_->legendEnabled = visible;
+    impl_->updateLegend();
+    update();
+}
+
+bool VtkView::legendVisible() const {
+    return impl_->legendEnabled;
+}
+
+bool VtkView::legendShown() const {
+    return impl_->legend->GetVisibility() != 0;
+}
+
+void VtkView::setEdgesVisible(bool visible) {
+    impl_->actor->GetProperty()->SetEdgeVisibility(visible);
+    update();
+}
+
+bool VtkView::edgesVisible() const {
+    return impl_->actor->GetProperty()->GetEdgeVisibility() != 0;
+}
+
+void VtkView::setAxesVisible(bool visible) {
+    impl_->axesWidget->SetEnabled(visible);
+    if (visible) impl_->axesWidget->InteractiveOff();
+    update();
+}
+
+bool VtkView::axesVisible() const {
+    return impl_->axesWidget->GetEnabled() != 0;
+}
+
+void VtkView::setUpAxis(UpAxis axis) {
+    impl_->upAxis = axis;
+}
+
+VtkView::UpAxis VtkView::upAxis() const {
+    return impl_->upAxis;
+}
+
+void VtkView::frameMesh() {
+    Eigen::AlignedBox3d box = impl_->bounds;
+    if (box.isEmpty()) return setStandardView(impl_->initialView);
+    double b[6] = {box.min().x(), box.max().x(), box.min().y(), box.max().y(), box.min().z(), box.max().z()};
+    impl_->renderer->ResetCamera(b);
+    vtkCamera* c = impl_->renderer->GetActiveCamera();
+    c->Modified();
+    impl_->cameraTime = c->GetMTime();
+    update();
+    emit cameraChanged();
+}
+
 Camera VtkView::camera() const {
     vtkCamera* c = impl_->renderer->GetActiveCamera();
     Camera camera;
@@ -653,8 +801,11 @@ void VtkView::setStandardView(StandardView view) {
         box = Eigen::AlignedBox3d(Eigen::Vector3d(-0.5, -0.5, -0.5), Eigen::Vector3d(0.5, 0.5, 0.5));
     const Camera current = camera();
     vtkCamera* c = impl_->renderer->GetActiveCamera();
-    setCamera(Camera::standardView(view, box, current.width, current.height, c->GetParallelProjection() != 0,
-                                   c->GetViewAngle()));
+    Camera standard = Camera::standardView(view, box, current.width, current.height,
+                                           c->GetParallelProjection() != 0, c->GetViewAngle());
+    if (impl_->upAxis == UpAxis::Y && view != StandardView::PosY && view != StandardView::NegY)
+        standard.up = Eigen::Vector3d::UnitY(); // the views along x, z and iso are never parallel to y
+    setCamera(standard);
 }
 
 void VtkView::setInitialView(StandardView view) {

@@ -126,6 +126,9 @@ Snapshot renderSnapshot(const Mesh& mesh, const Camera& camera, const SnapshotOp
     snapshot.covered = buffers.coveredCount();
     if (snapshot.covered == 0) throw InvalidInputError("The snapshot camera sees no part of the mesh.");
     snapshot.image = shadeFaces(mesh, buffers, minAngleFaceColors(mesh), options);
+    if (options.legend)
+        snapshot.image = appendRight(snapshot.image, renderMinAngleLegend(legendWidth(camera.height),
+                                                                          camera.height, options.background));
     return snapshot;
 }
 

@@ -10,6 +10,8 @@
 
 #include "base/option_check.h"
 
+#include "mesh/triangle_geometry.h"
+
 #include <CGAL/Monge_via_jet_fitting.h>
 
 #include <algorithm>
@@ -19,11 +21,10 @@
 namespace fss {
 namespace {
 
+using detail::toEigen;
+
 using MongeFitting = CGAL::Monge_via_jet_fitting<Kernel>;
 
-Eigen::Vector3d toEigen(const Point3& p) {
-    return {p.x(), p.y(), p.z()};
-}
 template <class V> Eigen::Vector3d vecToEigen(const V& v) {
     return {CGAL::to_double(v[0]), CGAL::to_double(v[1]), CGAL::to_double(v[2])};
 }

@@ -148,9 +148,9 @@ void writeMesh(const Mesh& mesh, const fs::path& path, const WriteOptions& optio
     const std::string ext = lower(path.extension().string());
     const MeshFormat* format = formatOfExtension(ext);
     if (!format)
-        failWrite(path,
-                  (ext.empty() ? std::string("it has no extension") : "the extension " + quoteToken(ext)) +
-                      " does not name a format (use .off, .obj, .ply or .stl)");
+        failWrite(path, (ext.empty() ? std::string("it has no extension, so the format is unknown")
+                                     : "the extension " + quoteToken(ext) + " does not name a format") +
+                            " (use .off, .obj, .ply or .stl)");
     std::error_code ec;
     if (fs::is_directory(path, ec)) failWrite(path, "it is a folder");
     WriteOptions clamped = options;

@@ -3,6 +3,8 @@
 #include "fss/camera_projector.h"
 #include "fss/error.h"
 
+#include "mesh/triangle_geometry.h"
+
 #include <CGAL/AABB_face_graph_triangle_primitive.h>
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
@@ -18,13 +20,12 @@
 namespace fss {
 namespace {
 
+using detail::toEigen;
+
 using Primitive = CGAL::AABB_face_graph_triangle_primitive<Mesh>;
 using Traits = CGAL::AABB_traits<Kernel, Primitive>;
 using Tree = CGAL::AABB_tree<Traits>;
 
-Eigen::Vector3d toEigen(const Point3& p) {
-    return {p.x(), p.y(), p.z()};
-}
 Point3 toPoint(const Eigen::Vector3d& v) {
     return {v.x(), v.y(), v.z()};
 }

@@ -11,6 +11,11 @@
 
 namespace fss::detail {
 
+/// \p p as an Eigen vector.
+inline Eigen::Vector3d toEigen(const Point3& p) {
+    return {p.x(), p.y(), p.z()};
+}
+
 /// The position of vertex \p v of \p m.
 inline Eigen::Vector3d pos(const Mesh& m, VertexIndex v) {
     const Point3& p = m.point(v);

@@ -135,6 +135,17 @@ public:
     /// Whether the view shows the reference mesh as a ghost (when the view supports it).
     bool ghostVisible() const { return ghost_; }
 
+    /// The History name of accepted step \p number (from 1) made by \p step: its view (a standard view
+    /// such as "from +X" when the camera looks along one, else "custom view"), its resolution and its
+    /// grid kind, e.g. "1. Scan from +Z, 256×192 px, regular grid". After an accept the History entry
+    /// adds acceptSummary().
+    static QString stepName(int number, const ScanStep& step);
+    /// What an accept did, shown in the status line and the History entry: faces replaced (StitchReport),
+    /// the whole mesh's share of valence-6 interior vertices and its smallest angle before → after, and
+    /// the stitch report's seam figures.
+    static QString acceptSummary(const StitchReport& report, double valence6Before, double valence6After,
+                                 double minAngleBefore, double minAngleAfter);
+
 public slots:
     /// A regular scan (ScanTool::step: the view's camera at the panel's resolution, the lasso if any) on
     /// the GUI thread; the result becomes the preview. On failure errorOccurred() with the reason (the
@@ -187,7 +198,11 @@ private:
     void afterMeshChange();
     void showPreview();
     void runFishbone();
+    void createToolBar();
     void reportError(const QString& message);
+    // Shows \p text in the status line until the next action.
+    void setNote(const QString& text);
+    bool eventFilter(QObject* watched, QEvent* event) override;
     void setBusy(bool busy, const QString& what = {});
     void updateStatus();
     void waitForWork();

@@ -1,6 +1,7 @@
 #pragma once
 /// \file scan_panel.h
-/// ScanPanel: the settings of the next scan — resolution (with the edge length it gives in world units),
+/// ScanPanel: the settings of the next scan — the target edge length in world units or the resolution
+/// (whichever was set last is held as the view changes; the edge length the resolution gives is shown),
 /// erosion / dilation radii, the triangulation and quality thresholds, force-replace, and the fishbone
 /// grid's spacing — and the scan camera they make from the view's camera.
 
@@ -29,9 +30,26 @@ public:
     ~ScanPanel() override;
 
     /// Scan resolution: the number of pixels (samples) along the longer side of the scan image; the
-    /// shorter side follows the view's aspect. Clamped to [16, 4096]; default 256.
+    /// shorter side follows the view's aspect. Clamped to [16, 4096]; default 256. Setting it (or typing
+    /// it) holds the resolution: followsTargetEdgeLength() becomes false.
     int resolution() const;
     void setResolution(int pixels);
+
+    /// The target edge length of a scan in world units: while followsTargetEdgeLength(), the resolution is
+    /// the one whose pixel footprint at the measuring point (updateEdgeLength) is closest to it, clamped to
+    /// [16, 4096], recomputed whenever the view changes. Setting it (or typing it) makes the resolution
+    /// follow it. setInputEdgeLength() sets it to the input's mean edge length.
+    double targetEdgeLength() const;
+    void setTargetEdgeLength(double length);
+    /// Whether the resolution follows targetEdgeLength() (true after setTargetEdgeLength or
+    /// setInputEdgeLength, false after setResolution; the "Keep edge length" check box).
+    bool followsTargetEdgeLength() const;
+    void setFollowsTargetEdgeLength(bool follow);
+    /// Shows the input mesh's mean edge length \p meanEdge (world units; ≤ 0: no mesh), makes it the target
+    /// edge length (the field's decimals and step adapt to its scale) and lets the resolution follow it.
+    void setInputEdgeLength(double meanEdge);
+    /// The input's mean edge length shown (0 when none).
+    double inputEdgeLength() const { return inputEdge_; }
     /// Morphological erosion radius in grid samples, [0, 8]; default 1.
     int erodeRadius() const;
     void setErodeRadius(int radius);
@@ -82,9 +100,18 @@ public:
 signals:
     /// Some setting changed (by the user or a setter).
     void settingsChanged();
+    /// Enter was pressed in the resolution or target edge length field: take a scan.
+    void scanRequested();
+
+protected:
+    bool eventFilter(QObject* watched, QEvent* event) override;
 
 private:
     void refreshEdgeLength();
+    // While following the target: sets the resolution whose footprint is closest to it.
+    void applyTarget();
+    // The pixel footprint at the measuring point of a scan of resolution \p pixels (0 when unknown).
+    double footprintAt(int pixels) const;
 
     QSpinBox* resolution_ = nullptr;
     QSpinBox* erode_ = nullptr;
@@ -96,6 +123,11 @@ private:
     QDoubleSpinBox* spacing_ = nullptr;
     QCheckBox* fineField_ = nullptr;
     QLabel* edgeLabel_ = nullptr;
+    QDoubleSpinBox* target_ = nullptr;
+    QCheckBox* follow_ = nullptr;
+    QLabel* inputLabel_ = nullptr;
+    double inputEdge_ = 0;
+    bool applying_ = false; // applyTarget is setting the resolution
     std::optional<Camera> viewCamera_;
     Eigen::Vector3d at_{0, 0, 0};
     double edgeLength_ = 0;

@@ -100,6 +100,31 @@ public:
     void setColorMap(ColorMap map);
     ColorMap colorMap() const;
 
+    /// Shows a colour legend (a vtkScalarBarActor at the right edge of the view) for every colour map but
+    /// ColorMap::None: the minimum angle 0°–60°, the valence deviation 0, 1, 2, ≥ 3 and boundary, or the
+    /// scan ids of the shown mesh (input and each scan, at most kMaxLegendScans entries). Shown by default.
+    void setLegendVisible(bool visible);
+    /// Whether the legend is enabled (it is drawn only while a colour map other than None is active).
+    bool legendVisible() const;
+    /// Whether a legend is drawn now (enabled, a colour map, a mesh).
+    bool legendShown() const;
+    /// Entries of the scan-id legend at most (the lowest ids; the input first).
+    static constexpr int kMaxLegendScans = 12;
+    /// Draws the triangle edges of the mesh (default on). Dense meshes look black with edges: turn off.
+    void setEdgesVisible(bool visible);
+    bool edgesVisible() const;
+    /// Shows an axis triad (vtkOrientationMarkerWidget with a vtkAxesActor) in the lower-left corner,
+    /// turning with the camera. Hidden by default (RemeshWidget shows it).
+    void setAxesVisible(bool visible);
+    bool axesVisible() const;
+    /// Which world axis points up in the standard views (setStandardView): Z (the default, as in
+    /// fss::Camera::standardView) or Y (as in many mesh files from graphics tools).
+    enum class UpAxis { Z, Y };
+    void setUpAxis(UpAxis axis);
+    UpAxis upAxis() const;
+    /// Frames the shown mesh (the whole mesh visible) keeping the viewing direction — the 'r' key.
+    void frameMesh();
+
     /// The current camera; width/height are the widget size times the device pixel ratio (at least 1).
     Camera camera() const;
     /// Makes \p camera the view's camera (eye, focal point, up, projection, clipping range). Its
@@ -107,7 +132,8 @@ public:
     /// \throw fss::InvalidInputError when camera.validate() fails; the view is unchanged then.
     void setCamera(const Camera& camera);
     /// Looks at the shown mesh from \p view (fss::Camera::standardView: the whole mesh is visible, up is
-    /// +z except for ±z views). Without a mesh the unit cube is framed.
+    /// +z except for ±z views; with UpAxis::Y the up vector is +y except for ±y views, which keep
+    /// standardView's). Without a mesh the unit cube is framed.
     void setStandardView(StandardView view);
     /// The standard view used for a newly set mesh; Iso unless changed.
     void setInitialView(StandardView view);

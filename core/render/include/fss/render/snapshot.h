@@ -50,7 +50,26 @@ struct SnapshotOptions {
     /// only the GPU (Gpu: no fallback), or CPU ray casting (Cpu).
     using Renderer = RendererChoice;
     Renderer renderer = Renderer::Auto; ///< see Renderer
+    /// Append a colour legend of the minimum-angle map at the right of the picture (renderMinAngleLegend,
+    /// legendWidth(height) pixels wide): the picture of the mesh itself is unchanged. Needs an OpenGL
+    /// context (Mesa EGL) even with the CPU renderer.
+    bool legend = false;
 };
+
+/// Width in pixels of the legend renderSnapshot appends for a picture \p height pixels high.
+inline int legendWidth(int height) {
+    return height / 4 < 110 ? 110 : height / 4;
+}
+
+/// The minimum-angle legend: VTK's vtkScalarBarActor (the colours of minAngleColor, 0 to 60 degrees, a
+/// title and five labels) rendered head-less in a Mesa EGL surfaceless context on \p background.
+/// \throw InvalidInputError for a size below 16 × 16; fss::Error (one sentence) when no OpenGL context can
+///        be made or it gives no image.
+Image renderMinAngleLegend(int width, int height, const Rgb& background);
+
+/// \p image with \p right placed at its right (same height). \throw InvalidInputError when the heights
+/// differ.
+Image appendRight(const Image& image, const Image& right);
 
 /// Shades \p buffers (rendered from \p mesh) with one colour per face: see the file comment. Covered pixels
 /// never take the background colour (a covered pixel that would equal it is changed by one unit of
@@ -69,9 +88,10 @@ struct Snapshot {
 };
 
 /// Renders \p mesh from \p camera (camera.width × camera.height pixels, clipping range fitted to the mesh)
-/// coloured by minimum angle. With Renderer::Auto a failure to create an OpenGL context falls back to
-/// CPU ray casting (Snapshot::renderer says which was used).
-/// \throw InvalidInputError when the mesh is empty or the camera is invalid or sees nothing of the mesh;
+/// coloured by minimum angle; with SnapshotOptions::legend the legend is appended at the right (the image
+/// is then legendWidth(camera.height) pixels wider). With Renderer::Auto a failure to create an OpenGL
+/// context falls back to CPU ray casting (Snapshot::renderer says which was used). \throw InvalidInputError
+/// when the mesh is empty or the camera is invalid or sees nothing of the mesh;
 ///        fss::Error when Renderer::Gpu is asked for and no OpenGL context can be made.
 Snapshot renderSnapshot(const Mesh& mesh, const Camera& camera, const SnapshotOptions& options = {});
 
