@@ -11,6 +11,7 @@ packages=(
   libvtk9-dev libglew-dev libegl-dev libgl-dev libgl1-mesa-dri libegl-mesa0 libgbm1
   qt6-base-dev qt6-base-dev-tools libqt6opengl6-dev qt6-tools-dev qt6-tools-dev-tools
   libgtest-dev libgmock-dev libbenchmark-dev
+  libgmsh-dev python3-meshio
   libcgal-demo xvfb xauth
 )
 

@@ -1,8 +1,10 @@
 #include "main_window.h"
 
 #include <fss/error.h>
+#include <fss/face_groups.h>
 #include <fss/mesh_io.h>
 #include <fss/metrics.h>
+#include <fss/render/fem_io.h>
 
 #include <QActionGroup>
 #include <QApplication>
@@ -212,7 +214,7 @@ void MainWindow::setColorMap(widgets::ColorMap map) {
 bool MainWindow::openMesh(const QString& path) {
     Mesh mesh;
     try {
-        mesh = readMesh(path.toStdString());
+        mesh = render::readMeshFile(path.toStdString());
     } catch (const std::exception& e) {
         reportError(tr("Open mesh"), QString::fromStdString(e.what()));
         return false;
@@ -233,7 +235,9 @@ bool MainWindow::openMesh(const QString& path) {
 
 bool MainWindow::saveMesh(const QString& path) {
     try {
-        writeMesh(mesh(), path.toStdString());
+        Mesh out = mesh();
+        if (hasFaceGroups(remesh_->referenceMesh())) transferFaceGroups(remesh_->referenceMesh(), out);
+        render::writeMeshFile(out, path.toStdString());
     } catch (const std::exception& e) {
         reportError(tr("Save mesh"), QString::fromStdString(e.what()));
         return false;
@@ -257,7 +261,8 @@ bool MainWindow::save() {
 }
 
 QString MainWindow::withFilterSuffix(const QString& path, const QString& filter) {
-    static const QStringList known = {"off", "obj", "ply", "stl"};
+    static const QStringList known = {"off", "obj", "ply", "stl", "msh", "inp",
+                                      "bdf", "nas", "unv", "vtu", "vtp"};
     if (known.contains(QFileInfo(path).suffix().toLower())) return path;
     const QRegularExpressionMatch m = QRegularExpression(QStringLiteral("\\*\\.(\\w+)")).match(filter);
     return m.hasMatch() ? path + QLatin1Char('.') + m.captured(1) : path;
@@ -372,9 +377,11 @@ void MainWindow::updateStatistics() {
 
 void MainWindow::openDialog() {
     if (!maybeSave()) return;
-    const QString path = QFileDialog::getOpenFileName(this, tr("Open mesh"), QFileInfo(meshPath_).path(),
-                                                      tr("Meshes (*.off *.obj *.ply *.stl);;OFF (*.off);;OBJ "
-                                                         "(*.obj);;PLY (*.ply);;STL (*.stl);;All files (*)"));
+    const QString path =
+        QFileDialog::getOpenFileName(this, tr("Open mesh"), QFileInfo(meshPath_).path(),
+                                     tr("Meshes (*.off *.obj *.ply *.stl *.msh *.vtu *.vtp *.vtk);;OFF "
+                                        "(*.off);;OBJ (*.obj);;PLY (*.ply);;STL (*.stl);;gmsh MSH "
+                                        "(*.msh);;VTK (*.vtu *.vtp *.vtk);;All files (*)"));
     if (!path.isEmpty()) openMesh(path);
 }
 
@@ -382,7 +389,10 @@ void MainWindow::saveDialog() {
     QString filter;
     const QString path = QFileDialog::getSaveFileName(
         this, tr("Save mesh"), savePath_.isEmpty() ? QFileInfo(meshPath_).path() : savePath_,
-        tr("PLY, keeps scan ids and quality (*.ply);;OFF (*.off);;OBJ (*.obj);;STL (*.stl)"), &filter);
+        tr("PLY, keeps scan ids and quality (*.ply);;OFF (*.off);;OBJ (*.obj);;STL (*.stl);;gmsh MSH 4.1, "
+           "groups as physical surfaces (*.msh);;Abaqus INP (*.inp);;Nastran BDF (*.bdf *.nas);;I-deas UNV "
+           "(*.unv);;VTK unstructured grid (*.vtu);;VTK poly data (*.vtp)"),
+        &filter);
     if (!path.isEmpty()) saveMesh(withFilterSuffix(path, filter));
 }
 

@@ -2,6 +2,7 @@
 //                  [--renderer auto|gpu|cpu] [--max-views N] [--no-metrics]
 #include "command_line.h"
 #include "commands.h"
+#include "mesh_files.h"
 #include "terminal_progress.h"
 
 #include "fss/auto_remesh.h"
@@ -40,17 +41,19 @@ struct CliAutoOptions {
     const CLI::Option* edge = nullptr;     // --edge-length, given when count() > 0
     const CLI::Option* vertices = nullptr; // --target-vertices, given when count() > 0
     bool json = false, noMetrics = false;
+    OutputFileOptions file;
 };
 
 int runAuto(const CliAutoOptions& o) {
     requireNotBoth(*o.edge, *o.vertices);
+    checkOutputFileOptions(o.outPath, o.file);
     AutoOptions options;
     if (o.edge->count() > 0) options.edgeLength = o.edgeLength;
     if (o.vertices->count() > 0) options.targetVertices = std::size_t(o.targetVertices);
     options.maxViews = o.maxViews;
     options.fishbone = !o.fishbone.empty();
 
-    const Mesh reference = readMesh(o.meshPath);
+    const Mesh reference = readInputMesh(o.meshPath);
     const render::RendererSelection renderer =
         render::chooseRenderer(*render::parseRendererChoice(o.rendererKind));
     if (!renderer.fallbackReason.empty())
@@ -62,7 +65,7 @@ int runAuto(const CliAutoOptions& o) {
     TerminalProgress bar;
     const AutoResult result = autoRemesh(reference, options, bar.progress());
     bar.finish();
-    writeMesh(result.mesh, o.outPath, WriteOptions{.binary = false});
+    writeOutputMesh(result.mesh, &reference, o.outPath, o.file, WriteOptions{.binary = false});
 
     std::optional<Metrics> metrics;
     if (!o.noMetrics) {
@@ -138,11 +141,16 @@ Subcommand addAuto(CLI::App& app) {
         "scan resolution from the target edge length, scan and stitch view after view (the quality mask "
         "keeps the best view of each region), then aim extra views at what is left from the input.",
         "examples:\n  fss-remesh auto fandisk.off -o fandisk-auto.off\n"
-        "  fss-remesh auto fandisk.off -o out.ply --target-vertices 10000 --fishbone auto --json");
-    p->add_option("MESH", o->meshPath, "The mesh to remesh (.off .obj .ply .stl).")
+        "  fss-remesh auto fandisk.off -o out.ply --target-vertices 10000 --fishbone auto --json\n"
+        "  fss-remesh auto part.obj -o part.msh --feature-edges");
+    p->add_option("MESH", o->meshPath, "The mesh to remesh (.off .obj .ply .stl .msh .vtu .vtp .vtk).")
         ->required()
         ->type_name("");
-    addOutputMesh(*p, o->outPath, "Output mesh (.ply keeps per-face quality and scan id).");
+    addOutputMesh(
+        *p, o->outPath,
+        "Output mesh (.off .obj .ply .stl, or for FEM .msh .inp .bdf .unv .vtu .vtp; .ply keeps per-face "
+        "quality and scan id). The input's face groups are carried to the output.");
+    addOutputFileOptions(*p, o->file);
     o->edge = addDouble(*p, "--edge-length", o->edgeLength, true, "L", "Target edge length in model units.");
     o->vertices = addInt(*p, "--target-vertices", o->targetVertices, 4, 1 << 30, "N",
                          "Target vertex count (default: the input's); the edge length follows from the area, "

@@ -4,6 +4,7 @@
 // Replays a session file head-less (session_file.h) and reports what it made.
 #include "command_line.h"
 #include "commands.h"
+#include "mesh_files.h"
 #include "stitch_json.h"
 #include "terminal_progress.h"
 
@@ -46,6 +47,7 @@ struct RunOptions {
     const CLI::Option* report = nullptr;   // given when count() > 0
     const CLI::Option* snapshot = nullptr; // given when count() > 0
     bool json = false, noSelf = false, quiet = false, legend = false;
+    OutputFileOptions file;
 };
 
 int runRun(const RunOptions& o) {
@@ -53,6 +55,7 @@ int runRun(const RunOptions& o) {
     const bool haveReport = o.report->count() > 0, haveSnapshot = o.snapshot->count() > 0, json = o.json;
     if (haveReport && o.reportPath.empty()) throw UsageError("The option --report needs a file name.");
     const auto view = parseStandardView(o.snapshotView);
+    checkOutputFileOptions(o.outPath, o.file);
 
     const auto start = Clock::now();
     const SessionFile file = loadSessionFile(o.sessionPath);
@@ -77,7 +80,7 @@ int runRun(const RunOptions& o) {
     const Mesh& result = replay.session.current();
 
     auto t = Clock::now();
-    writeMesh(result, o.outPath);
+    writeOutputMesh(result, &replay.session.reference(), o.outPath, o.file);
     const double writeSeconds = since(t);
 
     const bool wantReport = haveReport || json;
@@ -225,8 +228,11 @@ Subcommand addRun(CLI::App& app) {
                   "Session file (fss-session JSON, written by fss-demo or the C++ API).")
         ->required()
         ->type_name("");
-    addOutputMesh(*p, o->outPath,
-                  "Output mesh (.off .obj .ply .stl; .ply keeps per-face quality and scan id).");
+    addOutputMesh(
+        *p, o->outPath,
+        "Output mesh (.off .obj .ply .stl, or for FEM .msh .inp .bdf .unv .vtu .vtp; .ply keeps per-face "
+        "quality and scan id). The input's face groups are carried to the output.");
+    addOutputFileOptions(*p, o->file);
     o->report =
         p->add_option(
              "--report", o->reportPath,

@@ -5,6 +5,7 @@
 //                  "seed=X,Y[;dir=min|max][;h=PIXELS][;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...][;sampling=K]"]
 #include "command_line.h"
 #include "commands.h"
+#include "mesh_files.h"
 #include "stitch_json.h"
 
 #include "fss/camera.h"
@@ -349,6 +350,7 @@ struct ScanOptions {
     const CLI::Option* fishboneOption = nullptr;
     const CLI::Option* intoOption = nullptr;
     const CLI::Option* scanIdOption = nullptr;
+    OutputFileOptions file;
     bool parallel = false, json = false, force = false;
 };
 
@@ -370,7 +372,8 @@ int runScan(const ScanOptions& o) {
     params.scan.spacingPixels = o.spacing;
     params.scan.spacingWorld = o.spacingWorld;
 
-    const Mesh reference = readMesh(meshPath);
+    checkOutputFileOptions(o.outPath, o.file);
+    const Mesh reference = readInputMesh(meshPath);
     const Eigen::AlignedBox3d box = boundingBox(reference);
     if (o.cameraOption->count() > 0)
         params.camera = makeCamera(o.camera, box, w, h, o.parallel);
@@ -385,7 +388,7 @@ int runScan(const ScanOptions& o) {
     // The current mesh: the reference itself (first scan, or --into MESH) or the mesh of --into.
     std::optional<Mesh> intoMesh;
     if (haveInto && !sameFile(o.intoPath, meshPath)) {
-        intoMesh = readMesh(o.intoPath);
+        intoMesh = readInputMesh(o.intoPath);
         requireRemeshingOf(*intoMesh, o.intoPath, reference, meshPath, box);
     }
     const Mesh& current = intoMesh ? *intoMesh : reference;
@@ -428,7 +431,7 @@ int runScan(const ScanOptions& o) {
         stitchOptions.collectGarbage = true;
         const StitchReport report =
             stitchPatch(result, run.patch.mesh, run.samplingCamera, stitchOptions, run.currentBuffers.faceId);
-        writeMesh(result, o.outPath, WriteOptions{.binary = false});
+        writeOutputMesh(result, &reference, o.outPath, o.file, WriteOptions{.binary = false});
         j["into"] = o.intoPath;
         j["scan_id"] = params.scan.scanId;
         j["stitch"] = stitchReportJson<nlohmann::json>(report);
@@ -442,7 +445,7 @@ int runScan(const ScanOptions& o) {
              << " s -> " << result.number_of_faces() << " faces, written to " << o.outPath;
         summary += text.str();
     } else {
-        writeMesh(run.patch.mesh, o.outPath, WriteOptions{.binary = false});
+        writeOutputMesh(run.patch.mesh, &reference, o.outPath, o.file, WriteOptions{.binary = false});
         summary += ", written to " + o.outPath;
     }
     if (o.json)
@@ -472,7 +475,8 @@ Subcommand addScan(CLI::App& app) {
         ->type_name("");
     addOutputMesh(*p, o->outPath,
                   "Output file of the patch, or of the stitched mesh with --into (.ply keeps per-face "
-                  "quality and scan id).");
+                  "quality and scan id; FEM: .msh .inp .bdf .unv .vtu .vtp).");
+    addOutputFileOptions(*p, o->file);
     o->viewOption = p->add_option("--view", o->view,
                                   "Standard view fitted to the mesh: iso, +x, -x, +y, -y, +z, -z (default "
                                   "iso). '+x' looks from the +x side.")

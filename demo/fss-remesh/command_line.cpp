@@ -1,4 +1,5 @@
 #include "command_line.h"
+#include "mesh_files.h"
 
 #include "fss/camera.h"
 #include "fss/mesh_io.h"
@@ -96,9 +97,9 @@ CLI::Option* addOutputMesh(CLI::App& command, std::string& out, const std::strin
         ->required()
         ->check(validator(
             [](std::string& path) {
-                if (!isSupportedMeshFile(path))
-                    throw UsageError("The output file " + path +
-                                     " has no supported extension (.off .obj .ply .stl).");
+                if (!isOutputMeshFile(path))
+                    throw UsageError("The output file " + path + " has no supported extension (" +
+                                     outputExtensions() + ").");
             },
             "mesh file"));
 }

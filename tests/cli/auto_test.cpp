@@ -8,6 +8,7 @@
 #include "run_process.h"
 #include "test_data.h"
 
+#include "fss/face_groups.h"
 #include "fss/mesh_io.h"
 #include "fss/metrics.h"
 
@@ -15,7 +16,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <map>
 
 using fss::test::expectCleanFailure;
 using fss::test::meshPath;
@@ -193,4 +197,84 @@ TEST(CliAuto, HelpListsTheOptions) {
     EXPECT_EQ(r.exitCode, 0);
     for (const char* option : {"--edge-length", "--target-vertices", "--fishbone", "--json", "--renderer"})
         EXPECT_NE(r.out.find(option), std::string::npos) << option;
+}
+
+// ---- issue 22: the FEM hand-off ------------------------------------------------------------------------
+
+namespace {
+
+/// fandisk with two groups split by the plane z = mid-height, written as OBJ (`g upper` / `g lower`).
+std::string twoGroupFandiskObj(const std::string& upper = "upper") {
+    fss::Mesh mesh = fss::readMesh(kFandisk);
+    const double mid = fss::boundingBox(mesh).center().z();
+    fss::setGroupNames(mesh, {upper, "lower"});
+    auto group = mesh.property_map<fss::FaceIndex, std::int32_t>(fss::props::faceGroup).first;
+    for (fss::FaceIndex f : mesh.faces()) {
+        double z = 0;
+        for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
+            z += mesh.point(v).z() / 3;
+        group[f] = z > mid ? 0 : 1;
+    }
+    const auto path = tmpPath("cli_auto/fandisk_groups_" + upper + ".obj");
+    std::filesystem::create_directories(path.parent_path());
+    fss::writeMesh(mesh, path);
+    return path.string();
+}
+
+std::map<std::string, std::pair<std::size_t, double>> infoGroups(const std::string& file) {
+    const auto r = remesh({"info", file, "--json", "--no-self-intersections"});
+    EXPECT_EQ(r.exitCode, 0) << r.err;
+    std::map<std::string, std::pair<std::size_t, double>> out;
+    if (r.exitCode != 0) return out;
+    const nlohmann::json report = nlohmann::json::parse(r.out); // a named object: the loop must not dangle
+    for (const auto& g : report.at("groups"))
+        out[g.at("name").get<std::string>()] = {g.at("faces").get<std::size_t>(), g.at("area").get<double>()};
+    return out;
+}
+
+} // namespace
+
+// A CGAL mesh with two groups remeshed by `auto` into gmsh MSH 4.1 with feature edges: every output face
+// carries a group (read back through gmsh by `info`) and each group's area is within 1 % of the input's.
+TEST(CliAuto, FemHandOffCarriesGroups) {
+    const std::string input = twoGroupFandiskObj();
+    const auto out = tmpPath("cli_auto/fandisk_groups_auto.msh");
+    const auto p = remesh({"auto", input, "-o", out.string(), "--feature-edges", "--no-metrics"});
+    ASSERT_EQ(p.exitCode, 0) << p.err;
+    const auto before = infoGroups(input), after = infoGroups(out.string());
+    ASSERT_EQ(before.size(), 2u);
+    ASSERT_EQ(after.size(), 2u) << "a face without a group would add an entry with an empty name";
+    for (const char* name : {"upper", "lower"}) {
+        const double a = before.at(name).second, b = after.at(name).second;
+        EXPECT_NEAR(b, a, 0.01 * a) << name;
+        std::printf("[ measure  ] auto: group %s area %.6g -> %.6g (%.3f %%), %zu -> %zu faces\n", name, a, b,
+                    100 * (b / a - 1), before.at(name).first, after.at(name).first);
+    }
+    // The text report of `info` shows the groups and the quality measures FEM users check.
+    const auto text = remesh({"info", out.string(), "--no-self-intersections"});
+    EXPECT_NE(text.out.find("group 'upper'"), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find("scaled Jacobian"), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find("aspect ratio"), std::string::npos) << text.out;
+}
+
+TEST(CliAuto, FemHandOffBadInputIsOneSentence) {
+    const std::string input = twoGroupFandiskObj();
+    // Line elements cannot go into a PLY file: refused before any work.
+    expectCleanFailure(remesh({"auto", input, "-o", tmpPath("cli_auto/x.ply").string(), "--feature-edges"}),
+                       "--feature-edges");
+    expectCleanFailure(remesh({"auto", input, "-o", tmpPath("cli_auto/x.xyz").string()}), ".msh");
+    // A group name Abaqus cannot hold: one sentence, exit 1, no file.
+    const auto spaced = tmpPath("cli_auto/spaced_groups.obj");
+    {
+        std::ofstream f(spaced);
+        f << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\no my part\ng\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n";
+    }
+    // `o my part` names two groups: unknown group syntax for FSS.
+    expectCleanFailure(remesh({"info", spaced.string()}), "one group per face");
+    const auto inp = tmpPath("cli_auto/bad_name.inp");
+    std::filesystem::remove(inp);
+    const auto r = remesh({"scan", twoGroupFandiskObj("1st"), "-o", inp.string(), "--view", "iso"});
+    expectCleanFailure(r, "Abaqus INP cannot hold the group name '1st'");
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_FALSE(std::filesystem::exists(inp));
 }

@@ -446,7 +446,7 @@ TEST(Metrics, JsonHasTheDocumentedKeysAndValues) {
     const Metrics x = withReference(g, transformed(g, 1.0, 0, 0, 0.1));
     const nlohmann::json j = nlohmann::json::parse(fss::metricsToJson(x));
     ASSERT_TRUE(j.is_object());
-    EXPECT_EQ(j.size(), 29u);
+    EXPECT_EQ(j.size(), 33u); // 29 + the quality measures of issue 22 (aspect ratio, scaled Jacobian)
     EXPECT_EQ(j.at("vertices").get<std::size_t>(), x.vertices);
     EXPECT_EQ(j.at("faces").get<std::size_t>(), x.faces);
     EXPECT_EQ(j.at("edges").get<std::size_t>(), x.edges);
@@ -468,6 +468,10 @@ TEST(Metrics, JsonHasTheDocumentedKeysAndValues) {
         {"frac_min_angle_below_10", x.fracMinAngleBelow10},
         {"radius_ratio_mean", x.radiusRatioMean},
         {"radius_ratio_min", x.radiusRatioMin},
+        {"aspect_ratio_mean", x.aspectRatioMean},
+        {"aspect_ratio_max", x.aspectRatioMax},
+        {"scaled_jacobian_min", x.scaledJacobianMin},
+        {"scaled_jacobian_mean", x.scaledJacobianMean},
         {"edge_length_mean", x.edgeLengthMean},
         {"edge_length_cv", x.edgeLengthCv},
         {"bbox_diagonal", x.bboxDiagonal},

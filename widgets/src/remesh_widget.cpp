@@ -1,8 +1,10 @@
 #include "fss/widgets/remesh_widget.h"
 
 #include "fss/error.h"
+#include "fss/face_groups.h"
 #include "fss/mesh_io.h"
 #include "fss/metrics.h"
+#include "fss/render/fem_io.h"
 #include "fss/replay.h"
 #include "fss/session_file.h"
 #include "fss/widgets/fishbone_tool.h"
@@ -685,7 +687,10 @@ const Mesh& RemeshWidget::referenceMesh() const {
 bool RemeshWidget::saveMesh(const QString& path) {
     try {
         if (!d_->session) throw InvalidInputError("There is no mesh to save: open a mesh first.");
-        writeMesh(mesh(), path.toStdString());
+        // Any format of fss/render/fem_io.h, with the reference's face groups carried to the new faces.
+        Mesh out = mesh();
+        if (hasFaceGroups(d_->session->reference())) transferFaceGroups(d_->session->reference(), out);
+        render::writeMeshFile(out, path.toStdString());
     } catch (const std::exception& e) {
         reportError(sentence(e));
         return false;

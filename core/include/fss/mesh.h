@@ -45,3 +45,7 @@ inline Eigen::AlignedBox3d boundingBox(const Mesh& mesh) {
 inline constexpr float kInputFaceQuality = 1e30f;
 
 } // namespace fss
+
+// Named face groups (the surfaces FEM boundary conditions are attached to) are a third optional face
+// property, `f:group` (std::int32_t index into a group-name table that the mesh itself carries, -1 for a
+// face in no group): see fss/face_groups.h (props::faceGroup, groupNames, transferFaceGroups).

@@ -45,6 +45,10 @@ struct ReadReport {
     std::vector<std::string> repairs; ///< one sentence per repair made ("merged 12 duplicate points", ...)
     bool hasFaceQuality = false;      ///< a PLY face property `quality` was restored into props::faceQuality
     bool hasScanId = false;           ///< a PLY face property `scan_id` was restored into props::faceScanId
+    /// number of named face groups read (fss/face_groups.h): OBJ `g`/`o` statements, the solids of an ascii
+    /// STL file with more than one solid, the PLY face property `group` (names from "comment group <value>
+    /// <name>" header lines, else "group_<value>"); 0 when the file has none
+    std::size_t groups = 0;
     bool repaired() const { return !repairs.empty(); }
 };
 
@@ -80,6 +84,22 @@ Mesh readMesh(const std::filesystem::path& path, ReadReport* report = nullptr,
 ///        coordinates, or nothing left after repair.
 Mesh canonicalMesh(const Mesh& mesh);
 
+/// A polygon soup read by a reader outside core (fss/render/fem_io.h: VTK and gmsh files), to be turned
+/// into a Mesh exactly as readMesh turns its files' soups (same checks, repairs and report).
+struct PolygonSoup {
+    std::vector<Point3> points;
+    std::vector<std::vector<std::size_t>> polygons; ///< corner indices into points, ≥ 3 corners each
+    std::vector<std::int32_t> groups;               ///< per polygon (index into groupNames), or empty
+    std::vector<std::string> groupNames;            ///< names of the groups (fss/face_groups.h)
+};
+
+/// The mesh of \p soup, checked and repaired as readMesh does (see ReadOptions); \p source names the file
+/// in messages and \p format goes into the report.
+/// \throw IoError naming \p source when a polygon has fewer than 3 corners or an index out of range, a
+///        coordinate is not finite, a group index is outside groupNames, or readMesh would refuse the soup.
+Mesh meshFromPolygons(PolygonSoup soup, const std::filesystem::path& source, const std::string& format,
+                      ReadReport* report = nullptr, const ReadOptions& options = {});
+
 /// Options of writeMesh.
 struct WriteOptions {
     bool binary = false; ///< binary PLY / STL (ascii otherwise); binary PLY stores doubles, STL floats
@@ -88,7 +108,10 @@ struct WriteOptions {
 
 /// Writes a mesh; the format is chosen by the extension (.off .obj .ply .stl, case-insensitive). PLY files
 /// also store the face properties props::faceQuality (as `quality`) and props::faceScanId (as `scan_id`)
-/// when present; the other formats cannot hold them. Only valid elements are written, re-indexed
+/// when present; the other formats cannot hold them. Face groups (fss/face_groups.h) are written as the
+/// PLY face property `group` with "comment group <index> <name>" lines, as OBJ `g` statements and as one
+/// ascii STL solid per group; OFF and binary STL cannot hold them. (FEM and VTK formats:
+/// fss/render/fem_io.h.) Only valid elements are written, re-indexed
 /// contiguously in iteration order (removed elements of a mesh with garbage are skipped). STL holds
 /// triangles only: a face with more corners is written as a fan.
 /// The file is written to a temporary name in the same folder and renamed, so a failed write never
@@ -96,7 +119,8 @@ struct WriteOptions {
 /// \param mesh    the mesh to write
 /// \param path    the target file
 /// \param options see WriteOptions (precision is clamped to 1…17)
-/// \throw IoError naming the file when the extension is unknown or the file cannot be written.
+/// \throw IoError naming the file when the extension is unknown, a group name cannot be held (OBJ: white
+///        space or '#') or the file cannot be written.
 void writeMesh(const Mesh& mesh, const std::filesystem::path& path, const WriteOptions& options = {});
 
 /// True when the extension of \p path (case-insensitive) names a format writeMesh can write.

@@ -262,3 +262,14 @@ void AtomicFile::flush() {
 }
 
 } // namespace fss::detail::io
+
+namespace fss::detail::io {
+
+std::int32_t groupIndex(Soup& soup, std::string_view name) {
+    for (std::size_t i = 0; i < soup.groupNames.size(); ++i)
+        if (soup.groupNames[i] == name) return static_cast<std::int32_t>(i);
+    soup.groupNames.emplace_back(name);
+    return static_cast<std::int32_t>(soup.groupNames.size() - 1);
+}
+
+} // namespace fss::detail::io

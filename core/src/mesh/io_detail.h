@@ -13,6 +13,7 @@
 #include "fss/mesh_io.h"
 
 #include "fss/error.h"
+#include "fss/face_groups.h"
 
 #include <boost/container/small_vector.hpp>
 
@@ -140,10 +141,18 @@ public:
         tokenLine_ = line_;
         return true;
     }
-    /// Skips the rest of the current line (e.g. the name after 'solid').
-    void skipLine() {
+    /// Skips the rest of the current line (e.g. the name after 'solid') and returns it without the
+    /// surrounding blanks.
+    std::string_view skipLine() {
+        const std::size_t start = pos_;
         while (pos_ < text_.size() && text_[pos_] != '\n')
             ++pos_;
+        std::string_view rest = text_.substr(start, pos_ - start);
+        while (!rest.empty() && isBlank(rest.back()))
+            rest.remove_suffix(1);
+        while (!rest.empty() && isBlank(rest.front()))
+            rest.remove_prefix(1);
+        return rest;
     }
     std::string where() const { return "line " + std::to_string(tokenLine_) + ": "; }
 
@@ -192,6 +201,9 @@ struct Soup {
     std::vector<Polygon> polygons;
     std::vector<float> quality;       ///< per polygon, empty when the file has none
     std::vector<std::int32_t> scanId; ///< per polygon, empty when the file has none
+    std::vector<std::int32_t>
+        group; ///< per polygon: index into groupNames (kNoGroup: none); empty: no groups
+    std::vector<std::string> groupNames;
 };
 
 /// The bytes of a file plus its name for messages.
@@ -241,7 +253,9 @@ struct FlatMesh {
     std::vector<std::size_t> corners;
     std::vector<float> quality;
     std::vector<std::int32_t> scanId;
-    bool hasQuality = false, hasScanId = false;
+    std::vector<std::int32_t> group; // per face when hasGroups (fss/face_groups.h)
+    std::vector<std::string> groupNames;
+    bool hasQuality = false, hasScanId = false, hasGroups = false;
     std::size_t faces() const { return faceStart.size() - 1; }
     std::size_t degree(std::size_t f) const { return faceStart[f + 1] - faceStart[f]; }
     std::size_t corner(std::size_t f, std::size_t j) const { return corners[faceStart[f] + j]; }
@@ -303,6 +317,9 @@ inline void putPoint(std::string& s, const Point3& p, int precision) {
 // =====================================================================================================
 // Soup repair and mesh building (soup_repair.cpp, mesh_build.cpp)
 // =====================================================================================================
+
+/// The group index of the group called \p name in \p soup, added to its table when new.
+std::int32_t groupIndex(Soup& soup, std::string_view name);
 
 /// Turns the soup into a valid triangle mesh, repairing (and reporting) what must be repaired.
 Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOptions& options);

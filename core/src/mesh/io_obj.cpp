@@ -1,4 +1,5 @@
-// OBJ: the strict reader (positions and faces; the other statements are checked and ignored) and the writer.
+// OBJ: the strict reader (positions, faces and their groups `g`/`o`; the other statements are checked and
+// ignored) and the writer (groups as `g` statements).
 #include "mesh/io_detail.h"
 
 namespace fss::detail::io {
@@ -6,14 +7,18 @@ namespace fss::detail::io {
 Soup readObj(const Source& src, ReadReport& report) {
     report.format = "obj";
     static constexpr std::string_view ignored[] = {
-        "vt",       "vn",     "vp",         "l",         "p",     "o",     "g",      "s",     "usemtl",
-        "mtllib",   "cstype", "deg",        "bmat",      "step",  "curv",  "curv2",  "surf",  "parm",
-        "trim",     "hole",   "scrv",       "sp",        "end",   "con",   "mg",     "bevel", "c_interp",
-        "d_interp", "lod",    "shadow_obj", "trace_obj", "ctech", "stech", "maplib", "usemap"};
+        "vt",         "vn",        "vp",    "l",     "p",      "s",     "usemtl",   "mtllib",   "cstype",
+        "deg",        "bmat",      "step",  "curv",  "curv2",  "surf",  "parm",     "trim",     "hole",
+        "scrv",       "sp",        "end",   "con",   "mg",     "bevel", "c_interp", "d_interp", "lod",
+        "shadow_obj", "trace_obj", "ctech", "stech", "maplib", "usemap"};
     Lines lines(skipBomAndSpace(src.data), '#');
     Soup soup;
     std::vector<std::size_t> faceLine;
     std::string_view line, t;
+    // The group of the last `g` or `o` statement; a name enters the table with its first face.
+    std::string groupName;
+    std::int32_t group = kNoGroup;
+    bool grouped = false;
     while (lines.next(line)) {
         Tokens tok(line);
         tok.next(t);
@@ -55,10 +60,28 @@ Soup readObj(const Source& src, ReadReport& report) {
                 src.fail(where + face + " has " + std::to_string(poly.size()) +
                          " corners, but a face needs at least 3");
             soup.polygons.push_back(std::move(poly));
+            if (grouped && group == kNoGroup) group = groupIndex(soup, groupName);
+            soup.group.push_back(group);
             faceLine.push_back(lines.number());
+        } else if (t == "g" || t == "o") {
+            // One group per face: `g a b` (a face in two groups) cannot be held.
+            std::string_view name, extra;
+            if (!tok.next(name)) name = "default";
+            if (tok.next(extra))
+                src.fail(where + "the group statement names more than one group (" + quoteToken(name) +
+                         " and " + quoteToken(extra) + "), but FSS holds one group per face");
+            groupName = std::string(name);
+            group = kNoGroup;
+            grouped = true;
         } else if (std::find(std::begin(ignored), std::end(ignored), t) == std::end(ignored)) {
             src.fail(where + "unknown OBJ statement " + quoteToken(t));
         }
+    }
+    if (!grouped) {
+        soup.group.clear();
+    } else {
+        for (std::int32_t& g : soup.group)
+            if (g == kNoGroup) g = groupIndex(soup, "default"); // faces before the first group statement
     }
     // Positive indices may refer to vertices defined later in the file, so check them at the end.
     const std::size_t nv = soup.points.size();
@@ -74,6 +97,10 @@ Soup readObj(const Source& src, ReadReport& report) {
 
 void writeObj(const FlatMesh& m, const std::filesystem::path& path, const WriteOptions& options) {
     const int precision = options.precision;
+    for (const std::string& name : m.groupNames)
+        if (name.find_first_of(" \t\f\v#") != std::string::npos)
+            failWrite(path, "OBJ cannot hold the group name " + quoteToken(name) +
+                                " (a `g` statement ends a name at white space or '#')");
     AtomicFile file(path);
     std::string& s = file.out();
     s += "# written by FSS\n";
@@ -83,7 +110,15 @@ void writeObj(const FlatMesh& m, const std::filesystem::path& path, const WriteO
         s += '\n';
         file.flushIfLarge();
     }
+    std::int32_t group = kNoGroup;
     for (std::size_t f = 0; f < m.faces(); ++f) {
+        if (m.hasGroups && m.group[f] != group) {
+            group = m.group[f];
+            s += "g ";
+            s += group >= 0 && std::size_t(group) < m.groupNames.size() ? m.groupNames[std::size_t(group)]
+                                                                        : std::string("default");
+            s += '\n';
+        }
         s += 'f';
         for (std::size_t j = 0; j < m.degree(f); ++j) {
             s += ' ';

@@ -1,5 +1,5 @@
-// PLY: the strict reader (ascii, binary little and big endian; face properties quality and scan_id) and
-// the writer.
+// PLY: the strict reader (ascii, binary little and big endian; face properties quality, scan_id and group,
+// with group names from "comment group <value> <name>" header lines) and the writer.
 #include "mesh/io_detail.h"
 
 #include <cmath>
@@ -193,7 +193,7 @@ struct PlyLayout {
     const PlyElement* face = nullptr;
     std::size_t x = 0, y = 0, z = 0;
     std::size_t indices = 0;
-    std::optional<std::size_t> quality, scanId;
+    std::optional<std::size_t> quality, scanId, group;
 };
 
 template <class Reader>
@@ -250,6 +250,12 @@ void readPlyBody(const Source& src, Reader& r, const std::vector<PlyElement>& el
                         src.fail(r.where() + "face " + std::to_string(k) + " has scan_id " +
                                  std::to_string(v) + ", which is not a 32-bit integer");
                     soup.scanId.push_back(static_cast<std::int32_t>(v));
+                } else if (isFace && layout.group && pi == *layout.group) {
+                    if (!(v >= std::numeric_limits<std::int32_t>::min() &&
+                          v <= std::numeric_limits<std::int32_t>::max()))
+                        src.fail(r.where() + "face " + std::to_string(k) + " has group " + std::to_string(v) +
+                                 ", which is not a 32-bit integer");
+                    soup.group.push_back(static_cast<std::int32_t>(v));
                 }
             }
             r.end();
@@ -293,12 +299,26 @@ Soup parsePly(const Source& src, bool& binary) {
     enum class Encoding { Ascii, Little, Big };
     std::optional<Encoding> encoding;
     std::vector<PlyElement> elements;
+    std::vector<std::pair<long long, std::string>> groupComments; // "comment group <value> <name>"
     bool ended = false;
     while (!ended && nextHeaderLine(line)) {
         const std::string where = "header line " + std::to_string(lineNo) + ": ";
         Tokens tok(line);
         if (!tok.next(t)) continue;
-        if (t == "comment" || t == "obj_info") continue;
+        if (t == "comment") {
+            std::string_view word, value;
+            long long v = 0;
+            if (tok.next(word) && word == "group" && tok.next(value) && parseInteger(value, v)) {
+                std::string_view rest = line.substr(std::size_t(value.data() + value.size() - line.data()));
+                while (!rest.empty() && isBlank(rest.front()))
+                    rest.remove_prefix(1);
+                while (!rest.empty() && isBlank(rest.back()))
+                    rest.remove_suffix(1);
+                if (!rest.empty()) groupComments.emplace_back(v, std::string(rest));
+            }
+            continue;
+        }
+        if (t == "obj_info") continue;
         if (t == "end_header") {
             ended = true;
         } else if (t == "format") {
@@ -383,6 +403,10 @@ Soup parsePly(const Source& src, bool& binary) {
     layout.scanId = findProperty(*layout.face, "scan_id");
     if (layout.quality && layout.face->properties[*layout.quality].list) layout.quality.reset();
     if (layout.scanId && layout.face->properties[*layout.scanId].list) layout.scanId.reset();
+    layout.group = findProperty(*layout.face, "group");
+    if (layout.group && (layout.face->properties[*layout.group].list ||
+                         !plyIsInteger(layout.face->properties[*layout.group].type)))
+        src.fail("its face property 'group' is not a scalar integer, but FSS reads face groups as integers");
 
     // Guard the announced counts against the size of the data before reading anything.
     const std::string_view body = text.substr(pos);
@@ -410,6 +434,24 @@ Soup parsePly(const Source& src, bool& binary) {
         PlyAsciiReader reader(src, body, lineNo + 1);
         readPlyBody(src, reader, elements, layout, soup);
     }
+    // Group values → group indices in order of first use, named by "comment group <value> <name>" lines.
+    std::vector<std::pair<long long, std::int32_t>> seen;
+    for (std::int32_t& g : soup.group) {
+        if (g < 0) { // a face in no group
+            g = kNoGroup;
+            continue;
+        }
+        const auto it = std::find_if(seen.begin(), seen.end(), [&](const auto& e) { return e.first == g; });
+        if (it != seen.end()) {
+            g = it->second;
+            continue;
+        }
+        const auto named = std::find_if(groupComments.begin(), groupComments.end(),
+                                        [&](const auto& c) { return c.first == g; });
+        const std::string name = named != groupComments.end() ? named->second : "group_" + std::to_string(g);
+        seen.emplace_back(g, groupIndex(soup, name));
+        g = seen.back().second;
+    }
     return soup;
 }
 
@@ -434,7 +476,10 @@ void writePly(const FlatMesh& m, const std::filesystem::path& path, const WriteO
     const bool wideCount = maxDegree > 255;
     s += "ply\nformat ";
     s += !binary ? "ascii" : bigEndian ? "binary_big_endian" : "binary_little_endian";
-    s += " 1.0\ncomment written by FSS\nelement vertex ";
+    s += " 1.0\ncomment written by FSS\n";
+    for (std::size_t i = 0; m.hasGroups && i < m.groupNames.size(); ++i)
+        s += "comment group " + std::to_string(i) + " " + m.groupNames[i] + "\n";
+    s += "element vertex ";
     putInteger(s, m.points.size());
     s += "\nproperty double x\nproperty double y\nproperty double z\nelement face ";
     putInteger(s, m.faces());
@@ -442,6 +487,7 @@ void writePly(const FlatMesh& m, const std::filesystem::path& path, const WriteO
                    : "\nproperty list uchar int vertex_indices\n";
     if (m.hasQuality) s += "property float quality\n";
     if (m.hasScanId) s += "property int scan_id\n";
+    if (m.hasGroups) s += "property int group\n";
     s += "end_header\n";
     for (const Point3& p : m.points) {
         if (binary) {
@@ -465,6 +511,7 @@ void writePly(const FlatMesh& m, const std::filesystem::path& path, const WriteO
                 putBinary(s, static_cast<std::int32_t>(m.corner(f, j)), bigEndian);
             if (m.hasQuality) putBinary(s, m.quality[f], bigEndian);
             if (m.hasScanId) putBinary(s, m.scanId[f], bigEndian);
+            if (m.hasGroups) putBinary(s, m.group[f], bigEndian);
         } else {
             putInteger(s, d);
             for (std::size_t j = 0; j < d; ++j) {
@@ -478,6 +525,10 @@ void writePly(const FlatMesh& m, const std::filesystem::path& path, const WriteO
             if (m.hasScanId) {
                 s += ' ';
                 putInteger(s, m.scanId[f]);
+            }
+            if (m.hasGroups) {
+                s += ' ';
+                putInteger(s, m.group[f]);
             }
             s += '\n';
         }

@@ -1,5 +1,6 @@
 // STL: the strict readers (ascii and binary, told by the content; identical corners merged) and the
-// writer (faces with more than three corners as fans).
+// writer (faces with more than three corners as fans). An ascii file with several solids gives one face group
+// per solid name; a mesh with groups is written as one solid per group (ascii).
 #include "mesh/io_detail.h"
 
 #include <cmath>
@@ -49,7 +50,13 @@ Soup parseStlAscii(const Source& src) {
 
     ts.next(t);
     if (!equalsNoCase(t, "solid")) src.fail(ts.where() + "expected 'solid' but found " + quoteToken(t));
-    ts.skipLine();
+    // Each solid's faces form a group named after it (kept only when the file has more than one solid).
+    std::size_t solids = 1;
+    auto startSolid = [&](std::string_view name) {
+        const std::string fallback = "solid_" + std::to_string(solids);
+        return groupIndex(soup, name.empty() ? std::string_view(fallback) : name);
+    };
+    std::int32_t group = startSolid(ts.skipLine());
     while (true) {
         if (!ts.next(t)) src.fail("the file ends without 'endsolid' (the file is truncated)");
         if (equalsNoCase(t, "endsolid")) {
@@ -57,7 +64,8 @@ Soup parseStlAscii(const Source& src) {
             if (!ts.next(t)) break;
             if (!equalsNoCase(t, "solid"))
                 src.fail(ts.where() + "unexpected " + quoteToken(t) + " after 'endsolid'");
-            ts.skipLine();
+            ++solids;
+            group = startSolid(ts.skipLine());
             continue;
         }
         const std::string facet = "facet " + std::to_string(soup.polygons.size());
@@ -88,6 +96,11 @@ Soup parseStlAscii(const Source& src) {
                      " corners, but a face needs at least 3");
         expect("endfacet", facet);
         soup.polygons.push_back(std::move(poly));
+        soup.group.push_back(group);
+    }
+    if (solids < 2) {
+        soup.group.clear();
+        soup.groupNames.clear();
     }
     return soup;
 }
@@ -162,10 +175,8 @@ void writeStl(const FlatMesh& m, const std::filesystem::path& path, const WriteO
         header.resize(80, ' ');
         s += header;
         putBinary(s, static_cast<std::uint32_t>(triangles), false);
-    } else {
-        s += "solid fss\n";
     }
-    for (std::size_t f = 0; f < m.faces(); ++f) {
+    auto writeFace = [&](std::size_t f) {
         for (std::size_t j = 1; j + 1 < m.degree(f); ++j) {
             const std::array<const Point3*, 3> p{&m.points[m.corner(f, 0)], &m.points[m.corner(f, j)],
                                                  &m.points[m.corner(f, j + 1)]};
@@ -192,8 +203,23 @@ void writeStl(const FlatMesh& m, const std::filesystem::path& path, const WriteO
             }
             file.flushIfLarge();
         }
+    };
+    // Ascii with groups: one solid per group (the faces in no group form a solid named "fss").
+    const bool solids = !binary && m.hasGroups;
+    const auto groups = std::int32_t(m.groupNames.size());
+    auto groupOf = [&](std::size_t f) {
+        return m.group[f] >= 0 && m.group[f] < groups ? m.group[f] : kNoGroup;
+    };
+    bool anyUngrouped = !solids;
+    for (std::size_t f = 0; solids && f < m.faces(); ++f)
+        anyUngrouped = anyUngrouped || groupOf(f) == kNoGroup;
+    for (std::int32_t g = anyUngrouped ? kNoGroup : 0; g < (solids ? groups : 0); ++g) {
+        const std::string name = g >= 0 ? m.groupNames[std::size_t(g)] : std::string("fss");
+        if (!binary) s += "solid " + name + "\n";
+        for (std::size_t f = 0; f < m.faces(); ++f)
+            if (!solids || groupOf(f) == g) writeFace(f);
+        if (!binary) s += "endsolid " + name + "\n";
     }
-    if (!binary) s += "endsolid fss\n";
     file.commit();
 }
 

@@ -90,6 +90,9 @@ FlatMesh flatten(const Mesh& mesh) {
     const auto scanId = mesh.property_map<FaceIndex, std::int32_t>(props::faceScanId);
     flat.hasQuality = quality.second;
     flat.hasScanId = scanId.second;
+    const auto group = mesh.property_map<FaceIndex, std::int32_t>(props::faceGroup);
+    flat.hasGroups = group.second;
+    if (flat.hasGroups) flat.groupNames = groupNames(mesh);
     flat.faceStart.reserve(mesh.number_of_faces() + 1);
     flat.corners.reserve(3 * mesh.number_of_faces());
     for (FaceIndex f : mesh.faces()) {
@@ -98,6 +101,7 @@ FlatMesh flatten(const Mesh& mesh) {
         flat.faceStart.push_back(flat.corners.size());
         if (flat.hasQuality) flat.quality.push_back(quality.first[f]);
         if (flat.hasScanId) flat.scanId.push_back(scanId.first[f]);
+        if (flat.hasGroups) flat.group.push_back(group.first[f]);
     }
     return flat;
 }

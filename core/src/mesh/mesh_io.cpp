@@ -7,6 +7,7 @@
 #include "mesh/io_detail.h"
 
 #include <array>
+#include <cmath>
 #include <optional>
 #include <span>
 #include <system_error>
@@ -88,9 +89,55 @@ Mesh canonicalMesh(const Mesh& mesh) {
     }
     if (flat.hasQuality) soup.quality = flat.quality;
     if (flat.hasScanId) soup.scanId = flat.scanId;
+    if (flat.hasGroups) {
+        soup.group = flat.group;
+        soup.groupNames = flat.groupNames;
+    }
     const Source src{"(mesh in memory)", {}};
     ReadReport report;
     return soupToMesh(src, soup, report, ReadOptions{});
+}
+
+Mesh meshFromPolygons(PolygonSoup in, const fs::path& source, const std::string& format, ReadReport* report,
+                      const ReadOptions& options) {
+    ReadReport local;
+    ReadReport& rep = report ? *report : local;
+    rep = ReadReport{};
+    rep.format = format;
+    const Source src{source, {}};
+    Soup soup;
+    soup.points = std::move(in.points);
+    for (std::size_t i = 0; i < soup.points.size(); ++i) {
+        const Point3& p = soup.points[i];
+        if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z()))
+            src.fail("point " + std::to_string(i) + " has a NaN or infinite coordinate");
+    }
+    if (in.polygons.empty()) src.fail("it has no faces");
+    soup.polygons.reserve(in.polygons.size());
+    for (std::size_t f = 0; f < in.polygons.size(); ++f) {
+        const auto& poly = in.polygons[f];
+        if (poly.size() < 3)
+            src.fail("face " + std::to_string(f) + " has " + std::to_string(poly.size()) +
+                     " corners, but a face needs at least 3");
+        for (std::size_t c : poly)
+            if (c >= soup.points.size())
+                src.fail("face " + std::to_string(f) + " uses point " + std::to_string(c) +
+                         ", but there are only " + quantity(soup.points.size(), "point", "points"));
+        soup.polygons.emplace_back(poly.begin(), poly.end());
+    }
+    if (!in.groups.empty()) {
+        if (in.groups.size() != in.polygons.size())
+            src.fail("it has " + std::to_string(in.groups.size()) + " group values for " +
+                     quantity(in.polygons.size(), "face", "faces"));
+        for (std::size_t f = 0; f < in.groups.size(); ++f)
+            if (in.groups[f] != kNoGroup &&
+                (in.groups[f] < 0 || std::size_t(in.groups[f]) >= in.groupNames.size()))
+                src.fail("face " + std::to_string(f) + " is in group " + std::to_string(in.groups[f]) +
+                         ", which has no name");
+        soup.group = std::move(in.groups);
+        soup.groupNames = std::move(in.groupNames);
+    }
+    return soupToMesh(src, soup, rep, options);
 }
 
 bool isSupportedMeshFile(const fs::path& path) {

@@ -166,6 +166,8 @@ void measureShape(const Mesh& m, Metrics& out) {
     double minAngle = std::numeric_limits<double>::infinity();
     double maxAngle = 0, sumMinAngle = 0, sumRadiusRatio = 0;
     double minRadiusRatio = std::numeric_limits<double>::infinity();
+    double sumAspect = 0, maxAspect = 0, sumJacobian = 0,
+           minJacobian = std::numeric_limits<double>::infinity();
     std::size_t below30 = 0, below10 = 0;
     for (FaceIndex f : m.faces()) {
         const auto [a, b, c] = corners(m, f);
@@ -191,6 +193,20 @@ void measureShape(const Mesh& m, Metrics& out) {
         sumRadiusRatio += ratio;
         minRadiusRatio = std::min(minRadiusRatio, ratio);
 
+        // Verdict's (vtkMeshQuality's) triangle aspect ratio and scaled Jacobian (see metrics.h).
+        const double twiceArea = std::sqrt(CGAL::cross_product(ab, ca).squared_length());
+        const double longest = std::max({la, lb, lc});
+        const double aspect = twiceArea > 0
+                                  ? std::min(std::numeric_limits<double>::max(),
+                                             longest * (la + lb + lc) / (2 * std::sqrt(3.0) * twiceArea))
+                                  : std::numeric_limits<double>::max();
+        const double products = std::max({la * lb, lb * lc, lc * la});
+        const double jacobian = products > 0 ? std::min(1.0, 2 / std::sqrt(3.0) * twiceArea / products) : 0.0;
+        sumAspect += aspect;
+        maxAspect = std::max(maxAspect, aspect);
+        sumJacobian += jacobian;
+        minJacobian = std::min(minJacobian, jacobian);
+
         out.area += 0.5 * std::sqrt(CGAL::cross_product(ab, ca).squared_length());
     }
     const double n = double(m.number_of_faces());
@@ -201,6 +217,10 @@ void measureShape(const Mesh& m, Metrics& out) {
     out.fracMinAngleBelow10 = double(below10) / n;
     out.radiusRatioMean = sumRadiusRatio / n;
     out.radiusRatioMin = minRadiusRatio;
+    out.aspectRatioMean = std::min(std::numeric_limits<double>::max(), sumAspect / n);
+    out.aspectRatioMax = maxAspect;
+    out.scaledJacobianMin = minJacobian;
+    out.scaledJacobianMean = sumJacobian / n;
 }
 
 double bboxDiagonal(const Mesh& m) {
@@ -494,6 +514,10 @@ std::string metricsToJson(const Metrics& x, int indent) {
     j["frac_min_angle_below_10"] = x.fracMinAngleBelow10;
     j["radius_ratio_mean"] = x.radiusRatioMean;
     j["radius_ratio_min"] = x.radiusRatioMin;
+    j["aspect_ratio_mean"] = x.aspectRatioMean;
+    j["aspect_ratio_max"] = x.aspectRatioMax;
+    j["scaled_jacobian_min"] = x.scaledJacobianMin;
+    j["scaled_jacobian_mean"] = x.scaledJacobianMean;
     j["edge_length_mean"] = x.edgeLengthMean;
     j["edge_length_cv"] = x.edgeLengthCv;
     j["bbox_diagonal"] = x.bboxDiagonal;
@@ -531,7 +555,9 @@ std::string metricsToText(const Metrics& x) {
     row("angle min / max", fixed(x.minAngleDeg, 2) + " / " + fixed(x.maxAngleDeg, 2) + " deg");
     row("mean min angle", fixed(x.meanMinAngleDeg, 2) + " deg");
     row("min angle < 30 / < 10 deg", percent(x.fracMinAngleBelow30) + " / " + percent(x.fracMinAngleBelow10));
-    row("radius ratio mean / min", fixed(x.radiusRatioMean, 4) + " / " + fixed(x.radiusRatioMin, 4));
+    row("radius ratio (gamma) mean / min", fixed(x.radiusRatioMean, 4) + " / " + fixed(x.radiusRatioMin, 4));
+    row("aspect ratio mean / max", fixed(x.aspectRatioMean, 4) + " / " + fixed(x.aspectRatioMax, 4));
+    row("scaled Jacobian mean / min", fixed(x.scaledJacobianMean, 4) + " / " + fixed(x.scaledJacobianMin, 4));
     row("edge length mean (cv)", general(x.edgeLengthMean) + " (" + fixed(x.edgeLengthCv, 4) + ")");
     row("bbox diagonal", general(x.bboxDiagonal));
     row("area", general(x.area));

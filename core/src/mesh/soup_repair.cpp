@@ -474,6 +474,13 @@ Mesh soupToMesh(const Source& src, Soup& soup, ReadReport& report, const ReadOpt
             map[FaceIndex(Mesh::size_type(f))] = soup.scanId[origin[f]];
         report.hasScanId = true;
     }
+    if (!soup.group.empty()) {
+        setGroupNames(mesh, soup.groupNames);
+        auto map = mesh.property_map<FaceIndex, std::int32_t>(props::faceGroup).first;
+        for (std::size_t f = 0; f < polys.size(); ++f)
+            map[FaceIndex(Mesh::size_type(f))] = soup.group[origin[f]];
+        report.groups = soup.groupNames.size();
+    }
     return std::move(mesh);
 }
 

@@ -67,7 +67,9 @@ public:
     const Mesh& mesh() const;
     /// The reference mesh of the session (empty before the first mesh).
     const Mesh& referenceMesh() const;
-    /// Writes mesh() to \p path (fss::writeMesh; format by extension). On failure errorOccurred().
+    /// Writes mesh() to \p path (fss::render::writeMeshFile; format by extension, FEM and VTK formats
+    /// included), with the reference's face groups carried to it (fss::transferFaceGroups). On failure
+    /// errorOccurred().
     /// \return success
     bool saveMesh(const QString& path);
     /// The file the reference mesh was read from (openMesh, loadSession; or the file saveSession wrote
