@@ -253,6 +253,9 @@ LatticeFigures latticeScan(const fss::Mesh& ref, fss::MeshRenderer& renderer, fs
     fss::ScanParams params;
     params.camera = fss::Camera::standardView(view, bbox(ref), res, res);
     params.scan.lattice = lattice;
+    // The settings issue 20 measured (not yet the defaults): sliver quads dropped, six relaxation sweeps.
+    params.triangulate.minQuadAngleDeg = 20;
+    params.relaxIterations = 6;
     const fss::ScanResult r = fss::scanPatch(ref, renderer, ref, renderer, params);
     const fss::Metrics m = fss::computeMetrics(r.patch.mesh, {.selfIntersections = false, .reference = &ref});
     return {m.meanMinAngleDeg, m.fracMinAngleBelow30, m.fracValence6Interior, *m.hausdorffToRefRel, m.faces};
@@ -266,7 +269,8 @@ TEST(ScanPipeline, TriangularLatticeMakesRounderTrianglesThanThePixelGrid) {
     const fss::Mesh ref = load("fandisk.off");
     fss::CpuMeshRenderer renderer;
     renderer.setMesh(ref);
-    EXPECT_EQ(fss::ScanParams{}.scan.lattice, fss::Lattice::Triangular);
+    // The square pixel lattice stays the default until the stitch copes with the triangular one (issue 20).
+    EXPECT_EQ(fss::ScanParams{}.scan.lattice, fss::Lattice::Square);
     const auto tri = latticeScan(ref, renderer, fss::StandardView::Iso, 256, fss::Lattice::Triangular);
     const auto sq = latticeScan(ref, renderer, fss::StandardView::Iso, 256, fss::Lattice::Square);
     std::printf("fandisk iso 256²: triangular mean min angle %.1f°, %.1f %% < 30°, valence 6 %.3f, Hausdorff "

@@ -212,7 +212,9 @@ TEST(Scan, TriangularLatticeIsEquilateralOnAFrontalPlane) {
         SCOPED_TRACE(parallel ? "parallel" : "perspective");
         const Camera cam = tiltedCamera(0, parallel);
         fss::ScanWorkspace workspace;
-        const SampleGrid g = fss::sampleLattice(fss::rasterizeOnCpu(grid, cam), grid, workspace);
+        fss::ScanOptions triangular;
+        triangular.lattice = fss::Lattice::Triangular;
+        const SampleGrid g = fss::sampleLattice(fss::rasterizeOnCpu(grid, cam), grid, workspace, triangular);
         // Rows √3/2 px apart over 64 px: 73 rows; 64 samples per row plus the shear's 36 columns and one.
         ASSERT_EQ(g.rows, 73);
         ASSERT_EQ(g.cols, 64 + 36 + 1);
@@ -308,6 +310,7 @@ TEST(Scan, LatticeSpacingInWorldUnits) {
     const Mesh grid = plane();
     const Camera cam = tiltedCamera(0, true); // footprint 1/64 everywhere
     fss::ScanOptions o;
+    o.lattice = fss::Lattice::Triangular;
     o.spacingWorld = 3.0 / 64;
     EXPECT_NEAR(fss::latticeSpacingPixels(cam, o), 3.0, 1e-9);
     fss::ScanWorkspace workspace;

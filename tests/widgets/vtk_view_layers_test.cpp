@@ -178,6 +178,7 @@ private slots:
         }
         auto view = std::make_unique<VtkView>();
         view->setColorMap(ColorMap::ScanId); // before the mesh: kept for it
+        view->setLegendVisible(false);       // the face colours are probed, not the legend over them
         view->resize(400, 400);
         view->setInitialView(fss::StandardView::PosZ);
         view->setMesh(mesh);

@@ -55,15 +55,15 @@ struct FishboneOptions {
     /// A half-rib stops (its vertex and all beyond are left out of the grid) where it comes closer than
     /// minRibGap·h to the vertex of a neighbouring rib at the same position (ribs that pile up on the
     /// inner side of a curved backbone; issue #20). A fraction in [0, 1); 0 = no bound (the default here and
-    /// in files written before it; FishboneParams::defaultTracing sets 0.5).
+    /// in files written before it; 0.5 is the value measured in issue 20, not yet the default).
     double minRibGap = 0.0;
     /// A half-rib also stops where its edge turns more than this from the backbone's normal at its row
     /// (a rib that bends to follow the backbone makes slivers). Degrees in (0, 180]; 180 = no bound (the
-    /// default here; FishboneParams::defaultTracing sets 60).
+    /// default here; 60 is the value measured in issue 20, not yet the default).
     double maxRibTurnDeg = 180.0;
     /// The fishbone scan stops a half-rib where an edge after its first crosses a visible crease of the
     /// reference (FishboneParams::creaseAngleDeg > 0; a rib running onto a neighbouring face of a CAD part).
-    /// false here and in files written before it; FishboneParams::defaultTracing sets true.
+    /// false here and in files written before it (true is not yet the default, issue 20).
     bool stopRibsAtCreases = false;
 
     /// Checks the ranges: spacing finite and > 0, minRibGap in [0, 1), maxRibTurnDeg in (0, 180], and both

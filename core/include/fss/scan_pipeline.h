@@ -35,7 +35,7 @@ struct ScanParams {
     /// Sweeps of tangential relaxation of the patch's interior vertices on the reference (connectivity and
     /// border unchanged, moves that would cross a crease, turn a face or lower the local smallest angle are
     /// refused; core/src/mesh/relax.h); 0 = none. In [0, 100].
-    int relaxIterations = 6;
+    int relaxIterations = 0;
 
     /// Checks everything a scan needs before it renders: the camera (Camera::validate), the erosion and
     /// dilation radii (in [0, 1024]), relaxIterations (in [0, 100]), the lasso (validateLasso) when there is

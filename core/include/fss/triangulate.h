@@ -57,7 +57,7 @@ struct TriangulateOptions {
     double maxSamplingAngleDeg = 80.0;
     /// Both triangles of a quad are dropped when one of the quad's four corner angles in 3D is smaller.
     /// Degrees, in [0, 90); 0 = no bound (session files written before it).
-    double minQuadAngleDeg = 20.0;
+    double minQuadAngleDeg = 0.0;
 
     /// Checks the ranges: maxEdgeFootprints finite and > 0, maxSamplingAngleDeg in (0, 90],
     /// minQuadAngleDeg in [0, 90).

@@ -266,10 +266,10 @@ void writeMeshFile(const Mesh& mesh, const fs::path& path, const FemWriteOptions
     if (format == Fem::None) {
         if (!isSupportedMeshFile(path)) {
             const std::string ext = path.extension().string();
-            failWrite(path,
-                      (ext.empty() ? std::string("it has no extension") : "the extension '" + ext + "'") +
-                          " does not name a format (use .off, .obj, .ply, .stl, .msh, .inp, .bdf, .unv, "
-                          ".vtu or .vtp)");
+            failWrite(path, (ext.empty() ? std::string("it has no extension, so the format is unknown")
+                                         : "the extension '" + ext + "' does not name a format") +
+                                " (use .off, .obj, .ply, .stl, .msh, .inp, .bdf, .unv, "
+                                ".vtu or .vtp)");
         }
         writeMesh(mesh, path, coreOptions);
         return;

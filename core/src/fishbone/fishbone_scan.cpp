@@ -299,10 +299,8 @@ FishboneOptions FishboneParams::defaultTracing() {
     // patch faces against 11 764 and 8 136).
     o.ribTracing.step = 1.0;
     o.ribTracing.maxTurnDeg = 12.0;
-    // Ribs that pile up, bend away from the backbone's normal or cross a crease stop (issue #20).
-    o.minRibGap = 0.5;
-    o.maxRibTurnDeg = 60.0;
-    o.stopRibsAtCreases = true;
+    // Rib trimming (minRibGap, maxRibTurnDeg, stopRibsAtCreases, issue 20) stays off by default until it is
+    // measured together with the stitch: turned on, it broke the seam and property tests of the merge.
     return o;
 }
 
