@@ -5,6 +5,7 @@
 #include "fss/render/fem_io.h"
 
 #include <array>
+#include <cctype>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -12,6 +13,14 @@
 #include <vector>
 
 namespace fss::render::detail {
+
+/// The extension of \p path in lower case ("" when none), for choosing a format.
+inline std::string lowerExtension(const std::filesystem::path& path) {
+    std::string ext = path.extension().string();
+    for (char& c : ext)
+        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
+}
 
 /// The mesh as FEM files hold it: nodes, triangles with a group each, optional feature edges.
 struct FemMesh {

@@ -61,13 +61,6 @@ using namespace detail;
 
 namespace {
 
-std::string lowerExtension(const fs::path& path) {
-    std::string ext = path.extension().string();
-    for (char& c : ext)
-        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return ext;
-}
-
 enum class Fem { None, Msh, Unv, Inp, Bdf, Vtu, Vtp, VtkLegacy };
 
 Fem femFormat(const fs::path& path) {

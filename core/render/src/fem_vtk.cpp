@@ -43,13 +43,6 @@ namespace fs = std::filesystem;
 namespace fss::render::detail {
 namespace {
 
-std::string lowerExtension(const fs::path& path) {
-    std::string ext = path.extension().string();
-    for (char& c : ext)
-        c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return ext;
-}
-
 constexpr std::string_view kNamePrefix = "group:";
 
 /// Collects VTK's error and warning texts instead of printing them (a bad file must give one sentence).
