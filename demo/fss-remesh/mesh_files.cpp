@@ -21,6 +21,17 @@ void addOutputFileOptions(CLI::App& command, OutputFileOptions& options) {
                     "gmsh MSH version of a .msh output: 4.1 (default) or 2.2.")
         ->type_name("V")
         ->check(oneOf("--msh-version", {"4.1", "2.2"}));
+    command
+        .add_option("--max-nodes", options.maxNodes,
+                    "Refuse to write a file with more nodes than N (a target solver's limit, e.g. a student "
+                    "edition's); the format's own limit always applies.")
+        ->type_name("N")
+        ->check(CLI::PositiveNumber);
+    command
+        .add_option("--max-elements", options.maxElements,
+                    "Refuse to write a file with more elements (faces + feature edges) than N.")
+        ->type_name("N")
+        ->check(CLI::PositiveNumber);
 #else
     (void)command;
     (void)options;
@@ -74,6 +85,8 @@ void writeOutputMesh(Mesh mesh, const Mesh* reference, const std::string& path,
     fem.featureEdges = options.featureEdges;
     fem.featureAngleDeg = options.featureAngleDeg;
     fem.mshVersion = options.mshVersion == "2.2" ? 2.2 : 4.1;
+    fem.maxNodes = options.maxNodes;
+    fem.maxElements = options.maxElements;
     render::writeMeshFile(mesh, path, fem, coreOptions);
 #else
     (void)options;

@@ -8,18 +8,22 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstddef>
 #include <string>
 
 namespace fss::cli {
 
-/// Options of the output file (--feature-edges, --feature-angle, --msh-version).
+/// Options of the output file (--feature-edges, --feature-angle, --msh-version, --max-nodes,
+/// --max-elements).
 struct OutputFileOptions {
     bool featureEdges = false;
     double featureAngleDeg = 45;
     std::string mshVersion = "4.1";
+    std::size_t maxNodes = 0;    ///< 0: the format's own limit only
+    std::size_t maxElements = 0; ///< 0: the format's own limit only
 };
 
-/// Adds --feature-edges, --feature-angle and --msh-version to \p command.
+/// Adds --feature-edges, --feature-angle, --msh-version, --max-nodes and --max-elements to \p command.
 void addOutputFileOptions(CLI::App& command, OutputFileOptions& options);
 
 /// The extensions the output may have, for messages: ".off .obj .ply .stl ...".

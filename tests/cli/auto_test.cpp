@@ -277,4 +277,13 @@ TEST(CliAuto, FemHandOffBadInputIsOneSentence) {
     expectCleanFailure(r, "Abaqus INP cannot hold the group name '1st'");
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_FALSE(std::filesystem::exists(inp));
+    // A mesh over the target's limit (here one asked for: the formats' own need ~1e8 elements): one
+    // sentence, exit 1, no file.
+    const auto bdf = tmpPath("cli_auto/limited.bdf");
+    std::filesystem::remove(bdf);
+    const auto l =
+        remesh({"scan", twoGroupFandiskObj(), "-o", bdf.string(), "--view", "iso", "--max-nodes", "100"});
+    expectCleanFailure(l, "more than the 100 asked for as the limit");
+    EXPECT_EQ(l.exitCode, 1);
+    EXPECT_FALSE(std::filesystem::exists(bdf));
 }

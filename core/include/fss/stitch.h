@@ -187,8 +187,14 @@ struct StitchReport {
 ///        components glued in before (if any) — every invariant holds, but it is not the mesh of before the
 ///        call unless the cancel came during the first component's computation. Callers that need all or
 ///        nothing stitch a copy (Session::accept does).
+/// \param stitchedPatchFaces optional: set to one entry per face index of \p patch, 1 for the faces glued in
+///                 (what will replace the mesh), 0 for those trimmed, dropped or in skipped components (the
+///                 mesh stays as it was there); their count is patch.number_of_faces() −
+///                 StitchReport::patchFacesTrimmed. Lets a caller show what a stitch keeps (a trial stitch on
+///                 a copy).
 StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCamera,
                          const StitchOptions& options = {}, std::span<const std::uint32_t> faceIds = {},
-                         const Progress& progress = {});
+                         const Progress& progress = {},
+                         std::vector<std::uint8_t>* stitchedPatchFaces = nullptr);
 
 } // namespace fss

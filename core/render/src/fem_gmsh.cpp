@@ -51,13 +51,9 @@ private:
 } // namespace
 
 void writeGmsh(const FemMesh& m, const fs::path& path, const FemWriteOptions& options) {
-    const bool msh = path.extension() != ".unv" && path.extension() != ".UNV";
     for (const std::string& name : m.groupNames)
         if (name.find('"') != std::string::npos)
             failWrite(path, "gmsh cannot hold the group name '" + name + "' (it contains '\"')");
-    if (msh && options.mshVersion == 2.2 &&
-        (m.nodes.size() > 2147483647u || m.triangles.size() + m.edges.size() > 2147483647u))
-        failWrite(path, "MSH 2.2 cannot number more than 2147483647 nodes or elements (write MSH 4.1)");
     TempFile temp(path);
     {
         GmshScope gmshScope;

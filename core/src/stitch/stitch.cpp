@@ -327,6 +327,7 @@ struct PatchData {
     std::vector<std::array<int, 3>> tri; // counter-clockwise in the view
     std::vector<float> quality;
     std::vector<std::int32_t> scanId;
+    std::vector<std::uint32_t> face; // the patch's face index of each tri
     bool hasQuality = false, hasScanId = false;
 };
 
@@ -3430,6 +3431,7 @@ PatchData readPatch(const Mesh& patch, const View& view, std::size_t& dropped) {
             continue;
         }
         P.tri.push_back(t);
+        P.face.push_back(std::uint32_t(f));
         P.quality.push_back(q.second ? q.first[f] : kInputFaceQuality);
         P.scanId.push_back(s.second ? s.first[f] : -1);
     }
@@ -3462,8 +3464,9 @@ std::vector<std::vector<int>> components(const PatchData& P, const std::vector<i
 
 StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCamera,
                          const StitchOptions& options, std::span<const std::uint32_t> faceIds,
-                         const Progress& progress) {
+                         const Progress& progress, std::vector<std::uint8_t>* stitchedPatchFaces) {
     const auto start = std::chrono::steady_clock::now();
+    if (stitchedPatchFaces) stitchedPatchFaces->assign(patch.num_faces(), 0);
     scanCamera.validate();
     if (patch.number_of_faces() == 0) throw InvalidInputError("The patch has no faces.");
     if (!faceIds.empty() && faceIds.size() != std::size_t(scanCamera.width) * std::size_t(scanCamera.height))
@@ -3572,6 +3575,9 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
             });
         if (!applied) throw Error("Internal error: a rehearsed stitch could not be applied to the mesh.");
         stitched.insert(w.name);
+        if (stitchedPatchFaces)
+            for (int f : w.faces)
+                (*stitchedPatchFaces)[P.face[std::size_t(f)]] = 1;
         facesDone += w.faces.size();
         ++report.piecesStitched;
         report.facesRemoved += plan.removed.size();
