@@ -2,6 +2,7 @@
 
 #include "fss/error.h"
 #include "fss/face_groups.h"
+#include "fss/fishbone_scan.h"
 #include "fss/mesh_io.h"
 #include "fss/metrics.h"
 #include "fss/render/fem_io.h"
@@ -38,6 +39,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <mutex>
@@ -122,6 +124,51 @@ MeshFigures figuresOf(const Mesh& mesh) {
     const Metrics m = computeMetrics(mesh, options);
     return {m.fracValence6Interior, m.minAngleDeg};
 }
+
+// One trial stitch (see the file comment of remesh_widget.h), shared by the GUI and the trial's thread. The
+// inputs are copies made on the GUI thread; the thread writes the results, which the GUI reads once the
+// thread has finished.
+struct Trial {
+    const Session* session = nullptr; // the preview it is for: session and scan id
+    std::int32_t scanId = 0;
+    std::atomic<bool> cancel{false};
+    std::atomic<double> fraction{0.0};
+    Mesh mesh; // the current mesh, stitched in place
+    Mesh patch;
+    Camera camera;
+    StitchOptions options;
+    std::vector<std::uint32_t> faceIds;
+    StitchReport report;
+    std::vector<std::uint8_t> stitched; // per patch face index: 1 glued in, 0 trimmed
+    MeshFigures before, after;
+    std::string error;
+    bool cancelled = false;
+    bool finished = false; // the thread has ended and the GUI has taken its result
+    double seconds = 0;
+
+    // The stitch Session::accept runs (same options, camera and ID buffer), on the copy.
+    void run() {
+        const auto start = std::chrono::steady_clock::now();
+        const Progress progress([this](double f, std::string_view) {
+            fraction = f;
+            return !cancel.load();
+        });
+        try {
+            before = figuresOf(mesh);
+            progress.report(0.0, "stitch");
+            report = stitchPatch(mesh, patch, camera, options, faceIds, progress, &stitched);
+            if (mesh.has_garbage()) mesh.collect_garbage();
+            progress.report(0.95, "figures");
+            after = figuresOf(mesh);
+        } catch (const CancelledError&) {
+            cancelled = true;
+        } catch (const std::exception& e) {
+            error = e.what();
+        }
+        seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+    bool succeeded() const { return finished && !cancelled && error.empty(); }
+};
 
 } // namespace
 
@@ -224,6 +271,10 @@ struct RemeshWidget::Impl {
     bool updatingView = false;
     bool fishbonePending = false;
     std::int32_t nextScanId = 0;
+    // The trial stitch of the pending preview (null when none) and the thread running one (possibly an
+    // abandoned one: the next trial starts when it has ended).
+    std::shared_ptr<Trial> trial;
+    QThread* trialThread = nullptr;
 };
 
 RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_unique<Impl>()) {
@@ -317,8 +368,12 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     d.progressTimer = new QTimer(this);
     d.progressTimer->setInterval(250);
     connect(d.progressTimer, &QTimer::timeout, this, [this] {
-        if (!d_->job) return;
-        d_->progress->setValue(int(1000 * d_->job->fraction.load()));
+        if (isBusy() && d_->job) {
+            d_->progress->setValue(int(1000 * d_->job->fraction.load()));
+        } else if (d_->trial && d_->trialThread) {
+            d_->progress->setValue(int(1000 * d_->trial->fraction.load()));
+            updateStatus();
+        }
     });
 
     // Wiring.
@@ -459,10 +514,16 @@ void RemeshWidget::createToolBar() {
 RemeshWidget::~RemeshWidget() {
     d_->view->removeEventFilter(this); // the view outlives d_
     if (d_->job) d_->job->cancel = true;
+    if (d_->trial) d_->trial->cancel = true;
     if (d_->thread) {
         d_->thread->wait();
         delete d_->thread; // its finished() handler will not run any more
         d_->thread = nullptr;
+    }
+    if (d_->trialThread) {
+        d_->trialThread->wait(); // it only uses its own copies, and stops at its next progress report
+        delete d_->trialThread;
+        d_->trialThread = nullptr;
     }
     for (Tool* tool : {static_cast<Tool*>(d_->navigate), static_cast<Tool*>(d_->lasso),
                        static_cast<Tool*>(d_->scanTool), static_cast<Tool*>(d_->fishbone)})
@@ -496,6 +557,7 @@ bool RemeshWidget::setMesh(const Mesh& mesh, const QString& meshPath) {
 
 void RemeshWidget::installSession(std::unique_ptr<Session> session, const QString& meshPath, bool cpuRenderer,
                                   const CurvatureOptions& curvature) {
+    stopTrial(); // it belongs to the old session
     d_->undoStack->clear();
     d_->session = std::move(session);
     d_->meshPath = meshPath;
@@ -882,12 +944,17 @@ void RemeshWidget::accept() {
     const QString name = stepName(d_->undoStack->index() + 1, s->preview()->step);
     auto report = std::make_shared<StitchReport>();
     auto figures = std::make_shared<std::pair<MeshFigures, MeshFigures>>();
+    // A finished trial of this preview already measured the mesh before and after the stitch (the stitch is
+    // deterministic: Session::accept makes the trial's mesh). A running trial is abandoned.
+    const bool reuse = d_->trial && d_->trial->succeeded();
+    if (reuse) *figures = {d_->trial->before, d_->trial->after};
+    stopTrial();
     setBusy(true, tr("Stitching the scan into the mesh"));
     startWork(
-        [s, report, figures](const Progress& progress) {
-            figures->first = figuresOf(s->current());
+        [s, report, figures, reuse](const Progress& progress) {
+            if (!reuse) figures->first = figuresOf(s->current());
             *report = s->accept(progress);
-            figures->second = figuresOf(s->current());
+            if (!reuse) figures->second = figuresOf(s->current());
         },
         [this, report, name, figures] {
             const std::shared_ptr<Job> job = d_->job;
@@ -955,7 +1022,13 @@ void RemeshWidget::reject() {
 }
 
 void RemeshWidget::cancel() {
-    if (d_->job) d_->job->cancel = true;
+    if (isBusy()) {
+        if (d_->job) d_->job->cancel = true;
+    } else if (d_->trial && d_->trialThread && !d_->trial->finished) {
+        d_->trial->cancel = true;
+    } else {
+        return;
+    }
     d_->status->setText(tr("Cancelling…"));
 }
 
@@ -1009,7 +1082,10 @@ void RemeshWidget::afterMeshChange() {
 
 void RemeshWidget::showPreview() {
     const ScanPreview* preview = d_->session ? d_->session->preview() : nullptr;
-    if (preview)
+    updateTrial(); // drops a trial of another preview, starts this one's
+    if (preview && d_->trial && d_->trial->finished && !d_->trial->cancelled)
+        d_->view->setPreviewMesh(preview->patch.mesh, d_->trial->stitched);
+    else if (preview)
         d_->view->setPreviewMesh(preview->patch.mesh);
     else
         d_->view->clearPreviewMesh();
@@ -1018,6 +1094,100 @@ void RemeshWidget::showPreview() {
     d_->rejectAction->setEnabled(preview != nullptr && !isBusy());
     updateStatus();
     emit previewChanged();
+}
+
+bool RemeshWidget::isTrialRunning() const {
+    return d_->trial && !d_->trial->finished;
+}
+const Mesh* RemeshWidget::trialMesh() const {
+    return d_->trial && d_->trial->succeeded() ? &d_->trial->mesh : nullptr;
+}
+const StitchReport* RemeshWidget::trialReport() const {
+    return d_->trial && d_->trial->succeeded() ? &d_->trial->report : nullptr;
+}
+const std::vector<std::uint8_t>* RemeshWidget::trialStitchedFaces() const {
+    return d_->trial && d_->trial->succeeded() ? &d_->trial->stitched : nullptr;
+}
+
+// Keeps d_->trial on the pending preview: none without one (or while work runs: an accept consumes it),
+// else this preview's, started when no trial thread runs (an abandoned one is asked to stop; its end
+// starts the next).
+void RemeshWidget::updateTrial() {
+    const ScanPreview* preview = d_->session && !isBusy() ? d_->session->preview() : nullptr;
+    if (d_->trial && (!preview || d_->trial->session != d_->session.get() ||
+                      d_->trial->scanId != preview->step.params.scan.scanId))
+        stopTrial();
+    if (preview && !d_->trial && !d_->trialThread) startTrial();
+}
+
+void RemeshWidget::stopTrial() {
+    if (d_->trial) d_->trial->cancel = true;
+    d_->trial.reset();
+}
+
+void RemeshWidget::startTrial() {
+    const ScanPreview& p = *d_->session->preview();
+    auto t = std::make_shared<Trial>();
+    t->session = d_->session.get();
+    t->scanId = p.step.params.scan.scanId;
+    // The inputs of Session::accept, copied: the thread never touches the session.
+    t->mesh = d_->mesh;
+    t->patch = p.patch.mesh;
+    t->camera = p.step.fishbone ? fishboneSamplingCamera(p.step.params.camera, *p.step.fishbone)
+                                : p.step.params.camera;
+    t->options = p.step.stitch;
+    t->options.collectGarbage = true;
+    t->faceIds = p.currentBuffers.faceId;
+    d_->trial = t;
+    d_->trialThread = QThread::create([t] { t->run(); });
+    QThread* thread = d_->trialThread;
+    connect(thread, &QThread::finished, this, [this, thread, t] {
+        thread->deleteLater();
+        d_->trialThread = nullptr;
+        t->finished = true;
+        if (t == d_->trial) finishTrial();
+        updateTrial(); // a newer preview may be waiting for its trial
+        if (!d_->trialThread && !isBusy()) {
+            d_->progressTimer->stop();
+            d_->progress->hide();
+            d_->cancelButton->hide();
+        }
+        updateStatus();
+    });
+    if (!isBusy()) {
+        d_->progress->setRange(0, 1000);
+        d_->progress->setValue(0);
+        d_->progress->show();
+        d_->cancelButton->show();
+        d_->progressTimer->start();
+    }
+    thread->start();
+}
+
+// The trial of the pending preview has ended: shade what the stitch keeps.
+void RemeshWidget::finishTrial() {
+    const Trial& t = *d_->trial;
+    const ScanPreview* preview = d_->session->preview();
+    if (preview && !t.cancelled) d_->view->setPreviewMesh(preview->patch.mesh, t.stitched);
+    updateStatus();
+    emit trialFinished();
+}
+
+// What the status line adds about the trial of the pending preview.
+QString RemeshWidget::trialText() const {
+    if (!d_->trial) return {};
+    const Trial& t = *d_->trial;
+    if (!t.finished) return tr("Checking what the stitch keeps… %1 %").arg(int(100 * t.fraction.load()));
+    if (t.cancelled) return tr("The check of what the stitch keeps was cancelled.");
+    if (!t.error.empty())
+        return tr("The stitch would keep none of this scan (red): %1").arg(QString::fromStdString(t.error));
+    const std::size_t total = t.patch.number_of_faces();
+    const std::size_t kept = total - std::min(total, t.report.patchFacesTrimmed);
+    if (kept == total) return tr("All %1 patch faces will be stitched.").arg(total);
+    return tr("%1 of %2 patch faces will be stitched; the red ones are trimmed (the mesh stays as it is "
+              "there).")
+        .arg(kept)
+        .arg(total);
 }
 
 void RemeshWidget::reportError(const QString& message) {
@@ -1075,6 +1245,10 @@ void RemeshWidget::updateStatus() {
         text = d_->scanTool->statusText(); // what to do with the preview, whichever tool is active
     else if (d_->active)
         text = d_->active->statusText();
+    if (!isBusy() && d_->busyWhat.isEmpty() && d_->note.isEmpty() && hasPreview()) {
+        const QString trial = trialText();
+        if (!trial.isEmpty()) text += QLatin1Char(' ') + trial;
+    }
     if (text == d_->status->text()) return;
     d_->status->setText(text);
     emit statusChanged(text);

@@ -501,6 +501,8 @@ VtkView::VtkView(QWidget* parent) : QOpenGLWidget(parent), impl_(std::make_uniqu
     // Preview: opaque, its own colour with edges; pulled towards the viewer so that it shows where it
     // coincides with the mesh (a scan patch lies on the surface it was sampled from).
     d.previewMapper->ScalarVisibilityOff();
+    d.previewMapper->SetScalarModeToUseCellData();
+    d.previewMapper->SetColorModeToDirectScalars();
     d.previewMapper->SetRelativeCoincidentTopologyPolygonOffsetParameters(-2, -40);
     d.previewMapper->SetRelativeCoincidentTopologyLineOffsetParameters(-2, -40);
     d.previewActor->SetMapper(d.previewMapper);
@@ -863,12 +865,34 @@ bool VtkView::ghostVisible() const {
 }
 
 void VtkView::setPreviewMesh(const Mesh& patch) {
+    setPreviewMesh(patch, {});
+}
+
+void VtkView::setPreviewMesh(const Mesh& patch, const std::vector<std::uint8_t>& stitched) {
     auto& d = *impl_;
     if (patch.number_of_faces() == 0) {
         clearPreviewMesh();
         return;
     }
-    d.previewMapper->SetInputData(toPolyData(patch));
+    if (!stitched.empty() && stitched.size() != patch.num_faces())
+        throw InvalidInputError("The preview's stitched-face flags do not match its faces.");
+    vtkSmartPointer<vtkPolyData> data = toPolyData(patch);
+    if (!stitched.empty()) {
+        // Direct cell colours: VTK cell i is the i-th live face (toPolyData).
+        vtkNew<vtkUnsignedCharArray> colours;
+        colours->SetNumberOfComponents(3);
+        colours->SetNumberOfTuples(vtkIdType(patch.number_of_faces()));
+        vtkIdType cell = 0;
+        for (FaceIndex f : patch.faces()) {
+            const double* c = stitched[std::size_t(f)] ? kPreview : kPreviewTrimmed;
+            for (int k = 0; k < 3; ++k)
+                colours->SetValue(3 * cell + k, static_cast<unsigned char>(std::lround(255 * c[k])));
+            ++cell;
+        }
+        data->GetCellData()->SetScalars(colours);
+    }
+    d.previewMapper->SetScalarVisibility(stitched.empty() ? 0 : 1);
+    d.previewMapper->SetInputData(data);
     d.previewActor->VisibilityOn();
     update();
 }

@@ -11,6 +11,16 @@
 /// curvature estimate of a first fishbone scan — runs on a worker thread with progress and Cancel, and the
 /// tools are disabled meanwhile. The Session is touched by one thread at a time: while isBusy() the
 /// widget does not call it from the GUI thread (undo / redo wait for the worker to finish).
+///
+/// **Trial stitch.** A stitch trims the parts of a patch it cannot glue in safely, and there the mesh keeps
+/// its input faces. So that the preview shows what will replace the mesh, every new preview is stitched on
+/// a copy of the current mesh on a second background thread (the trial: progress in the status bar,
+/// Cancel stops it, the widget stays interactive and isBusy() stays false). When it has finished the
+/// preview shades the faces the stitch keeps in VtkView::kPreview and those it trims in
+/// VtkView::kPreviewTrimmed, and the status line says "N of M patch faces will be stitched". Accept then
+/// reuses the trial's whole-mesh figures (valence 6, smallest angle before → after); the stitch itself is
+/// run again by Session::accept (the session takes no precomputed result), which is deterministic: the
+/// accepted mesh equals the trial's (trialMesh()).
 
 #include "fss/mesh.h"
 #include "fss/session.h"
@@ -19,8 +29,10 @@
 #include <QString>
 #include <QWidget>
 
+#include <cstdint>
 #include <functional>
 #include <memory>
+#include <vector>
 
 class QAction;
 class QLabel;
@@ -132,6 +144,14 @@ public:
     bool isBusy() const;
     /// The sentence in the status line: what the active tool expects next, or what is running.
     QString statusText() const;
+    /// Whether the trial stitch of the pending preview is running (see the file comment).
+    bool isTrialRunning() const;
+    /// The trial stitch of the pending preview, once it has finished without error: the mesh Accept will
+    /// make, its stitch report, and per face index of the preview's patch 1 (stitched) or 0 (trimmed).
+    /// Null while it runs, after it failed or was cancelled, and without a preview.
+    const Mesh* trialMesh() const;
+    const StitchReport* trialReport() const;
+    const std::vector<std::uint8_t>* trialStitchedFaces() const;
     /// Whether the view shows the reference mesh as a ghost (when the view supports it).
     bool ghostVisible() const { return ghost_; }
 
@@ -157,7 +177,8 @@ public slots:
     void accept();
     /// Drops the preview.
     void reject();
-    /// Asks running work to stop, honoured at its next progress report: a stitch stops between patch
+    /// Asks running work (or, when none runs, the trial stitch) to stop, honoured at its next progress
+    /// report: a stitch stops between patch
     /// components and trim rounds (Session::accept then leaves the mesh unchanged and the preview stays),
     /// the curvature estimate between vertex blocks, a session replay (loadSession) at once.
     void cancel();
@@ -179,6 +200,9 @@ signals:
     void previewChanged();
     /// loadSession() replayed \p path: mesh() is its result and undoStack() its history.
     void sessionLoaded(const QString& path);
+    /// The trial stitch of the preview ended (finished: trialMesh() is set; failed or cancelled: null, and
+    /// the status line says so).
+    void trialFinished();
 
 private:
     struct Impl;
@@ -197,6 +221,11 @@ private:
     void failReplay(const QString& message);
     void afterMeshChange();
     void showPreview();
+    void updateTrial();
+    void startTrial();
+    void finishTrial();
+    void stopTrial();
+    QString trialText() const;
     void runFishbone();
     void createToolBar();
     void reportError(const QString& message);

@@ -23,6 +23,7 @@
 #include <QPointF>
 #include <QString>
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string_view>
@@ -174,6 +175,12 @@ public:
     /// the mesh: polygon offset pulls it towards the viewer so it stays visible where it coincides with the
     /// mesh. An empty mesh clears the preview. The camera is not moved. \pre every face is a triangle.
     void setPreviewMesh(const Mesh& patch);
+    /// As setPreviewMesh(patch), shading each face by what a stitch does with it: \p stitched has one entry
+    /// per face index of \p patch (stitchPatch's stitchedPatchFaces), non-zero: kPreview (the face will
+    /// replace the mesh), zero: kPreviewTrimmed (trimmed: the mesh stays as it is there). An empty
+    /// \p stitched shows the whole patch in kPreview. \pre stitched is empty or has patch.num_faces()
+    /// entries.
+    void setPreviewMesh(const Mesh& patch, const std::vector<std::uint8_t>& stitched);
     /// Removes the preview mesh.
     void clearPreviewMesh();
     /// Whether a preview mesh is shown.
@@ -201,6 +208,8 @@ public:
     static constexpr double kGhostOpacity = 0.35;
     /// RGB colour of the preview mesh (components in [0, 1]): a saturated blue, unlike every colour map.
     static constexpr double kPreview[3] = {0.15, 0.45, 0.95};
+    /// RGB colour of the preview's faces a stitch trims (setPreviewMesh with `stitched`): a brick red.
+    static constexpr double kPreviewTrimmed[3] = {0.85, 0.22, 0.15};
 
     /// RGB background colour of the view (components in [0, 1]).
     static constexpr double kBackground[3] = {0.32, 0.34, 0.43};
