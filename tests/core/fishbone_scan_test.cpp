@@ -491,3 +491,96 @@ TEST(FishboneScan, HintedRayCastOnFacesSmallerThanAPixelMatchesTheAabbTree) {
     // The pixel's own face is hit by fewer than 2/3 of the rays: most of the rest needed the walk.
     EXPECT_LT(hintHits, 2 * hits / 3);
 }
+
+// ---- Sliver figures of issue #20 (item 3) ---------------------------------------------------------------
+
+namespace {
+
+struct AngleFigures {
+    std::size_t faces = 0;
+    double minDeg = 90, meanDeg = 0, below30 = 0, below10 = 0;
+};
+
+AngleFigures angleFigures(const Mesh& m) {
+    AngleFigures a;
+    for (auto f : m.faces()) {
+        std::array<Vector3d, 3> p;
+        int k = 0;
+        for (auto v : CGAL::vertices_around_face(m.halfedge(f), m))
+            p[std::size_t(k++)] = pt(m, v);
+        double smallest = 180;
+        for (int i = 0; i < 3; ++i) {
+            const Vector3d u = (p[std::size_t((i + 1) % 3)] - p[std::size_t(i)]).normalized();
+            const Vector3d w = (p[std::size_t((i + 2) % 3)] - p[std::size_t(i)]).normalized();
+            smallest =
+                std::min(smallest, std::acos(std::clamp(u.dot(w), -1.0, 1.0)) * 180 / std::numbers::pi);
+        }
+        ++a.faces;
+        a.minDeg = std::min(a.minDeg, smallest);
+        a.meanDeg += smallest;
+        a.below30 += smallest < 30 ? 1 : 0;
+        a.below10 += smallest < 10 ? 1 : 0;
+    }
+    if (a.faces) {
+        a.meanDeg /= double(a.faces);
+        a.below30 /= double(a.faces);
+        a.below10 /= double(a.faces);
+    }
+    return a;
+}
+
+} // namespace
+
+// The creased ring's ridge from the crease scene's camera and from straight above (the ridge a closed circle
+// on the screen), h = 2 px, with and without the lasso: the rib trimming of issue #20 (minRibGap 0.5,
+// maxRibTurnDeg 60, ribs stopped at creases) and the sliver-quad bound (20°) against none. Prints the
+// figures of the issue's report; asserts what the trimming achieves today.
+TEST(FishboneScan, RibTrimmingFiguresOnTheCreasedRing) {
+    const CreaseScene scene;
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(scene.ring);
+    fss::FishboneCache cache;
+    fss::Camera top = scene.camera;
+    top.eye = Vector3d(0, 0, 8.0); // the whole ridge in view (its outer silhouette from above)
+    top.focal = Vector3d(0, 0, 0);
+    top.up = {0, 1, 0};
+    top.viewAngleDeg = 45;
+    top.fitClippingRange(bbox(scene.ring));
+    const Vector3d ridgeTop = top.project(Vector3d(kRidge, 0, 0));
+    struct Case {
+        const char* name;
+        fss::Camera camera;
+        Vector2d seed;
+        bool lasso;
+    };
+    const std::vector<Case> cases = {{"front", scene.camera, scene.ridgeSeed(), false},
+                                     {"front+lasso", scene.camera, scene.ridgeSeed(), true},
+                                     {"top (closed)", top, Vector2d(ridgeTop.x(), ridgeTop.y()), false}};
+    for (const Case& c : cases)
+        for (bool trim : {false, true}) {
+            fss::ScanParams params;
+            params.camera = c.camera;
+            if (c.lasso) params.lasso = scene.lasso;
+            params.triangulate.minQuadAngleDeg = trim ? 20 : 0;
+            fss::FishboneParams fb;
+            fb.seed = c.seed;
+            fb.spacing = 2;
+            if (trim) {
+                fb.tracing.minRibGap = 0.5;
+                fb.tracing.maxRibTurnDeg = 60;
+                fb.tracing.stopRibsAtCreases = true;
+            }
+            const fss::FishboneScanResult r =
+                fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+            const AngleFigures a = angleFigures(r.patch.mesh);
+            std::printf("creased ring %-13s %-9s: %5zu faces, %3d rows, smallest %5.1f°, mean %4.1f°, %5.1f "
+                        "%% < 30°, "
+                        "%5.1f %% < 10°, %zu sliver quads dropped\n",
+                        c.name, trim ? "trimmed" : "untrimmed", a.faces, r.counts.rows, a.minDeg, a.meanDeg,
+                        100 * a.below30, 100 * a.below10, r.patch.report.sliverQuads);
+            EXPECT_GT(a.faces, 200u);
+            if (trim) {
+                EXPECT_GE(a.minDeg, 0.0);
+            }
+        }
+}
