@@ -189,7 +189,8 @@ LatticeBasis chooseAdaptiveLattice(const FrameBuffers& referenceBuffers, const M
     LatticeBasis best;
     best.a = {spacing, 0};
     best.b = spacing * Eigen::Vector2d(-0.5, std::sqrt(3.0) / 2.0);
-    double bestScore = -1;
+    double bestScore = 0;
+    bool any = false;
     for (int tilt = 0; tilt <= 60; tilt += 10)
         for (int dir = 0; dir < (tilt == 0 ? 1 : 12); ++dir)
             for (int turn = 0; turn < 8; ++turn) {
@@ -203,9 +204,10 @@ LatticeBasis chooseAdaptiveLattice(const FrameBuffers& referenceBuffers, const M
                 double score = 0;
                 for (const Eigen::Matrix2d& m : planes) {
                     const double g = smallestAngleDeg(m * c.a, m * c.b);
-                    if (g >= countFromDeg) score += g;
+                    if (g >= countFromDeg) score += g - 30.0;
                 }
-                if (score > bestScore * (1 + 1e-9) + 1e-9) {
+                if (!any || score > bestScore + 1e-9 * (1 + std::abs(bestScore))) {
+                    any = true;
                     bestScore = score;
                     best = c;
                 }
