@@ -541,8 +541,11 @@ TEST(FishboneScan, RibTrimmingFiguresOnTheCreasedRing) {
     renderer.setMesh(scene.ring);
     fss::FishboneCache cache;
     fss::Camera top = scene.camera;
-    top.eye = Vector3d(0, 0, 8.0); // the whole ridge in view (its outer silhouette from above)
+    // From 75° above the ring's centre the whole ridge is in view (the silhouette on the far side).
+    const double up = 75 * std::numbers::pi / 180;
     top.focal = Vector3d(0, 0, 0);
+    top.eye = 9.0 * Vector3d(std::cos(up), 0, std::sin(up));
+    top.viewAngleDeg = 45;
     top.up = {0, 1, 0};
     top.viewAngleDeg = 45;
     top.fitClippingRange(bbox(scene.ring));
@@ -555,7 +558,7 @@ TEST(FishboneScan, RibTrimmingFiguresOnTheCreasedRing) {
     };
     const std::vector<Case> cases = {{"front", scene.camera, scene.ridgeSeed(), false},
                                      {"front+lasso", scene.camera, scene.ridgeSeed(), true},
-                                     {"top (closed)", top, Vector2d(ridgeTop.x(), ridgeTop.y()), false}};
+                                     {"top (closed)", top, Vector2d(ridgeTop.x() - 2, ridgeTop.y()), false}};
     for (const Case& c : cases)
         for (bool trim : {false, true}) {
             fss::ScanParams params;
@@ -578,9 +581,70 @@ TEST(FishboneScan, RibTrimmingFiguresOnTheCreasedRing) {
                         "%5.1f %% < 10°, %zu sliver quads dropped\n",
                         c.name, trim ? "trimmed" : "untrimmed", a.faces, r.counts.rows, a.minDeg, a.meanDeg,
                         100 * a.below30, 100 * a.below10, r.patch.report.sliverQuads);
-            EXPECT_GT(a.faces, 200u);
-            if (trim) {
-                EXPECT_GE(a.minDeg, 0.0);
-            }
+            EXPECT_GT(a.faces, 100u);
+            // Measured (issue #20 report): smallest 18.2° (front, with or without lasso), 27.0° (top); the
+            // issue's 20° is not met on the front view, trimmed or not.
+            EXPECT_GE(a.minDeg, 15.0);
+            EXPECT_EQ(a.below10, 0.0);
         }
+}
+
+// A key-rib moved by 1 px (issue #20: "moves no sample by more than 2 px"): two traced key-ribs on the
+// creased ring's ridge, the second moved by one pixel in eight directions; the largest screen move of a
+// rib vertex present in both grids, printed (the figure of the issue's report).
+TEST(FishboneScan, KeyRibMovedByOnePixelFigures) {
+    const CreaseScene scene;
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(scene.ring);
+    fss::FishboneCache cache;
+    fss::ScanParams params;
+    params.camera = scene.camera;
+    fss::FishboneParams fb;
+    fb.seed = scene.ridgeSeed();
+    fb.spacing = 3;
+    const fss::FishboneScanResult first =
+        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+    fb.keyRibs = {first.fishbone.at(first.counts.rows / 4, first.fishbone.backboneColumn),
+                  first.fishbone.at(3 * first.counts.rows / 4, first.fishbone.backboneColumn)};
+    // Each key-rib starts at the backbone sample nearest its point: the second point 1 px before the
+    // midpoint of two samples, then moved by 1 px along the backbone across that midpoint (the worst case),
+    // and 1 px in eight directions from the sample itself.
+    const fss::FishboneGrid& g0 = first.fishbone;
+    const int r2 = 3 * first.counts.rows / 4;
+    const Vector2d along = (g0.at(r2 + 1, g0.backboneColumn) - g0.at(r2, g0.backboneColumn)).normalized();
+    const Vector2d beforeMid =
+        0.5 * (g0.at(r2, g0.backboneColumn) + g0.at(r2 + 1, g0.backboneColumn)) - 0.5 * along;
+    double worst = 0;
+    for (int k = 0; k < 9; ++k) {
+        fss::FishboneParams from = fb, moved = fb;
+        const double t = k * std::numbers::pi / 4;
+        if (k == 8) {
+            from.keyRibs[1] = beforeMid;
+            moved.keyRibs[1] = beforeMid + along;
+        } else {
+            moved.keyRibs[1] += Vector2d(std::cos(t), std::sin(t));
+        }
+        const fss::FishboneScanResult base =
+            fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, from, cache);
+        const fss::FishboneScanResult r =
+            fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, moved, cache);
+        const fss::FishboneGrid &a = base.fishbone, &b = r.fishbone;
+        double most = 0;
+        std::size_t common = 0;
+        for (int row = 0; row < std::min(a.rows, b.rows); ++row)
+            for (int dc = -std::min(a.backboneColumn, b.backboneColumn);
+                 a.backboneColumn + dc < a.cols && b.backboneColumn + dc < b.cols; ++dc) {
+                if (!a.isPresent(row, a.backboneColumn + dc) || !b.isPresent(row, b.backboneColumn + dc))
+                    continue;
+                ++common;
+                most = std::max(most,
+                                (a.at(row, a.backboneColumn + dc) - b.at(row, b.backboneColumn + dc)).norm());
+            }
+        std::printf("key-rib moved by 1 px %s%3d°: %zu common rib vertices, largest move %.2f px\n",
+                    k == 8 ? "across a midpoint, " : "towards ", k == 8 ? 0 : 45 * k, common, most);
+        EXPECT_GT(common, 100u);
+        worst = std::max(worst, most);
+    }
+    std::printf("key-rib moved by 1 px: largest sample move %.2f px (issue #20 asks <= 2)\n", worst);
+    EXPECT_LE(worst, 2.0); // measured 0.61 px across a midpoint, 0 elsewhere
 }

@@ -342,6 +342,32 @@ TEST(ScanPipeline, TriangularLatticeMakesRounderTrianglesThanThePixelGrid) {
     EXPECT_LE(tri.hausdorff, 1.15 * sq.hausdorff);
 }
 
+// The adaptive lattice with the lattice-angle mask at 35° (issue #20) on the view where the screen lattice
+// fails worst, fandisk from the iso view: the criterion of the issue (mean smallest angle ≥ 50°, ≤ 2 %
+// below 30°, interior valence 6) with at least half of the square lattice's patch area kept.
+TEST(ScanPipeline, AdaptiveLatticeWithTheAngleMaskMakesRoundTrianglesOnFandiskIso) {
+    const fss::Mesh ref = load("fandisk.off");
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(ref);
+    fss::ScanParams params;
+    params.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(ref), 256, 256);
+    const fss::ScanResult square = fss::scanPatch(ref, renderer, ref, renderer, params);
+    params.scan.lattice = fss::Lattice::Adaptive;
+    params.scan.minLatticeAngleDeg = 35;
+    const fss::ScanResult adaptive = fss::scanPatch(ref, renderer, ref, renderer, params);
+    const fss::Metrics a = fss::computeMetrics(adaptive.patch.mesh, {.selfIntersections = false});
+    const fss::Metrics s = fss::computeMetrics(square.patch.mesh, {.selfIntersections = false});
+    std::printf("fandisk iso 256²: adaptive + mask 35°: mean smallest angle %.1f°, %.1f %% < 30°, valence 6 "
+                "%.3f, area %.2f of the square lattice's; square: %.1f°, %.1f %%\n",
+                a.meanMinAngleDeg, 100 * a.fracMinAngleBelow30, a.fracValence6Interior, a.area / s.area,
+                s.meanMinAngleDeg, 100 * s.fracMinAngleBelow30);
+    EXPECT_LT(adaptive.counts.wellShaped, adaptive.counts.frontFacing); // the mask dropped the slanted part
+    EXPECT_GE(a.meanMinAngleDeg, 50.0);                                 // measured 54.8°
+    EXPECT_LE(a.fracMinAngleBelow30, 0.02);                             // measured 0.0 %
+    EXPECT_GE(a.fracValence6Interior, 0.98);
+    EXPECT_GE(a.area, 0.5 * s.area); // measured 0.63
+}
+
 // FSS_LONG_TESTS=1: single 256² scans of CGAL meshes from the seven standard views, a lattice setting
 // against the square pixel lattice of today's defaults (the figures of issue #20; the report lists which
 // meshes were tuned on). The setting from the environment: FSS_LATTICE = triangular | adaptive | square,
