@@ -269,6 +269,7 @@ ScanRun regularScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& c
     j["counts"] = {{"pixels", c.pixels},
                    {"covered", c.covered},
                    {"front_facing", c.frontFacing},
+                   {"well_shaped", c.wellShaped},
                    {"after_lasso", c.afterLasso},
                    {"after_quality", c.afterQuality},
                    {"after_morphology", c.afterMorphology}};
@@ -341,7 +342,7 @@ struct ScanOptions {
     std::vector<double> camera; // --camera's numbers
     int w = 256, h = 256, erode = 1, dilate = 1, scanId = 0;
     double zoom = 1, maxEdge = 3, maxAngle = 80, margin = 0.1, spacing = 1, spacingWorld = 0,
-           minQuadAngle = 20;
+           minQuadAngle = 20, minLatticeAngle = 0;
     Lasso lasso;                             // normalised
     FishboneParams fishbone;                 // normalised
     const CLI::Option* viewOption = nullptr; // the options below are given when their count() > 0
@@ -368,7 +369,10 @@ int runScan(const ScanOptions& o) {
     params.quality.margin = o.margin;
     params.quality.forceReplace = o.force;
     params.scan.scanId = o.scanId;
-    params.scan.lattice = o.lattice == "square" ? Lattice::Square : Lattice::Triangular;
+    params.scan.lattice = o.lattice == "square"     ? Lattice::Square
+                          : o.lattice == "adaptive" ? Lattice::Adaptive
+                                                    : Lattice::Triangular;
+    params.scan.minLatticeAngleDeg = o.minLatticeAngle;
     params.scan.spacingPixels = o.spacing;
     params.scan.spacingWorld = o.spacingWorld;
 
@@ -515,9 +519,13 @@ Subcommand addScan(CLI::App& app) {
     p->add_option("--lattice", o->lattice,
                   "Sample lattice of a regular scan: triangular (default; rows offset by half a spacing, "
                   "equilateral triangles on the screen) or square (one sample per pixel centre, the paper's "
-                  "pixel grid).")
+                  "pixel grid) or adaptive (a triangular lattice compressed and turned per view so that the "
+                  "most of the visible surface gets round triangles despite its slant).")
         ->type_name("L")
-        ->check(oneOf("--lattice", {"triangular", "square"}));
+        ->check(oneOf("--lattice", {"triangular", "square", "adaptive"}));
+    addDouble(*p, "--min-lattice-angle", o->minLatticeAngle, false, "DEG",
+              "Leave to other views the surface where the lattice's triangles would have a smallest angle "
+              "below DEG degrees (its slant), in [0, 60) (default 0 = keep all).");
     addDouble(*p, "--spacing", o->spacing, true, "PX",
               "Sample spacing of a regular scan's lattice in pixels, 0.25 to 1024 (default 1).");
     addDouble(*p, "--spacing-world", o->spacingWorld, true, "D",

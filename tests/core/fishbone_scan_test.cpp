@@ -491,3 +491,160 @@ TEST(FishboneScan, HintedRayCastOnFacesSmallerThanAPixelMatchesTheAabbTree) {
     // The pixel's own face is hit by fewer than 2/3 of the rays: most of the rest needed the walk.
     EXPECT_LT(hintHits, 2 * hits / 3);
 }
+
+// ---- Sliver figures of issue #20 (item 3) ---------------------------------------------------------------
+
+namespace {
+
+struct AngleFigures {
+    std::size_t faces = 0;
+    double minDeg = 90, meanDeg = 0, below30 = 0, below10 = 0;
+};
+
+AngleFigures angleFigures(const Mesh& m) {
+    AngleFigures a;
+    for (auto f : m.faces()) {
+        std::array<Vector3d, 3> p;
+        int k = 0;
+        for (auto v : CGAL::vertices_around_face(m.halfedge(f), m))
+            p[std::size_t(k++)] = pt(m, v);
+        double smallest = 180;
+        for (int i = 0; i < 3; ++i) {
+            const Vector3d u = (p[std::size_t((i + 1) % 3)] - p[std::size_t(i)]).normalized();
+            const Vector3d w = (p[std::size_t((i + 2) % 3)] - p[std::size_t(i)]).normalized();
+            smallest =
+                std::min(smallest, std::acos(std::clamp(u.dot(w), -1.0, 1.0)) * 180 / std::numbers::pi);
+        }
+        ++a.faces;
+        a.minDeg = std::min(a.minDeg, smallest);
+        a.meanDeg += smallest;
+        a.below30 += smallest < 30 ? 1 : 0;
+        a.below10 += smallest < 10 ? 1 : 0;
+    }
+    if (a.faces) {
+        a.meanDeg /= double(a.faces);
+        a.below30 /= double(a.faces);
+        a.below10 /= double(a.faces);
+    }
+    return a;
+}
+
+} // namespace
+
+// The creased ring's ridge from the crease scene's camera and from straight above (the ridge a closed circle
+// on the screen), h = 2 px, with and without the lasso: the rib trimming of issue #20 (minRibGap 0.5,
+// maxRibTurnDeg 60, ribs stopped at creases) and the sliver-quad bound (20°) against none. Prints the
+// figures of the issue's report; asserts what the trimming achieves today.
+TEST(FishboneScan, RibTrimmingFiguresOnTheCreasedRing) {
+    const CreaseScene scene;
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(scene.ring);
+    fss::FishboneCache cache;
+    fss::Camera top = scene.camera;
+    // From 75° above the ring's centre the whole ridge is in view (the silhouette on the far side).
+    const double up = 75 * std::numbers::pi / 180;
+    top.focal = Vector3d(0, 0, 0);
+    top.eye = 9.0 * Vector3d(std::cos(up), 0, std::sin(up));
+    top.viewAngleDeg = 45;
+    top.up = {0, 1, 0};
+    top.viewAngleDeg = 45;
+    top.fitClippingRange(bbox(scene.ring));
+    const Vector3d ridgeTop = top.project(Vector3d(kRidge, 0, 0));
+    struct Case {
+        const char* name;
+        fss::Camera camera;
+        Vector2d seed;
+        bool lasso;
+    };
+    const std::vector<Case> cases = {{"front", scene.camera, scene.ridgeSeed(), false},
+                                     {"front+lasso", scene.camera, scene.ridgeSeed(), true},
+                                     {"top (closed)", top, Vector2d(ridgeTop.x() - 2, ridgeTop.y()), false}};
+    for (const Case& c : cases)
+        for (bool trim : {false, true}) {
+            fss::ScanParams params;
+            params.camera = c.camera;
+            if (c.lasso) params.lasso = scene.lasso;
+            params.triangulate.minQuadAngleDeg = trim ? 20 : 0;
+            fss::FishboneParams fb;
+            fb.seed = c.seed;
+            fb.spacing = 2;
+            if (trim) {
+                fb.tracing.minRibGap = 0.5;
+                fb.tracing.maxRibTurnDeg = 60;
+                fb.tracing.stopRibsAtCreases = true;
+            }
+            const fss::FishboneScanResult r =
+                fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+            const AngleFigures a = angleFigures(r.patch.mesh);
+            std::printf("creased ring %-13s %-9s: %5zu faces, %3d rows, smallest %5.1f°, mean %4.1f°, %5.1f "
+                        "%% < 30°, "
+                        "%5.1f %% < 10°, %zu sliver quads dropped\n",
+                        c.name, trim ? "trimmed" : "untrimmed", a.faces, r.counts.rows, a.minDeg, a.meanDeg,
+                        100 * a.below30, 100 * a.below10, r.patch.report.sliverQuads);
+            EXPECT_GT(a.faces, 100u);
+            // Measured (issue #20 report): smallest 18.2° (front, with or without lasso), 27.0° (top); the
+            // issue's 20° is not met on the front view, trimmed or not.
+            EXPECT_GE(a.minDeg, 15.0);
+            EXPECT_EQ(a.below10, 0.0);
+        }
+}
+
+// A key-rib moved by 1 px (issue #20: "moves no sample by more than 2 px"): two traced key-ribs on the
+// creased ring's ridge, the second moved by one pixel in eight directions; the largest screen move of a
+// rib vertex present in both grids, printed (the figure of the issue's report).
+TEST(FishboneScan, KeyRibMovedByOnePixelFigures) {
+    const CreaseScene scene;
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(scene.ring);
+    fss::FishboneCache cache;
+    fss::ScanParams params;
+    params.camera = scene.camera;
+    fss::FishboneParams fb;
+    fb.seed = scene.ridgeSeed();
+    fb.spacing = 3;
+    const fss::FishboneScanResult first =
+        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+    fb.keyRibs = {first.fishbone.at(first.counts.rows / 4, first.fishbone.backboneColumn),
+                  first.fishbone.at(3 * first.counts.rows / 4, first.fishbone.backboneColumn)};
+    // Each key-rib starts at the backbone sample nearest its point: the second point 1 px before the
+    // midpoint of two samples, then moved by 1 px along the backbone across that midpoint (the worst case),
+    // and 1 px in eight directions from the sample itself.
+    const fss::FishboneGrid& g0 = first.fishbone;
+    const int r2 = 3 * first.counts.rows / 4;
+    const Vector2d along = (g0.at(r2 + 1, g0.backboneColumn) - g0.at(r2, g0.backboneColumn)).normalized();
+    const Vector2d beforeMid =
+        0.5 * (g0.at(r2, g0.backboneColumn) + g0.at(r2 + 1, g0.backboneColumn)) - 0.5 * along;
+    double worst = 0;
+    for (int k = 0; k < 9; ++k) {
+        fss::FishboneParams from = fb, moved = fb;
+        const double t = k * std::numbers::pi / 4;
+        if (k == 8) {
+            from.keyRibs[1] = beforeMid;
+            moved.keyRibs[1] = beforeMid + along;
+        } else {
+            moved.keyRibs[1] += Vector2d(std::cos(t), std::sin(t));
+        }
+        const fss::FishboneScanResult base =
+            fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, from, cache);
+        const fss::FishboneScanResult r =
+            fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, moved, cache);
+        const fss::FishboneGrid &a = base.fishbone, &b = r.fishbone;
+        double most = 0;
+        std::size_t common = 0;
+        for (int row = 0; row < std::min(a.rows, b.rows); ++row)
+            for (int dc = -std::min(a.backboneColumn, b.backboneColumn);
+                 a.backboneColumn + dc < a.cols && b.backboneColumn + dc < b.cols; ++dc) {
+                if (!a.isPresent(row, a.backboneColumn + dc) || !b.isPresent(row, b.backboneColumn + dc))
+                    continue;
+                ++common;
+                most = std::max(most,
+                                (a.at(row, a.backboneColumn + dc) - b.at(row, b.backboneColumn + dc)).norm());
+            }
+        std::printf("key-rib moved by 1 px %s%3d°: %zu common rib vertices, largest move %.2f px\n",
+                    k == 8 ? "across a midpoint, " : "towards ", k == 8 ? 0 : 45 * k, common, most);
+        EXPECT_GT(common, 100u);
+        worst = std::max(worst, most);
+    }
+    std::printf("key-rib moved by 1 px: largest sample move %.2f px (issue #20 asks <= 2)\n", worst);
+    EXPECT_LE(worst, 2.0); // measured 0.61 px across a midpoint, 0 elsewhere
+}

@@ -349,7 +349,74 @@ TEST(Scan, LatticeOptionsAreValidated) {
     EXPECT_NE(messageOf(o).find("ScanOptions::spacingWorld"), std::string::npos) << messageOf(o);
     o.spacingWorld = 0;
     o.lattice = static_cast<fss::Lattice>(7);
-    EXPECT_NE(messageOf(o).find("ScanOptions::lattice must be Triangular or Square, not 7"),
+    EXPECT_NE(messageOf(o).find("ScanOptions::lattice must be Triangular, Square or Adaptive, not 7"),
               std::string::npos)
         << messageOf(o);
+    o.lattice = fss::Lattice::Adaptive;
+    o.minLatticeAngleDeg = 60;
+    EXPECT_NE(messageOf(o).find("ScanOptions::minLatticeAngleDeg must be in [0, 60)"), std::string::npos)
+        << messageOf(o);
+}
+
+// A plane seen at a slant of 50°: the screen's equilateral lattice is stretched by 1/cos 50° across the
+// tilt axis on the plane — smallest angle 2·asin(½ / |(½, √3/2 / cos 50°)|) = 40.7° analytically, which
+// latticeAngleOnPlane and the triangulated patch both give; the adaptive lattice is compressed by cos 50° on
+// the screen instead and gives equilateral triangles on the plane (with 1/cos 50° more samples); the
+// lattice-angle mask drops the whole plane from the triangular lattice at 45° and none of it at 40°.
+TEST(Scan, AdaptiveLatticeIsEquilateralOnATiltedPlane) {
+    const Mesh grid = plane();
+    const Camera cam = tiltedCamera(50, true);
+    const FrameBuffers fb = fss::rasterizeOnCpu(grid, cam);
+    const double stretched = 1.0 / std::cos(50 * kDeg);
+    const double expected = 2 * std::asin(0.5 / std::hypot(0.5, std::sqrt(3.0) / 2 * stretched)) / kDeg;
+    const fss::CameraProjector projector(cam);
+    const fss::LatticeBasis triangular{{1, 0}, {-0.5, std::sqrt(3.0) / 2}};
+    EXPECT_NEAR(fss::latticeAngleOnPlane(projector, {2, 2, 0}, {0, 0, 1}, triangular), expected, 1e-4);
+    EXPECT_NEAR(fss::latticeAngleOnPlane(projector, {2, 2, 0}, {0, 0, 1}, {{1, 0}, {0, 1}}),
+                std::atan(std::cos(50 * kDeg)) / kDeg, 1e-4); // the square lattice's right triangles
+    const fss::LatticeBasis adaptive = fss::chooseAdaptiveLattice(fb, grid, 1.0, 35);
+    EXPECT_NEAR(fss::latticeAngleOnPlane(projector, {2, 2, 0}, {0, 0, 1}, adaptive), 60.0, 1e-4);
+    EXPECT_NEAR(std::abs(adaptive.a.x() * adaptive.b.y() - adaptive.a.y() * adaptive.b.x()),
+                std::sqrt(3.0) / 2 * std::cos(50 * kDeg), 1e-9); // cell area on the screen
+    auto worstAngle = [&](fss::Lattice lattice) {
+        fss::ScanWorkspace workspace;
+        fss::ScanOptions o;
+        o.lattice = lattice;
+        const SampleGrid g = fss::sampleLattice(fb, grid, workspace, o);
+        const fss::Patch patch = fss::triangulateGrid(g);
+        const Mesh& m = patch.mesh;
+        EXPECT_GT(m.number_of_faces(), 5000u);
+        double worst = 90, best = 0;
+        for (auto f : m.faces()) {
+            std::vector<Eigen::Vector3d> p;
+            for (auto v : CGAL::vertices_around_face(m.halfedge(f), m))
+                p.emplace_back(m.point(v).x(), m.point(v).y(), m.point(v).z());
+            const double a = smallestAngleDeg(p[0], p[1], p[2]);
+            worst = std::min(worst, a);
+            best = std::max(best, a);
+        }
+        std::size_t interior = 0, six = 0;
+        for (auto v : m.vertices()) {
+            if (m.is_border(v)) continue;
+            ++interior;
+            six += m.degree(v) == 6;
+        }
+        EXPECT_EQ(six, interior);
+        return std::make_pair(worst, g.hitCount());
+    };
+    const auto [triWorst, triHits] = worstAngle(fss::Lattice::Triangular);
+    const auto [adaWorst, adaHits] = worstAngle(fss::Lattice::Adaptive);
+    EXPECT_NEAR(triWorst, expected, 1e-3);
+    EXPECT_GE(adaWorst, 59.99);
+    EXPECT_NEAR(double(adaHits) / double(triHits), stretched, 0.05 * stretched);
+    // The mask, on the triangular lattice's grid.
+    fss::ScanWorkspace workspace;
+    fss::ScanOptions o;
+    o.lattice = fss::Lattice::Triangular;
+    SampleGrid g = fss::sampleLattice(fb, grid, workspace, o);
+    const std::size_t admissible = g.admissibleCount();
+    EXPECT_EQ(fss::applyLatticeAngleMask(g, 40.0), 0u);
+    EXPECT_EQ(fss::applyLatticeAngleMask(g, 45.0), admissible);
+    EXPECT_EQ(g.admissibleCount(), 0u);
+    EXPECT_EQ(g.validCount(), 0u);
 }

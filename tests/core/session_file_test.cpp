@@ -87,6 +87,7 @@ void expectSame(const fss::ScanStep& a, const fss::ScanStep& b) {
     EXPECT_EQ(a.params.scan.lattice, b.params.scan.lattice);
     EXPECT_TRUE(sameBits(a.params.scan.spacingPixels, b.params.scan.spacingPixels));
     EXPECT_TRUE(sameBits(a.params.scan.spacingWorld, b.params.scan.spacingWorld));
+    EXPECT_TRUE(sameBits(a.params.scan.minLatticeAngleDeg, b.params.scan.minLatticeAngleDeg));
     EXPECT_EQ(a.params.relaxIterations, b.params.relaxIterations);
     EXPECT_TRUE(sameBits(a.params.triangulate.minQuadAngleDeg, b.params.triangulate.minQuadAngleDeg));
     EXPECT_TRUE(sameBits(a.params.quality.margin, b.params.quality.margin));
@@ -170,6 +171,7 @@ fss::ScanStep regularStep() {
     s.params.scan.lattice = fss::Lattice::Triangular;
     s.params.scan.spacingPixels = 1.75;
     s.params.scan.spacingWorld = 0.125;
+    s.params.scan.minLatticeAngleDeg = 37.5;
     s.params.relaxIterations = 3;
     s.params.triangulate.minQuadAngleDeg = 17.5;
     s.params.quality.margin = 0.0625;
@@ -458,12 +460,18 @@ TEST_F(BadSessionFile, LatticeAndRelaxationAreOptionalAndOffWhenAbsent) {
     j["events"][0]["step"]["scan"].erase("spacing_world");
     j["events"][0]["step"].erase("relax_iterations");
     j["events"][0]["step"]["triangulate"].erase("min_quad_angle_deg");
+    ASSERT_EQ(j["events"][0]["step"]["scan"]["min_lattice_angle_deg"], 37.5);
+    j["events"][0]["step"]["scan"].erase("min_lattice_angle_deg");
     const fss::ScanStep old = stepOf(j);
     EXPECT_EQ(old.params.scan.lattice, fss::Lattice::Square);
     EXPECT_EQ(old.params.scan.spacingPixels, 1.0);
     EXPECT_EQ(old.params.scan.spacingWorld, 0.0);
     EXPECT_EQ(old.params.relaxIterations, 0);
     EXPECT_EQ(old.params.triangulate.minQuadAngleDeg, 0.0);
+    EXPECT_EQ(old.params.scan.minLatticeAngleDeg, 0.0);
+    j = good_;
+    j["events"][0]["step"]["scan"]["lattice"] = "adaptive";
+    EXPECT_EQ(stepOf(j).params.scan.lattice, fss::Lattice::Adaptive);
     // Written back, a step on the pixel lattice without relaxation has none of the fields: old files
     // round-trip to the same text.
     fss::SessionFile f = sampleFile(mesh_);
@@ -472,10 +480,12 @@ TEST_F(BadSessionFile, LatticeAndRelaxationAreOptionalAndOffWhenAbsent) {
     f.events.at(0).step.params.scan.spacingWorld = 0;
     f.events.at(0).step.params.relaxIterations = 0;
     f.events.at(0).step.params.triangulate.minQuadAngleDeg = 0;
+    f.events.at(0).step.params.scan.minLatticeAngleDeg = 0;
     const Json written = Json::parse(fss::sessionFileToJson(f));
     EXPECT_FALSE(written["events"][0]["step"]["scan"].contains("lattice"));
     EXPECT_FALSE(written["events"][0]["step"].contains("relax_iterations"));
     EXPECT_FALSE(written["events"][0]["step"]["triangulate"].contains("min_quad_angle_deg"));
+    EXPECT_FALSE(written["events"][0]["step"]["scan"].contains("min_lattice_angle_deg"));
     j = good_;
     j["events"][0]["step"]["scan"]["lattice"] = "hexagonal";
     EXPECT_NE(load(j).find("events[0].step.scan.lattice must be"), std::string::npos) << load(j);

@@ -29,6 +29,7 @@
 
 #include <Eigen/Core>
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 
@@ -42,6 +43,11 @@ enum class Lattice {
     /// The pixel lattice of the paper: one sample per pixel centre (right isosceles triangles). Still the
     /// default: with the triangular lattice the stitch seam and property tests failed (issue 20).
     Square,
+    /// A triangular lattice chosen per view (chooseAdaptiveLattice): the equilateral lattice compressed on
+    /// the screen along one direction by cos θ0 and turned, so that its triangles are equilateral on a
+    /// plane tilted by θ0 — the (θ0, direction, turn) for which the most of the visible surface gets round
+    /// triangles. A fixed screen lattice is squashed by cos θ on surfaces seen at a slant θ (issue #20).
+    Adaptive,
 };
 
 /// Options of sampleRegularGrid / sampleLattice (and setSampleOnSurface).
@@ -61,9 +67,16 @@ struct ScanOptions {
     /// When > 0: the spacing in world units instead, converted to pixels with the pixel footprint at the
     /// camera's focal point (latticeSpacingPixels).
     double spacingWorld = 0.0;
+    /// The lattice-angle mask (applyLatticeAngleMask): a sample where the lattice's triangle, mapped onto
+    /// the plane of the sample's reference face, has a smallest angle below this many degrees is not
+    /// admissible — this view would sample that part of the surface too slanted for round triangles, and
+    /// leaves it to another view (the paper's sampling-quality mask, on the triangles' shape). Also the
+    /// angle chooseAdaptiveLattice counts coverage at (35° when 0). In [0, 60); 0 = no mask.
+    double minLatticeAngleDeg = 0.0;
 
     /// Checks the ranges: qualityAngleLimitDeg in (0, 90), maxSnapFootprints finite and ≥ 0, lattice one of
-    /// the enumerators, spacingPixels finite and in [0.25, 1024], spacingWorld finite and ≥ 0.
+    /// the enumerators, spacingPixels finite and in [0.25, 1024], spacingWorld finite and ≥ 0,
+    /// minLatticeAngleDeg in [0, 60).
     /// \throw InvalidOptionError naming the field ("ScanOptions::qualityAngleLimitDeg must be in (0, 90), not
     ///        90.").
     void validate() const;
@@ -137,10 +150,43 @@ SampleGrid sampleRegularGrid(const FrameBuffers& referenceBuffers, const Mesh& r
 ///    intersected with it or with the faces a walk over the surface reaches. A sample whose pixel shows no
 ///    surface, or whose ray the walk cannot place, misses.
 ///    The sampling quality is multiplied by s (a coarser lattice makes longer edges, scan.h).
+///  - Lattice::Adaptive: sample (r, c) at o + c·a + r·b with chooseAdaptiveLattice's basis (countFromDeg =
+///    minLatticeAngleDeg, or 35), o near the image centre; rows and columns cover the image (samples
+///    outside it miss); found as above.
 /// \throw as sampleRegularGrid; InvalidInputError when the world spacing is out of range.
 SampleGrid sampleLattice(const FrameBuffers& referenceBuffers, const Mesh& reference,
                          ScanWorkspace& workspace, const ScanOptions& options = {},
                          const Progress& progress = {});
+
+/// The screen basis of a lattice: sample (r, c) at origin + c·a + r·b; the triangulation's triangles have
+/// the screen edges a, b and a + b (triangulate.h's diagonal (r, c)–(r+1, c+1)).
+struct LatticeBasis {
+    Eigen::Vector2d a{1, 0};
+    Eigen::Vector2d b{0, 1};
+};
+
+/// The smallest angle, in degrees, of the triangle with screen edges \p basis.a, b and a + b mapped onto
+/// the plane through \p point with unit normal \p normal as \p camera sees it (the projection linearised
+/// at \p point). 0 when the plane is seen edge-on.
+double latticeAngleOnPlane(const CameraProjector& camera, const Eigen::Vector3d& point,
+                           const Eigen::Vector3d& normal, const LatticeBasis& basis);
+
+/// The basis of Lattice::Adaptive for \p referenceBuffers' view at \p spacing pixels: among equilateral
+/// screen lattices (side \p spacing) compressed by cos θ0 (θ0 = 0°, 10°, …, 60°) along one of 12
+/// directions and turned by 0°, 7.5°, …, 52.5°, the one that maximises Σ (g − 30°) over a fixed subsample
+/// of at most ~3000 covered front-facing pixels with g = latticeAngleOnPlane ≥ \p countFromDeg (pixels
+/// below it count 0: the mask drops them). The offset of 30° weighs roundness against coverage; it was
+/// tuned on fandisk and bull (issue #20: with 0 the iso view of fandisk kept a mean smallest angle of
+/// 42.8°, with 30° 54.8°). θ0 = 0 without turn (the Triangular lattice's basis) wins ties.
+/// Deterministic; linear in the subsample × 584 candidates.
+LatticeBasis chooseAdaptiveLattice(const FrameBuffers& referenceBuffers, const Mesh& reference,
+                                   double spacing, double countFromDeg);
+
+/// The lattice-angle mask (ScanOptions::minLatticeAngleDeg): every admissible sample of \p grid (a
+/// regular lattice: its basis is read from the screen positions of samples (0, 0), (0, 1), (1, 1)) whose
+/// latticeAngleOnPlane on its reference face is below \p minAngleDeg becomes not admissible and not
+/// valid. Returns how many. Nothing for \p minAngleDeg ≤ 0 or a grid with fewer than 2 rows or columns.
+std::size_t applyLatticeAngleMask(SampleGrid& grid, double minAngleDeg);
 
 /// Where the viewing ray \p ray through screen position \p screen meets the reference, found from the
 /// ID buffer (DESIGN.md §1, shared by sampleLattice and the fishbone scan).

@@ -65,6 +65,7 @@ struct ScanCounts {
     std::size_t pixels = 0;          ///< width × height
     std::size_t covered = 0;         ///< samples on the reference surface (hit)
     std::size_t frontFacing = 0;     ///< of those, on front-facing reference faces (admissible)
+    std::size_t wellShaped = 0;      ///< admissible after the lattice-angle mask (ScanOptions)
     std::size_t afterLasso = 0;      ///< admissible after the lasso
     std::size_t afterQuality = 0;    ///< admissible after the quality mask
     std::size_t afterMorphology = 0; ///< valid after erosion, dilation and clean-up

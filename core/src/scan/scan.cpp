@@ -7,6 +7,8 @@
 #include "base/parallel_rows.h"
 #include "scan/scan_workspace_impl.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -14,6 +16,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace fss {
 namespace {
@@ -118,7 +121,116 @@ void checkBuffers(const FrameBuffers& referenceBuffers) {
                                 std::to_string(w) + "x" + std::to_string(h) + " camera.");
 }
 
+// The inverse of the screen Jacobian of the plane through \p point with normal \p normal, in an orthonormal
+// basis of the plane: screen vector w ↦ tangent coordinates of the plane vector that projects onto w
+// (the projection linearised at the point, a step of one pixel footprint). False when seen edge-on.
+bool planeFromScreen(const CameraProjector& camera, const Eigen::Vector3d& point,
+                     const Eigen::Vector3d& normal, Eigen::Matrix2d& inverse) {
+    const Eigen::Vector3d t1 = normal.unitOrthogonal(), t2 = normal.cross(t1);
+    const double eps = camera.pixelFootprint(point);
+    if (!(eps > 0) || !std::isfinite(eps)) return false;
+    const Eigen::Vector2d p0 = camera.project(point).head<2>();
+    Eigen::Matrix2d j;
+    j.col(0) = (camera.project(point + eps * t1).head<2>() - p0) / eps;
+    j.col(1) = (camera.project(point + eps * t2).head<2>() - p0) / eps;
+    const double det = j.determinant();
+    if (!(std::abs(det) > 1e-9 * j.squaredNorm()) || !std::isfinite(det)) return false;
+    inverse = j.inverse();
+    return true;
+}
+
+// Smallest angle (degrees) of the triangle with edge vectors u, v, u + v.
+double smallestAngleDeg(const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
+    double l[3] = {u.squaredNorm(), v.squaredNorm(), (u + v).squaredNorm()};
+    std::sort(l, l + 3);
+    if (!(l[0] > 0)) return 0.0;
+    const double c = (l[1] + l[2] - l[0]) / (2.0 * std::sqrt(l[1] * l[2]));
+    return std::acos(std::clamp(c, -1.0, 1.0)) / kDegToRad;
+}
+
 } // namespace
+
+double latticeAngleOnPlane(const CameraProjector& camera, const Eigen::Vector3d& point,
+                           const Eigen::Vector3d& normal, const LatticeBasis& basis) {
+    Eigen::Matrix2d m;
+    if (!planeFromScreen(camera, point, normal, m)) return 0.0;
+    return smallestAngleDeg(m * basis.a, m * basis.b);
+}
+
+LatticeBasis chooseAdaptiveLattice(const FrameBuffers& referenceBuffers, const Mesh& reference,
+                                   double spacing, double countFromDeg) {
+    checkBuffers(referenceBuffers);
+    const Camera& camera = referenceBuffers.camera;
+    const CameraProjector projector(camera);
+    const int w = camera.width, h = camera.height;
+    // A fixed subsample of the covered front-facing pixels: the inverse screen Jacobian of each.
+    const int stride = std::max(1, int(std::ceil(std::sqrt(double(w) * double(h) / 3000.0))));
+    std::vector<Eigen::Matrix2d> planes;
+    const std::size_t faceCount = reference.number_of_faces() + reference.number_of_removed_faces();
+    for (int y = stride / 2; y < h; y += stride)
+        for (int x = stride / 2; x < w; x += stride) {
+            const std::uint32_t id = referenceBuffers.faceAt(x, y);
+            if (id == FrameBuffers::kNoFace || id >= faceCount || reference.is_removed(FaceIndex(id)) ||
+                reference.degree(FaceIndex(id)) != 3)
+                continue;
+            const FaceGeometry g = faceGeometry(reference, FaceIndex(id));
+            const auto [point, ray] =
+                projector.unprojectPixelCentreWithRay(x, y, referenceBuffers.depthAt(x, y));
+            if (!(g.normal.squaredNorm() > 0) || !(g.normal.dot(ray.direction) < 0)) continue;
+            Eigen::Matrix2d m;
+            if (planeFromScreen(projector, point, g.normal, m)) planes.push_back(m);
+        }
+    auto rotation = [](double deg) {
+        const double t = deg * kDegToRad;
+        Eigen::Matrix2d r;
+        r << std::cos(t), -std::sin(t), std::sin(t), std::cos(t);
+        return r;
+    };
+    LatticeBasis best;
+    best.a = {spacing, 0};
+    best.b = spacing * Eigen::Vector2d(-0.5, std::sqrt(3.0) / 2.0);
+    double bestScore = 0;
+    bool any = false;
+    for (int tilt = 0; tilt <= 60; tilt += 10)
+        for (int dir = 0; dir < (tilt == 0 ? 1 : 12); ++dir)
+            for (int turn = 0; turn < 8; ++turn) {
+                const Eigen::Matrix2d rd = rotation(15.0 * dir);
+                const Eigen::Matrix2d k =
+                    rd * Eigen::Vector2d(1.0, std::cos(tilt * kDegToRad)).asDiagonal() * rd.transpose();
+                const Eigen::Matrix2d rt = rotation(7.5 * turn);
+                LatticeBasis c;
+                c.a = spacing * k * rt * Eigen::Vector2d(1, 0);
+                c.b = spacing * k * rt * Eigen::Vector2d(-0.5, std::sqrt(3.0) / 2.0);
+                double score = 0;
+                for (const Eigen::Matrix2d& m : planes) {
+                    const double g = smallestAngleDeg(m * c.a, m * c.b);
+                    if (g >= countFromDeg) score += g - 30.0;
+                }
+                if (!any || score > bestScore + 1e-9 * (1 + std::abs(bestScore))) {
+                    any = true;
+                    bestScore = score;
+                    best = c;
+                }
+            }
+    return best;
+}
+
+std::size_t applyLatticeAngleMask(SampleGrid& grid, double minAngleDeg) {
+    if (!(minAngleDeg > 0) || grid.rows < 2 || grid.cols < 2) return 0;
+    const Eigen::Vector2d o = grid.at(0, 0).screen;
+    LatticeBasis basis;
+    basis.a = grid.at(0, 1).screen - o;
+    basis.b = grid.at(1, 1).screen - o - basis.a;
+    const CameraProjector projector(grid.camera);
+    std::size_t masked = 0;
+    for (Sample& s : grid.samples) {
+        if (!s.admissible) continue;
+        if (latticeAngleOnPlane(projector, s.point, s.normal, basis) >= minAngleDeg) continue;
+        s.admissible = s.valid = false;
+        ++masked;
+    }
+    return masked;
+}
 
 float sampleQuality(double footprint, double samplingAngle, double qualityAngleLimitDeg) {
     const double cosLimit = std::cos(std::clamp(qualityAngleLimitDeg, 0.0, 89.9) * kDegToRad);
@@ -289,15 +401,49 @@ SampleGrid sampleLattice(const FrameBuffers& referenceBuffers, const Mesh& refer
     checkBuffers(referenceBuffers);
     const Camera& camera = referenceBuffers.camera;
     const int w = camera.width, h = camera.height;
-    const bool triangular = options.lattice == Lattice::Triangular;
-    // The sheared lattice (see scan.h): x = x0 + (c − shear·r)·s, y = y0 + r·dy.
-    const double shear = triangular ? 0.5 : 0.0;
-    const double dy = triangular ? spacing * std::sqrt(3.0) / 2.0 : spacing;
-    const int rows = std::max(1, int(std::floor(double(h) / dy)));
-    const int rowLength = std::max(1, int(std::floor(double(w) / spacing)));
-    const double y0 = (double(h) - double(rows - 1) * dy) / 2.0;
-    const double x0 = (double(w) - double(rowLength - 1) * spacing) / 2.0;
-    const int cols = rowLength + int(std::ceil(shear * double(rows - 1))) + (triangular ? 1 : 0);
+    // Sample (r, c) at origin + c·a + r·b. The triangular lattice is stored sheared (see scan.h):
+    // x = x0 + (c − r/2)·s, y = y0 + r·(√3/2)·s; the square one x = x0 + c·s, y = y0 + r·s.
+    Eigen::Vector2d origin, a, b;
+    int rows = 0, cols = 0;
+    if (options.lattice == Lattice::Adaptive) {
+        const LatticeBasis basis =
+            chooseAdaptiveLattice(referenceBuffers, reference, spacing,
+                                  options.minLatticeAngleDeg > 0 ? options.minLatticeAngleDeg : 35.0);
+        a = basis.a;
+        b = basis.b;
+        // The lattice coordinates of the image's corners bound the rows and columns that cover it.
+        Eigen::Matrix2d m;
+        m.col(0) = a;
+        m.col(1) = b;
+        const Eigen::Matrix2d inv = m.inverse();
+        const Eigen::Vector2d centre(0.5 * w, 0.5 * h);
+        double cMin = 0, cMax = 0, rMin = 0, rMax = 0;
+        for (const Eigen::Vector2d& corner :
+             {Eigen::Vector2d(0, 0), Eigen::Vector2d(w, 0), Eigen::Vector2d(0, h), Eigen::Vector2d(w, h)}) {
+            const Eigen::Vector2d cr = inv * (corner - centre);
+            cMin = std::min(cMin, cr.x());
+            cMax = std::max(cMax, cr.x());
+            rMin = std::min(rMin, cr.y());
+            rMax = std::max(rMax, cr.y());
+        }
+        const double c0 = std::floor(cMin), r0 = std::floor(rMin);
+        cols = int(std::ceil(cMax) - c0) + 1;
+        rows = int(std::ceil(rMax) - r0) + 1;
+        origin = centre + c0 * a + r0 * b;
+    } else {
+        const bool triangular = options.lattice == Lattice::Triangular;
+        const double shear = triangular ? 0.5 : 0.0;
+        const double dy = triangular ? spacing * std::sqrt(3.0) / 2.0 : spacing;
+        rows = std::max(1, int(std::floor(double(h) / dy)));
+        const int rowLength = std::max(1, int(std::floor(double(w) / spacing)));
+        origin = {(double(w) - double(rowLength - 1) * spacing) / 2.0,
+                  (double(h) - double(rows - 1) * dy) / 2.0};
+        cols = rowLength + int(std::ceil(shear * double(rows - 1))) + (triangular ? 1 : 0);
+        a = {spacing, 0};
+        b = {-shear * spacing, dy};
+    }
+    const bool adaptive = options.lattice == Lattice::Adaptive;
+    const double shear = -b.x() / spacing, dy = b.y();
     SampleGrid grid;
     grid.rows = rows;
     grid.cols = cols;
@@ -317,7 +463,10 @@ SampleGrid sampleLattice(const FrameBuffers& referenceBuffers, const Mesh& refer
                 for (int c = 0; c < cols; ++c) {
                     Sample& s = grid.at(r, c);
                     s = Sample{};
-                    s.screen = {x0 + (double(c) - shear * double(r)) * spacing, y0 + double(r) * dy};
+                    s.screen = adaptive
+                                   ? Eigen::Vector2d(origin + double(c) * a + double(r) * b)
+                                   : Eigen::Vector2d(origin.x() + (double(c) - shear * double(r)) * spacing,
+                                                     origin.y() + double(r) * dy);
                     if (!(s.screen.x() >= 0 && s.screen.x() < w && s.screen.y() >= 0 && s.screen.y() < h))
                         continue;
                     const std::uint32_t id = referenceBuffers.faceAt(int(s.screen.x()), int(s.screen.y()));

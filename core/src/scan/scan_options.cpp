@@ -15,10 +15,11 @@ void ScanOptions::validate() const {
     const detail::OptionCheck check("ScanOptions");
     check.inRange("qualityAngleLimitDeg", qualityAngleLimitDeg, 0, 90, true, true);
     check.nonNegative("maxSnapFootprints", maxSnapFootprints);
-    if (lattice != Lattice::Triangular && lattice != Lattice::Square)
-        check.fail("lattice", "must be Triangular or Square, not " + std::to_string(int(lattice)));
+    if (lattice != Lattice::Triangular && lattice != Lattice::Square && lattice != Lattice::Adaptive)
+        check.fail("lattice", "must be Triangular, Square or Adaptive, not " + std::to_string(int(lattice)));
     check.inRange("spacingPixels", spacingPixels, 0.25, 1024, false, false);
     check.nonNegative("spacingWorld", spacingWorld);
+    check.inRange("minLatticeAngleDeg", minLatticeAngleDeg, 0, 60, false, true);
 }
 
 void QualityMaskOptions::validate() const {

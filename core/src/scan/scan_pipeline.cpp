@@ -139,6 +139,8 @@ ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, con
     if (result.counts.frontFacing == 0)
         throw InvalidInputError(
             "The scan camera sees only the back of the surface; it is probably inside the mesh.");
+    applyLatticeAngleMask(result.grid, params.scan.minLatticeAngleDeg);
+    result.counts.wellShaped = result.grid.admissibleCount();
 
     MaskStages stages;
     if (params.lasso) stages.lasso = &*params.lasso;

@@ -166,10 +166,15 @@ struct Writer {
             {"max_snap_footprints", number(p.scan.maxSnapFootprints, f + ".scan.max_snap_footprints")}};
         // The lattice only when it is not the pixel lattice, which files without it mean (issue #20).
         if (p.scan.lattice != Lattice::Square || p.scan.spacingPixels != 1.0 || p.scan.spacingWorld != 0.0) {
-            j["scan"]["lattice"] = p.scan.lattice == Lattice::Triangular ? "triangular" : "square";
+            j["scan"]["lattice"] = p.scan.lattice == Lattice::Triangular ? "triangular"
+                                   : p.scan.lattice == Lattice::Adaptive ? "adaptive"
+                                                                         : "square";
             j["scan"]["spacing_px"] = number(p.scan.spacingPixels, f + ".scan.spacing_px");
             j["scan"]["spacing_world"] = number(p.scan.spacingWorld, f + ".scan.spacing_world");
         }
+        if (p.scan.minLatticeAngleDeg != 0) // absent: 0, as files written before it (issue #20)
+            j["scan"]["min_lattice_angle_deg"] =
+                number(p.scan.minLatticeAngleDeg, f + ".scan.min_lattice_angle_deg");
         j["quality_mask"] = {{"margin", number(p.quality.margin, f + ".quality_mask.margin")},
                              {"force_replace", p.quality.forceReplace},
                              {"search_rings", p.quality.searchRings}};
@@ -524,17 +529,20 @@ ScanStep readStep(const Node& n) {
     p.relaxIterations = n.has("relax_iterations") ? intField(n.at("relax_iterations")) : 0;
     const Node scan = n.at("scan");
     scan.onlyKeys({"scan_id", "quality_angle_limit_deg", "max_snap_footprints", "lattice", "spacing_px",
-                   "spacing_world"});
+                   "spacing_world", "min_lattice_angle_deg"});
     p.scan.scanId = std::int32_t(scan.at("scan_id").integer(std::numeric_limits<std::int32_t>::min(),
                                                             std::numeric_limits<std::int32_t>::max(),
                                                             "a 32-bit integer"));
     p.scan.qualityAngleLimitDeg = scan.at("quality_angle_limit_deg").number();
     p.scan.maxSnapFootprints = scan.at("max_snap_footprints").number();
     // Files written before the triangular lattice (issue #20) scanned on the pixel lattice.
-    p.scan.lattice =
-        scan.has("lattice") && scan.at("lattice").choice({"triangular", "square"}) == "triangular"
-            ? Lattice::Triangular
-            : Lattice::Square;
+    const std::string lattice =
+        scan.has("lattice") ? scan.at("lattice").choice({"triangular", "square", "adaptive"}) : "square";
+    p.scan.lattice = lattice == "triangular" ? Lattice::Triangular
+                     : lattice == "adaptive" ? Lattice::Adaptive
+                                             : Lattice::Square;
+    p.scan.minLatticeAngleDeg =
+        scan.has("min_lattice_angle_deg") ? scan.at("min_lattice_angle_deg").number() : 0.0;
     p.scan.spacingPixels = scan.has("spacing_px") ? scan.at("spacing_px").number() : 1.0;
     p.scan.spacingWorld = scan.has("spacing_world") ? scan.at("spacing_world").number() : 0.0;
     const Node quality = n.at("quality_mask");
