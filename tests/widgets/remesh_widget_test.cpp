@@ -797,7 +797,8 @@ private slots:
 
     // Issue 19 (Deliver 3): accept latency in the widget at 100k and 1M faces — the worker's Session::accept
     // plus the widget's update of its view, quality panel and history — against the core stitch inside it
-    // (StitchReport::seconds). A measurement, not a test: runs with FSS_BENCH_ACCEPT=1 and prints the figures.
+    // (StitchReport::seconds). A measurement, not a test: runs with FSS_BENCH_ACCEPT=1 and prints the
+    // figures.
     void acceptLatency() {
         if (qEnvironmentVariableIntValue("FSS_BENCH_ACCEPT") != 1)
             QSKIP("a measurement: set FSS_BENCH_ACCEPT=1 to run it");
@@ -826,11 +827,12 @@ private slots:
             const qint64 paintMs = timer.elapsed();
             QCOMPARE(accepted.count(), 1);
             const auto report = accepted.at(0).at(0).value<fss::StitchReport>();
-            qInfo("accept latency, %zu faces: scan %lld ms (%zu patch faces); widget accept %lld ms (worker + "
-                  "view, quality panel and history updated), of which the core stitch %.0f ms: widget / stitch "
-                  "%.2f; the next repaint %lld ms",
-                  std::size_t(sphere.number_of_faces()), scanMs, patchFaces, acceptMs, 1e3 * report.seconds,
-                  double(acceptMs) / (1e3 * report.seconds), paintMs);
+            qInfo(
+                "accept latency, %zu faces: scan %lld ms (%zu patch faces); widget accept %lld ms (worker + "
+                "view, quality panel and history updated), of which the core stitch %.0f ms: widget / stitch "
+                "%.2f; the next repaint %lld ms",
+                std::size_t(sphere.number_of_faces()), scanMs, patchFaces, acceptMs, 1e3 * report.seconds,
+                double(acceptMs) / (1e3 * report.seconds), paintMs);
         }
     }
 
