@@ -47,6 +47,7 @@
 #include <memory>
 #include <numbers>
 #include <set>
+#include <utility>
 
 namespace PMP = CGAL::Polygon_mesh_processing;
 using fss::widgets::FishboneTool;
@@ -802,8 +803,9 @@ private slots:
     void acceptLatency() {
         if (qEnvironmentVariableIntValue("FSS_BENCH_ACCEPT") != 1)
             QSKIP("a measurement: set FSS_BENCH_ACCEPT=1 to run it");
-        for (const int nu : {250, 1000}) {
-            const fss::Mesh sphere = fss::shapes::uvSphere(nu, nu / 2 + 1);
+        // uvSphere(nu, nv) has 2·nu·(nv − 1) faces: 100k and 1M.
+        for (const auto& [nu, nv] : {std::pair{250, 201}, std::pair{1000, 501}}) {
+            const fss::Mesh sphere = fss::shapes::uvSphere(nu, nv);
             auto w = shownWidget(sphere);
             QVERIFY(w);
             w->view()->setStandardView(fss::StandardView::PosX);
