@@ -4,6 +4,7 @@
 #include "fss/mesh_io.h"
 #include "fss/session.h"
 #include "fss/shapes.h"
+#include "fss/stitch.h"
 
 #include "test_data.h"
 
@@ -324,6 +325,101 @@ TEST(Session, UndoRestoresAMeshTheStitchShrank) {
     EXPECT_EQ(fingerprint(session.current()), original);
     session.redo();
     EXPECT_EQ(fingerprint(session.current()), after);
+}
+
+// The first differing records of two meshes, element array by element array (no circulation, so it
+// also works on a broken mesh); empty when they agree.
+std::string firstDifferences(const fss::Mesh& a, const fss::Mesh& b) {
+    std::ostringstream out;
+    if (a.num_vertices() != b.num_vertices() || a.num_halfedges() != b.num_halfedges() ||
+        a.num_faces() != b.num_faces())
+        out << "sizes " << a.num_vertices() << '/' << a.num_halfedges() << '/' << a.num_faces() << " vs "
+            << b.num_vertices() << '/' << b.num_halfedges() << '/' << b.num_faces() << '\n';
+    int shown = 0;
+    for (std::size_t i = 0; i < std::min(a.num_vertices(), b.num_vertices()) && shown < 5; ++i) {
+        const fss::VertexIndex v(static_cast<fss::Mesh::size_type>(i));
+        if (a.point(v) != b.point(v) || a.halfedge(v) != b.halfedge(v)) {
+            out << "vertex " << i << ": " << std::size_t(a.halfedge(v)) << " vs "
+                << std::size_t(b.halfedge(v)) << '\n';
+            ++shown;
+        }
+    }
+    shown = 0;
+    for (std::size_t i = 0; i < std::min(a.num_halfedges(), b.num_halfedges()) && shown < 5; ++i) {
+        const fss::HalfedgeIndex h(static_cast<fss::Mesh::size_type>(i));
+        if (a.next(h) != b.next(h) || a.prev(h) != b.prev(h) || a.target(h) != b.target(h) ||
+            a.face(h) != b.face(h)) {
+            out << "halfedge " << i << ": next " << std::size_t(a.next(h)) << '/' << std::size_t(b.next(h))
+                << " prev " << std::size_t(a.prev(h)) << '/' << std::size_t(b.prev(h)) << " target "
+                << std::size_t(a.target(h)) << '/' << std::size_t(b.target(h)) << " face "
+                << std::size_t(a.face(h)) << '/' << std::size_t(b.face(h)) << '\n';
+            ++shown;
+        }
+    }
+    shown = 0;
+    for (std::size_t i = 0; i < std::min(a.num_faces(), b.num_faces()) && shown < 5; ++i) {
+        const fss::FaceIndex f(static_cast<fss::Mesh::size_type>(i));
+        if (a.halfedge(f) != b.halfedge(f)) {
+            out << "face " << i << ": " << std::size_t(a.halfedge(f)) << " vs " << std::size_t(b.halfedge(f))
+                << '\n';
+            ++shown;
+        }
+    }
+    return out.str();
+}
+
+// accept() stitches in place and collects the garbage locally (MeshJournal): the result is index for index
+// the mesh that stitching a copy and running CGAL's collect_garbage() gives, and undo / redo walk between the
+// two exactly — on fandisk's random scans (growing the mesh) and on coarse scans of a fine sphere (shrinking
+// it, so that old elements move into the removed ones' places).
+TEST(Session, AcceptInPlaceEqualsAStitchedCopyWithItsGarbageCollected) {
+    for (const bool shrink : {false, true}) {
+        fss::Session session(shrink ? fss::shapes::uvSphere(160, 80)
+                                    : fss::readMesh(fss::test::meshPath("fandisk.off")));
+        std::mt19937 rng(shrink ? 11 : 29);
+        const Eigen::AlignedBox3d box = fss::boundingBox(session.reference());
+        int accepted = 0, shrunk = 0;
+        for (int attempt = 0; attempt < 24 && accepted < 6; ++attempt) {
+            fss::ScanStep step = randomStep(rng, box, shrink ? 24 : 48, shrink ? 40 : 160, attempt + 1);
+            step.params.quality.forceReplace = true;
+            try {
+                session.scan(step);
+            } catch (const fss::InvalidInputError&) {
+                continue;
+            }
+            const fss::ScanPreview& preview = *session.preview();
+            const fss::Mesh before = session.current();
+            fss::Mesh copy = before;
+            fss::StitchOptions options = preview.step.stitch;
+            options.collectGarbage = true;
+            bool stitched = true;
+            try {
+                fss::stitchPatch(copy, preview.patch.mesh, preview.step.params.camera, options,
+                                 preview.currentBuffers.faceId);
+            } catch (const fss::InvalidInputError&) {
+                stitched = false;
+            }
+            if (!stitched) {
+                EXPECT_THROW(session.accept(), fss::InvalidInputError);
+                EXPECT_EQ(fingerprint(session.current()), fingerprint(before));
+                continue;
+            }
+            session.accept();
+            ++accepted;
+            ASSERT_EQ(firstDifferences(session.current(), copy), "") << "scan " << attempt + 1;
+            const std::string after = fingerprint(copy);
+            ASSERT_EQ(fingerprint(session.current()), after) << "scan " << attempt + 1;
+            shrunk += session.current().number_of_faces() < before.number_of_faces();
+            session.undo();
+            ASSERT_EQ(fingerprint(session.current()), fingerprint(before)) << "scan " << attempt + 1;
+            session.redo();
+            ASSERT_EQ(fingerprint(session.current()), after) << "scan " << attempt + 1;
+        }
+        EXPECT_GE(accepted, 3) << (shrink ? "sphere" : "fandisk");
+        if (shrink) {
+            EXPECT_GE(shrunk, 1);
+        }
+    }
 }
 
 // A failing accept (validation failure, cancellation) leaves the current mesh, the preview, the history

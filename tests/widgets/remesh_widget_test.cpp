@@ -51,6 +51,7 @@
 #include <memory>
 #include <numbers>
 #include <set>
+#include <utility>
 
 namespace PMP = CGAL::Polygon_mesh_processing;
 using fss::widgets::FishboneTool;
@@ -971,6 +972,48 @@ private slots:
         QVERIFY(w->isBusy());
         w.reset(); // must wait for the worker (which uses the session) instead of crashing
         QVERIFY(!w);
+    }
+
+    // Issue 19 (Deliver 3): accept latency in the widget at 100k and 1M faces — the worker's Session::accept
+    // plus the widget's update of its view, quality panel and history — against the core stitch inside it
+    // (StitchReport::seconds). A measurement, not a test: runs with FSS_BENCH_ACCEPT=1 and prints the
+    // figures.
+    void acceptLatency() {
+        if (qEnvironmentVariableIntValue("FSS_BENCH_ACCEPT") != 1)
+            QSKIP("a measurement: set FSS_BENCH_ACCEPT=1 to run it");
+        // uvSphere(nu, nv) has 2·nu·(nv − 1) faces: 100k and 1M.
+        for (const auto& [nu, nv] : {std::pair{250, 201}, std::pair{1000, 501}}) {
+            const fss::Mesh sphere = fss::shapes::uvSphere(nu, nv);
+            auto w = shownWidget(sphere);
+            QVERIFY(w);
+            w->view()->setStandardView(fss::StandardView::PosX);
+            w->scanPanel()->setResolution(256);
+            w->setActiveTool(w->lassoTool());
+            QWidget* view = w->view();
+            drawLasso(view, QPointF(view->width() / 2.0, view->height() / 2.0), view->height() / 3.0);
+            QElapsedTimer scanTimer;
+            scanTimer.start();
+            QVERIFY(w->scan());
+            const qint64 scanMs = scanTimer.elapsed();
+            const std::size_t patchFaces = w->session()->preview()->patch.mesh.number_of_faces();
+            QSignalSpy accepted(w.get(), &RemeshWidget::scanAccepted);
+            QElapsedTimer timer;
+            timer.start();
+            w->accept();
+            QVERIFY(waitIdle(*w));
+            const qint64 acceptMs = timer.elapsed();
+            timer.restart();
+            view->repaint();
+            const qint64 paintMs = timer.elapsed();
+            QCOMPARE(accepted.count(), 1);
+            const auto report = accepted.at(0).at(0).value<fss::StitchReport>();
+            qInfo(
+                "accept latency, %zu faces: scan %lld ms (%zu patch faces); widget accept %lld ms (worker + "
+                "view, quality panel and history updated), of which the core stitch %.0f ms: widget / stitch "
+                "%.2f; the next repaint %lld ms",
+                std::size_t(sphere.number_of_faces()), scanMs, patchFaces, acceptMs, 1e3 * report.seconds,
+                double(acceptMs) / (1e3 * report.seconds), paintMs);
+        }
     }
 
     void guiKeepsProcessingEventsWhileA100kFaceStitchRuns() {

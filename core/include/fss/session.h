@@ -20,9 +20,9 @@
 /// and face; every face with the same halfedge, hence the same vertex indices in the same order; the same
 /// face properties props::faceQuality and props::faceScanId (bit-identical values, and present or absent
 /// as before). Other properties an input file may have brought are resized with the mesh but their values
-/// are not recorded. To make this possible the current mesh never holds garbage: the session runs
-/// collect_garbage() after every stitch (deterministic), and it does so on the reference at construction
-/// (a reference with garbage is renumbered).
+/// are not recorded. To make this possible the current mesh never holds garbage: the session collects it
+/// after every stitch, exactly as collect_garbage() does (deterministic; done locally, see below), and it
+/// runs collect_garbage() on the reference at construction (a reference with garbage is renumbered).
 ///
 /// **History memory.** A step stores the index-wise difference of the element arrays between the mesh
 /// before and after it: for every vertex, halfedge and face whose record changed (or that exists in one
@@ -31,9 +31,10 @@
 /// for an element present in one state only — plus a few hundred bytes for the ScanStep and StitchReport.
 /// A stitch adding F faces and removing R therefore costs roughly 90 × (F + R) bytes whatever the mesh size
 /// (measured: an 18k-face patch costs 1.6 MB in a 10k- and 1.7 MB in a 300k-face sphere, whose element
-/// arrays take 2.1 and 22 MB). Finding the changed records compares the two states once per accept (linear in
-/// the mesh, a few milliseconds per 100k faces); undo() and redo() write the records back in time
-/// proportional to the change.
+/// arrays take 2.1 and 22 MB). accept() stitches into the current mesh in place while a journal keeps the
+/// records of every element the stitch may change, then collects the garbage where it lies and compares only
+/// those records: no copy of the mesh, no pass over it, so accept() costs the stitch plus time proportional
+/// to the change; undo() and redo() write the records back in time proportional to the change too.
 ///
 /// A Session is not thread-safe: call it from one thread at a time (the widgets run scan() and accept()
 /// on a worker thread while the GUI only reads what it copied).
@@ -126,7 +127,8 @@ public:
     /// "stitch", "record").
     /// \throw InvalidInputError when there is no preview or nothing could be stitched (the preview stays);
     ///        CancelledError. Strong guarantee: on failure the current mesh, the preview, the history and
-    ///        the event log are unchanged (the stitch runs on a copy that replaces the mesh only at the end).
+    ///        the event log are unchanged (what the stitch changed in place is written back from its
+    ///        journal, bit for bit).
     const StitchReport& accept(const Progress& progress = {});
 
     bool canUndo() const;

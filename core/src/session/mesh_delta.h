@@ -14,6 +14,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
+#include <unordered_map>
 #include <vector>
 
 namespace fss::detail {
@@ -55,6 +57,7 @@ public:
     std::size_t records() const;
 
 private:
+    friend class MeshJournal;
     void apply(Mesh& mesh, bool forward) const;
 
     ArrayDelta<VertexRecord> vertices_;
@@ -62,6 +65,47 @@ private:
     ArrayDelta<FaceRecord> faces_;
     bool qualityBefore_ = false, qualityAfter_ = false; // props::faceQuality present in each state
     bool scanIdBefore_ = false, scanIdAfter_ = false;   // props::faceScanId present in each state
+};
+
+/// The MeshDelta of an edit made in place, in time proportional to the edit (Session::accept): before the
+/// edit touches a garbage-free mesh, record() keeps the records of every element it may change; finish()
+/// then collects the garbage exactly as Mesh::collect_garbage() does (the same swaps, so the same indices,
+/// bit for bit) while touching only the removed elements, the elements that move into their places and
+/// those that refer to them, and returns what MeshDelta::between(before, after) would, comparing only the
+/// recorded elements.
+///
+/// The caller guarantees the edit changes no element that record() was not told about: every element
+/// changed is new (beyond the sizes at construction, or reused from garbage the edit removed) or one of the
+/// given vertices, the halfedges into and out of them, the faces around them, or a given face (with its
+/// halfedges and vertices). Removing and adding faces around recorded vertices (CGAL's Euler operations,
+/// Mesh::add_face, remove_face, add_vertex, remove_vertex, remove_edge) satisfies that.
+class MeshJournal {
+public:
+    /// Starts recording an edit of \p mesh, which must be garbage-free. \throw std::logic_error on garbage.
+    explicit MeshJournal(const Mesh& mesh);
+
+    /// Keeps the current records (the state before the edit where not recorded yet) of \p vertices, the
+    /// vertices of \p faces, every halfedge into and out of these vertices and every face around them.
+    void record(const Mesh& mesh, std::span<const VertexIndex> vertices, std::span<const FaceIndex> faces);
+    /// Nothing recorded yet (the edit has not started).
+    bool empty() const { return vertices_.empty() && halfedges_.empty() && faces_.empty(); }
+
+    /// Collects the garbage of \p mesh as collect_garbage() would (without shrinking the arrays' capacity)
+    /// and returns the delta from the state at construction to the result. Call once.
+    /// \throw std::logic_error when the mesh's garbage does not agree with its removed counts.
+    MeshDelta finish(Mesh& mesh);
+
+private:
+    void keepVertex(const Mesh& mesh, VertexIndex v);
+    void keepHalfedge(const Mesh& mesh, HalfedgeIndex h);
+    void keepFace(const Mesh& mesh, FaceIndex f);
+
+    std::size_t vertexCount_, halfedgeCount_, faceCount_; // sizes at construction
+    bool hadQuality_, hadScanId_;
+    // Records before the edit, by index (only indices below the sizes at construction).
+    std::unordered_map<std::uint32_t, MeshDelta::VertexRecord> vertices_;
+    std::unordered_map<std::uint32_t, MeshDelta::HalfedgeRecord> halfedges_;
+    std::unordered_map<std::uint32_t, MeshDelta::FaceRecord> faces_;
 };
 
 } // namespace fss::detail

@@ -1,17 +1,20 @@
 // Session: reference, current mesh, preview, history (session.h).
 //
-// The current mesh is kept garbage-free (collect_garbage after every stitch, which is deterministic), so
-// it is fully described by its element arrays. Each history step stores the index-wise difference of those
-// arrays between the states before and after the stitch (detail::MeshDelta); undo / redo write one side
-// back. Finding the differing records compares the two states once per accept (O(mesh), a few ms per
-// 100k faces); the record itself, and undo / redo, are O(change).
+// The current mesh is kept garbage-free (its garbage collected after every stitch, as collect_garbage()
+// does, which is deterministic), so it is fully described by its element arrays. Each history step stores
+// the index-wise difference of those arrays between the states before and after the stitch
+// (detail::MeshDelta); undo / redo write one side back. accept() stitches in place and journals the records
+// the stitch may change (detail::MeshJournal), so accept, undo and redo are all O(change), not O(mesh).
 #include "fss/session.h"
 
 #include "fss/error.h"
 #include "session/mesh_delta.h"
+#include "stitch/stitch_edits.h"
 
 #include <chrono>
 #include <deque>
+#include <optional>
+#include <span>
 #include <utility>
 
 namespace fss {
@@ -154,12 +157,15 @@ const StitchReport& Session::accept(const Progress& progress) {
     Impl& d = *impl_;
     if (!d.preview) throw InvalidInputError("There is no scan to accept: take a scan first.");
     progress.report(0.0, "stitch");
-    // Everything is computed on a copy; the session's state changes only after the last step that can
-    // throw (strong guarantee).
-    Mesh next = d.current;
+    // The stitch edits the current mesh in place while a journal keeps the records of every element it
+    // may change; the journal then collects the garbage where it is (as collect_garbage() would) and gives
+    // the history's delta, all in time proportional to the change. Until the step is recorded, any failure
+    // writes the journal's records back (strong guarantee): the mesh is then as it was, bit for bit.
+    Mesh& mesh = d.current;
+    detail::MeshJournal journal(mesh);
     const ScanPreview& p = *d.preview;
     StitchOptions options = p.step.stitch;
-    options.collectGarbage = true;
+    options.collectGarbage = false; // the journal does it (same result)
     // The stitch reports its own progress (and is cancellable) between components: mapped into [0, 0.9).
     const Progress stitchProgress([&progress](double fraction, std::string_view stage) {
         progress.report(0.85 * fraction, stage);
@@ -168,20 +174,31 @@ const StitchReport& Session::accept(const Progress& progress) {
     // A fishbone scan samples (and rendered the current mesh) with its sampling camera.
     const Camera camera = p.step.fishbone ? fishboneSamplingCamera(p.step.params.camera, *p.step.fishbone)
                                           : p.step.params.camera;
-    StitchReport report =
-        stitchPatch(next, p.patch.mesh, camera, options, p.currentBuffers.faceId, stitchProgress);
-    if (next.has_garbage()) next.collect_garbage();
-    progress.report(0.9, "record");
-    HistoryItem item{p.step, std::move(report), detail::MeshDelta::between(d.current, next)};
-    d.events.reserve(d.events.size() + 1);
-    progress.report(1.0, "stitch");
-    SessionEvent event{SessionEvent::Kind::Accept, p.step};
-    d.history.push_back(std::move(item)); // strong guarantee of deque::push_back
+    std::optional<HistoryItem> item;
+    std::optional<SessionEvent> event;
+    try {
+        StitchReport report = detail::stitchPatch(
+            mesh, p.patch.mesh, camera, options, p.currentBuffers.faceId, stitchProgress,
+            [&journal](const Mesh& m, std::span<const FaceIndex> removed, std::span<const VertexIndex> used) {
+                journal.record(m, used, removed);
+            });
+        progress.report(0.9, "record");
+        item.emplace(HistoryItem{p.step, std::move(report), journal.finish(mesh)});
+        d.events.reserve(d.events.size() + 1);
+        event.emplace(SessionEvent{SessionEvent::Kind::Accept, p.step});
+        progress.report(1.0, "stitch");
+        d.history.push_back(std::move(*item)); // strong guarantee of deque::push_back
+    } catch (...) {
+        if (item)
+            item->delta.applyBackward(mesh); // the garbage is collected: back to the mesh before
+        else if (!journal.empty())
+            journal.finish(mesh).applyBackward(mesh);
+        throw;
+    }
     // No allocation from here on.
     d.history.erase(d.history.begin() + std::ptrdiff_t(d.applied), d.history.end() - 1); // drop redo steps
-    d.current = std::move(next);
     d.currentRendererValid = false;
-    d.events.push_back(std::move(event)); // capacity reserved above: no allocation
+    d.events.push_back(std::move(*event)); // capacity reserved above: no allocation
     while (d.history.size() > d.options.maxUndoSteps) {
         d.history.pop_front();
         ++d.forgotten;

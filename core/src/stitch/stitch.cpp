@@ -34,6 +34,7 @@
 #include "mesh/local_ops.h"
 #include "stitch/lift.h"
 #include "stitch/seam_quality.h"
+#include "stitch/stitch_edits.h"
 #include "stitch/strip_refill.h"
 
 #include "fss/error.h"
@@ -49,6 +50,9 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
 #include <deque>
 #include <limits>
 #include <map>
@@ -56,6 +60,7 @@
 #include <queue>
 #include <set>
 #include <stdexcept>
+#include <string_view>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -265,10 +270,10 @@ private:
 // Map from mesh indices (vertex or face numbers, never kNone) to values: open addressing with linear
 // probing. The searches over the faces under a patch look indices up millions of times; this is several
 // times faster than std::unordered_map there. Pointers to values stay valid until the next insertion.
-template <class V> class IndexMap {
+template <class V, class Key = std::uint32_t> class IndexMap {
 public:
     // The value of key and whether it was inserted now (then set to `init`).
-    std::pair<V*, bool> try_emplace(std::uint32_t key, const V& init = V()) {
+    std::pair<V*, bool> try_emplace(Key key, const V& init = V()) {
         if (2 * (size_ + 1) > keys_.size()) grow();
         std::size_t i = slot(key);
         if (keys_[i] == key) return {&values_[i], false};
@@ -277,14 +282,20 @@ public:
         ++size_;
         return {&values_[i], true};
     }
-    bool insert(std::uint32_t key) { return try_emplace(key).second; }
-    V& operator[](std::uint32_t key) { return *try_emplace(key).first; }
-    const V* find(std::uint32_t key) const {
+    bool insert(Key key) { return try_emplace(key).second; }
+    V& operator[](Key key) { return *try_emplace(key).first; }
+    const V* find(Key key) const {
         if (keys_.empty()) return nullptr;
         const std::size_t i = slot(key);
         return keys_[i] == key ? &values_[i] : nullptr;
     }
-    std::size_t count(std::uint32_t key) const { return find(key) ? 1 : 0; }
+    // The value of a key that must be there.
+    const V& at(Key key) const {
+        const V* v = find(key);
+        if (!v) throw std::logic_error("IndexMap::at: no such key");
+        return *v;
+    }
+    std::size_t count(Key key) const { return find(key) ? 1 : 0; }
     std::size_t size() const { return size_; }
     void clear() {
         keys_.clear();
@@ -293,16 +304,16 @@ public:
     }
 
 private:
-    static constexpr std::uint32_t kEmpty = kNone;
-    std::size_t slot(std::uint32_t key) const {
+    static constexpr Key kEmpty = std::numeric_limits<Key>::max(); // never a key (kNone, or two of them)
+    std::size_t slot(Key key) const {
         const std::size_t mask = keys_.size() - 1;
-        std::size_t i = (std::size_t(key) * 0x9E3779B97F4A7C15ull) >> 20 & mask;
+        std::size_t i = std::size_t((std::uint64_t(key) * 0x9E3779B97F4A7C15ull) >> 20) & mask;
         while (keys_[i] != key && keys_[i] != kEmpty)
             i = (i + 1) & mask;
         return i;
     }
     void grow() {
-        std::vector<std::uint32_t> keys(std::max<std::size_t>(64, 2 * keys_.size()), kEmpty);
+        std::vector<Key> keys(std::max<std::size_t>(64, 2 * keys_.size()), kEmpty);
         std::vector<V> values(keys.size());
         keys.swap(keys_);
         values.swap(values_);
@@ -313,7 +324,7 @@ private:
                 values_[i] = std::move(values[j]);
             }
     }
-    std::vector<std::uint32_t> keys_;
+    std::vector<Key> keys_;
     std::vector<V> values_;
     std::size_t size_ = 0;
 };
@@ -426,10 +437,10 @@ bool replay(Mesh& m, const Plan& plan, const VertexOf& vertexOf, const FaceOf& f
 // small local mesh on which the stitch is built, optimised, checked and rehearsed.
 struct Star {
     Mesh S;
-    std::unordered_map<std::uint32_t, VertexIndex> fromCurrent;   // current vertex → S vertex
-    std::unordered_map<std::uint32_t, FaceIndex> faceFromCurrent; // current face → S face
-    Mesh::Property_map<VertexIndex, std::uint32_t> cur;           // S vertex → current vertex (kNone: new)
-    Mesh::Property_map<FaceIndex, bool> kept;                     // face of the current mesh that stays
+    IndexMap<VertexIndex> fromCurrent;                  // current vertex → S vertex
+    IndexMap<FaceIndex> faceFromCurrent;                // current face → S face
+    Mesh::Property_map<VertexIndex, std::uint32_t> cur; // S vertex → current vertex (kNone: new)
+    Mesh::Property_map<FaceIndex, bool> kept;           // face of the current mesh that stays
     std::vector<VertexIndex> full; // S vertices whose whole star is in S (vertices of the replaced faces)
     std::unordered_set<std::uint32_t> fullCurrent; // the same, as current-mesh vertices
     // Is the whole star of S vertex v in S (a vertex of the replaced faces, or a new one)?
@@ -451,10 +462,10 @@ bool buildStar(const Mesh& M, const std::vector<FaceIndex>& replaced, Star& st) 
     auto vertexOf = [&](VertexIndex v) {
         auto [it, fresh] = st.fromCurrent.try_emplace(std::uint32_t(v));
         if (fresh) {
-            it->second = st.S.add_vertex(M.point(v));
-            st.cur[it->second] = std::uint32_t(v);
+            *it = st.S.add_vertex(M.point(v));
+            st.cur[*it] = std::uint32_t(v);
         }
-        return it->second;
+        return *it;
     };
     for (FaceIndex f : faces) {
         std::array<VertexIndex, 3> vs;
@@ -555,6 +566,60 @@ private:
     std::size_t work_ = 0;
 };
 
+// Time per stage of the stitch, printed to stderr by stitchPatch when the environment variable
+// FSS_STITCH_PROFILE is 1 (issue 19's breakdown; off otherwise, one branch per stage).
+class StageClock {
+public:
+    static bool enabled() {
+        static const bool on = [] {
+            const char* e = std::getenv("FSS_STITCH_PROFILE");
+            return e && std::string_view(e) == "1";
+        }();
+        return on;
+    }
+    // Adds the time since the previous lap (or start()) to `stage`.
+    static void lap(const char* stage) {
+        if (!enabled()) return;
+        const double now = cpuMs();
+        auto& t = totals();
+        auto it = std::find_if(t.begin(), t.end(), [&](const auto& e) { return e.first == stage; });
+        if (it == t.end()) it = t.insert(t.end(), {stage, 0.0});
+        it->second += now - last();
+        last() = now;
+    }
+    static void start() {
+        if (!enabled()) return;
+        totals().clear();
+        last() = cpuMs();
+    }
+    static void print() {
+        if (!enabled()) return;
+        double sum = 0;
+        for (const auto& [stage, ms] : totals())
+            sum += ms;
+        std::fprintf(stderr, "stitch stages (ms):");
+        for (const auto& [stage, ms] : totals())
+            std::fprintf(stderr, " %s %.1f;", stage, ms);
+        std::fprintf(stderr, " total %.1f\n", sum);
+    }
+
+private:
+    static std::vector<std::pair<const char*, double>>& totals() {
+        static std::vector<std::pair<const char*, double>> t;
+        return t;
+    }
+    // CPU time of the calling thread (the stitch is single-threaded; the machine may be shared).
+    static double cpuMs() {
+        timespec ts{};
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+        return 1e3 * double(ts.tv_sec) + 1e-6 * double(ts.tv_nsec);
+    }
+    static double& last() {
+        static double t = 0;
+        return t;
+    }
+};
+
 class ComponentStitcher {
 public:
     ComponentStitcher(const Mesh& m, const PatchData& p, const View& view, const StitchOptions& o,
@@ -570,23 +635,30 @@ public:
         Attempt a;
         // Cancellation points (progress_) lie in the steps' long loops; none of them touches the mesh.
         constexpr int kSteps = 8;
+        StageClock::lap("other");
         if (!setupComponent(a)) return a;
+        StageClock::lap("setup");
         progress_.step(1, kSteps);
         if (!findRegion(a)) return a;
+        StageClock::lap("region");
         if (!preTrim(a)) return a;
         progress_.step(2, kSteps);
         if (!splitRegion(a)) return a;
+        StageClock::lap("split");
         buildLocalVertices();
         snap();
         progress_.step(3, kSteps);
         if (!computeCrossings(a)) return a;
+        StageClock::lap("snap+crossings");
         Cdt cdt;
         std::vector<CdtVertex> vh;
         if (!triangulate(cdt, vh, a)) return a;
         progress_.step(4, kSteps);
         if (!classify(cdt, vh, a)) return a;
         if (!checkCoverage(cdt, vh, a)) return a;
+        StageClock::lap("cdt");
         if (!assemble(cdt, a)) return a;
+        StageClock::lap("assemble");
         progress_.step(5, kSteps);
         if (!buildAndOptimise(a)) return a;
         a.ok = true;
@@ -2030,7 +2102,7 @@ private:
     // Adds faces in an order that grows from the hole's border (each face next to what is there).
     static std::vector<std::size_t> growthOrder(const std::vector<std::array<VertexIndex, 3>>& faces,
                                                 const Mesh& m) {
-        std::unordered_map<std::uint64_t, std::size_t> byEdge;
+        IndexMap<std::size_t, std::uint64_t> byEdge;
         for (std::size_t i = 0; i < faces.size(); ++i)
             for (int k = 0; k < 3; ++k)
                 byEdge[dirKey(std::uint32_t(faces[i][std::size_t(k)]),
@@ -2055,11 +2127,12 @@ private:
                 queue.pop_front();
                 order.push_back(i);
                 for (int k = 0; k < 3; ++k) {
-                    auto it = byEdge.find(dirKey(std::uint32_t(faces[i][std::size_t((k + 1) % 3)]),
-                                                 std::uint32_t(faces[i][std::size_t(k)])));
-                    if (it != byEdge.end() && !done[it->second]) {
-                        done[it->second] = 1;
-                        queue.push_back(it->second);
+                    const std::size_t* j =
+                        byEdge.find(dirKey(std::uint32_t(faces[i][std::size_t((k + 1) % 3)]),
+                                           std::uint32_t(faces[i][std::size_t(k)])));
+                    if (j && !done[*j]) {
+                        done[*j] = 1;
+                        queue.push_back(*j);
                     }
                 }
             }
@@ -2077,9 +2150,12 @@ private:
     bool buildAndOptimise(Attempt& a) {
         Local loc;
         Mesh& S = loc.star.S;
+        StageClock::lap("other");
         if (!buildStar(M_, replaced_, loc.star)) return fail(a, "the mesh is not manifold near its seam");
+        StageClock::lap("star");
         // A copy is cheaper than building the star again (the copied maps address the copy's arrays).
         loc.pristine = loc.star;
+        StageClock::lap("star copy");
         loc.pristine.cur = loc.pristine.S.property_map<VertexIndex, std::uint32_t>("v:cur").first;
         loc.pristine.kept = loc.pristine.S.property_map<FaceIndex, bool>("f:kept").first;
         loc.lid = S.add_property_map<VertexIndex, int>("v:lid", -1).first;
@@ -2103,9 +2179,9 @@ private:
             const LVert& l = L_[i];
             if (!l.alive) continue;
             if (l.kind == LVert::Region) {
-                auto it = loc.star.fromCurrent.find(l.cur);
-                if (it == loc.star.fromCurrent.end()) continue; // a region vertex of no replaced face
-                sv[i] = it->second;
+                const VertexIndex* it = loc.star.fromCurrent.find(l.cur);
+                if (!it) continue; // a region vertex of no replaced face
+                sv[i] = *it;
             }
         }
         // Fresh vertices are created on use, in order.
@@ -2136,11 +2212,15 @@ private:
                 loc.lid[sv[i]] = int(i);
                 loc.uv[sv[i]] = L_[i].uv;
             }
+        StageClock::lap("local:vertices");
         for (FaceIndex f : replaced_)
             removeFaceKeeping(S, loc.star.faceFromCurrent.at(std::uint32_t(f)),
                               [&](VertexIndex v) { return reusedCur.count(loc.star.cur[v]) > 0; });
+        StageClock::lap("local:remove");
         std::vector<int> bad;
-        for (std::size_t i : growthOrder(faceVs, S)) {
+        const auto order = growthOrder(faceVs, S);
+        StageClock::lap("local:growthOrder");
+        for (std::size_t i : order) {
             progress_.tick();
             const FaceIndex g = S.add_face(faceVs[i][0], faceVs[i][1], faceVs[i][2]);
             if (g == Mesh::null_face()) {
@@ -2157,6 +2237,7 @@ private:
             loc.offView[g] = newFaces_[i].offView;
         }
         if (!bad.empty()) return fail(a, "its seam would not be manifold", std::move(bad));
+        StageClock::lap("local:add_face");
         for (VertexIndex v : S.vertices()) {
             bool lockedV = S.is_border(v);
             for (FaceIndex f : CGAL::faces_around_target(S.halfedge(v), S))
@@ -2167,15 +2248,19 @@ private:
             for (std::size_t j = 0; j + 1 < pe.line.size(); ++j)
                 loc.seam.insert(seamKey(sv[std::size_t(pe.line[j])], sv[std::size_t(pe.line[j + 1])]));
 
+        StageClock::lap("local mesh");
         progress_.step(6, 8);
         if (O_.optimiseSeam) {
             const Refill refill = refill_ ? refillSeam(loc) : Refill::NotDone;
             if (refill == Refill::Broken) return retryWithoutRefill(a);
             if (refill == Refill::NotDone) optimise(loc, a.plan);
         }
+        StageClock::lap("optimise");
         progress_.step(7, 8);
         if (!validate(loc, bordersBefore, a)) return loc.refilled ? retryWithoutRefill(a) : false;
+        StageClock::lap("validate:self-intersections");
         const bool ok = extractPlan(loc, a);
+        StageClock::lap("plan:seam figures");
         return ok;
     }
 
@@ -2437,7 +2522,9 @@ private:
                 if (collapseEach(cands) == 0) break;
             }
         };
+        StageClock::lap("optimise:other");
         collapsePass();
+        StageClock::lap("optimise:collapse");
         // -- refinement outside the patch: split long edges of the pieces around the seam (the new vertices
         // lie on the old surface: in a face's plane or on a mesh edge), graded from the patch's edge length
         // at the seam outwards, then flip within the faces' planes.
@@ -2445,14 +2532,17 @@ private:
             if (refineOutside(loc) == 0) break;
             flipPass(loc, plan);
         }
+        StageClock::lap("optimise:refine");
         collapsePass();
         flipPass(loc, plan);
+        StageClock::lap("optimise:collapse+flip");
         // -- smoothing: the vertices added outside the patch move within their face's plane towards the
         // centre of their neighbours where that raises the smallest angle around them.
         for (int pass = 0; pass < 3; ++pass) {
             if (smoothOutside(loc) == 0) break;
             flipPass(loc, plan);
         }
+        StageClock::lap("optimise:smooth");
         // -- needles: a face near the seam with a small angle loses its shortest edge when collapsing it
         // (either way, with every check of tryCollapse: no fold, no flip in the view, pieces outside stay
         // in their planes) raises the smallest angle around; then flip again.
@@ -2476,11 +2566,14 @@ private:
             if (collapseEach(cands) == 0) break;
             flipPass(loc, plan);
         }
+        StageClock::lap("optimise:needles");
         valencePass(loc, plan);
+        StageClock::lap("optimise:valence");
         // -- last smoothing: the free vertices near the seam whose smallest angle around is still small
         // search for a better place (smoothOutside with search; no flips after it, so the valences stay).
         for (int pass = 0; pass < 2; ++pass)
             if (smoothOutside(loc, true) == 0) break;
+        StageClock::lap("optimise:search");
     }
 
     // The smallest angle of the faces (v, p, q) of `ring` (faces `faces`) with v moved from p0 to p1, or -1
@@ -2911,19 +3004,26 @@ private:
     std::vector<std::pair<double, FaceIndex>> thinFaces(const Local& loc,
                                                         const std::unordered_set<std::uint32_t>& near) {
         const Mesh& S = loc.star.S;
+        // The faces with a vertex in `near` (found around those vertices, not among all faces of S).
+        std::vector<FaceIndex> faces;
+        for (std::uint32_t vi : near) {
+            const VertexIndex v(vi);
+            if (S.is_removed(v) || S.is_isolated(v)) continue;
+            for (FaceIndex f : CGAL::faces_around_target(S.halfedge(v), S))
+                if (f != Mesh::null_face()) faces.push_back(f);
+        }
+        std::sort(faces.begin(), faces.end());
+        faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
         std::vector<std::pair<double, FaceIndex>> thin;
-        for (FaceIndex f : S.faces()) {
+        for (FaceIndex f : faces) {
             progress_.tick();
             if (loc.star.kept[f]) continue;
             const HalfedgeIndex h0 = S.halfedge(f);
             const VertexIndex v[3] = {S.source(h0), S.target(h0), S.target(S.next(h0))};
-            if (!near.count(std::uint32_t(v[0])) && !near.count(std::uint32_t(v[1])) &&
-                !near.count(std::uint32_t(v[2])))
-                continue;
             const double ang = minAngle(pt(S, v[0]), pt(S, v[1]), pt(S, v[2]));
             if (ang < kNeedleDeg * kDeg) thin.push_back({ang, f});
         }
-        std::sort(thin.begin(), thin.end());
+        std::sort(thin.begin(), thin.end()); // (angle, face): the same order however the faces were found
         return thin;
     }
 
@@ -3161,8 +3261,10 @@ private:
         if (!bad.empty() || bordersAfter != bordersBefore)
             return fail(a, "it would open or close a hole in the mesh", std::move(bad));
         // No new self-intersections among the local faces.
+        StageClock::lap("validate:faces+vertices");
         std::vector<std::pair<FaceIndex, FaceIndex>> pairs;
         const auto candidates = intersectionCandidates(loc);
+        StageClock::lap("validate:candidates");
         progress_.tick(candidates.size());
         PMP::self_intersections(candidates, S, std::back_inserter(pairs));
         for (const auto& [f, g] : pairs) {
@@ -3178,10 +3280,11 @@ private:
     // from the faces next to kept faces (the hole's border) across S's edges.
     static std::vector<std::size_t> growthOrderIn(const Mesh& S, const std::vector<FaceIndex>& sfaces,
                                                   const Local& loc) {
-        std::unordered_map<std::uint32_t, std::size_t> index;
-        index.reserve(sfaces.size());
+        // Position of each face of S in sfaces (kAbsent: not there).
+        constexpr std::size_t kAbsent = std::numeric_limits<std::size_t>::max();
+        std::vector<std::size_t> index(S.num_faces(), kAbsent);
         for (std::size_t i = 0; i < sfaces.size(); ++i)
-            index[std::uint32_t(sfaces[i])] = i;
+            index[std::size_t(sfaces[i])] = i;
         std::vector<char> done(sfaces.size(), 0);
         std::vector<std::size_t> order;
         order.reserve(sfaces.size());
@@ -3191,7 +3294,7 @@ private:
                 const FaceIndex g = S.face(S.opposite(h));
                 // Next to a face that exists before the additions (kept, or left unchanged).
                 if (!done[i] &&
-                    (g == Mesh::null_face() || loc.star.kept[g] || !index.count(std::uint32_t(g)))) {
+                    (g == Mesh::null_face() || loc.star.kept[g] || index[std::size_t(g)] == kAbsent)) {
                     done[i] = 1;
                     queue.push_back(i);
                 }
@@ -3204,10 +3307,10 @@ private:
                 for (HalfedgeIndex h : CGAL::halfedges_around_face(S.halfedge(sfaces[i]), S)) {
                     const FaceIndex g = S.face(S.opposite(h));
                     if (g == Mesh::null_face() || loc.star.kept[g]) continue;
-                    auto it = index.find(std::uint32_t(g));
-                    if (it != index.end() && !done[it->second]) {
-                        done[it->second] = 1;
-                        queue.push_back(it->second);
+                    const std::size_t j = index[std::size_t(g)];
+                    if (j != kAbsent && !done[j]) {
+                        done[j] = 1;
+                        queue.push_back(j);
                     }
                 }
             }
@@ -3283,6 +3386,7 @@ private:
             }
             pf.push_back(p);
         }
+        StageClock::lap("plan");
         // Rehearse: add fresh vertices, remove the replaced faces, add the faces in growth order.
         std::vector<VertexIndex> fresh;
         for (const Vec3& p : plan.freshPositions)
@@ -3303,12 +3407,14 @@ private:
             rf.push_back(r);
         }
         const auto order = growthOrderIn(S, sfaces, loc);
+        StageClock::lap("rehearsal:prepare");
         progress_.step(8, 8);
         for (std::size_t i : order) {
             progress_.tick();
             if (rehearsal.S.add_face(rf[i][0], rf[i][1], rf[i][2]) == Mesh::null_face())
                 return fail(a, "internal error: the stitch could not be rehearsed");
         }
+        StageClock::lap("rehearsal:add_face");
         for (std::size_t i : order) {
             plan.faces.push_back(pf[i]);
             plan.quality.push_back(loc.quality[sfaces[i]]);
@@ -3465,7 +3571,16 @@ std::vector<std::vector<int>> components(const PatchData& P, const std::vector<i
 StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCamera,
                          const StitchOptions& options, std::span<const std::uint32_t> faceIds,
                          const Progress& progress, std::vector<std::uint8_t>* stitchedPatchFaces) {
+    return detail::stitchPatch(current, patch, scanCamera, options, faceIds, progress, {},
+                               stitchedPatchFaces);
+}
+
+StitchReport detail::stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCamera,
+                                 const StitchOptions& options, std::span<const std::uint32_t> faceIds,
+                                 const Progress& progress, const BeforeStitchEdit& beforeEdit,
+                                 std::vector<std::uint8_t>* stitchedPatchFaces) {
     const auto start = std::chrono::steady_clock::now();
+    StageClock::start();
     if (stitchedPatchFaces) stitchedPatchFaces->assign(patch.num_faces(), 0);
     scanCamera.validate();
     if (patch.number_of_faces() == 0) throw InvalidInputError("The patch has no faces.");
@@ -3558,6 +3673,14 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
             continue;
         }
         // Apply: every check has passed on the local copy and the rehearsal succeeded.
+        StageClock::lap("other");
+        if (beforeEdit) {
+            std::vector<VertexIndex> used(a.plan.reused);
+            for (const auto& face : a.plan.faces)
+                for (const PlanVertex& v : face)
+                    if (!v.fresh) used.push_back(VertexIndex(v.index));
+            beforeEdit(current, a.plan.removed, used);
+        }
         if (!propsReady) {
             if (P.hasQuality)
                 current.add_property_map<FaceIndex, float>(props::faceQuality, kInputFaceQuality);
@@ -3574,6 +3697,7 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
                 if (s.second) s.first[f] = plan.scanId[i];
             });
         if (!applied) throw Error("Internal error: a rehearsed stitch could not be applied to the mesh.");
+        StageClock::lap("apply");
         stitched.insert(w.name);
         if (stitchedPatchFaces)
             for (int f : w.faces)
@@ -3619,6 +3743,8 @@ StitchReport stitchPatch(Mesh& current, const Mesh& patch, const Camera& scanCam
             (componentCount > 1 ? " (" + std::to_string(componentCount) + " components)" : std::string()) +
             ": " + (firstReason.empty() ? std::string("it is empty") : firstReason.begin()->second) + ".");
     if (options.collectGarbage) current.collect_garbage();
+    StageClock::lap("other");
+    StageClock::print();
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return report;
 }
