@@ -3,8 +3,8 @@
 // into its current mesh in place and journals the elements each edit may change (session/mesh_delta.h).
 #include "fss/stitch.h"
 
-#include <functional>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
