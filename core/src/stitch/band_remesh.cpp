@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <unordered_map>
 #include <unordered_set>
@@ -21,11 +22,15 @@ namespace fss::stitch {
 namespace {
 
 constexpr double kBandDeg = std::numbers::pi / 180.0;
+// Faces with a smaller smallest angle (degrees) have no reliable normal for finding creases.
+constexpr double kSliverDeg = 10.0;
+// A crease vertex between two crease edges that turn by at most this (degrees) may be collapsed along them.
+constexpr double kStraightCreaseDeg = 20.0;
 using V3 = Eigen::Vector3d;
 
 std::uint64_t bandKey(VertexIndex a, VertexIndex b) {
-    const auto [x, y] = std::minmax(std::uint32_t(a), std::uint32_t(b));
-    return (std::uint64_t(x) << 32) | y;
+    const std::uint32_t x = std::uint32_t(a), y = std::uint32_t(b); // (std::minmax of temporaries dangles)
+    return x < y ? (std::uint64_t(x) << 32) | y : (std::uint64_t(y) << 32) | x;
 }
 
 // The state of one remeshing: the mesh, which faces are in the band, per-vertex sizes and reference hints.
@@ -45,6 +50,10 @@ public:
         flipPass();
         relaxPass(2);
         flipPass();
+        for (int it = 0; it < 3; ++it) {
+            improvePass();
+            flipPass();
+        }
         measure(report_.minAngleAfterDeg, report_.fracAbove30After);
         for (std::size_t f = 0; f < band_.size(); ++f)
             if (band_[f] && !S_.is_removed(FaceIndex(std::uint32_t(f))))
@@ -75,6 +84,19 @@ private:
         const HalfedgeIndex h = S_.halfedge(f);
         return detail::unitNormal(detail::pos(S_, S_.source(h)), detail::pos(S_, S_.target(h)),
                                   detail::pos(S_, S_.target(S_.next(h))));
+    }
+    V3 areaVector(FaceIndex f) const {
+        const HalfedgeIndex h = S_.halfedge(f);
+        const V3 a = detail::pos(S_, S_.source(h));
+        return (detail::pos(S_, S_.target(h)) - a).cross(detail::pos(S_, S_.target(S_.next(h))) - a);
+    }
+    // The normal a face's replacement is compared with: its own where it is well shaped, else \p fallback
+    // (an area-weighted normal around it: a sliver's own normal says nothing about the surface).
+    V3 referenceNormal(FaceIndex f, const V3& fallback) const {
+        const HalfedgeIndex h = S_.halfedge(f);
+        const V3 a = detail::pos(S_, S_.source(h)), b = detail::pos(S_, S_.target(h)),
+                 c = detail::pos(S_, S_.target(S_.next(h)));
+        return detail::minAngle(a, b, c) >= kSliverDeg * kBandDeg ? detail::unitNormal(a, b, c) : fallback;
     }
     bool facing(const V3& a, const V3& b, const V3& c) const {
         const V3 n = (b - a).cross(c - a);
@@ -117,10 +139,19 @@ private:
                 (!wholeStarInBand(v) || (in_.fixed && in_.fixed(v))) ? 1 : 0;
         // Creases: band edges between band faces whose normals differ by more than the crease angle.
         const double creaseCos = std::cos(in_.creaseAngleDeg * kBandDeg);
+        auto creaseNormal = [&](FaceIndex f) -> V3 {
+            if (in_.creaseNormal) return in_.creaseNormal(f);
+            const HalfedgeIndex h = S_.halfedge(f);
+            const V3 a = detail::pos(S_, S_.source(h)), b = detail::pos(S_, S_.target(h)),
+                     c = detail::pos(S_, S_.target(S_.next(h)));
+            return detail::minAngle(a, b, c) >= kSliverDeg * kBandDeg ? detail::unitNormal(a, b, c)
+                                                                      : V3(0, 0, 0);
+        };
         for (FaceIndex f : in_.band)
             for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
                 if (!interiorEdge(h)) continue;
-                if (faceNormal(S_.face(h)).dot(faceNormal(S_.face(S_.opposite(h)))) < creaseCos)
+                const V3 n1 = creaseNormal(S_.face(h)), n2 = creaseNormal(S_.face(S_.opposite(h)));
+                if (n1.squaredNorm() > 0 && n2.squaredNorm() > 0 && n1.dot(n2) < creaseCos)
                     addCrease(S_.source(h), S_.target(h));
             }
         // Crease corners and ends stay (a vertex with other than two crease edges).
@@ -257,7 +288,8 @@ private:
             }
         }
         const FaceIndex f1 = S_.face(h), f2 = S_.face(S_.opposite(h));
-        const V3 n1 = faceNormal(f1), n2 = faceNormal(f2);
+        const V3 quad = (areaVector(f1) + areaVector(f2)).normalized();
+        const V3 n1 = referenceNormal(f1, quad), n2 = referenceNormal(f2, quad);
         if (!acceptableFace(pa, q, pc, n1) || !acceptableFace(q, pb, pc, n1) ||
             !acceptableFace(pb, q, pd, n2) || !acceptableFace(q, pa, pd, n2))
             return false;
@@ -299,7 +331,7 @@ private:
             const auto [a, b] = c.second;
             if (S_.is_removed(a) || S_.is_removed(b)) continue;
             const HalfedgeIndex h = S_.halfedge(a, b);
-            if (h == Mesh::null_halfedge() || !interiorEdge(h) || isCrease(a, b)) continue;
+            if (h == Mesh::null_halfedge() || !interiorEdge(h)) continue;
             double sa = -1, sb = -1;
             const bool okA = collapsible(a, b, sa), okB = collapsible(b, a, sb);
             if (!okA && !okB) continue;
@@ -309,18 +341,34 @@ private:
     }
     // Whether `from` may go into `to` (to keeps its place); score: the smallest angle after.
     bool collapsible(VertexIndex from, VertexIndex to, double& score) {
-        if (isFixed(from) || creaseDegree(from) > 0 || !wholeStarInBand(from)) return false;
+        if (isFixed(from) || !wholeStarInBand(from)) return false;
+        if (creaseDegree(from) > 0) {
+            // Only along a nearly straight crease, onto its neighbour on it: the crease keeps its line.
+            if (creaseDegree(from) != 2 || !isCrease(from, to)) return false;
+            VertexIndex other = Mesh::null_vertex();
+            for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(from), S_))
+                if (w != to && isCrease(from, w)) other = w;
+            if (other == Mesh::null_vertex()) return false;
+            const V3 pf = detail::pos(S_, from);
+            if (detail::angleBetween(pf - detail::pos(S_, to), detail::pos(S_, other) - pf) >
+                kStraightCreaseDeg * kBandDeg)
+                return false;
+        }
         const HalfedgeIndex h = S_.halfedge(from, to);
         if (!detail::canCollapse(S_, S_.edge(h), true)) return false;
         const V3 pt = detail::pos(S_, to);
         const double limit = 4.0 / 3.0 * sizeOf(to);
+        V3 star(0, 0, 0);
+        for (HalfedgeIndex g : CGAL::halfedges_around_target(S_.halfedge(from), S_))
+            star += areaVector(S_.face(g));
+        star.normalize();
         double oldMin = std::numbers::pi, newMin = std::numbers::pi;
         for (HalfedgeIndex g : CGAL::halfedges_around_target(S_.halfedge(from), S_)) {
             const VertexIndex p = S_.target(S_.next(g)), q = S_.source(g);
             const V3 pp = detail::pos(S_, p), pq = detail::pos(S_, q), pf = detail::pos(S_, from);
             oldMin = std::min(oldMin, detail::minAngle(pf, pp, pq));
             if (p == to || q == to) continue;
-            if (!acceptableFace(pt, pp, pq, faceNormal(S_.face(g)))) return false;
+            if (!acceptableFace(pt, pp, pq, referenceNormal(S_.face(g), star))) return false;
             if ((pp - pt).norm() > limit) return false;
             newMin = std::min(newMin, detail::minAngle(pt, pp, pq));
         }
@@ -336,6 +384,14 @@ private:
         const FaceIndex keepHint = at(hint_, std::size_t(to), Mesh::null_face());
         const char keepFixed = char(isFixed(to));
         const char keepTouched = at(touched_, std::size_t(to), char(0));
+        // Crease edges at either end go to the survivor (a crease through `from` continues from `to`).
+        std::vector<VertexIndex> creaseEnds;
+        for (VertexIndex x : {from, to})
+            for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(x), S_))
+                if (w != from && w != to && isCrease(x, w)) creaseEnds.push_back(w);
+        for (VertexIndex x : {from, to})
+            for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(x), S_))
+                removeCrease(x, w);
         const VertexIndex kept = CGAL::Euler::collapse_edge(S_.edge(h), S_);
         band_[std::size_t(f1)] = 0;
         band_[std::size_t(f2)] = 0;
@@ -346,15 +402,9 @@ private:
             hint_[std::size_t(kept)] = keepHint;
             fixed_[std::size_t(kept)] = keepFixed;
             touched_[std::size_t(kept)] = keepTouched;
-            // Crease edges at `to` now have `kept` as their end (none at `from`: it was not on a crease).
-            std::vector<VertexIndex> ends;
-            for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(kept), S_))
-                if (isCrease(to, w)) ends.push_back(w);
-            for (VertexIndex w : ends) {
-                removeCrease(to, w);
-                addCrease(kept, w);
-            }
         }
+        for (VertexIndex w : creaseEnds)
+            addCrease(kept, w);
         ++report_.collapses;
     }
 
@@ -373,7 +423,9 @@ private:
                 const VertexIndex c = S_.target(S_.next(h)), d = S_.target(S_.next(S_.opposite(h)));
                 const V3 pa = detail::pos(S_, a), pb = detail::pos(S_, b), pc = detail::pos(S_, c),
                          pd = detail::pos(S_, d);
-                const V3 n1 = faceNormal(S_.face(h)), n2 = faceNormal(S_.face(S_.opposite(h)));
+                const V3 quad = (areaVector(S_.face(h)) + areaVector(S_.face(S_.opposite(h)))).normalized();
+                const V3 n1 = referenceNormal(S_.face(h), quad),
+                         n2 = referenceNormal(S_.face(S_.opposite(h)), quad);
                 // New faces (a, d, c) and (b, c, d).
                 if (!acceptableFace(pa, pd, pc, n1) || !acceptableFace(pa, pd, pc, n2) ||
                     !acceptableFace(pb, pc, pd, n1) || !acceptableFace(pb, pc, pd, n2))
@@ -440,6 +492,94 @@ private:
             hint_[std::size_t(verts[k])] = hints[k];
             if (detail::pos(S_, verts[k]) != before[k]) touch(verts[k]);
         }
+    }
+
+    // ---- relocation of the free vertices of faces below the aim: the place on the draft around the vertex
+    // (a search over tangential offsets, each projected) that maximises the smallest angle of its star.
+    // Own search rather than a smoothing rule: near a fixed, irregular border the centroid is often not
+    // where the worst angle improves.
+    void improvePass() {
+        std::vector<VertexIndex> verts;
+        std::unordered_set<std::uint32_t> seen;
+        for (std::size_t f = 0; f < band_.size(); ++f) {
+            const FaceIndex g(static_cast<std::uint32_t>(f));
+            if (!band_[f] || S_.is_removed(g)) continue;
+            const HalfedgeIndex h = S_.halfedge(g);
+            if (detail::minAngle(detail::pos(S_, S_.source(h)), detail::pos(S_, S_.target(h)),
+                                 detail::pos(S_, S_.target(S_.next(h)))) >= in_.minAngleDeg * kBandDeg)
+                continue;
+            for (VertexIndex v : CGAL::vertices_around_face(h, S_))
+                if (!isFixed(v) && creaseDegree(v) == 0 && wholeStarInBand(v) &&
+                    at(hint_, std::size_t(v), Mesh::null_face()) != Mesh::null_face() &&
+                    seen.insert(std::uint32_t(v)).second)
+                    verts.push_back(v);
+        }
+        std::sort(verts.begin(), verts.end());
+        const double creaseCos = std::cos(in_.creaseAngleDeg * kBandDeg);
+        const double maxTurn = in_.maxNormalTurnDeg * kBandDeg;
+        for (VertexIndex v : verts) {
+            const V3 p = detail::pos(S_, v);
+            const FaceIndex hint = hint_[std::size_t(v)];
+            const HalfedgeIndex rh = ref_.halfedge(hint);
+            const V3 n0 =
+                detail::unitNormal(detail::pos(ref_, ref_.source(rh)), detail::pos(ref_, ref_.target(rh)),
+                                   detail::pos(ref_, ref_.target(ref_.next(rh))));
+            if (!(n0.squaredNorm() > 0)) continue;
+            const V3 u = (std::abs(n0.x()) < 0.9 ? V3(1, 0, 0) : V3(0, 1, 0)).cross(n0).normalized();
+            const V3 w = n0.cross(u);
+            double shortest = std::numeric_limits<double>::infinity();
+            for (VertexIndex x : CGAL::vertices_around_target(S_.halfedge(v), S_))
+                shortest = std::min(shortest, (detail::pos(S_, x) - p).norm());
+            double best = starMinAngle(v, p);
+            V3 bestP = p;
+            FaceIndex bestFace = hint;
+            for (double r : {0.4, 0.2, 0.1})
+                for (int k = 0; k < 12; ++k) {
+                    const double t = 2 * std::numbers::pi * k / 12;
+                    const V3 q = p + r * shortest * (std::cos(t) * u + std::sin(t) * w);
+                    const SurfacePoint sp = closestPointNear(ref_, q, hint, LocalSearchOptions{.rings = 1});
+                    if (!sp || sp.distance > 0.5 * r * shortest) continue;
+                    const HalfedgeIndex sh = ref_.halfedge(sp.face);
+                    const V3 n = detail::unitNormal(detail::pos(ref_, ref_.source(sh)),
+                                                    detail::pos(ref_, ref_.target(sh)),
+                                                    detail::pos(ref_, ref_.target(ref_.next(sh))));
+                    if (n.dot(n0) < creaseCos) continue;
+                    const double a = starMinAngle(v, sp.point);
+                    if (a > best + 1e-9 && starAcceptable(v, sp.point, maxTurn)) {
+                        best = a;
+                        bestP = sp.point;
+                        bestFace = sp.face;
+                    }
+                }
+            if (bestP != p) {
+                S_.point(v) = Point3(bestP.x(), bestP.y(), bestP.z());
+                hint_[std::size_t(v)] = bestFace;
+                touch(v);
+                ++report_.moves;
+            }
+        }
+    }
+    double starMinAngle(VertexIndex v, const V3& at) const {
+        double m = std::numbers::pi;
+        for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
+            if (S_.is_border(h)) continue;
+            m = std::min(m, detail::minAngle(detail::pos(S_, S_.source(h)), at,
+                                             detail::pos(S_, S_.target(S_.next(h)))));
+        }
+        return m;
+    }
+    bool starAcceptable(VertexIndex v, const V3& at, double maxTurn) const {
+        V3 star(0, 0, 0);
+        for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_))
+            star += areaVector(S_.face(h));
+        star.normalize();
+        for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
+            const V3 b = detail::pos(S_, S_.source(h)), c = detail::pos(S_, S_.target(S_.next(h)));
+            if (!facing(b, at, c)) return false;
+            const V3 n = detail::unitNormal(b, at, c);
+            if (detail::angleBetween(n, referenceNormal(S_.face(h), star)) > maxTurn) return false;
+        }
+        return true;
     }
 
     const BandRemeshInput& in_;

@@ -22,6 +22,8 @@
 #include "fss/camera.h"
 #include "fss/mesh.h"
 
+#include <Eigen/Core>
+
 #include <cstddef>
 #include <functional>
 #include <vector>
@@ -40,6 +42,10 @@ struct BandRemeshInput {
     std::function<void(VertexIndex to, VertexIndex from)> vertexData;
     /// Called for every face the stage creates (\p from: the face it was split from).
     std::function<void(FaceIndex to, FaceIndex from)> faceData;
+    /// The normal of a band face for finding creases (unit, or zero when unknown: an edge of such a face is
+    /// no crease). When empty: the face's own normal where its smallest angle is at least 10 deg (a sliver's
+    /// normal says nothing about the surface), else unknown.
+    std::function<Eigen::Vector3d(FaceIndex)> creaseNormal;
     double edgeLength = 0;          ///< initial target edge length inside the band (world units), > 0
     double creaseAngleDeg = 30.0;   ///< band edges whose faces' normals differ more are creases
     double maxNormalTurnDeg = 20.0; ///< no operation turns a face's normal by more

@@ -50,6 +50,8 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <deque>
 #include <limits>
 #include <map>
@@ -2267,6 +2269,15 @@ private:
             loc.planeNormal[to] = loc.planeNormal[from];
             loc.minAllowed[to] = loc.minAllowed[from];
             loc.offView[to] = false;
+        };
+        // Creases: pieces of old faces outside the patch carry their face's plane (reliable even for a
+        // sliver piece); other faces their own normal unless they are slivers.
+        in.creaseNormal = [&](FaceIndex f) -> Eigen::Vector3d {
+            if (!loc.patchSide[f] && loc.planeNormal[f].squaredNorm() > 0)
+                return loc.planeNormal[f].normalized();
+            const HalfedgeIndex h = S.halfedge(f);
+            const Vec3 a = pt(S, S.source(h)), b = pt(S, S.target(h)), c = pt(S, S.target(S.next(h)));
+            return minAngle(a, b, c) >= 10.0 * kDeg ? Vec3(normalOf(a, b, c).normalized()) : Vec3(0, 0, 0);
         };
         in.edgeLength = h3_;
         in.maxNormalTurnDeg = O_.maxNormalChangeDeg;
