@@ -2,7 +2,7 @@
 
 # ccache when present (speeds up rebuilds of the CGAL translation units a lot).
 find_program(FSS_CCACHE ccache)
-# The tests use a precompiled header (tests/CMakeLists.txt); ccache caches such compilations only with
+# The header checks use a precompiled header (cmake/FSSHeaderCheck.cmake); ccache caches such compilations only with
 # these sloppiness settings (ccache manual, "Precompiled headers"): the header's content is still hashed.
 if(FSS_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
   set(_fss_ccache env "CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime"

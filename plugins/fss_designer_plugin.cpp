@@ -67,3 +67,5 @@ QList<QDesignerCustomWidgetInterface*> WidgetCollection::customWidgets() const {
 }
 
 } // namespace fss::designer
+
+#include "moc_fss_designer_plugin.cpp" // meta-object code compiled here, as in widgets/ (one parse less)

@@ -456,3 +456,5 @@ QString MainWindow::saveScreenshot(const QString& path) {
 }
 
 } // namespace fss::demo
+
+#include "moc_main_window.cpp" // meta-object code compiled here, as in widgets/ (one parse less)

@@ -21,6 +21,9 @@
 #include <fstream>
 #include <map>
 
+// A namespace of its own: the CLI tests share one program (tests/CMakeLists.txt) and each has a remesh().
+namespace fss_cli_auto_test {
+
 using fss::test::expectCleanFailure;
 using fss::test::meshPath;
 using fss::test::tmpPath;
@@ -278,3 +281,5 @@ TEST(CliAuto, FemHandOffBadInputIsOneSentence) {
     EXPECT_EQ(r.exitCode, 1);
     EXPECT_FALSE(std::filesystem::exists(inp));
 }
+
+} // namespace fss_cli_auto_test

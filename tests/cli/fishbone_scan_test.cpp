@@ -10,6 +10,9 @@
 
 #include <gtest/gtest.h>
 
+// A namespace of its own: the CLI tests share one program (tests/CMakeLists.txt) and each has a remesh().
+namespace fss_cli_fishbone_scan_test {
+
 using fss::test::expectCleanFailure;
 using fss::test::meshPath;
 using fss::test::tmpPath;
@@ -80,3 +83,5 @@ TEST(CliFishbone, MalformedSpecsFailWithOneSentence) {
     expectCleanFailure(scan("seed=0.4,0.55;keyribs=0.4,0.45|0.4,0.65"),
                        "pixels from the backbone, farther than 2h");
 }
+
+} // namespace fss_cli_fishbone_scan_test

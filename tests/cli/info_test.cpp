@@ -8,6 +8,9 @@
 
 #include <fstream>
 
+// A namespace of its own: the CLI tests share one program (tests/CMakeLists.txt) and each has a remesh().
+namespace fss_cli_info_test {
+
 using fss::test::expectCleanFailure;
 using fss::test::meshPath;
 using fss::test::remeshExe;
@@ -118,3 +121,5 @@ TEST(CliInfo, BadInputsGiveOneSentenceAndNonZeroExit) {
     expectCleanFailure(remesh({"info", (dir / "does_not_exist.off").string()}), "does_not_exist.off");
     expectCleanFailure(remesh({"info", dir.string()}), "cli_bad"); // a folder, not a file
 }
+
+} // namespace fss_cli_info_test

@@ -15,6 +15,9 @@
 #include <functional>
 #include <string>
 
+// A namespace of its own: the CLI tests share one program (tests/CMakeLists.txt) and each has a remesh().
+namespace fss_cli_run_test {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -229,3 +232,5 @@ TEST(CliRun, ExampleSessionReplays) {
 }
 
 } // namespace
+
+} // namespace fss_cli_run_test

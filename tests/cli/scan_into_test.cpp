@@ -19,6 +19,9 @@
 #include <filesystem>
 #include <set>
 
+// A namespace of its own: the CLI tests share one program (tests/CMakeLists.txt) and each has a remesh().
+namespace fss_cli_scan_into_test {
+
 namespace PMP = CGAL::Polygon_mesh_processing;
 using fss::test::expectCleanFailure;
 using fss::test::meshPath;
@@ -186,3 +189,5 @@ TEST(CliScanInto, FailuresSaySoAndWriteNothing) {
         remesh({"scan", input, "--into", input, "-o", tmpPath("cli_scan_into/x.abc").string()});
     EXPECT_EQ(usage.exitCode, 2) << usage.err;
 }
+
+} // namespace fss_cli_scan_into_test

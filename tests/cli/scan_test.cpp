@@ -12,6 +12,9 @@
 
 #include <cstdlib>
 
+// A namespace of its own: the CLI tests share one program (tests/CMakeLists.txt) and each has a remesh().
+namespace fss_cli_scan_test {
+
 using fss::test::expectCleanFailure;
 using fss::test::meshPath;
 using fss::test::tmpPath;
@@ -124,3 +127,5 @@ TEST(CliScan, BadScansFailWithOneSentence) {
     expectCleanFailure(remesh({"scan", kFandisk, "-o", tmpPath("cli_scan/x.abc").string()}), "extension");
     expectCleanFailure(remesh({"scan", tmpPath("cli_scan/missing.off").string(), "-o", out}), "missing.off");
 }
+
+} // namespace fss_cli_scan_test

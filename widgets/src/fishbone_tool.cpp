@@ -353,3 +353,5 @@ bool FishboneTool::handleEvent(QEvent* event) {
 }
 
 } // namespace fss::widgets
+
+#include "fss/widgets/moc_fishbone_tool.cpp" // meta-object code compiled here: widgets/CMakeLists.txt says why

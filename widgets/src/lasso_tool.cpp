@@ -122,3 +122,5 @@ bool LassoTool::handleEvent(QEvent* event) {
 }
 
 } // namespace fss::widgets
+
+#include "fss/widgets/moc_lasso_tool.cpp" // meta-object code compiled here: widgets/CMakeLists.txt says why

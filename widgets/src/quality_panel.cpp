@@ -130,3 +130,5 @@ void QualityPanel::paintEvent(QPaintEvent*) {
 }
 
 } // namespace fss::widgets
+
+#include "fss/widgets/moc_quality_panel.cpp" // meta-object code compiled here: widgets/CMakeLists.txt says why

@@ -1089,3 +1089,5 @@ void RemeshWidget::waitForWork() {
 }
 
 } // namespace fss::widgets
+
+#include "fss/widgets/moc_remesh_widget.cpp" // meta-object code compiled here: widgets/CMakeLists.txt says why

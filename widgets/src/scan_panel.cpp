@@ -315,3 +315,5 @@ void ScanPanel::refreshEdgeLength() {
 }
 
 } // namespace fss::widgets
+
+#include "fss/widgets/moc_scan_panel.cpp" // meta-object code compiled here: widgets/CMakeLists.txt says why

@@ -68,3 +68,5 @@ bool ScanTool::handleEvent(QEvent* event) {
 }
 
 } // namespace fss::widgets
+
+#include "fss/widgets/moc_scan_tool.cpp" // meta-object code compiled here: widgets/CMakeLists.txt says why

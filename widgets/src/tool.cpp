@@ -58,3 +58,5 @@ QString NavigateTool::statusText() const {
 }
 
 } // namespace fss::widgets
+
+#include "fss/widgets/moc_tool.cpp" // meta-object code compiled here: widgets/CMakeLists.txt says why

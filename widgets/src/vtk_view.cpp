@@ -996,3 +996,5 @@ void VtkView::leaveEvent(QEvent* event) {
 }
 
 } // namespace fss::widgets
+
+#include "fss/widgets/moc_vtk_view.cpp" // meta-object code compiled here: widgets/CMakeLists.txt says why
