@@ -141,8 +141,8 @@ struct Writer {
         j["max_trim_rounds"] = s.maxTrimRounds;
         j["min_component_faces"] = s.minComponentFaces;
         j["collect_garbage"] = s.collectGarbage;
-        if (s.peelTrim) j["peel_trim"] = true;       // written only when on: older files stay byte-identical
-        if (s.refillSeam) j["refill_seam"] = true;   // written only when on: older files stay byte-identical
+        if (s.peelTrim) j["peel_trim"] = true;     // written only when on: older files stay byte-identical
+        if (s.refillSeam) j["refill_seam"] = true; // written only when on: older files stay byte-identical
         if (s.remeshSeam) j["remesh_seam"] = true; // written only when on: older files stay byte-identical
         // Written only when not 0 (+0.0; -0.0 is written to keep the bits): older files, recorded with 0,
         // stay byte-identical.
