@@ -670,6 +670,14 @@ TEST_F(BadSessionFile, LaterStitchOptionsAreOptional) {
     j["events"][0]["step"]["stitch"].erase("peel_trim");
     EXPECT_EQ(stitchOf(j).outsideMinAngleFloorDeg, 0.0);
     EXPECT_FALSE(stitchOf(j).peelTrim);
+    // The band remesh (stitch v2, off by default): absent = off; written only when on, and read back so.
+    EXPECT_FALSE(defaults.contains("remesh_seam"));
+    EXPECT_FALSE(stitchOf(j).remeshSeam);
+    fss::SessionFile on = sampleFile(mesh_);
+    on.events[0].step.stitch.remeshSeam = true;
+    const Json onJson = Json::parse(fss::sessionFileToJson(on));
+    EXPECT_EQ(onJson["events"][0]["step"]["stitch"]["remesh_seam"], true);
+    EXPECT_TRUE(stitchOf(onJson).remeshSeam);
     // -0.0 is not 0 bit for bit: it is written, and comes back with its sign.
     fss::SessionFile f = sampleFile(mesh_);
     f.events[0].step.stitch.outsideMinAngleFloorDeg = -0.0;

@@ -1,9 +1,16 @@
 // Stages of stitch v2 (DESIGN.md §6.2), each on its own: the gap triangulation (gap_triangulation.h), the
-// lift onto the reference (lift.h), the seam figures (seam_quality.h). References are independent: polygon
-// areas by the shoelace formula, the camera's own projection, angles of known triangles.
+// lift onto the reference (lift.h), the seam figures (seam_quality.h), the band remesh (band_remesh.h).
+// References are independent: polygon areas by the shoelace formula, the camera's own projection, angles of
+// known triangles, planes and crease lines of known shapes.
+#include "stitch/band_remesh.h"
 #include "stitch/gap_triangulation.h"
 #include "stitch/lift.h"
 #include "stitch/seam_quality.h"
+
+#include "fss/shapes.h"
+#include "mesh/local_ops.h"
+
+#include <CGAL/boost/graph/helpers.h>
 
 #include <gtest/gtest.h>
 
@@ -229,4 +236,147 @@ TEST(SeamQuality, AnglesAndValenceFigures) {
     EXPECT_NEAR(q.minAngleDeg, std::atan2(0.1, 0.5) * 180 / std::numbers::pi, 1e-9);
     EXPECT_EQ(q.vertices(), 4u);
     EXPECT_EQ(q.fracValence5To7(), 0.5);
+}
+
+namespace {
+
+// A seam-like band of slivers on a planar grid: every edge of row y = 6 split close to its end (as version
+// 1's crossings do), so the faces along the row have angles of a few degrees.
+struct SliverGrid {
+    fss::Mesh mesh = fss::shapes::grid(12, 12, 1.0);
+    std::vector<fss::FaceIndex> band;
+    fss::Camera camera;
+    SliverGrid() {
+        std::vector<fss::HalfedgeIndex> row;
+        for (fss::EdgeIndex e : mesh.edges()) {
+            const fss::HalfedgeIndex h = mesh.halfedge(e);
+            const auto a = mesh.point(mesh.source(h)), b = mesh.point(mesh.target(h));
+            if (a.y() == 6 && b.y() == 6 && std::min(a.x(), b.x()) >= 2 && std::max(a.x(), b.x()) <= 10)
+                row.push_back(h);
+        }
+        for (fss::HalfedgeIndex h : row) {
+            const auto a = mesh.point(mesh.source(h)), b = mesh.point(mesh.target(h));
+            fss::detail::splitEdge(mesh, h, a + 0.93 * (b - a));
+        }
+        for (fss::FaceIndex f : mesh.faces()) {
+            double x = 0, y = 0;
+            for (auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
+                x += mesh.point(v).x() / 3;
+                y += mesh.point(v).y() / 3;
+            }
+            if (x > 1.5 && x < 10.5 && y > 3.5 && y < 8.5) band.push_back(f);
+        }
+        camera.eye = {6, 6, 25};
+        camera.focal = {6, 6, 0};
+        camera.width = camera.height = 256;
+    }
+};
+
+double smallestAngleOf(const fss::Mesh& m, fss::FaceIndex f) {
+    const auto h = m.halfedge(f);
+    auto p = [&](fss::VertexIndex v) {
+        return Eigen::Vector3d(m.point(v).x(), m.point(v).y(), m.point(v).z());
+    };
+    return fss::stitch::smallestAngleDeg(p(m.source(h)), p(m.target(h)), p(m.target(m.next(h))));
+}
+
+double faceArea(const fss::Mesh& m, fss::FaceIndex f) {
+    const auto h = m.halfedge(f);
+    const auto a = m.point(m.source(h)), b = m.point(m.target(h)), c = m.point(m.target(m.next(h)));
+    return 0.5 * ((b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x())); // signed, in z = 0
+}
+
+} // namespace
+
+// The band remesh on a plane: the slivers are gone (every band face >= 30 deg), every vertex stays in the
+// plane, the band's area (shoelace, signed: no face turned over) is what it was, and the faces and vertices
+// outside the band are untouched.
+TEST(BandRemesh, PlanarSliverBandBecomesWellShaped) {
+    SliverGrid g;
+    fss::Mesh& m = g.mesh;
+    double before = 180, areaBefore = 0;
+    for (fss::FaceIndex f : g.band) {
+        before = std::min(before, smallestAngleOf(m, f));
+        areaBefore += faceArea(m, f);
+    }
+    ASSERT_LT(before, 5.0);
+    std::set<fss::FaceIndex> inBand(g.band.begin(), g.band.end());
+    std::map<fss::FaceIndex, std::array<fss::Point3, 3>> outside;
+    for (fss::FaceIndex f : m.faces())
+        if (!inBand.count(f)) {
+            std::array<fss::Point3, 3> p;
+            int k = 0;
+            for (auto v : CGAL::vertices_around_face(m.halfedge(f), m))
+                p[std::size_t(k++)] = m.point(v);
+            outside[f] = p;
+        }
+    fss::stitch::BandRemeshInput in;
+    in.mesh = &m;
+    in.band = g.band;
+    in.camera = &g.camera;
+    in.edgeLength = 1.0;
+    std::size_t created = 0;
+    in.faceData = [&](fss::FaceIndex, fss::FaceIndex) { ++created; };
+    const auto r = fss::stitch::remeshBand(in);
+    EXPECT_TRUE(m.is_valid(false));
+    EXPECT_TRUE(CGAL::is_triangle_mesh(m));
+    double after = 180, areaAfter = 0, above30 = 0;
+    for (fss::FaceIndex f : r.faces) {
+        const double a = smallestAngleOf(m, f);
+        after = std::min(after, a);
+        above30 += a >= 30;
+        areaAfter += faceArea(m, f);
+        EXPECT_GT(faceArea(m, f), 0.0);
+    }
+    for (fss::VertexIndex v : m.vertices())
+        EXPECT_EQ(m.point(v).z(), 0.0);
+    EXPECT_NEAR(areaAfter, areaBefore, 1e-9);
+    for (const auto& [f, p] : outside) {
+        ASSERT_FALSE(m.is_removed(f));
+        int k = 0;
+        for (auto v : CGAL::vertices_around_face(m.halfedge(f), m))
+            EXPECT_EQ(m.point(v), p[std::size_t(k++)]);
+    }
+    std::printf("band: smallest angle %.2f -> %.2f deg, %.3f of %zu faces >= 30 deg; %zu splits, %zu "
+                "collapses, %zu flips, %zu moves\n",
+                before, after, above30 / double(r.faces.size()), r.faces.size(), r.splits, r.collapses,
+                r.flips, r.moves);
+    EXPECT_NEAR(r.minAngleBeforeDeg, before, 1e-9);
+    EXPECT_NEAR(r.minAngleAfterDeg, after, 1e-9);
+    EXPECT_GE(after, 30.0);
+    EXPECT_EQ(created, r.splits * 2);
+}
+
+// Across a crease (a roof z = -0.6 |x - 6|, the faces' normals 62 deg apart): every vertex stays on the roof,
+// no edge crosses the ridge (the crease is kept as a line of edges), and the slivers are gone.
+TEST(BandRemesh, CreaseIsKept) {
+    SliverGrid g;
+    fss::Mesh& m = g.mesh;
+    for (fss::VertexIndex v : m.vertices()) {
+        const auto p = m.point(v);
+        m.point(v) = fss::Point3(p.x(), p.y(), -0.6 * std::abs(p.x() - 6));
+    }
+    fss::stitch::BandRemeshInput in;
+    in.mesh = &m;
+    in.band = g.band;
+    in.camera = &g.camera;
+    in.edgeLength = 1.0;
+    const auto r = fss::stitch::remeshBand(in);
+    EXPECT_TRUE(m.is_valid(false));
+    for (fss::VertexIndex v : m.vertices()) {
+        const auto p = m.point(v);
+        EXPECT_NEAR(p.z(), -0.6 * std::abs(p.x() - 6), 1e-9);
+    }
+    for (fss::EdgeIndex e : m.edges()) {
+        const double a = m.point(m.vertex(e, 0)).x() - 6, b = m.point(m.vertex(e, 1)).x() - 6;
+        EXPECT_FALSE((a < -1e-9 && b > 1e-9) || (a > 1e-9 && b < -1e-9)) << "an edge crosses the ridge";
+    }
+    double after = 180;
+    for (fss::FaceIndex f : r.faces)
+        after = std::min(after, smallestAngleOf(m, f));
+    std::printf(
+        "roof band: smallest angle %.2f -> %.2f deg; %zu splits, %zu collapses, %zu flips, %zu moves\n",
+        r.minAngleBeforeDeg, after, r.splits, r.collapses, r.flips, r.moves);
+    EXPECT_LT(r.minAngleBeforeDeg, 5.0);
+    EXPECT_GE(after, 30.0);
 }

@@ -42,7 +42,8 @@
 ///                     "collect_garbage": false, "peel_trim": true (optional: written only when true,
 ///                     absent = false), "outside_min_angle_floor_deg": 10 (optional: written only when
 ///                     not 0, absent = 0), "refill_seam": true (optional: written only when true,
-///                     absent = false; stitch v2's seam refill, DESIGN.md §6.2) } } },
+///                     absent = false; stitch v2's seam refill, DESIGN.md §6.2), "remesh_seam": true
+///                     (optional: written only when true, absent = false; stitch v2's band remesh) } } },
 ///     { "kind": "undo" }, { "kind": "redo" } ] }
 /// STREAMLINE = { "step": 0.25, "min_step": 0.015625, "max_length": null (unbounded) | L,
 ///                "min_anisotropy": 0.05,

@@ -45,6 +45,15 @@ struct StitchOptions {
     /// version 1's repair (smallest seam angle 3.7 vs ≥ 10 deg; issue 19). Session files write it only when
     /// on ("refill_seam": true), so files without it replay as before.
     bool refillSeam = false;
+    /// Version 2 of the seam, design B (DESIGN.md §6.2, stitch/band_remesh.h): after version 1's glue and
+    /// repair, the band of new faces along the seam (both sides, about three rings wide) is remeshed in 3D on
+    /// the glued surface: splits, collapses and flips towards the local edge length (graded from the patch's
+    /// to the mesh's) and valence 6, tangential relaxation with projection; the band's border and creases
+    /// stay. Where the band comes out worse than version 1 left it (smallest angle) or fails the checks,
+    /// version 1's result is used. Off by default for now: better than version 1 on every untuned mesh
+    /// measured (DESIGN.md §6.2), but the tests whose figures it changes are not re-derived yet (issue 19).
+    /// Session files write it only when on ("remesh_seam": true).
+    bool remeshSeam = false;
     /// Seam edges shorter than this × the patch's median edge length are collapsed. The same fraction of
     /// the local patch edge length (in pixels) is the distance within which a patch boundary vertex is
     /// snapped onto a mesh vertex or edge, and a mesh vertex onto a patch boundary edge.

@@ -143,6 +143,7 @@ struct Writer {
         j["collect_garbage"] = s.collectGarbage;
         if (s.peelTrim) j["peel_trim"] = true;     // written only when on: older files stay byte-identical
         if (s.refillSeam) j["refill_seam"] = true; // written only when on: older files stay byte-identical
+        if (s.remeshSeam) j["remesh_seam"] = true; // written only when on: older files stay byte-identical
         // Written only when not 0 (+0.0; -0.0 is written to keep the bits): older files, recorded with 0,
         // stay byte-identical.
         if (std::bit_cast<std::uint64_t>(s.outsideMinAngleFloorDeg) != 0)
@@ -486,7 +487,7 @@ StitchOptions readStitch(const Node& n) {
     n.onlyKeys({"seam_rings", "optimise_seam", "collapse_edge_ratio", "seam_grading", "min_angle_floor_deg",
                 "max_view_angle_deg", "max_normal_change_deg", "max_gap_ratio", "max_trim_rounds",
                 "min_component_faces", "collect_garbage", "peel_trim", "outside_min_angle_floor_deg",
-                "refill_seam"});
+                "refill_seam", "remesh_seam"});
     StitchOptions s;
     s.seamRings = intField(n.at("seam_rings"));
     s.optimiseSeam = n.at("optimise_seam").boolean();
@@ -502,6 +503,7 @@ StitchOptions readStitch(const Node& n) {
     // Optional, absent in files written before they were stored: what those files were recorded with.
     s.peelTrim = n.has("peel_trim") && n.at("peel_trim").boolean();
     s.refillSeam = n.has("refill_seam") && n.at("refill_seam").boolean();
+    s.remeshSeam = n.has("remesh_seam") && n.at("remesh_seam").boolean();
     s.outsideMinAngleFloorDeg =
         n.has("outside_min_angle_floor_deg") ? n.at("outside_min_angle_floor_deg").number() : 0.0;
     validated(n, [&] { s.validate(); });

@@ -32,6 +32,7 @@
 
 #include "base/disjoint_sets.h"
 #include "mesh/local_ops.h"
+#include "stitch/band_remesh.h"
 #include "stitch/lift.h"
 #include "stitch/seam_quality.h"
 #include "stitch/stitch_edits.h"
@@ -2093,6 +2094,7 @@ private:
         Star pristine; // the star as copied from the current mesh, for the rehearsal
         // After a strip refill (v2): `seam` holds the fill's edges; the seam line's figures as glued.
         bool refilled = false;
+        bool remeshed = false; // the seam band was remeshed in 3D (band_remesh.h): `seam` holds its edges
         std::size_t seamLineEdges = 0;
         double seamLineLength = 0;
     };
@@ -2254,10 +2256,16 @@ private:
             const Refill refill = refill_ ? refillSeam(loc) : Refill::NotDone;
             if (refill == Refill::Broken) return retryWithoutRefill(a);
             if (refill == Refill::NotDone) optimise(loc, a.plan);
+            if (remesh_ && refill != Refill::Applied && !remeshBand(loc, a.plan))
+                return retryWithoutRemesh(a);
         }
         StageClock::lap("optimise");
         progress_.step(7, 8);
-        if (!validate(loc, bordersBefore, a)) return loc.refilled ? retryWithoutRefill(a) : false;
+        if (!validate(loc, bordersBefore, a)) {
+            if (loc.refilled) return retryWithoutRefill(a);
+            if (loc.remeshed) return retryWithoutRemesh(a);
+            return false;
+        }
         StageClock::lap("validate:self-intersections");
         const bool ok = extractPlan(loc, a);
         StageClock::lap("plan:seam figures");
@@ -2275,6 +2283,119 @@ private:
         refill_ = true;
         return ok;
     }
+    // ---- v2, design B: the seam band remeshed in 3D on the draft (band_remesh.h, DESIGN.md §6.2)
+    // Where the band comes out worse than version 1 left it, or its result fails the checks, the component is
+    // built again without it.
+    bool retryWithoutRemesh(Attempt& a) {
+        remesh_ = false;
+        a = Attempt{};
+        const bool ok = buildAndOptimise(a);
+        remesh_ = true;
+        return ok;
+    }
+    // False when the band came out worse than version 1's (the caller then builds the component again).
+    bool remeshBand(Local& loc, Plan& plan) {
+        Mesh& S = loc.star.S;
+        // The band: new faces the view sees with a vertex within kBandRings rings (over such faces) of the
+        // seam line.
+        constexpr int kBandRings = 2;
+        auto usable = [&](FaceIndex f) {
+            return f != Mesh::null_face() && !loc.star.kept[f] && !loc.offView[f];
+        };
+        std::unordered_set<std::uint32_t> near;
+        std::vector<VertexIndex> ring;
+        for (const auto& [p, q] : loc.seam) {
+            loc.seamLineLength += (pt(S, VertexIndex(p)) - pt(S, VertexIndex(q))).norm();
+            for (std::uint32_t v : {p, q})
+                if (near.insert(v).second) ring.push_back(VertexIndex(v));
+        }
+        loc.seamLineEdges = loc.seam.size();
+        std::sort(ring.begin(), ring.end());
+        for (int r = 0; r < kBandRings; ++r) {
+            std::vector<VertexIndex> next;
+            for (VertexIndex v : ring)
+                for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(v), S))
+                    if (usable(S.face(h)) && near.insert(std::uint32_t(S.source(h))).second)
+                        next.push_back(S.source(h));
+            std::sort(next.begin(), next.end());
+            ring.swap(next);
+        }
+        stitch::BandRemeshInput in;
+        in.mesh = &S;
+        for (FaceIndex f : S.faces()) {
+            if (!usable(f)) continue;
+            for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(f), S))
+                if (near.count(std::uint32_t(v))) {
+                    in.band.push_back(f);
+                    break;
+                }
+        }
+        if (in.band.empty()) return true;
+        in.camera = &V_.camera();
+        in.fixed = [&](VertexIndex v) { return bool(loc.locked[v]); };
+        in.vertexData = [&](VertexIndex to, VertexIndex from) {
+            if (from == Mesh::null_vertex()) {
+                loc.star.cur[to] = kNone;
+                loc.lid[to] = -1;
+                loc.locked[to] = false;
+            } else {
+                loc.star.cur[to] = loc.star.cur[from];
+                loc.lid[to] = loc.lid[from];
+                loc.uv[to] = loc.uv[from];
+                loc.locked[to] = loc.locked[from];
+            }
+        };
+        in.faceData = [&](FaceIndex to, FaceIndex from) {
+            loc.star.kept[to] = false;
+            loc.quality[to] = loc.quality[from];
+            loc.scanId[to] = loc.scanId[from];
+            loc.patchSide[to] = loc.patchSide[from];
+            loc.planeNormal[to] = loc.planeNormal[from];
+            loc.minAllowed[to] = loc.minAllowed[from];
+            loc.offView[to] = false;
+        };
+        // Creases: pieces of old faces outside the patch carry their face's plane (reliable even for a
+        // sliver piece); other faces their own normal unless they are slivers.
+        in.creaseNormal = [&](FaceIndex f) -> Eigen::Vector3d {
+            if (!loc.patchSide[f] && loc.planeNormal[f].squaredNorm() > 0)
+                return loc.planeNormal[f].normalized();
+            const HalfedgeIndex h = S.halfedge(f);
+            const Vec3 a = pt(S, S.source(h)), b = pt(S, S.target(h)), c = pt(S, S.target(S.next(h)));
+            return minAngle(a, b, c) >= 10.0 * kDeg ? Vec3(normalOf(a, b, c).normalized()) : Vec3(0, 0, 0);
+        };
+        in.edgeLength = h3_;
+        in.maxNormalTurnDeg = O_.maxNormalChangeDeg;
+        const stitch::BandRemeshReport r = stitch::remeshBand(in);
+        progress_.tick(in.band.size());
+        const bool worse = r.minAngleAfterDeg < r.minAngleBeforeDeg &&
+                           !(r.minAngleAfterDeg >= 20.0 && r.fracAbove30After >= r.fracAbove30Before);
+        if (worse) return false;
+        // Moved and new vertices: their place in the view; a mesh vertex that moved becomes a new vertex
+        // (the old one goes with the replaced faces around it: its whole star is in the band).
+        for (VertexIndex v : r.touched) {
+            double w;
+            Point2 uv;
+            if (!V_.project(pt(S, v), uv, w)) return false;
+            loc.uv[v] = uv;
+            if (loc.star.cur[v] != kNone) {
+                loc.star.cur[v] = kNone;
+                loc.lid[v] = -1;
+            }
+        }
+        loc.seam.clear();
+        for (FaceIndex f : r.faces) {
+            const HalfedgeIndex h = S.halfedge(f);
+            const VertexIndex x = S.source(h), y = S.target(h), z = S.target(S.next(h));
+            loc.seam.insert(seamKey(x, y));
+            loc.seam.insert(seamKey(y, z));
+            loc.seam.insert(seamKey(z, x));
+        }
+        loc.remeshed = true;
+        plan.flips += r.flips;
+        plan.collapses += r.collapses;
+        return true;
+    }
+
     Refill refillSeam(Local& loc) {
         Mesh& S = loc.star.S;
         // The strip: new faces the view sees with a vertex on the seam or next to it (over new faces).
@@ -3428,7 +3549,7 @@ private:
             seamVerts.insert(p);
             seamVerts.insert(q);
         }
-        if (loc.refilled) {
+        if (loc.refilled || loc.remeshed) {
             plan.seamEdges = loc.seamLineEdges;
             plan.seamLength = loc.seamLineLength;
         }
@@ -3454,6 +3575,7 @@ private:
     bool curHasQuality_, curHasScanId_;
     ComponentProgress& progress_;
     bool refill_ = O_.refillSeam; // v2 strip refill (off for the retry after a failed refill)
+    bool remesh_ = O_.remeshSeam; // v2 band remesh (off for the retry after a worse or failed one)
     Mesh::Property_map<FaceIndex, float> curQuality_;
     Mesh::Property_map<FaceIndex, std::int32_t> curScanId_;
 

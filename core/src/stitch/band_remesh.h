@@ -1,0 +1,68 @@
+#pragma once
+// Stitch v2, design B (DESIGN.md §6.2): the seam band remeshed in 3D. After version 1 has glued the patch in
+// (a draft on the stitch's local mesh: the patch, pieces of the old faces around it, its repair passes), the
+// faces along the seam on both sides, a few rings wide, are remeshed on the draft surface by guarded local
+// operations in the manner of isotropic remeshing (Botsch & Kobbelt 2004): splits of long edges, collapses
+// of short ones, flips towards valence 6 and larger angles, tangential relaxation with projection onto the
+// draft (mesh/relax.h). Sizes are graded from the band's border (patch edges on one side, the old mesh's
+// edges on the other) across the band, so the band meets both without slivers.
+//
+// Own operations rather than CGAL's PMP::isotropic_remeshing (CGAL 5.5): that one takes a single target
+// length (no grading between a fine patch and a coarse mesh), projects onto the input without refusing a move
+// that would turn a face away from the scan camera or cross a crease, and gives no hook to carry the stitch's
+// per-face data through its operations.
+//
+// The band's border vertices, the caller's fixed vertices and corners of creases never move; border edges
+// and crease edges are never flipped or collapsed (crease edges may be split, the new vertex on the edge).
+// No operation turns a face away from the camera, makes it degenerate or turns its normal by more than
+// maxNormalTurnDeg; collapses and moves never lower the smallest angle around them below the smaller of the
+// angle before and minAngleDeg. Only band faces change. The caller validates the result (stitch.cpp,
+// DESIGN.md §6.1 step 7).
+
+#include "fss/camera.h"
+#include "fss/mesh.h"
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+namespace fss::stitch {
+
+/// What to remesh and how.
+struct BandRemeshInput {
+    Mesh* mesh = nullptr;           ///< the local mesh holding the draft (edited in place)
+    std::vector<FaceIndex> band;    ///< its faces to remesh: front-facing, on the draft surface
+    const Camera* camera = nullptr; ///< the scan camera: every band face keeps facing it
+    /// Vertices that must stay (besides the band's border and crease corners).
+    std::function<bool(VertexIndex)> fixed;
+    /// Called for every vertex the stage creates (a split) and for the surviving descriptor of a collapse
+    /// when it is not the kept vertex (\p from is then the kept vertex whose data \p to takes over).
+    std::function<void(VertexIndex to, VertexIndex from)> vertexData;
+    /// Called for every face the stage creates (\p from: the face it was split from).
+    std::function<void(FaceIndex to, FaceIndex from)> faceData;
+    /// The normal of a band face for finding creases (unit, or zero when unknown: an edge of such a face is
+    /// no crease). When empty: the face's own normal where its smallest angle is at least 10 deg (a sliver's
+    /// normal says nothing about the surface), else unknown.
+    std::function<Eigen::Vector3d(FaceIndex)> creaseNormal;
+    double edgeLength = 0;          ///< initial target edge length inside the band (world units), > 0
+    double creaseAngleDeg = 30.0;   ///< band edges whose faces' normals differ more are creases
+    double maxNormalTurnDeg = 20.0; ///< no operation turns a face's normal by more
+    double minAngleDeg = 30.0;      ///< collapses and flips aim at faces of at least this smallest angle
+    int iterations = 4;             ///< rounds of (split, collapse, flip, relax)
+};
+
+/// What the stage did.
+struct BandRemeshReport {
+    std::vector<FaceIndex> faces;     ///< the band's faces afterwards
+    std::vector<VertexIndex> touched; ///< vertices created or moved (live at the end)
+    std::size_t splits = 0, collapses = 0, flips = 0, moves = 0;
+    double minAngleBeforeDeg = 180, minAngleAfterDeg = 180; ///< smallest angle over the band
+    double fracAbove30Before = 1, fracAbove30After = 1;     ///< share of band faces ≥ 30 deg
+};
+
+/// Remeshes the band (see BandRemeshInput). \pre the band faces are triangles of *mesh.
+BandRemeshReport remeshBand(const BandRemeshInput& input);
+
+} // namespace fss::stitch
