@@ -110,7 +110,12 @@ private slots:
         const fss::Camera& camera = preview.step.params.camera;
         const Eigen::Vector2d expected(seed.x() * camera.width / view->width(),
                                        seed.y() * camera.height / view->height());
-        QVERIFY((*preview.step.fishbone->seed - expected).norm() < 1e-9);
+        const Eigen::Vector2d got = *preview.step.fishbone->seed;
+        QVERIFY2((got - expected).norm() < 1e-9, qPrintable(QString("seed (%1, %2) scan px, clicked (%3, %4)")
+                                                                .arg(got.x(), 0, 'g', 17)
+                                                                .arg(got.y(), 0, 'g', 17)
+                                                                .arg(expected.x(), 0, 'g', 17)
+                                                                .arg(expected.y(), 0, 'g', 17)));
         // The backbone shown passes through the clicked point.
         double nearest = 1e9;
         for (const QPointF& p : w->fishboneTool()->backbone())

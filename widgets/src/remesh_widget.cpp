@@ -340,6 +340,11 @@ RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_uniq
     d.status = new QLabel(this);
     d.status->setWordWrap(true);
     d.status->setObjectName(QStringLiteral("status"));
+    // Always two lines high and never wider than the window: a message that wraps must not resize the view
+    // (that re-renders the whole mesh and changes the scan size under the user's clicks).
+    d.status->setFixedHeight(2 * d.status->fontMetrics().lineSpacing() + 2 * d.status->margin());
+    d.status->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Fixed);
+    d.status->setAlignment(Qt::AlignLeft | Qt::AlignVCenter);
     d.view->installEventFilter(this); // a resize changes the scan size the status line tells
     d.progress = new QProgressBar(this);
     d.progress->setMaximumWidth(220);
