@@ -19,10 +19,12 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -647,4 +649,472 @@ TEST(FishboneScan, KeyRibMovedByOnePixelFigures) {
     }
     std::printf("key-rib moved by 1 px: largest sample move %.2f px (issue #20 asks <= 2)\n", worst);
     EXPECT_LE(worst, 2.0); // measured 0.61 px across a midpoint, 0 elsewhere
+}
+
+// ---- Backbone loops and crease stops (issue #20, item 3) -------------------------------------------------
+
+namespace {
+
+// The crease scene's ring from 75° above its centre: the whole ridge is in view, a closed curve on the
+// screen (as in RibTrimmingFiguresOnTheCreasedRing).
+fss::Camera topCamera(const CreaseScene& scene) {
+    fss::Camera top = scene.camera;
+    const double up = 75 * std::numbers::pi / 180;
+    top.focal = Vector3d(0, 0, 0);
+    top.eye = 9.0 * Vector3d(std::cos(up), 0, std::sin(up));
+    top.up = {0, 1, 0};
+    top.viewAngleDeg = 45;
+    top.fitClippingRange(bbox(scene.ring));
+    return top;
+}
+
+// Border cycles of a mesh.
+int borderCycles(const Mesh& m) {
+    std::vector<char> seen(m.number_of_halfedges(), 0);
+    int cycles = 0;
+    for (auto h : m.halfedges()) {
+        if (!m.is_border(h) || seen[h.idx()]) continue;
+        ++cycles;
+        for (auto g = h; !seen[g.idx()]; g = m.next(g))
+            seen[g.idx()] = 1;
+    }
+    return cycles;
+}
+
+// Border edges of the patch along rib rows \p a or \p b (both end vertices on that row).
+int borderEdgesAlongRows(const fss::Patch& patch, int a, int b) {
+    const Mesh& m = patch.mesh;
+    const auto index = m.property_map<fss::VertexIndex, fss::GridIndex>(fss::props::vertexGridIndex).first;
+    int n = 0;
+    for (auto e : m.edges()) {
+        if (!m.is_border(e)) continue;
+        const fss::GridIndex s = index[m.vertex(e, 0)], t = index[m.vertex(e, 1)];
+        n += s.row == t.row && (s.row == a || s.row == b);
+    }
+    return n;
+}
+
+} // namespace
+
+// A closed backbone closes the grid: the ridge of the creased ring seen from above is a closed curve; with
+// closeLoops the traced backbone is a loop whose closing edge is about h long, the grid's last and first
+// ribs are neighbours, and the patch is an annulus (two border cycles, the ridge's outer and inner sides)
+// with no border edge along its first or last rib. Without it the backbone runs on past its start (the
+// old behaviour: a gap beside an overlap) and the first and last ribs are borders.
+TEST(FishboneScan, ClosedBackboneClosesTheGridOfTheRidge) {
+    const CreaseScene scene;
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(scene.ring);
+    fss::FishboneCache cache;
+    fss::ScanParams params;
+    params.camera = topCamera(scene);
+    const Vector3d ridge = params.camera.project(Vector3d(kRidge, 0, 0));
+    fss::FishboneParams fb;
+    fb.seed = Vector2d(ridge.x() - 2, ridge.y());
+    fb.spacing = 2;
+    fb.tracing.closeLoops = true;
+    const fss::FishboneScanResult closed =
+        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+    fb.tracing.closeLoops = false;
+    const fss::FishboneScanResult open =
+        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+    const fss::FishboneGrid& g = closed.fishbone;
+    ASSERT_TRUE(g.closed);
+    EXPECT_FALSE(open.fishbone.closed);
+    const int n = g.rows, bc = g.backboneColumn;
+    const double closing = (g.at(n - 1, bc) - g.at(0, bc)).norm(), other = (g.at(1, bc) - g.at(0, bc)).norm();
+    std::printf("closed ridge: %d rows (open: %d), closing edge %.3f px, next %.3f px; border cycles %d "
+                "(open: %d); border edges along the first/last rib %d (open: %d); %zu faces (open: %zu)\n",
+                n, open.fishbone.rows, closing, other, borderCycles(closed.patch.mesh),
+                borderCycles(open.patch.mesh), borderEdgesAlongRows(closed.patch, 0, n - 1),
+                borderEdgesAlongRows(open.patch, 0, open.fishbone.rows - 1),
+                std::size_t(closed.patch.mesh.number_of_faces()),
+                std::size_t(open.patch.mesh.number_of_faces()));
+    EXPECT_NEAR(closing, fb.spacing, 0.25 * fb.spacing);
+    EXPECT_TRUE(CGAL::is_valid_polygon_mesh(closed.patch.mesh));
+    EXPECT_EQ(borderCycles(closed.patch.mesh), 2);
+    EXPECT_EQ(borderEdgesAlongRows(closed.patch, 0, n - 1), 0);
+    EXPECT_EQ(borderCycles(open.patch.mesh), 1);
+    EXPECT_GT(borderEdgesAlongRows(open.patch, 0, open.fishbone.rows - 1), 10);
+    // The seam: faces with vertices on both the last and the first rib.
+    const auto index =
+        closed.patch.mesh.property_map<fss::VertexIndex, fss::GridIndex>(fss::props::vertexGridIndex).first;
+    int seamFaces = 0;
+    for (auto f : closed.patch.mesh.faces()) {
+        bool first = false, last = false;
+        for (auto v : CGAL::vertices_around_face(closed.patch.mesh.halfedge(f), closed.patch.mesh)) {
+            first = first || index[v].row == 0;
+            last = last || index[v].row == n - 1;
+        }
+        seamFaces += first && last;
+    }
+    EXPECT_GT(seamFaces, 20);
+    EXPECT_EQ(closed.grid.rows, n);
+    EXPECT_EQ(closed.patch.rows, n);
+    // Every patch vertex is its grid sample's point.
+    for (auto v : closed.patch.mesh.vertices()) {
+        const fss::GridIndex i = index[v];
+        ASSERT_EQ(closed.patch.vertexAt(i.row, i.col), v);
+        const fss::Sample& s = closed.grid.at(i.row, i.col);
+        ASSERT_TRUE(s.valid);
+        ASSERT_LT((s.point - pt(closed.patch.mesh, v)).norm(), 1e-12);
+    }
+}
+
+// Backbones and ribs stop at a crease they would cross: on the creased ring's upper flank (z = 0.2, above
+// the ridge at z = 0) a backbone along the max-curvature direction runs down the meridian across the ridge
+// unless stopBackboneAtCreases; ribs of a backbone along the min direction run down across the ridge
+// unless stopRibsAtCreases. Measured on the samples' 3D points: below the ridge by more than the first
+// edge's reach (2h) there is nothing left.
+TEST(FishboneScan, BackboneAndRibsStopAtTheRidge) {
+    const CreaseScene scene;
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(scene.ring);
+    fss::FishboneCache cache;
+    fss::ScanParams params;
+    params.camera = scene.camera;
+    const double z = 0.2, s = kCentre + std::sqrt(kRho * kRho - (z + kD) * (z + kD));
+    const Vector3d seed3 = params.camera.project(Vector3d(s, 0, z));
+    const double hWorld = 2 * scene.camera.pixelFootprint(Vector3d(kRidge, 0, 0));
+    auto below = [&](const fss::FishboneScanResult& r, bool backboneOnly) {
+        int n = 0;
+        for (int row = 0; row < r.grid.rows; ++row)
+            for (int c = 0; c < r.grid.cols; ++c) {
+                if (backboneOnly && c != r.fishbone.backboneColumn) continue;
+                const fss::Sample& x = r.grid.at(row, c);
+                n += x.hit && x.point.z() < -2 * hWorld;
+            }
+        return n;
+    };
+    fss::FishboneParams fb;
+    fb.seed = seed3.head<2>();
+    fb.spacing = 2;
+    fb.direction = fss::PrincipalDirection::Max;
+    const fss::FishboneScanResult across =
+        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+    fb.tracing.stopBackboneAtCreases = true;
+    const fss::FishboneScanResult stopped =
+        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+    fb.direction = fss::PrincipalDirection::Min;
+    fb.tracing.stopBackboneAtCreases = false;
+    const fss::FishboneScanResult ribs =
+        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+    fb.tracing.stopRibsAtCreases = true;
+    const fss::FishboneScanResult ribsStopped =
+        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+    std::printf(
+        "creased ring, seed on the upper flank: backbone across the ridge %d samples below it (%d rows), "
+        "stopped %d (%d rows); ribs %d samples below, stopped %d\n",
+        below(across, true), across.fishbone.rows, below(stopped, true), stopped.fishbone.rows,
+        below(ribs, false), below(ribsStopped, false));
+    EXPECT_GT(below(across, true), 5);
+    EXPECT_EQ(below(stopped, true), 0);
+    EXPECT_GT(stopped.fishbone.rows, 5);
+    EXPECT_GT(below(ribs, false), 50);
+    EXPECT_EQ(below(ribsStopped, false), 0);
+}
+
+// ---- The sliver table of issue #20 (FSS_LONG_TESTS=1) -----------------------------------------------------
+
+namespace {
+
+// A torus-like ring with two sharp circular ridges: the surface of revolution of a lens (two circular arcs
+// of radius rho, centres at s = R, z = ∓d, meeting at z = 0 in the outer ridge s = R + √(rho² − d²) and the
+// inner ridge s = R − √(rho² − d²), each with a dihedral turn of 2·asin(d/rho) = 60°). Closed.
+constexpr double kLensR = 2.0, kLensRho = 0.6, kLensD = 0.3;
+const double kLensHalf = std::sqrt(kLensRho * kLensRho - kLensD * kLensD);
+
+Mesh lensTorus(int nu, int m) {
+    Mesh mesh;
+    const double phi0 = std::asin(kLensD / kLensRho);
+    std::vector<Vector2d> section; // (s, z) around the lens: the upper arc outer → inner, the lower back
+    for (int k = 0; k < m; ++k) {
+        const double a = phi0 + (std::numbers::pi - 2 * phi0) * k / m;
+        section.emplace_back(kLensR + kLensRho * std::cos(a), -kLensD + kLensRho * std::sin(a));
+    }
+    for (int k = 0; k < m; ++k) {
+        const double a = std::numbers::pi - phi0 - (std::numbers::pi - 2 * phi0) * k / m;
+        section.emplace_back(kLensR + kLensRho * std::cos(a), kLensD - kLensRho * std::sin(a));
+    }
+    const int nv = int(section.size());
+    std::vector<fss::VertexIndex> v(std::size_t(nu) * std::size_t(nv));
+    for (int j = 0; j < nv; ++j)
+        for (int i = 0; i < nu; ++i) {
+            const double phi = 2 * std::numbers::pi * i / nu;
+            v[std::size_t(j) * nu + i] = mesh.add_vertex(
+                fss::Point3(section[std::size_t(j)].x() * std::cos(phi),
+                            section[std::size_t(j)].x() * std::sin(phi), section[std::size_t(j)].y()));
+        }
+    for (int j = 0; j < nv; ++j)
+        for (int i = 0; i < nu; ++i) {
+            const int j1 = (j + 1) % nv, i1 = (i + 1) % nu;
+            const auto a = v[std::size_t(j) * nu + i], b = v[std::size_t(j) * nu + i1];
+            const auto c = v[std::size_t(j1) * nu + i1], d = v[std::size_t(j1) * nu + i];
+            if ((i + j) % 2 == 0) { // alternating diagonals, as creasedRing
+                mesh.add_face(a, d, c);
+                mesh.add_face(a, c, b);
+            } else {
+                mesh.add_face(a, d, b);
+                mesh.add_face(b, d, c);
+            }
+        }
+    return mesh;
+}
+
+double distanceToLensRidges(const Vector3d& p) {
+    const double s = std::hypot(p.x(), p.y());
+    return std::min(std::hypot(s - (kLensR + kLensHalf), p.z()), std::hypot(s - (kLensR - kLensHalf), p.z()));
+}
+
+fss::Camera lookAt(const Mesh& mesh, const Vector3d& focal, const Vector3d& eye, const Vector3d& up,
+                   double angle, int size) {
+    fss::Camera c;
+    c.focal = focal;
+    c.eye = eye;
+    c.up = up;
+    c.viewAngleDeg = angle;
+    c.width = c.height = size;
+    c.fitClippingRange(bbox(mesh));
+    return c;
+}
+
+// Sharp-edge chains of a CGAL mesh (dihedral > 30°, chained through vertices with two sharp edges).
+std::vector<std::vector<Vector3d>> creaseChains(const Mesh& m, fss::FishboneCache& cache) {
+    const std::vector<fss::EdgeIndex>& sharp = cache.creaseEdges(m, 30.0);
+    std::vector<std::vector<fss::HalfedgeIndex>> out(m.number_of_vertices());
+    for (auto e : sharp) {
+        out[m.source(m.halfedge(e)).idx()].push_back(m.halfedge(e));
+        out[m.target(m.halfedge(e)).idx()].push_back(m.opposite(m.halfedge(e)));
+    }
+    std::vector<char> used(m.number_of_edges(), 0);
+    std::vector<std::vector<Vector3d>> chains;
+    for (auto v : m.vertices()) {
+        const auto& hs = out[v.idx()];
+        if (hs.empty() || hs.size() == 2) continue;
+        for (auto h : hs) {
+            if (used[m.edge(h).idx()]) continue;
+            std::vector<Vector3d> chain{pt(m, m.source(h))};
+            for (;;) {
+                used[m.edge(h).idx()] = 1;
+                chain.push_back(pt(m, m.target(h)));
+                const auto& next = out[m.target(h).idx()];
+                if (next.size() != 2) break;
+                h = m.edge(next[0]) == m.edge(h) ? next[1] : next[0];
+                if (used[m.edge(h).idx()]) break;
+            }
+            chains.push_back(std::move(chain));
+        }
+    }
+    return chains;
+}
+
+double distanceToPolyline(const std::vector<Vector3d>& line, const Vector3d& p) {
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+        const Vector3d a = line[i], ab = line[i + 1] - a;
+        const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+        best = std::min(best, (a + t * ab - p).norm());
+    }
+    return best;
+}
+
+struct SliverCase {
+    std::string name;
+    const Mesh* mesh = nullptr;
+    fss::Camera camera;
+    Vector2d seed;
+    std::function<double(const Vector3d&)> creaseDistance; // to the crease the backbone follows
+    std::string tuned;                                     // "tuned" or "untuned"
+};
+
+// A view and a seed on a curved crease of a CGAL mesh: of the seven standard views at 256² and the chains of
+// sharp edges turning by 30–180° over at least 12 edges, the (chain, view) whose visible middle edge is seen
+// most frontally (both faces), its midpoint the seed.
+std::optional<SliverCase> cgalCase(const std::string& name, const Mesh& m, fss::FishboneCache& cache) {
+    const std::vector<std::vector<Vector3d>> chains = creaseChains(m, cache);
+    std::optional<SliverCase> best;
+    double bestScore = 0;
+    const fss::RayCaster& caster = cache.rayCaster(m);
+    for (const fss::StandardView view :
+         {fss::StandardView::Iso, fss::StandardView::PosX, fss::StandardView::NegX, fss::StandardView::PosY,
+          fss::StandardView::NegY, fss::StandardView::PosZ, fss::StandardView::NegZ}) {
+        const fss::Camera camera = fss::Camera::standardView(view, bbox(m), 256, 256);
+        for (const auto& chain : chains) {
+            if (chain.size() < 13) continue;
+            const Vector3d d0 = (chain[1] - chain[0]).normalized(),
+                           d1 = (chain.back() - chain[chain.size() - 2]).normalized();
+            const double turn = std::acos(std::clamp(d0.dot(d1), -1.0, 1.0)) * 180 / std::numbers::pi;
+            if (turn < 30 || turn > 180 - 1e-9) continue;
+            const std::size_t mid = chain.size() / 2;
+            const Vector3d p = 0.5 * (chain[mid] + chain[mid - 1]);
+            const Vector3d s = camera.project(p);
+            if (!(s.x() > 32 && s.y() > 32 && s.x() < 224 && s.y() < 224)) continue;
+            // Visible: the ray through the seed hits within a footprint of the crease point.
+            const fss::SurfacePoint hit = caster.intersect(camera.ray(s.x(), s.y()));
+            if (!hit || (hit.point - p).norm() > 2 * camera.pixelFootprint(p)) continue;
+            // Frontal: the surface normals on both sides of the crease near the seed face the camera.
+            const Vector3d toEye = (camera.eye - p).normalized();
+            double score = 1;
+            const Vector3d along = (chain[mid] - chain[mid - 1]).normalized();
+            const Vector3d side = along.cross(toEye).normalized();
+            for (const double sign : {1.0, -1.0}) {
+                const Vector3d q = p + sign * 4 * camera.pixelFootprint(p) * side;
+                score = std::min(score, faceNormal(m, caster.closestPoint(q).face).dot(toEye));
+            }
+            if (score > bestScore) {
+                bestScore = score;
+                SliverCase c;
+                c.name = name + " " + fss::standardViewName(view);
+                c.mesh = &m;
+                c.camera = camera;
+                c.seed = s.head<2>();
+                c.creaseDistance = [chain](const Vector3d& q) { return distanceToPolyline(chain, q); };
+                best = c;
+            }
+        }
+    }
+    return best;
+}
+
+} // namespace
+
+// The figures of issue #20's fishbone criteria on shapes and meshes: for each case, h = 2 px, with and
+// without a lasso (a square of 0.6 W around the seed), the paper's fishbone ("paper") and the issue-20 set
+// ("issue20": closeLoops, stopBackboneAtCreases, minRibGap 0.5, maxRibTurnDeg 60, stopRibsAtCreases,
+// minQuadAngleDeg 20): the patch's smallest angle, the share of faces below 30°, the mean normal error of the
+// faces within 2h of the crease near the backbone (screen distance ≤ 3h to a backbone sample) against the
+// regular grid's at the same spacing (the scan at W/2 × H/2), and whether the grid closed. Printed only.
+// FSS_LONG_TESTS=1 build/bin/core_tests --gtest_filter='FishboneScan.SliverTable'
+TEST(FishboneScan, SliverTable) {
+    if (!std::getenv("FSS_LONG_TESTS")) GTEST_SKIP() << "set FSS_LONG_TESTS=1";
+    const CreaseScene scene;
+    const Mesh lens = lensTorus(720, 60);
+    std::vector<Mesh> cgal;
+    std::vector<std::string> names;
+    for (const char* n : {"fandisk", "anchor", "rotor", "part", "joint", "spool", "blade", "pinion"}) {
+        names.emplace_back(n);
+        cgal.push_back(fss::readMesh(fss::test::meshPath(std::string(n) + ".off").string()));
+    }
+    std::vector<fss::FishboneCache> caches(cgal.size() + 2);
+    std::vector<SliverCase> cases;
+    const fss::Camera top = topCamera(scene);
+    const Vector3d ridgeTop = top.project(Vector3d(kRidge, 0, 0));
+    cases.push_back({"ring front", &scene.ring, scene.camera, scene.ridgeSeed(), distanceToRidge, "tuned"});
+    cases.push_back({"ring top (closed)", &scene.ring, top, Vector2d(ridgeTop.x() - 2, ridgeTop.y()),
+                     distanceToRidge, "tuned"});
+    {
+        const double az = 0.7, el = 12 * std::numbers::pi / 180;
+        const Vector3d focal(kRidge * std::cos(az), kRidge * std::sin(az), 0);
+        const fss::Camera c = lookAt(scene.ring, focal,
+                                     focal + 3.5 * Vector3d(std::cos(az + 0.5) * std::cos(el),
+                                                            std::sin(az + 0.5) * std::cos(el), std::sin(el)),
+                                     {0, 0, 1}, 35, 200);
+        const Vector3d s = c.project(focal);
+        cases.push_back({"ring oblique", &scene.ring, c, s.head<2>(), distanceToRidge, "untuned"});
+    }
+    {
+        const double el = 35 * std::numbers::pi / 180, outer = kLensR + kLensHalf;
+        const Vector3d focal(outer, 0, 0);
+        const fss::Camera c =
+            lookAt(lens, focal, focal + 4.0 * Vector3d(std::cos(el), 0.3, std::sin(el)), {0, 0, 1}, 35, 200);
+        cases.push_back(
+            {"lens torus side", &lens, c, c.project(focal).head<2>(), distanceToLensRidges, "untuned"});
+        const fss::Camera t = lookAt(lens, Vector3d(0, 0, 0), Vector3d(2.0, 0.5, 9.0), {0, 1, 0}, 45, 256);
+        const Vector3d s = t.project(Vector3d(outer * std::cos(0.3), outer * std::sin(0.3), 0));
+        cases.push_back({"lens torus top (closed)", &lens, t, s.head<2>(), distanceToLensRidges, "untuned"});
+    }
+    for (std::size_t i = 0; i < cgal.size(); ++i)
+        if (std::optional<SliverCase> c = cgalCase(names[i], cgal[i], caches[i])) {
+            c->tuned = names[i] == "fandisk" ? "tuned" : "untuned";
+            cases.push_back(*c);
+        } else {
+            std::printf("%s: no curved crease chain found in the standard views\n", names[i].c_str());
+        }
+
+    std::printf("%-26s %-7s %-6s %-7s | %5s %6s %6s | %6s %6s %5s | %s\n", "case", "set", "lasso", "",
+                "faces", "min°", "<30%", "nerr°", "grid°", "ratio", "closed");
+    for (const SliverCase& c : cases) {
+        fss::CpuMeshRenderer renderer;
+        renderer.setMesh(*c.mesh);
+        fss::FishboneCache cache;
+        const fss::RayCaster& caster = cache.rayCaster(*c.mesh);
+        const fss::SurfacePoint seedHit = caster.intersect(c.camera.ray(c.seed.x(), c.seed.y()));
+        if (!seedHit) {
+            std::printf("%s: the seed misses\n", c.name.c_str());
+            continue;
+        }
+        const double h = 2, hWorld = h * c.camera.pixelFootprint(seedHit.point);
+        for (const bool lasso : {false, true})
+            for (const bool issue20 : {false, true}) {
+                fss::ScanParams params;
+                params.camera = c.camera;
+                const double half = 0.3 * c.camera.width;
+                fss::Lasso l;
+                l.points = {c.seed + Vector2d(-half, -half), c.seed + Vector2d(half, -half),
+                            c.seed + Vector2d(half, half), c.seed + Vector2d(-half, half)};
+                if (lasso) params.lasso = l;
+                fss::FishboneParams fb;
+                fb.seed = c.seed;
+                fb.spacing = h;
+                if (issue20) {
+                    fb.tracing.closeLoops = fb.tracing.stopBackboneAtCreases = fb.tracing.stopRibsAtCreases =
+                        true;
+                    fb.tracing.minRibGap = 0.5;
+                    fb.tracing.maxRibTurnDeg = 60;
+                    params.triangulate.minQuadAngleDeg = 20;
+                }
+                fss::FishboneScanResult r;
+                try {
+                    r = fss::scanFishbonePatch(*c.mesh, renderer, *c.mesh, renderer, params, fb, cache);
+                } catch (const fss::InvalidInputError& e) {
+                    std::printf("%-26s %-7s %-6s: %s\n", c.name.c_str(), issue20 ? "issue20" : "paper",
+                                lasso ? "lasso" : "-", e.what());
+                    continue;
+                }
+                // The regular grid at the same spacing: the scan at W/h × H/h.
+                fss::ScanParams grid = params;
+                grid.triangulate.minQuadAngleDeg = 0;
+                grid.camera.width = int(c.camera.width / h);
+                grid.camera.height = int(c.camera.height / h);
+                if (grid.lasso)
+                    for (Vector2d& q : grid.lasso->points)
+                        q /= h;
+                const fss::ScanResult regular = fss::scanPatch(*c.mesh, renderer, *c.mesh, renderer, grid);
+                std::vector<Vector2d> backbone;
+                for (int row = 0; row < r.fishbone.rows; ++row)
+                    if (r.fishbone.isPresent(row, r.fishbone.backboneColumn))
+                        backbone.push_back(r.fishbone.at(row, r.fishbone.backboneColumn));
+                auto nearError = [&](const Mesh& m) {
+                    double sum = 0;
+                    std::size_t n = 0;
+                    for (auto f : m.faces()) {
+                        Vector3d centroid = Vector3d::Zero();
+                        for (auto v : CGAL::vertices_around_face(m.halfedge(f), m))
+                            centroid += pt(m, v) / 3;
+                        if (c.creaseDistance(centroid) > 2 * hWorld) continue;
+                        const Vector2d s = c.camera.project(centroid).head<2>();
+                        bool near = false;
+                        for (const Vector2d& b : backbone)
+                            near = near || (b - s).norm() <= 3 * h;
+                        if (!near) continue;
+                        const Vector3d ref = faceNormal(*c.mesh, caster.closestPoint(centroid).face);
+                        sum += std::acos(std::clamp(faceNormal(m, f).dot(ref), -1.0, 1.0)) * 180 /
+                               std::numbers::pi;
+                        ++n;
+                    }
+                    return n ? sum / double(n) : std::numeric_limits<double>::quiet_NaN();
+                };
+                const AngleFigures a = angleFigures(r.patch.mesh);
+                const double fishError = nearError(r.patch.mesh), gridError = nearError(regular.patch.mesh);
+                std::printf("%-26s %-7s %-6s %-7s | %5zu %6.1f %6.1f | %6.2f %6.2f %5.2f | %s\n",
+                            c.name.c_str(), issue20 ? "issue20" : "paper", lasso ? "lasso" : "-",
+                            c.tuned.c_str(), a.faces, a.minDeg, 100 * a.below30, fishError, gridError,
+                            fishError / gridError,
+                            r.fishbone.closed ? (borderEdgesAlongRows(r.patch, 0, r.fishbone.rows - 1) == 0
+                                                     ? "closed, no seam border"
+                                                     : "closed, seam border")
+                                              : "open");
+                EXPECT_GT(a.faces, 0u);
+            }
+    }
 }

@@ -527,3 +527,72 @@ TEST(Fishbone, TrimRibsStopsConvergingAndTurningRibs) {
     EXPECT_EQ(fss::trimRibs(same, backbone, options), 0u);
     EXPECT_EQ(same.present, untrimmed.present);
 }
+
+// Backbone loops (issue #20, FishboneOptions::closeLoops): a streamline that runs 1.4 times round a circle
+// of radius 20 px from its seed (both halves overlapping beyond the seed, as a traced backbone on a closed
+// ridge does) becomes a closed backbone of round(2π·20/h) samples on the circle, starting at the seed, the
+// closing edge as long as the others; a streamline that curls into a loop away from its seed (a "6") is cut
+// before it comes back near itself; a straight one is only resampled.
+TEST(Fishbone, BackboneLoopsCloseOrStop) {
+    const double h = 3.0, radius = 20.0;
+    const Eigen::Vector2d centre(50, 50);
+    auto onCircle = [&](double a) {
+        return Eigen::Vector2d(centre + radius * Eigen::Vector2d(std::cos(a), std::sin(a)));
+    };
+    fss::Streamline circle;
+    for (double a = -0.7 * 2 * kPi; a <= 0.7 * 2 * kPi + 1e-9; a += 0.02)
+        circle.points.push_back(onCircle(a));
+    circle.seedIndex = std::size_t(std::lround(0.7 * 2 * kPi / 0.02));
+    const Backbone closed = fss::backboneFromStreamline(circle, h, true);
+    ASSERT_TRUE(closed.closed);
+    const std::size_t n = std::size_t(std::lround(2 * kPi * radius / h));
+    EXPECT_EQ(closed.samples.size(), n);
+    EXPECT_EQ(closed.seedIndex, 0u);
+    EXPECT_LT((closed.samples.front() - circle.points[circle.seedIndex]).norm(), 1e-9);
+    for (std::size_t i = 0; i < closed.samples.size(); ++i) {
+        EXPECT_NEAR((closed.samples[i] - centre).norm(), radius, 0.05);
+        const double edge = (closed.samples[(i + 1) % n] - closed.samples[i]).norm();
+        EXPECT_NEAR(edge, 2 * radius * std::sin(kPi / double(n)), 0.05) << "edge " << i;
+    }
+    // Tangents wrap: at the seed the tangent is the circle's (perpendicular to the radius).
+    EXPECT_NEAR(closed.tangent(0).dot((closed.samples[0] - centre).normalized()), 0.0, 1e-3);
+    // Without closeLoops the same streamline is resampled as before: open, and overlapping itself.
+    const Backbone open = fss::backboneFromStreamline(circle, h, false);
+    EXPECT_FALSE(open.closed);
+    EXPECT_GT(open.samples.size(), n + n / 4);
+
+    // A "6": straight from the seed for 30 px, then once round a circle of radius 10 px and back over the
+    // circle's first point. Cut before a sample within h/2 of a kept one three or more samples away.
+    fss::Streamline six;
+    for (double x = 0; x < 30; x += 0.25)
+        six.points.emplace_back(x, 0.0);
+    for (double a = 0; a <= 1.5 * 2 * kPi; a += 0.02)
+        six.points.emplace_back(30 + 10 * std::sin(a), 10 - 10 * std::cos(a));
+    six.seedIndex = 0;
+    const Backbone cut = fss::backboneFromStreamline(six, h, true);
+    EXPECT_FALSE(cut.closed);
+    const Backbone uncut = fss::backboneFromStreamline(six, h, false);
+    EXPECT_LT(cut.samples.size(), uncut.samples.size());
+    auto closestNonAdjacent = [](const Polyline2& s) {
+        double d = std::numeric_limits<double>::infinity();
+        for (std::size_t i = 0; i < s.size(); ++i)
+            for (std::size_t j = i + 3; j < s.size(); ++j)
+                d = std::min(d, (s[i] - s[j]).norm());
+        return d;
+    };
+    EXPECT_LT(closestNonAdjacent(uncut.samples), 0.5 * h);
+    EXPECT_GE(closestNonAdjacent(cut.samples), 0.5 * h);
+    // The loop is kept up to its last sample before the overlap: more than the straight part and most
+    // of the circle's 2π·10/h ≈ 21 samples.
+    EXPECT_GT(cut.samples.size(), 10u + 15u);
+    // A straight streamline: the same samples with or without the loop test.
+    fss::Streamline line;
+    for (double x = -20; x <= 20; x += 0.25)
+        line.points.emplace_back(x, 3.0);
+    line.seedIndex = 80;
+    const Backbone a = fss::backboneFromStreamline(line, h, true),
+                   b = fss::backboneFromStreamline(line, h, false);
+    EXPECT_EQ(a.samples, b.samples);
+    EXPECT_EQ(a.seedIndex, b.seedIndex);
+    EXPECT_FALSE(a.closed);
+}

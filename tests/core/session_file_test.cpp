@@ -109,6 +109,12 @@ void expectSame(const fss::ScanStep& a, const fss::ScanStep& b) {
         expectSame(fa.drawnBackbone, fb.drawnBackbone);
         EXPECT_TRUE(sameBits(fa.tracing.spacing, fb.tracing.spacing));
         EXPECT_EQ(fa.tracing.extendBeyondKeyRibs, fb.tracing.extendBeyondKeyRibs);
+        EXPECT_TRUE(sameBits(fa.tracing.minRibGap, fb.tracing.minRibGap));
+        EXPECT_TRUE(sameBits(fa.tracing.maxRibTurnDeg, fb.tracing.maxRibTurnDeg));
+        EXPECT_EQ(fa.tracing.stopRibsAtCreases, fb.tracing.stopRibsAtCreases);
+        EXPECT_EQ(fa.tracing.closeLoops, fb.tracing.closeLoops);
+        EXPECT_EQ(fa.tracing.stopBackboneAtCreases, fb.tracing.stopBackboneAtCreases);
+        EXPECT_EQ(fa.tracing.isotropicRibs, fb.tracing.isotropicRibs);
         expectSame(fa.tracing.backboneTracing, fb.tracing.backboneTracing);
         expectSame(fa.tracing.ribTracing, fb.tracing.ribTracing);
         EXPECT_TRUE(sameBits(fa.minSeedAnisotropy, fb.minSeedAnisotropy));
@@ -208,6 +214,12 @@ fss::ScanStep fishboneStep() {
     fb.drawnBackbone = {{20, 30}, {40, 50.5}, {60.75, 55}};
     fb.tracing.spacing = 2.5;
     fb.tracing.extendBeyondKeyRibs = false;
+    fb.tracing.minRibGap = 0.5;
+    fb.tracing.maxRibTurnDeg = 60;
+    fb.tracing.stopRibsAtCreases = true;
+    fb.tracing.closeLoops = true;
+    fb.tracing.stopBackboneAtCreases = true;
+    fb.tracing.isotropicRibs = true;
     fb.tracing.backboneTracing.step = 0.3;
     fb.tracing.backboneTracing.minStep = 0.01;
     fb.tracing.backboneTracing.maxLength = 77.5;
@@ -438,6 +450,34 @@ TEST_F(BadSessionFile, FishboneSamplingFactorIsOptionalAndOneWhenAbsent) {
     j["events"][1]["step"]["fishbone"].erase("sampling_factor");
     EXPECT_EQ(samplingFactorOf(j), 1);
     EXPECT_EQ(fss::FishboneParams{}.samplingFactor, 0); // new scans choose it
+}
+
+// Files written before the backbone's loop and crease handling (issue #20) traced backbones without them:
+// without the keys they load with both off and replay as recorded.
+TEST_F(BadSessionFile, FishboneLoopCreaseAndSurfaceSpacingKeysAreOptionalAndOffWhenAbsent) {
+    auto tracingOf = [&](const Json& j) {
+        const auto path = fss::test::tmpPath("loops_" + name_ + ".session.json");
+        {
+            std::ofstream out(path, std::ios::binary | std::ios::trunc);
+            out << j.dump(2);
+        }
+        return fss::loadSessionFile(path).events.at(1).step.fishbone.value().tracing;
+    };
+    Json j = good_;
+    Json& t = j["events"][1]["step"]["fishbone"]["tracing"];
+    ASSERT_TRUE(t.contains("close_loops"));
+    ASSERT_TRUE(t.contains("stop_backbone_at_creases"));
+    ASSERT_TRUE(t.contains("isotropic_ribs"));
+    EXPECT_TRUE(tracingOf(j).closeLoops);
+    EXPECT_TRUE(tracingOf(j).stopBackboneAtCreases);
+    EXPECT_TRUE(tracingOf(j).isotropicRibs);
+    t.erase("close_loops");
+    t.erase("stop_backbone_at_creases");
+    t.erase("isotropic_ribs");
+    EXPECT_FALSE(tracingOf(j).closeLoops);
+    EXPECT_FALSE(tracingOf(j).stopBackboneAtCreases);
+    EXPECT_FALSE(tracingOf(j).isotropicRibs);
+    EXPECT_FALSE(fss::FishboneParams{}.tracing.closeLoops);
 }
 
 // Files written before the triangular lattice and the patch relaxation (issue #20) scanned on the pixel

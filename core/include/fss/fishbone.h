@@ -37,6 +37,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace fss {
@@ -65,6 +66,27 @@ struct FishboneOptions {
     /// reference (FishboneParams::creaseAngleDeg > 0; a rib running onto a neighbouring face of a CAD part).
     /// false here and in files written before it (true is not yet the default, issue 20).
     bool stopRibsAtCreases = false;
+    /// Loops of a traced backbone (issue 20): where the backbone comes back within h/2 of a point it passed
+    /// at least 4h of arc length before, heading the same way, it is a closed curve: the loop through the
+    /// seed is resampled at n = round(L/h) equal arcs (spacing L/n) and Backbone::closed is set, so that the
+    /// grid's first and last rows are neighbours (FishboneGrid::closed) instead of a gap beside an overlap.
+    /// A backbone that comes that close to itself otherwise (a loop not through its seed, or heading the
+    /// other way) stops before it. false here and in files written before it (no loop test; issue 20).
+    bool closeLoops = false;
+    /// The fishbone scan stops a traced backbone, outwards from its seed, before its first edge that
+    /// crosses a visible crease of the reference at more than 30° (FishboneParams::creaseAngleDeg > 0; a
+    /// crease it runs along does not stop it). A closed backbone so cut is open. false here and in files
+    /// written before it (issue 20).
+    bool stopBackboneAtCreases = false;
+    /// Ribs spaced on the surface (issue 20): the fishbone scan gives the traced ribs surfaceLength, so that
+    /// each rib's vertices are as far apart on the surface as its backbone sample is from its neighbours
+    /// (instead of h on the screen: on a surface slanted across the backbone the screen spacing makes quads
+    /// up to 1/cos θ times longer one way than the other, and their triangles slivers). Automatic mode only
+    /// (key-ribs are blended with the paper's constant h). false here and in files written before it.
+    bool isotropicRibs = false;
+    /// The surface length of the screen segment a – b (set by the fishbone scan for isotropicRibs; empty: no
+    /// surface spacing). Must be safe to call from several threads. Not stored in session files.
+    std::function<double(const Eigen::Vector2d& a, const Eigen::Vector2d& b)> surfaceLength{};
 
     /// Checks the ranges: spacing finite and > 0, minRibGap in [0, 1), maxRibTurnDeg in (0, 180], and both
     /// tracings (StreamlineOptions::validate, named
@@ -77,6 +99,9 @@ struct FishboneOptions {
 struct Backbone {
     Polyline2 samples;         ///< consecutive samples at distance h
     std::size_t seedIndex = 0; ///< the picked point (traced backbone) or the first drawn point
+    /// A closed curve (FishboneOptions::closeLoops): samples.back() is followed by samples.front() at about
+    /// the spacing, and tangents wrap around.
+    bool closed = false;
     /// Unit screen tangent at sample r (central difference; one-sided at the ends).
     /// \pre samples.size() ≥ 2 and r < samples.size().
     Eigen::Vector2d tangent(std::size_t r) const;
@@ -114,6 +139,9 @@ struct FishboneGrid {
     double spacing = 0;                  ///< h
     std::vector<Eigen::Vector2d> screen; ///< rows·cols sub-pixel screen positions (unused where absent)
     std::vector<std::uint8_t> present;   ///< 1 where a rib vertex exists (and lies inside the image)
+    /// Rows wrap around (a closed backbone): row rows − 1 and row 0 are neighbours, as any two consecutive
+    /// rows (the fishbone scan triangulates the quads between them too).
+    bool closed = false;
 
     std::size_t index(int r, int c) const { return std::size_t(r) * std::size_t(cols) + std::size_t(c); }
     bool isPresent(int r, int c) const {
@@ -129,6 +157,13 @@ struct FishboneGrid {
 /// stops first, so the other goes on. Returns the number of vertices removed.
 /// \pre grid.rows == backbone.samples.size() ≥ 2.
 std::size_t trimRibs(FishboneGrid& grid, const Backbone& backbone, const FishboneOptions& options);
+
+/// The loop handling of FishboneOptions::closeLoops on a traced streamline \p line (not yet resampled):
+/// the closed loop through its seed resampled at n = round(L/h) ≥ 3 equal arcs, starting at the seed
+/// (Backbone::closed), or else the streamline resampled every h and cut, outwards from the seed, before
+/// the first sample that comes within h/2 of a kept sample at least three samples away.
+/// \pre h > 0 and finite. \throw InvalidInputError otherwise.
+Backbone backboneFromStreamline(const Streamline& line, double h, bool closeLoops);
 
 /// [E0, {αᵢ}] of one rib half whose first vertex lies on the backbone (the paper's key-rib representation).
 /// Any polyline is accepted: fewer than two points give an empty shape. The turning angles are exact

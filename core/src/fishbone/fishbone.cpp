@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <optional>
@@ -82,7 +83,9 @@ std::pair<Polyline2, Polyline2> splitAt(const Polyline2& line, const Closest& c,
 
 Eigen::Vector2d Backbone::tangent(std::size_t r) const {
     requireBackbone(*this);
-    const std::size_t a = r == 0 ? 0 : r - 1, b = std::min(r + 1, samples.size() - 1);
+    const std::size_t n = samples.size();
+    if (closed && n > 2) return (samples[(r + 1) % n] - samples[(r + n - 1) % n]).normalized();
+    const std::size_t a = r == 0 ? 0 : r - 1, b = std::min(r + 1, n - 1);
     return (samples[b] - samples[a]).normalized();
 }
 
@@ -213,15 +216,106 @@ Polyline2 catmullRomSpline(const Polyline2& input, double maxSegment) {
 
 // ---- Backbone and ribs ----------------------------------------------------------------------------------
 
+namespace {
+
+// Unit tangent of a dense polyline at point i (central difference, one-sided at the ends).
+Eigen::Vector2d denseTangent(const Polyline2& c, std::size_t i) {
+    const std::size_t a = i == 0 ? 0 : i - 1, b = std::min(i + 1, c.size() - 1);
+    const Eigen::Vector2d d = c[b] - c[a];
+    const double len = d.norm();
+    return len > 0 ? Eigen::Vector2d(d / len) : Eigen::Vector2d::Zero();
+}
+
+// The closed loop through the seed of a dense streamline, resampled at equal arcs from the seed, if the
+// streamline closes (see FishboneOptions::closeLoops): the shortest stretch c[i … j] around the seed
+// (i ≤ seed ≤ j) whose ends lie within h/2 of each other, at least 4h of arc apart, heading the same way.
+std::optional<Polyline2> closedLoop(const Polyline2& c, std::size_t seed, double h) {
+    if (c.size() < 3) return std::nullopt;
+    std::vector<double> arc(c.size(), 0.0);
+    for (std::size_t k = 1; k < c.size(); ++k)
+        arc[k] = arc[k - 1] + (c[k] - c[k - 1]).norm();
+    double best = std::numeric_limits<double>::infinity();
+    std::size_t bi = 0, bj = 0;
+    for (std::size_t j = seed; j < c.size(); ++j)
+        for (std::size_t i = seed + 1; i-- > 0;) {
+            const double span = arc[j] - arc[i];
+            if (span >= best) break;
+            if (span < 4 * h || (c[j] - c[i]).norm() >= 0.5 * h) continue;
+            if (denseTangent(c, i).dot(denseTangent(c, j)) < 0.5) continue;
+            best = span;
+            bi = i;
+            bj = j;
+        }
+    if (!std::isfinite(best)) return std::nullopt;
+    // The loop from the seed: c[seed … bj], then c[bi … seed] (c[bj] joins c[bi]).
+    Polyline2 loop(c.begin() + std::ptrdiff_t(seed), c.begin() + std::ptrdiff_t(bj) + 1);
+    loop.insert(loop.end(), c.begin() + std::ptrdiff_t(bi), c.begin() + std::ptrdiff_t(seed) + 1);
+    double length = 0;
+    for (std::size_t k = 1; k < loop.size(); ++k)
+        length += (loop[k] - loop[k - 1]).norm();
+    const std::size_t n = std::max<std::size_t>(3, std::size_t(std::lround(length / h)));
+    const double step = length / double(n);
+    Polyline2 out{loop.front()};
+    double at = 0; // arc length at loop[k]
+    for (std::size_t k = 1; k < loop.size() && out.size() < n; ++k) {
+        const double len = (loop[k] - loop[k - 1]).norm();
+        while (out.size() < n && double(out.size()) * step <= at + len) {
+            const double t = len > 0 ? (double(out.size()) * step - at) / len : 0.0;
+            out.push_back(loop[k - 1] + t * (loop[k] - loop[k - 1]));
+        }
+        at += len;
+    }
+    return out;
+}
+
+} // namespace
+
+Backbone backboneFromStreamline(const Streamline& line, double h, bool closeLoops) {
+    requireSpacing(h);
+    Backbone b;
+    if (closeLoops && !line.points.empty())
+        if (std::optional<Polyline2> loop = closedLoop(line.points, line.seedIndex, h)) {
+            b.samples = std::move(*loop);
+            b.closed = true;
+            return b;
+        }
+    const Streamline resampled = resampleAtSpacing(line, h);
+    b.samples = resampled.points;
+    b.seedIndex = resampled.seedIndex;
+    if (!closeLoops || b.samples.size() < 4) return b;
+    // Cut outwards from the seed before the first sample that comes back near a kept one (a loop).
+    const Polyline2& s = b.samples;
+    std::size_t lo = b.seedIndex, hi = b.seedIndex; // kept: [lo, hi]
+    auto nearKept = [&](std::size_t j) {
+        for (std::size_t i = lo; i <= hi; ++i)
+            if ((i + 3 <= j || j + 3 <= i) && (s[i] - s[j]).norm() < 0.5 * h) return true;
+        return false;
+    };
+    bool forward = true, backward = true;
+    while (forward || backward) {
+        if (forward) {
+            if (hi + 1 < s.size() && !nearKept(hi + 1))
+                ++hi;
+            else
+                forward = false;
+        }
+        if (backward) {
+            if (lo > 0 && !nearKept(lo - 1))
+                --lo;
+            else
+                backward = false;
+        }
+    }
+    b.samples.assign(s.begin() + std::ptrdiff_t(lo), s.begin() + std::ptrdiff_t(hi) + 1);
+    b.seedIndex -= lo;
+    return b;
+}
+
 Backbone traceBackbone(const DirectionField& backboneField, const Eigen::Vector2d& seed,
                        const FishboneOptions& options) {
     requireSpacing(options.spacing);
-    const Streamline line =
-        resampleAtSpacing(traceStreamline(backboneField, seed, options.backboneTracing), options.spacing);
-    Backbone b;
-    b.samples = line.points;
-    b.seedIndex = line.seedIndex;
-    return b;
+    return backboneFromStreamline(traceStreamline(backboneField, seed, options.backboneTracing),
+                                  options.spacing, options.closeLoops);
 }
 
 Backbone drawnBackbone(const Polyline2& points, const FishboneOptions& options) {
@@ -235,6 +329,48 @@ Backbone drawnBackbone(const Polyline2& points, const FishboneOptions& options) 
     return b;
 }
 
+namespace {
+
+// Resamples a dense rib half at equal surface arc length \p target (FishboneOptions::surfaceLength): the
+// first vertex is kept, each further one where the surface length along the polyline reaches the next
+// multiple of target; the tail shorter than target is dropped.
+Polyline2
+resampleOnSurface(const Polyline2& dense, double target,
+                  const std::function<double(const Eigen::Vector2d&, const Eigen::Vector2d&)>& length) {
+    Polyline2 out;
+    if (dense.empty()) return out;
+    out.push_back(dense.front());
+    double at = 0;
+    for (std::size_t i = 1; i < dense.size(); ++i) {
+        const double seg = length(dense[i - 1], dense[i]);
+        if (!(seg > 0) || !std::isfinite(seg)) continue;
+        while (double(out.size()) * target <= at + seg) {
+            const double t = (double(out.size()) * target - at) / seg;
+            out.push_back(dense[i - 1] + t * (dense[i] - dense[i - 1]));
+        }
+        at += seg;
+    }
+    return out;
+}
+
+// The surface spacing of the backbone at sample r: the mean surface length of its edges to its neighbours.
+double backboneSurfaceSpacing(const Backbone& b, std::size_t r, const FishboneOptions& options) {
+    const std::size_t n = b.samples.size();
+    double sum = 0;
+    int count = 0;
+    if (r > 0 || b.closed) {
+        sum += options.surfaceLength(b.samples[(r + n - 1) % n], b.samples[r]);
+        ++count;
+    }
+    if (r + 1 < n || b.closed) {
+        sum += options.surfaceLength(b.samples[r], b.samples[(r + 1) % n]);
+        ++count;
+    }
+    return count ? sum / count : 0.0;
+}
+
+} // namespace
+
 std::vector<Rib> traceRibs(const DirectionField& ribField, const Backbone& backbone, std::size_t first,
                            std::size_t count, const FishboneOptions& options) {
     requireSpacing(options.spacing);
@@ -247,6 +383,7 @@ std::vector<Rib> traceRibs(const DirectionField& ribField, const Backbone& backb
     std::vector<Rib> ribs(count);
     std::vector<HalfStart> starts;
     std::vector<Polyline2*> targets;
+    std::vector<std::size_t> owners; // the rib of each target
     for (std::size_t i = 0; i < count; ++i) {
         const Eigen::Vector2d p0 = backbone.samples[first + i], n = backbone.normal(first + i);
         ribs[i] = Rib{{p0}, {p0}};
@@ -255,11 +392,19 @@ std::vector<Rib> traceRibs(const DirectionField& ribField, const Backbone& backb
             if (!ribHalfTraceable(ribField, p0, side, options)) continue;
             starts.push_back({p0, side});
             targets.push_back(positive ? &ribs[i].positive : &ribs[i].negative);
+            owners.push_back(i);
         }
     }
     const std::vector<StreamlineHalf> halves = traceHalvesInLockstep(ribField, starts, options.ribTracing);
-    for (std::size_t k = 0; k < halves.size(); ++k)
-        *targets[k] = resampleAtSpacing(halves[k].points, options.spacing);
+    std::vector<double> surface(count, 0.0);
+    if (options.isotropicRibs && options.surfaceLength)
+        for (std::size_t i = 0; i < count; ++i)
+            surface[i] = backboneSurfaceSpacing(backbone, first + i, options);
+    for (std::size_t k = 0; k < halves.size(); ++k) {
+        const std::size_t i = owners[k];
+        *targets[k] = surface[i] > 0 ? resampleOnSurface(halves[k].points, surface[i], options.surfaceLength)
+                                     : resampleAtSpacing(halves[k].points, options.spacing);
+    }
     return ribs;
 }
 
@@ -319,6 +464,7 @@ FishboneGrid assembleFishboneGrid(const Backbone& backbone, const std::vector<Ri
     g.cols = int(neg + 1 + pos);
     g.backboneColumn = int(neg);
     g.spacing = spacing;
+    g.closed = backbone.closed && ribs.size() > 2;
     g.screen.assign(std::size_t(g.rows) * std::size_t(g.cols), Eigen::Vector2d::Zero());
     g.present.assign(g.screen.size(), 0);
     const bool clip = width > 0 && height > 0;
@@ -362,10 +508,12 @@ std::size_t trimRibs(FishboneGrid& grid, const Backbone& backbone, const Fishbon
                     if (turnBound && len > 0 && (double(side) * edge).dot(normal) < cosTurn * len)
                         stopped = true;
                 }
-                for (const int dr : {-1, 1})
-                    if (!stopped && minGap > 0 && grid.isPresent(r + dr, c) &&
-                        (grid.at(r + dr, c) - grid.at(r, c)).norm() < minGap)
+                for (const int dr : {-1, 1}) {
+                    const int n = grid.closed ? (r + dr + grid.rows) % grid.rows : r + dr;
+                    if (!stopped && minGap > 0 && grid.isPresent(n, c) &&
+                        (grid.at(n, c) - grid.at(r, c)).norm() < minGap)
                         stopped = true;
+                }
                 if (stopped) {
                     grid.present[i] = 0;
                     ++removed;
@@ -430,7 +578,7 @@ FishboneGrid keyRibFishbone(const Backbone& backbone, std::vector<KeyRib> keyRib
     const double h = options.spacing;
     const std::size_t first = options.extendBeyondKeyRibs ? 0 : keys.front().row;
     const std::size_t last = options.extendBeyondKeyRibs ? backbone.samples.size() - 1 : keys.back().row;
-    Backbone part;
+    Backbone part; // open: key-ribs are blended along the backbone, not across a closed backbone's seam
     part.samples.assign(backbone.samples.begin() + std::ptrdiff_t(first),
                         backbone.samples.begin() + std::ptrdiff_t(last) + 1);
     part.seedIndex =

@@ -8,10 +8,15 @@
 #include "fishbone/fishbone_options.h"
 #include "mesh/features.h"
 
+#include <CGAL/boost/graph/iterator.h>
+
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <memory>
 #include <numbers>
 #include <numeric>
 #include <optional>
@@ -168,6 +173,62 @@ public:
                         return true;
                 }
         return false;
+    }
+
+    /// Whether the segment \p a – \p b crosses a crease segment at more than 30° (a crease the segment runs
+    /// along, such as the one a backbone follows, does not count).
+    bool crossesAcross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const {
+        if (!a.allFinite() || !b.allFinite()) return false;
+        const double cosAlong = std::cos(30.0 * std::numbers::pi / 180.0);
+        const Eigen::Vector2d d = b - a;
+        auto side = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
+            const double v = (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x();
+            return v > 0 ? 1 : (v < 0 ? -1 : 0);
+        };
+        const int x0 = cellOf(std::min(a.x(), b.x()), cellsX_), x1 = cellOf(std::max(a.x(), b.x()), cellsX_),
+                  y0 = cellOf(std::min(a.y(), b.y()), cellsY_), y1 = cellOf(std::max(a.y(), b.y()), cellsY_);
+        for (int y = y0; y <= y1; ++y)
+            for (int x = x0; x <= x1; ++x)
+                for (std::size_t i : cells_[std::size_t(y) * std::size_t(cellsX_) + std::size_t(x)]) {
+                    const CreaseSegment& s = segments_[i];
+                    const Eigen::Vector2d e = s.b - s.a;
+                    if (std::abs(d.dot(e)) >= cosAlong * d.norm() * e.norm()) continue;
+                    if (side(a, b, s.a) * side(a, b, s.b) < 0 && side(s.a, s.b, a) * side(s.a, s.b, b) < 0)
+                        return true;
+                }
+        return false;
+    }
+
+    /// Cuts \p backbone outwards from its seed before its first edge that crosses a crease (crossesAcross);
+    /// a closed backbone with such an edge becomes open. Returns the number of samples removed.
+    std::size_t cutBackbone(Backbone& backbone) const {
+        const Polyline2& s = backbone.samples;
+        const std::size_t n = s.size();
+        if (n < 2) return 0;
+        if (backbone.closed) {
+            // Forward from the seed (sample 0) to the first crossing edge, backward likewise.
+            std::size_t f = 0, b = 0; // kept: samples n − b … n − 1, 0 … f
+            while (f + 1 < n && !crossesAcross(s[f], s[f + 1]))
+                ++f;
+            if (f + 1 == n && !crossesAcross(s[n - 1], s[0])) return 0; // no crossing: stays closed
+            while (b + 1 + f < n && !crossesAcross(s[(n - b) % n], s[n - 1 - b]))
+                ++b;
+            Polyline2 open(s.end() - std::ptrdiff_t(b), s.end());
+            open.insert(open.end(), s.begin(), s.begin() + std::ptrdiff_t(f) + 1);
+            backbone.seedIndex = b;
+            backbone.samples = std::move(open);
+            backbone.closed = false;
+            return n - backbone.samples.size();
+        }
+        std::size_t lo = backbone.seedIndex, hi = backbone.seedIndex;
+        while (hi + 1 < n && !crossesAcross(s[hi], s[hi + 1]))
+            ++hi;
+        while (lo > 0 && !crossesAcross(s[lo], s[lo - 1]))
+            --lo;
+        const std::size_t removed = n - (hi - lo + 1);
+        backbone.samples = Polyline2(s.begin() + std::ptrdiff_t(lo), s.begin() + std::ptrdiff_t(hi) + 1);
+        backbone.seedIndex -= lo;
+        return removed;
     }
 
     /// Stops the half-ribs of \p grid where an edge after the first (which starts on the backbone, maybe
@@ -360,6 +421,122 @@ SampleGrid rayCastFishbone(const FishboneGrid& fishbone, const FrameBuffers& ref
 
 namespace {
 
+// FishboneOptions::surfaceLength on the sampling image: a screen point's surface point is its viewing ray on
+// the plane of the face the ID buffer shows under it (as the regular scan places its samples); a segment's
+// length is the distance of its ends' surface points. An end on the background: the other end's pixel
+// footprint times the screen length (both: 0, which the resampling skips).
+std::function<double(const Eigen::Vector2d&, const Eigen::Vector2d&)>
+surfaceMetric(const Mesh& mesh, const FrameBuffers& buffers) {
+    auto rays = std::make_shared<RayFactory>(buffers.camera);
+    auto onSurface = [&mesh, &buffers, rays](const Eigen::Vector2d& q) -> std::optional<Eigen::Vector3d> {
+        const int x = int(std::floor(q.x())), y = int(std::floor(q.y()));
+        if (!q.allFinite() || x < 0 || y < 0 || x >= buffers.width() || y >= buffers.height() ||
+            !buffers.covered(x, y))
+            return std::nullopt;
+        const HalfedgeIndex h = mesh.halfedge(FaceIndex(buffers.faceAt(x, y)));
+        auto p = [&](VertexIndex v) {
+            const Point3& a = mesh.point(v);
+            return Eigen::Vector3d(a.x(), a.y(), a.z());
+        };
+        const Eigen::Vector3d a = p(mesh.source(h)), b = p(mesh.target(h)), c = p(mesh.target(mesh.next(h)));
+        const Eigen::Vector3d n = (b - a).cross(c - a);
+        const Ray ray = (*rays)(q.x(), q.y());
+        const double dn = n.dot(ray.direction);
+        if (!(std::abs(dn) > 1e-12 * n.norm())) return std::nullopt;
+        return Eigen::Vector3d(ray.origin + (n.dot(a - ray.origin) / dn) * ray.direction);
+    };
+    return [onSurface, &buffers](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+        const std::optional<Eigen::Vector3d> pa = onSurface(a), pb = onSurface(b);
+        if (pa && pb) return (*pb - *pa).norm();
+        if (!pa && !pb) return 0.0;
+        return buffers.camera.pixelFootprint(pa ? *pa : *pb) * (b - a).norm();
+    };
+}
+
+// A closed fishbone grid (n rows that wrap) unrolled for the masks and the triangulation: the last p rows,
+// the n rows, then rows 0 … p again, so that the morphology sees every row's true neighbours and the quads
+// between the last and the first row are triangulated (padded row p + n repeats row 0).
+FishboneGrid unrollClosedGrid(const FishboneGrid& g, int p) {
+    FishboneGrid out = g;
+    out.closed = false;
+    out.rows = g.rows + 2 * p + 1;
+    out.screen.resize(std::size_t(out.rows) * std::size_t(g.cols));
+    out.present.resize(out.screen.size());
+    for (int r = 0; r < out.rows; ++r) {
+        const int from = ((r - p) % g.rows + g.rows) % g.rows;
+        std::copy_n(g.screen.begin() + std::ptrdiff_t(g.index(from, 0)), g.cols,
+                    out.screen.begin() + std::ptrdiff_t(out.index(r, 0)));
+        std::copy_n(g.present.begin() + std::ptrdiff_t(g.index(from, 0)), g.cols,
+                    out.present.begin() + std::ptrdiff_t(out.index(r, 0)));
+    }
+    return out;
+}
+
+// The patch of an unrolled closed grid (unrollClosedGrid): its faces between padded rows p and p + n, with
+// row p + n (the repeat of row 0) merged into row p, so the grid closes without a seam; the grid cropped to
+// the n rows. Samples of equal screen positions are cast, masked and triangulated alike, so the merged
+// rows are the same vertices; a face that would make the patch non-manifold is left out (counted as a
+// non-manifold triangle).
+void closeUnrolledPatch(Patch& patch, SampleGrid& grid, int n, int p) {
+    const Mesh& in = patch.mesh;
+    const auto [inIndex, hasIndex] = in.property_map<VertexIndex, GridIndex>(props::vertexGridIndex);
+    const auto [inQuality, hasQuality] = in.property_map<FaceIndex, float>(props::faceQuality);
+    const auto [inScan, hasScan] = in.property_map<FaceIndex, std::int32_t>(props::faceScanId);
+    if (!hasIndex) return;
+    Mesh out;
+    auto outIndex = out.add_property_map<VertexIndex, GridIndex>(props::vertexGridIndex).first;
+    auto outQuality = out.add_property_map<FaceIndex, float>(props::faceQuality, 0.0f).first;
+    auto outScan = out.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1).first;
+    const int cols = grid.cols;
+    std::vector<VertexIndex> made(std::size_t(n) * std::size_t(cols), Mesh::null_vertex());
+    auto vertexOf = [&](VertexIndex v) {
+        const GridIndex g = inIndex[v];
+        const int row = g.row - p == n ? 0 : g.row - p;
+        VertexIndex& m = made[std::size_t(row) * std::size_t(cols) + std::size_t(g.col)];
+        if (m == Mesh::null_vertex()) {
+            m = out.add_vertex(in.point(v));
+            outIndex[m] = GridIndex{row, g.col};
+        }
+        return m;
+    };
+    std::size_t refused = 0;
+    for (FaceIndex f : in.faces()) {
+        std::array<VertexIndex, 3> v{};
+        int k = 0;
+        bool core = true;
+        for (VertexIndex x : CGAL::vertices_around_face(in.halfedge(f), in)) {
+            const int row = inIndex[x].row;
+            core = core && row >= p && row <= p + n;
+            v[std::size_t(k++)] = x;
+        }
+        if (!core || k != 3) continue;
+        const FaceIndex g = out.add_face(vertexOf(v[0]), vertexOf(v[1]), vertexOf(v[2]));
+        if (g == Mesh::null_face()) {
+            ++refused;
+            continue;
+        }
+        if (hasQuality) outQuality[g] = inQuality[f];
+        if (hasScan) outScan[g] = inScan[f];
+    }
+    for (VertexIndex v : out.vertices())
+        if (out.is_isolated(v)) out.remove_vertex(v);
+    out.collect_garbage();
+    patch.mesh = std::move(out);
+    patch.rows = n;
+    patch.vertexOfSample.assign(std::size_t(n) * std::size_t(cols), Mesh::null_vertex());
+    const auto index = patch.mesh.property_map<VertexIndex, GridIndex>(props::vertexGridIndex).first;
+    for (VertexIndex v : patch.mesh.vertices())
+        patch.vertexOfSample[std::size_t(index[v].row) * std::size_t(cols) + std::size_t(index[v].col)] = v;
+    patch.report.faces = patch.mesh.number_of_faces();
+    patch.report.nonManifoldTriangles += refused;
+    SampleGrid cropped(n, cols);
+    cropped.camera = grid.camera;
+    cropped.scanId = grid.scanId;
+    std::copy_n(grid.samples.begin() + std::ptrdiff_t(grid.index(p, 0)), std::size_t(n) * std::size_t(cols),
+                cropped.samples.begin());
+    grid = std::move(cropped);
+}
+
 // The scan on its sampling image: \p params and \p fb are already scaled to it (and validated); \p k is
 // the sampling factor, only for the positions in error messages (which the user gave in scan pixels).
 FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& referenceRenderer,
@@ -462,10 +639,12 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
                 return creases.nearestAlong(q, heading);
             };
         backbone = traceBackbone(backboneField, *fb.seed, backboneOptions);
+        if (options.stopBackboneAtCreases && !creases.empty()) creases.cutBackbone(backbone);
     }
     if (backbone.samples.size() < 2)
         throw InvalidInputError("The fishbone backbone has fewer than two samples; pick a point on a longer "
                                 "feature or reduce h.");
+    if (options.isotropicRibs) options.surfaceLength = surfaceMetric(reference, buffers);
     if (!keyRibMode) {
         // The ribs are independent streamlines, traced on the scan threads (the grid is the same for any
         // thread count).
@@ -506,8 +685,13 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
 
     progress.report(0.6, "ray casting");
     t = Clock::now();
-    result.grid = rayCastFishbone(result.fishbone, buffers, reference, caster, params.scan, fb.raycast,
-                                  &result.counts.onHintFace);
+    // A closed grid is cast, masked and triangulated unrolled (unrollClosedGrid), then closed again.
+    const bool closedGrid = result.fishbone.closed;
+    const int pad = std::max(0, params.erodeRadius) +
+                    std::max(0, params.dilateRadius < 0 ? params.erodeRadius : params.dilateRadius) + 1;
+    result.grid =
+        rayCastFishbone(closedGrid ? unrollClosedGrid(result.fishbone, pad) : result.fishbone, buffers,
+                        reference, caster, params.scan, fb.raycast, &result.counts.onHintFace);
     // Sampling quality as on the scan image (its pixel footprint, 1/k of the sampling image's), so that the
     // quality mask ranks a fishbone patch the same whatever k is. The footprints stay the sampling camera's
     // (the triangulation's edge limits are in them).
@@ -538,6 +722,7 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
                          "erosion or reduce h.";
     MaskedPatch masked = maskAndTriangulate(result.grid, stages, progress);
     result.patch = std::move(masked.patch);
+    if (closedGrid) closeUnrolledPatch(result.patch, result.grid, result.fishbone.rows, pad);
     result.counts.afterLasso = masked.counts.afterLasso;
     result.counts.afterQuality = masked.counts.afterQuality;
     result.counts.afterMorphology = masked.counts.afterMorphology;

@@ -115,6 +115,9 @@ struct Writer {
         if (p.tracing.minRibGap != 0)
             t["min_rib_gap"] = number(p.tracing.minRibGap, f + ".tracing.min_rib_gap");
         if (p.tracing.stopRibsAtCreases) t["stop_ribs_at_creases"] = true;
+        if (p.tracing.closeLoops) t["close_loops"] = true;
+        if (p.tracing.stopBackboneAtCreases) t["stop_backbone_at_creases"] = true;
+        if (p.tracing.isotropicRibs) t["isotropic_ribs"] = true;
         if (p.tracing.maxRibTurnDeg != 180)
             t["max_rib_turn_deg"] = number(p.tracing.maxRibTurnDeg, f + ".tracing.max_rib_turn_deg");
         t["backbone"] = streamline(p.tracing.backboneTracing, f + ".tracing.backbone");
@@ -459,12 +462,16 @@ FishboneParams readFishbone(const Node& n) {
     p.drawnBackbone = n.at("drawn_backbone").points();
     const Node t = n.at("tracing");
     t.onlyKeys({"spacing", "extend_beyond_key_ribs", "backbone", "ribs", "min_rib_gap", "max_rib_turn_deg",
-                "stop_ribs_at_creases"});
+                "stop_ribs_at_creases", "close_loops", "stop_backbone_at_creases", "isotropic_ribs"});
     p.tracing.spacing = t.at("spacing").number();
     p.tracing.extendBeyondKeyRibs = t.at("extend_beyond_key_ribs").boolean();
     p.tracing.minRibGap = t.has("min_rib_gap") ? t.at("min_rib_gap").number() : 0.0;
     p.tracing.maxRibTurnDeg = t.has("max_rib_turn_deg") ? t.at("max_rib_turn_deg").number() : 180.0;
     p.tracing.stopRibsAtCreases = t.has("stop_ribs_at_creases") && t.at("stop_ribs_at_creases").boolean();
+    p.tracing.closeLoops = t.has("close_loops") && t.at("close_loops").boolean();
+    p.tracing.stopBackboneAtCreases =
+        t.has("stop_backbone_at_creases") && t.at("stop_backbone_at_creases").boolean();
+    p.tracing.isotropicRibs = t.has("isotropic_ribs") && t.at("isotropic_ribs").boolean();
     p.tracing.backboneTracing = readStreamline(t.at("backbone"));
     p.tracing.ribTracing = readStreamline(t.at("ribs"));
     p.minSeedAnisotropy = n.at("min_seed_anisotropy").number();
