@@ -668,6 +668,67 @@ fss::Camera topCamera(const CreaseScene& scene) {
     return top;
 }
 
+// A torus-like ring with two sharp circular ridges, on top and at the bottom of its tube: the surface of
+// revolution of a lens standing upright (two circular arcs of radius rho, centres at s = R ∓ d, z = 0,
+// meeting at s = R, z = ±√(rho² − d²), each ridge with a dihedral turn of 2·asin(d/rho) = 60°). Closed. Its
+// meridian curvature 1/rho exceeds the parallel one, so the ridges follow the min-curvature direction, and
+// the top ridge is a closed curve in full view from above.
+constexpr double kLensR = 2.0, kLensRho = 0.6, kLensD = 0.3;
+const double kLensHalf = std::sqrt(kLensRho * kLensRho - kLensD * kLensD);
+
+Mesh lensTorus(int nu, int m) {
+    Mesh mesh;
+    const double a0 = std::acos(kLensD / kLensRho);
+    std::vector<Vector2d> section; // (s, z): the outer arc bottom → top, then the inner arc top → bottom
+    for (int k = 0; k < m; ++k) {
+        const double a = -a0 + 2 * a0 * k / m;
+        section.emplace_back(kLensR - kLensD + kLensRho * std::cos(a), kLensRho * std::sin(a));
+    }
+    for (int k = 0; k < m; ++k) {
+        const double a = a0 - 2 * a0 * k / m;
+        section.emplace_back(kLensR + kLensD - kLensRho * std::cos(a), kLensRho * std::sin(a));
+    }
+    const int nv = int(section.size());
+    std::vector<fss::VertexIndex> v(std::size_t(nu) * std::size_t(nv));
+    for (int j = 0; j < nv; ++j)
+        for (int i = 0; i < nu; ++i) {
+            const double phi = 2 * std::numbers::pi * i / nu;
+            v[std::size_t(j) * nu + i] = mesh.add_vertex(
+                fss::Point3(section[std::size_t(j)].x() * std::cos(phi),
+                            section[std::size_t(j)].x() * std::sin(phi), section[std::size_t(j)].y()));
+        }
+    for (int j = 0; j < nv; ++j)
+        for (int i = 0; i < nu; ++i) {
+            const int j1 = (j + 1) % nv, i1 = (i + 1) % nu;
+            const auto a = v[std::size_t(j) * nu + i], b = v[std::size_t(j) * nu + i1];
+            const auto c = v[std::size_t(j1) * nu + i1], d = v[std::size_t(j1) * nu + i];
+            if ((i + j) % 2 == 0) { // alternating diagonals, as creasedRing
+                mesh.add_face(a, b, c);
+                mesh.add_face(a, c, d);
+            } else {
+                mesh.add_face(a, b, d);
+                mesh.add_face(b, c, d);
+            }
+        }
+    return mesh;
+}
+
+double distanceToLensRidges(const Vector3d& p) {
+    return std::hypot(std::hypot(p.x(), p.y()) - kLensR, std::abs(p.z()) - kLensHalf);
+}
+
+fss::Camera lookAt(const Mesh& mesh, const Vector3d& focal, const Vector3d& eye, const Vector3d& up,
+                   double angle, int size) {
+    fss::Camera c;
+    c.focal = focal;
+    c.eye = eye;
+    c.up = up;
+    c.viewAngleDeg = angle;
+    c.width = c.height = size;
+    c.fitClippingRange(bbox(mesh));
+    return c;
+}
+
 // Border cycles of a mesh.
 int borderCycles(const Mesh& m) {
     std::vector<char> seen(m.number_of_halfedges(), 0);
@@ -696,28 +757,29 @@ int borderEdgesAlongRows(const fss::Patch& patch, int a, int b) {
 
 } // namespace
 
-// A closed backbone closes the grid: the ridge of the creased ring seen from above is a closed curve; with
+// A closed backbone closes the grid: the top ridge of the lens torus seen from above is a closed curve; with
 // closeLoops the traced backbone is a loop whose closing edge is about h long, the grid's last and first
 // ribs are neighbours, and the patch is an annulus (two border cycles, the ridge's outer and inner sides)
 // with no border edge along its first or last rib. Without it the backbone runs on past its start (the
 // old behaviour: a gap beside an overlap) and the first and last ribs are borders.
+// (The creased ring's ridge is no such curve: it is the ring's silhouette from above.)
 TEST(FishboneScan, ClosedBackboneClosesTheGridOfTheRidge) {
-    const CreaseScene scene;
+    const Mesh lens = lensTorus(360, 40);
     fss::CpuMeshRenderer renderer;
-    renderer.setMesh(scene.ring);
+    renderer.setMesh(lens);
     fss::FishboneCache cache;
     fss::ScanParams params;
-    params.camera = topCamera(scene);
-    const Vector3d ridge = params.camera.project(Vector3d(kRidge, 0, 0));
+    params.camera = lookAt(lens, Vector3d(0, 0, kLensHalf), Vector3d(1.5, 0.5, 9.0), {0, 1, 0}, 45, 160);
+    const Vector3d ridge = params.camera.project(Vector3d(kLensR, 0, kLensHalf));
     fss::FishboneParams fb;
-    fb.seed = Vector2d(ridge.x() - 2, ridge.y());
+    fb.seed = ridge.head<2>();
     fb.spacing = 2;
     fb.tracing.closeLoops = true;
     const fss::FishboneScanResult closed =
-        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+        fss::scanFishbonePatch(lens, renderer, lens, renderer, params, fb, cache);
     fb.tracing.closeLoops = false;
     const fss::FishboneScanResult open =
-        fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+        fss::scanFishbonePatch(lens, renderer, lens, renderer, params, fb, cache);
     const fss::FishboneGrid& g = closed.fishbone;
     ASSERT_TRUE(g.closed);
     EXPECT_FALSE(open.fishbone.closed);
@@ -735,7 +797,7 @@ TEST(FishboneScan, ClosedBackboneClosesTheGridOfTheRidge) {
     EXPECT_EQ(borderCycles(closed.patch.mesh), 2);
     EXPECT_EQ(borderEdgesAlongRows(closed.patch, 0, n - 1), 0);
     EXPECT_EQ(borderCycles(open.patch.mesh), 1);
-    EXPECT_GT(borderEdgesAlongRows(open.patch, 0, open.fishbone.rows - 1), 10);
+    EXPECT_GE(borderEdgesAlongRows(open.patch, 0, open.fishbone.rows - 1), 5);
     // The seam: faces with vertices on both the last and the first rib.
     const auto index =
         closed.patch.mesh.property_map<fss::VertexIndex, fss::GridIndex>(fss::props::vertexGridIndex).first;
@@ -748,7 +810,9 @@ TEST(FishboneScan, ClosedBackboneClosesTheGridOfTheRidge) {
         }
         seamFaces += first && last;
     }
-    EXPECT_GT(seamFaces, 20);
+    // As many as between any two neighbouring ribs, on average.
+    EXPECT_GE(double(seamFaces),
+              0.8 * double(closed.patch.mesh.number_of_faces()) / double(closed.fishbone.rows));
     EXPECT_EQ(closed.grid.rows, n);
     EXPECT_EQ(closed.patch.rows, n);
     // Every patch vertex is its grid sample's point.
@@ -807,7 +871,8 @@ TEST(FishboneScan, BackboneAndRibsStopAtTheRidge) {
         "stopped %d (%d rows); ribs %d samples below, stopped %d\n",
         below(across, true), across.fishbone.rows, below(stopped, true), stopped.fishbone.rows,
         below(ribs, false), below(ribsStopped, false));
-    EXPECT_GT(below(across, true), 5);
+    EXPECT_GE(below(across, true), 2);
+    EXPECT_LT(stopped.fishbone.rows, across.fishbone.rows);
     EXPECT_EQ(below(stopped, true), 0);
     EXPECT_GT(stopped.fishbone.rows, 5);
     EXPECT_GT(below(ribs, false), 50);
@@ -817,66 +882,6 @@ TEST(FishboneScan, BackboneAndRibsStopAtTheRidge) {
 // ---- The sliver table of issue #20 (FSS_LONG_TESTS=1) -----------------------------------------------------
 
 namespace {
-
-// A torus-like ring with two sharp circular ridges: the surface of revolution of a lens (two circular arcs
-// of radius rho, centres at s = R, z = ∓d, meeting at z = 0 in the outer ridge s = R + √(rho² − d²) and the
-// inner ridge s = R − √(rho² − d²), each with a dihedral turn of 2·asin(d/rho) = 60°). Closed.
-constexpr double kLensR = 2.0, kLensRho = 0.6, kLensD = 0.3;
-const double kLensHalf = std::sqrt(kLensRho * kLensRho - kLensD * kLensD);
-
-Mesh lensTorus(int nu, int m) {
-    Mesh mesh;
-    const double phi0 = std::asin(kLensD / kLensRho);
-    std::vector<Vector2d> section; // (s, z) around the lens: the upper arc outer → inner, the lower back
-    for (int k = 0; k < m; ++k) {
-        const double a = phi0 + (std::numbers::pi - 2 * phi0) * k / m;
-        section.emplace_back(kLensR + kLensRho * std::cos(a), -kLensD + kLensRho * std::sin(a));
-    }
-    for (int k = 0; k < m; ++k) {
-        const double a = std::numbers::pi - phi0 - (std::numbers::pi - 2 * phi0) * k / m;
-        section.emplace_back(kLensR + kLensRho * std::cos(a), kLensD - kLensRho * std::sin(a));
-    }
-    const int nv = int(section.size());
-    std::vector<fss::VertexIndex> v(std::size_t(nu) * std::size_t(nv));
-    for (int j = 0; j < nv; ++j)
-        for (int i = 0; i < nu; ++i) {
-            const double phi = 2 * std::numbers::pi * i / nu;
-            v[std::size_t(j) * nu + i] = mesh.add_vertex(
-                fss::Point3(section[std::size_t(j)].x() * std::cos(phi),
-                            section[std::size_t(j)].x() * std::sin(phi), section[std::size_t(j)].y()));
-        }
-    for (int j = 0; j < nv; ++j)
-        for (int i = 0; i < nu; ++i) {
-            const int j1 = (j + 1) % nv, i1 = (i + 1) % nu;
-            const auto a = v[std::size_t(j) * nu + i], b = v[std::size_t(j) * nu + i1];
-            const auto c = v[std::size_t(j1) * nu + i1], d = v[std::size_t(j1) * nu + i];
-            if ((i + j) % 2 == 0) { // alternating diagonals, as creasedRing
-                mesh.add_face(a, d, c);
-                mesh.add_face(a, c, b);
-            } else {
-                mesh.add_face(a, d, b);
-                mesh.add_face(b, d, c);
-            }
-        }
-    return mesh;
-}
-
-double distanceToLensRidges(const Vector3d& p) {
-    const double s = std::hypot(p.x(), p.y());
-    return std::min(std::hypot(s - (kLensR + kLensHalf), p.z()), std::hypot(s - (kLensR - kLensHalf), p.z()));
-}
-
-fss::Camera lookAt(const Mesh& mesh, const Vector3d& focal, const Vector3d& eye, const Vector3d& up,
-                   double angle, int size) {
-    fss::Camera c;
-    c.focal = focal;
-    c.eye = eye;
-    c.up = up;
-    c.viewAngleDeg = angle;
-    c.width = c.height = size;
-    c.fitClippingRange(bbox(mesh));
-    return c;
-}
 
 // Sharp-edge chains of a CGAL mesh (dihedral > 30°, chained through vertices with two sharp edges).
 std::vector<std::vector<Vector3d>> creaseChains(const Mesh& m, fss::FishboneCache& cache) {
@@ -905,6 +910,21 @@ std::vector<std::vector<Vector3d>> creaseChains(const Mesh& m, fss::FishboneCach
             chains.push_back(std::move(chain));
         }
     }
+    // Closed loops (every vertex with two sharp edges): from any unused sharp edge round to it.
+    for (auto e : sharp) {
+        if (used[e.idx()]) continue;
+        auto h = m.halfedge(e);
+        std::vector<Vector3d> chain{pt(m, m.source(h))};
+        for (;;) {
+            used[m.edge(h).idx()] = 1;
+            chain.push_back(pt(m, m.target(h)));
+            const auto& next = out[m.target(h).idx()];
+            if (next.size() != 2) break;
+            h = m.edge(next[0]) == m.edge(h) ? next[1] : next[0];
+            if (used[m.edge(h).idx()]) break;
+        }
+        chains.push_back(std::move(chain));
+    }
     return chains;
 }
 
@@ -930,38 +950,52 @@ struct SliverCase {
 // A view and a seed on a curved crease of a CGAL mesh: of the seven standard views at 256² and the chains of
 // sharp edges turning by 30–180° over at least 12 edges, the (chain, view) whose visible middle edge is seen
 // most frontally (both faces), its midpoint the seed.
-std::optional<SliverCase> cgalCase(const std::string& name, const Mesh& m, fss::FishboneCache& cache) {
+std::vector<SliverCase> cgalCases(const std::string& name, const Mesh& m, fss::FishboneCache& cache) {
     const std::vector<std::vector<Vector3d>> chains = creaseChains(m, cache);
-    std::optional<SliverCase> best;
-    double bestScore = 0;
     const fss::RayCaster& caster = cache.rayCaster(m);
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(m);
+    std::vector<std::pair<double, SliverCase>> perView;
     for (const fss::StandardView view :
          {fss::StandardView::Iso, fss::StandardView::PosX, fss::StandardView::NegX, fss::StandardView::PosY,
           fss::StandardView::NegY, fss::StandardView::PosZ, fss::StandardView::NegZ}) {
         const fss::Camera camera = fss::Camera::standardView(view, bbox(m), 256, 256);
+        fss::Camera sampling = camera;
+        sampling.width = sampling.height = 128; // k = 2 for h = 2
+        const fss::FrameBuffers buffers = renderer.render(sampling);
+        double bestScore = 0.3;
+        std::optional<SliverCase> best;
         for (const auto& chain : chains) {
-            if (chain.size() < 13) continue;
-            const Vector3d d0 = (chain[1] - chain[0]).normalized(),
-                           d1 = (chain.back() - chain[chain.size() - 2]).normalized();
-            const double turn = std::acos(std::clamp(d0.dot(d1), -1.0, 1.0)) * 180 / std::numbers::pi;
-            if (turn < 30 || turn > 180 - 1e-9) continue;
-            const std::size_t mid = chain.size() / 2;
-            const Vector3d p = 0.5 * (chain[mid] + chain[mid - 1]);
-            const Vector3d s = camera.project(p);
-            if (!(s.x() > 32 && s.y() > 32 && s.x() < 224 && s.y() < 224)) continue;
-            // Visible: the ray through the seed hits within a footprint of the crease point.
-            const fss::SurfacePoint hit = caster.intersect(camera.ray(s.x(), s.y()));
-            if (!hit || (hit.point - p).norm() > 2 * camera.pixelFootprint(p)) continue;
-            // Frontal: the surface normals on both sides of the crease near the seed face the camera.
-            const Vector3d toEye = (camera.eye - p).normalized();
-            double score = 1;
-            const Vector3d along = (chain[mid] - chain[mid - 1]).normalized();
-            const Vector3d side = along.cross(toEye).normalized();
-            for (const double sign : {1.0, -1.0}) {
-                const Vector3d q = p + sign * 4 * camera.pixelFootprint(p) * side;
-                score = std::min(score, faceNormal(m, caster.closestPoint(q).face).dot(toEye));
-            }
-            if (score > bestScore) {
+            // Windows of 12 edges: turning by 20–150° in all, at most 20° at a vertex (a smooth curve).
+            for (std::size_t mid = 6; mid + 6 < chain.size(); mid += 3) {
+                double total = 0, most = 0;
+                for (std::size_t k = mid - 5; k <= mid + 5; ++k) {
+                    const Vector3d u = (chain[k] - chain[k - 1]).normalized(),
+                                   w = (chain[k + 1] - chain[k]).normalized();
+                    const double a = std::acos(std::clamp(u.dot(w), -1.0, 1.0)) * 180 / std::numbers::pi;
+                    total += a;
+                    most = std::max(most, a);
+                }
+                if (total < 20 || total > 150 || most > 20) continue;
+                const Vector3d p = 0.5 * (chain[mid] + chain[mid - 1]);
+                const Vector3d s = camera.project(p);
+                if (!(s.x() > 32 && s.y() > 32 && s.x() < 224 && s.y() < 224)) continue;
+                const fss::SurfacePoint hit = caster.intersect(camera.ray(s.x(), s.y()));
+                if (!hit || (hit.point - p).norm() > 2 * camera.pixelFootprint(p)) continue;
+                bool covered = true; // the seed's 3 × 3 pixels of the sampling image
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx)
+                        covered = covered && buffers.covered(int(s.x() / 2) + dx, int(s.y() / 2) + dy);
+                if (!covered) continue;
+                // Frontal: the surface on both sides of the crease near the seed faces the camera.
+                const Vector3d toEye = (camera.eye - p).normalized();
+                const Vector3d side = (chain[mid] - chain[mid - 1]).normalized().cross(toEye).normalized();
+                double score = 1;
+                for (const double sign : {1.0, -1.0}) {
+                    const Vector3d q = p + sign * 4 * camera.pixelFootprint(p) * side;
+                    score = std::min(score, faceNormal(m, caster.closestPoint(q).face).dot(toEye));
+                }
+                if (score <= bestScore) continue;
                 bestScore = score;
                 SliverCase c;
                 c.name = name + " " + fss::standardViewName(view);
@@ -972,19 +1006,41 @@ std::optional<SliverCase> cgalCase(const std::string& name, const Mesh& m, fss::
                 best = c;
             }
         }
+        if (best) perView.emplace_back(bestScore, *best);
     }
-    return best;
+    // The two most frontal views.
+    std::stable_sort(perView.begin(), perView.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::vector<SliverCase> out;
+    for (std::size_t i = 0; i < perView.size() && i < 2; ++i)
+        out.push_back(perView[i].second);
+    return out;
 }
 
 } // namespace
 
+// "open", or for a closed grid the border edges along its first and last rib (the seam) against the mean
+// along any other two neighbouring ribs (ribs of unequal length leave some anywhere).
+static std::string closedText(const fss::FishboneScanResult& r) {
+    if (!r.fishbone.closed) return "open";
+    const int n = r.fishbone.rows;
+    double others = 0;
+    for (int row = 1; row + 1 < n; ++row)
+        others += borderEdgesAlongRows(r.patch, row, row + 1);
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "closed: %d seam border edges (%.1f elsewhere)",
+                  borderEdgesAlongRows(r.patch, 0, n - 1), others / double(n - 2));
+    return buf;
+}
+
 // The figures of issue #20's fishbone criteria on shapes and meshes: for each case, h = 2 px, with and
 // without a lasso (a square of 0.6 W around the seed), the paper's fishbone ("paper") and the issue-20 set
 // ("issue20": closeLoops, stopBackboneAtCreases, minRibGap 0.5, maxRibTurnDeg 60, stopRibsAtCreases,
-// minQuadAngleDeg 20): the patch's smallest angle, the share of faces below 30°, the mean normal error of the
-// faces within 2h of the crease near the backbone (screen distance ≤ 3h to a backbone sample) against the
-// regular grid's at the same spacing (the scan at W/2 × H/2), and whether the grid closed. Printed only.
-// FSS_LONG_TESTS=1 build/bin/core_tests --gtest_filter='FishboneScan.SliverTable'
+// minQuadAngleDeg 20) and "+iso" (that and isotropicRibs): the patch's smallest angle, the share of faces
+// below 30°, the mean normal error of the faces within 2h of the crease near the backbone (screen distance ≤
+// 3h to a backbone sample) against the regular grid's at the same spacing (the scan at W/2 × H/2), and
+// whether the grid closed. Printed only. FSS_LONG_TESTS=1 build/bin/core_tests
+// --gtest_filter='FishboneScan.SliverTable'
 TEST(FishboneScan, SliverTable) {
     if (!std::getenv("FSS_LONG_TESTS")) GTEST_SKIP() << "set FSS_LONG_TESTS=1";
     const CreaseScene scene;
@@ -1013,31 +1069,49 @@ TEST(FishboneScan, SliverTable) {
         cases.push_back({"ring oblique", &scene.ring, c, s.head<2>(), distanceToRidge, "untuned"});
     }
     {
-        const double el = 35 * std::numbers::pi / 180, outer = kLensR + kLensHalf;
-        const Vector3d focal(outer, 0, 0);
+        const double el = 35 * std::numbers::pi / 180;
+        const Vector3d focal(kLensR, 0, kLensHalf);
         const fss::Camera c =
             lookAt(lens, focal, focal + 4.0 * Vector3d(std::cos(el), 0.3, std::sin(el)), {0, 0, 1}, 35, 200);
         cases.push_back(
             {"lens torus side", &lens, c, c.project(focal).head<2>(), distanceToLensRidges, "untuned"});
-        const fss::Camera t = lookAt(lens, Vector3d(0, 0, 0), Vector3d(2.0, 0.5, 9.0), {0, 1, 0}, 45, 256);
-        const Vector3d s = t.project(Vector3d(outer * std::cos(0.3), outer * std::sin(0.3), 0));
+        const fss::Camera t =
+            lookAt(lens, Vector3d(0, 0, kLensHalf), Vector3d(2.0, 0.5, 9.0), {0, 1, 0}, 45, 256);
+        const Vector3d s = t.project(Vector3d(kLensR * std::cos(0.3), kLensR * std::sin(0.3), kLensHalf));
         cases.push_back({"lens torus top (closed)", &lens, t, s.head<2>(), distanceToLensRidges, "untuned"});
     }
-    for (std::size_t i = 0; i < cgal.size(); ++i)
-        if (std::optional<SliverCase> c = cgalCase(names[i], cgal[i], caches[i])) {
-            c->tuned = names[i] == "fandisk" ? "tuned" : "untuned";
-            cases.push_back(*c);
-        } else {
+    for (std::size_t i = 0; i < cgal.size(); ++i) {
+        std::vector<SliverCase> found = cgalCases(names[i], cgal[i], caches[i]);
+        if (found.empty())
             std::printf("%s: no curved crease chain found in the standard views\n", names[i].c_str());
+        for (SliverCase& c : found) {
+            c.tuned = names[i] == "fandisk" ? "tuned" : "untuned";
+            cases.push_back(std::move(c));
         }
+    }
 
     std::printf("%-26s %-7s %-6s %-7s | %5s %6s %6s | %6s %6s %5s | %s\n", "case", "set", "lasso", "",
                 "faces", "min°", "<30%", "nerr°", "grid°", "ratio", "closed");
-    for (const SliverCase& c : cases) {
+    for (SliverCase& c : cases) {
         fss::CpuMeshRenderer renderer;
         renderer.setMesh(*c.mesh);
         fss::FishboneCache cache;
         const fss::RayCaster& caster = cache.rayCaster(*c.mesh);
+        {
+            // The seed on a covered pixel of the sampling image (k = 2): nudged by up to 2 px if needed.
+            fss::Camera sampling = c.camera;
+            sampling.width /= 2;
+            sampling.height /= 2;
+            const fss::FrameBuffers b = renderer.render(sampling);
+            auto covered = [&](const Vector2d& q) { return b.covered(int(q.x() / 2), int(q.y() / 2)); };
+            for (int k = 0; k < 25 && !covered(c.seed); ++k) {
+                const Vector2d q = c.seed + Vector2d(k % 5 - 2, k / 5 - 2);
+                if (covered(q)) {
+                    std::printf("%s: seed nudged by (%d, %d)\n", c.name.c_str(), k % 5 - 2, k / 5 - 2);
+                    c.seed = q;
+                }
+            }
+        }
         const fss::SurfacePoint seedHit = caster.intersect(c.camera.ray(c.seed.x(), c.seed.y()));
         if (!seedHit) {
             std::printf("%s: the seed misses\n", c.name.c_str());
@@ -1045,7 +1119,9 @@ TEST(FishboneScan, SliverTable) {
         }
         const double h = 2, hWorld = h * c.camera.pixelFootprint(seedHit.point);
         for (const bool lasso : {false, true})
-            for (const bool issue20 : {false, true}) {
+            for (const int set : {0, 1, 2}) {
+                const bool issue20 = set > 0;
+                const char* setName = set == 0 ? "paper" : set == 1 ? "issue20" : "+iso";
                 fss::ScanParams params;
                 params.camera = c.camera;
                 const double half = 0.3 * c.camera.width;
@@ -1061,14 +1137,15 @@ TEST(FishboneScan, SliverTable) {
                         true;
                     fb.tracing.minRibGap = 0.5;
                     fb.tracing.maxRibTurnDeg = 60;
+                    fb.tracing.isotropicRibs = set == 2;
                     params.triangulate.minQuadAngleDeg = 20;
                 }
                 fss::FishboneScanResult r;
                 try {
                     r = fss::scanFishbonePatch(*c.mesh, renderer, *c.mesh, renderer, params, fb, cache);
                 } catch (const fss::InvalidInputError& e) {
-                    std::printf("%-26s %-7s %-6s: %s\n", c.name.c_str(), issue20 ? "issue20" : "paper",
-                                lasso ? "lasso" : "-", e.what());
+                    std::printf("%-26s %-7s %-6s: %s\n", c.name.c_str(), setName, lasso ? "lasso" : "-",
+                                e.what());
                     continue;
                 }
                 // The regular grid at the same spacing: the scan at W/h × H/h.
@@ -1107,14 +1184,58 @@ TEST(FishboneScan, SliverTable) {
                 const AngleFigures a = angleFigures(r.patch.mesh);
                 const double fishError = nearError(r.patch.mesh), gridError = nearError(regular.patch.mesh);
                 std::printf("%-26s %-7s %-6s %-7s | %5zu %6.1f %6.1f | %6.2f %6.2f %5.2f | %s\n",
-                            c.name.c_str(), issue20 ? "issue20" : "paper", lasso ? "lasso" : "-",
-                            c.tuned.c_str(), a.faces, a.minDeg, 100 * a.below30, fishError, gridError,
-                            fishError / gridError,
-                            r.fishbone.closed ? (borderEdgesAlongRows(r.patch, 0, r.fishbone.rows - 1) == 0
-                                                     ? "closed, no seam border"
-                                                     : "closed, seam border")
-                                              : "open");
+                            c.name.c_str(), setName, lasso ? "lasso" : "-", c.tuned.c_str(), a.faces,
+                            a.minDeg, 100 * a.below30, fishError, gridError, fishError / gridError,
+                            closedText(r).c_str());
                 EXPECT_GT(a.faces, 0u);
             }
     }
+}
+
+// Ribs spaced on the surface (FishboneOptions::isotropicRibs): on the creased ring's front view the lower
+// flank is seen at about 60° and the upper one frontally, so ribs spaced h on the screen have surface edges
+// up to twice the backbone's spacing on the lower flank. With isotropicRibs each rib edge's surface length
+// (the samples' 3D points) is the backbone's surface spacing at its row: the share of rib edges within 20 %
+// of it, over edges that do not cross the ridge.
+TEST(FishboneScan, IsotropicRibsAreSpacedOnTheSurface) {
+    const CreaseScene scene;
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(scene.ring);
+    fss::FishboneCache cache;
+    fss::ScanParams params;
+    params.camera = scene.camera;
+    fss::FishboneParams fb;
+    fb.seed = scene.ridgeSeed();
+    fb.spacing = 2;
+    auto within = [&](bool isotropic) {
+        fb.tracing.isotropicRibs = isotropic;
+        const fss::FishboneScanResult r =
+            fss::scanFishbonePatch(scene.ring, renderer, scene.ring, renderer, params, fb, cache);
+        const fss::SampleGrid& g = r.grid;
+        const int bc = r.fishbone.backboneColumn;
+        std::size_t edges = 0, good = 0;
+        for (int row = 1; row + 1 < g.rows; ++row) {
+            const fss::Sample &a = g.at(row - 1, bc), &b = g.at(row + 1, bc);
+            if (!a.hit || !b.hit) continue;
+            const double spacing = 0.5 * (a.point - b.point).norm();
+            for (int c = 1; c < g.cols; ++c) {
+                const fss::Sample &p = g.at(row, c - 1), &q = g.at(row, c);
+                if (!p.hit || !q.hit || !r.fishbone.isPresent(row, c) || !r.fishbone.isPresent(row, c - 1))
+                    continue;
+                if ((p.point.z() > 0) != (q.point.z() > 0)) continue; // across the ridge
+                const double ratio = (p.point - q.point).norm() / spacing;
+                ++edges;
+                good += ratio > 0.8 && ratio < 1.25;
+            }
+        }
+        std::printf(
+            "creased ring front, %s ribs: %zu rib edges, %.1f %% within 20 %% of the backbone's surface "
+            "spacing\n",
+            isotropic ? "isotropic" : "screen-spaced", edges, 100.0 * double(good) / double(edges));
+        EXPECT_GT(edges, 500u);
+        return double(good) / double(edges);
+    };
+    const double screen = within(false), surface = within(true);
+    EXPECT_GT(surface, 0.9);
+    EXPECT_LT(screen, 0.85); // measured 95.0 % and 80.2 %
 }

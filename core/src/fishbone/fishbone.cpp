@@ -332,23 +332,45 @@ Backbone drawnBackbone(const Polyline2& points, const FishboneOptions& options) 
 namespace {
 
 // Resamples a dense rib half at equal surface arc length \p target (FishboneOptions::surfaceLength): the
-// first vertex is kept, each further one where the surface length along the polyline reaches the next
-// multiple of target; the tail shorter than target is dropped.
+// first vertex is kept, each further one where the surface length along the polyline since the previous
+// vertex reaches target, but never closer than \p minScreen to it on the screen (on a surface seen almost
+// edge-on the vertices would crowd into a pixel, where the ray casts are least reliable: there the edges
+// grow longer than target instead). A dense segment longer than 3·target on the surface spans a depth jump
+// (an occlusion boundary): the rib ends before it.
 Polyline2
-resampleOnSurface(const Polyline2& dense, double target,
+resampleOnSurface(const Polyline2& dense, double target, double minScreen,
                   const std::function<double(const Eigen::Vector2d&, const Eigen::Vector2d&)>& length) {
     Polyline2 out;
     if (dense.empty()) return out;
     out.push_back(dense.front());
-    double at = 0;
+    double since = 0; // surface length from the last vertex to dense[i − 1]
     for (std::size_t i = 1; i < dense.size(); ++i) {
         const double seg = length(dense[i - 1], dense[i]);
-        if (!(seg > 0) || !std::isfinite(seg)) continue;
-        while (double(out.size()) * target <= at + seg) {
-            const double t = (double(out.size()) * target - at) / seg;
-            out.push_back(dense[i - 1] + t * (dense[i] - dense[i - 1]));
+        if (!std::isfinite(seg) || seg > 3 * target) break;
+        if (!(seg > 0)) continue;
+        double t0 = 0; // the part of this segment before t0 is accounted for
+        for (;;) {
+            const double t = std::max(t0, t0 + (target - since) / seg); // since may exceed target
+            if (t > 1) break;
+            const Eigen::Vector2d q = dense[i - 1] + t * (dense[i] - dense[i - 1]);
+            if ((q - out.back()).norm() < minScreen) { // too close on the screen: go on along the segment
+                const Eigen::Vector2d e = dense[i] - dense[i - 1];
+                // The point of the segment at distance minScreen from the last vertex, if any.
+                const Eigen::Vector2d f = dense[i - 1] - out.back();
+                const double A = e.squaredNorm(), B = e.dot(f), C = f.squaredNorm() - minScreen * minScreen;
+                const double disc = B * B - A * C;
+                const double u = disc >= 0 && A > 0 ? (-B + std::sqrt(disc)) / A : 2.0;
+                if (u > 1) break;
+                out.push_back(dense[i - 1] + std::max(u, t) * e);
+                since = 0;
+                t0 = std::max(u, t);
+                continue;
+            }
+            out.push_back(q);
+            since = 0;
+            t0 = t;
         }
-        at += seg;
+        since += (1 - t0) * seg;
     }
     return out;
 }
@@ -402,7 +424,8 @@ std::vector<Rib> traceRibs(const DirectionField& ribField, const Backbone& backb
             surface[i] = backboneSurfaceSpacing(backbone, first + i, options);
     for (std::size_t k = 0; k < halves.size(); ++k) {
         const std::size_t i = owners[k];
-        *targets[k] = surface[i] > 0 ? resampleOnSurface(halves[k].points, surface[i], options.surfaceLength)
+        *targets[k] = surface[i] > 0 ? resampleOnSurface(halves[k].points, surface[i], 0.5 * options.spacing,
+                                                         options.surfaceLength)
                                      : resampleAtSpacing(halves[k].points, options.spacing);
     }
     return ribs;

@@ -68,9 +68,13 @@ struct CreaseSegment {
 };
 
 /// The crease edges visible in \p buffers: projected, and kept when the ID buffer shows one of the edge's
-/// two faces within a pixel of the edge's midpoint.
+/// two faces within a pixel of the edge's midpoint — or, given \p caster (the stops of issue 20), when the
+/// ray through the midpoint's screen position hits the reference within a pixel footprint of it: where the
+/// faces are smaller than a pixel the ID buffer mostly shows other faces beside the crease, and the first
+/// test alone missed most of the creased ring's ridge at 80². (The backbone's crease following keeps the
+/// first test alone, so that recorded sessions replay as before.)
 std::vector<CreaseSegment> visibleCreases(const Mesh& mesh, const std::vector<EdgeIndex>& edges,
-                                          const FrameBuffers& buffers) {
+                                          const FrameBuffers& buffers, const RayCaster* caster = nullptr) {
     std::vector<CreaseSegment> out;
     if (edges.empty()) return out;
     const Camera& camera = buffers.camera;
@@ -98,6 +102,14 @@ std::vector<CreaseSegment> visibleCreases(const Mesh& mesh, const std::vector<Ed
                 const std::uint32_t id = buffers.faceAt(x, y);
                 visible = id == f0 || id == f1;
             }
+        if (!visible && caster && mx >= 0 && my >= 0 && mx < w && my < h) {
+            const Point3 p = CGAL::midpoint(mesh.point(mesh.source(he)), mesh.point(mesh.target(he)));
+            const Eigen::Vector3d m3(p.x(), p.y(), p.z());
+            const std::uint32_t id = buffers.faceAt(mx, my);
+            const SurfacePoint hit = caster->intersect(
+                camera.ray(m.x(), m.y()), id == FrameBuffers::kNoFace ? Mesh::null_face() : FaceIndex(id));
+            visible = hit && (hit.point - m3).norm() <= camera.pixelFootprint(m3);
+        }
         if (visible) out.push_back({a, b});
     }
     return out;
@@ -611,17 +623,21 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
 
     progress.report(0.4, "tracing");
     t = Clock::now();
-    // The visible creases (crease following of the backbone, ribs stopped at creases), made once when needed.
-    std::optional<CreaseIndex> creaseIndex;
-    auto visible = [&]() -> const CreaseIndex& {
-        if (!creaseIndex)
-            creaseIndex.emplace(
-                fb.creaseAngleDeg > 0
-                    ? visibleCreases(reference, cache.creaseEdges(reference, fb.creaseAngleDeg), buffers)
-                    : std::vector<CreaseSegment>{},
-                fb.creaseSnapRadius, W, H);
-        return *creaseIndex;
+    // The visible creases, made once when needed: for the crease following of the backbone, and (with the ray
+    // test of visibleCreases) for the stops of issue 20.
+    std::optional<CreaseIndex> creaseIndex, stopIndex;
+    auto index = [&](std::optional<CreaseIndex>& i, const RayCaster* rays) -> const CreaseIndex& {
+        if (!i) {
+            std::vector<CreaseSegment> segments;
+            if (fb.creaseAngleDeg > 0)
+                segments =
+                    visibleCreases(reference, cache.creaseEdges(reference, fb.creaseAngleDeg), buffers, rays);
+            i.emplace(std::move(segments), fb.creaseSnapRadius, W, H);
+        }
+        return *i;
     };
+    auto visible = [&]() -> const CreaseIndex& { return index(creaseIndex, nullptr); };
+    auto stops = [&]() -> const CreaseIndex& { return index(stopIndex, &caster); };
     Backbone backbone;
     if (drawnBackbone) {
         backbone = fss::drawnBackbone(fb.drawnBackbone, options);
@@ -639,7 +655,7 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
                 return creases.nearestAlong(q, heading);
             };
         backbone = traceBackbone(backboneField, *fb.seed, backboneOptions);
-        if (options.stopBackboneAtCreases && !creases.empty()) creases.cutBackbone(backbone);
+        if (options.stopBackboneAtCreases && fb.creaseAngleDeg > 0) stops().cutBackbone(backbone);
     }
     if (backbone.samples.size() < 2)
         throw InvalidInputError("The fishbone backbone has fewer than two samples; pick a point on a longer "
@@ -676,7 +692,7 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
         }
         result.fishbone = keyRibFishbone(backbone, std::move(keys), options, W, H);
     }
-    if (options.stopRibsAtCreases && fb.creaseAngleDeg > 0) visible().stopRibsAtCreases(result.fishbone);
+    if (options.stopRibsAtCreases && fb.creaseAngleDeg > 0) stops().stopRibsAtCreases(result.fishbone);
     result.timings.tracing = secondsSince(t);
     result.counts.directionPixels = backboneField.computedPixels() + ribField.computedPixels();
     result.counts.rows = result.fishbone.rows;
