@@ -433,29 +433,23 @@ SampleGrid rayCastFishbone(const FishboneGrid& fishbone, const FrameBuffers& ref
 
 namespace {
 
-// FishboneOptions::surfaceLength on the sampling image: a screen point's surface point is its viewing ray on
-// the plane of the face the ID buffer shows under it (as the regular scan places its samples); a segment's
-// length is the distance of its ends' surface points. An end on the background: the other end's pixel
-// footprint times the screen length (both: 0, which the resampling skips).
+// FishboneOptions::surfaceLength on the sampling image: a screen point's surface point is where its viewing
+// ray hits the reference (RayCaster with the ID buffer's face under it as the hint, as the rib vertices are
+// cast); a segment's length is the distance of its ends' surface points. An end on the background: the other
+// end's pixel footprint times the screen length (both: 0, which the resampling skips).
 std::function<double(const Eigen::Vector2d&, const Eigen::Vector2d&)>
-surfaceMetric(const Mesh& mesh, const FrameBuffers& buffers) {
+surfaceMetric(const FrameBuffers& buffers, const RayCaster& caster, const LocalSearchOptions& search) {
     auto rays = std::make_shared<RayFactory>(buffers.camera);
-    auto onSurface = [&mesh, &buffers, rays](const Eigen::Vector2d& q) -> std::optional<Eigen::Vector3d> {
+    auto onSurface = [&buffers, &caster, &search,
+                      rays](const Eigen::Vector2d& q) -> std::optional<Eigen::Vector3d> {
         const int x = int(std::floor(q.x())), y = int(std::floor(q.y()));
         if (!q.allFinite() || x < 0 || y < 0 || x >= buffers.width() || y >= buffers.height() ||
             !buffers.covered(x, y))
             return std::nullopt;
-        const HalfedgeIndex h = mesh.halfedge(FaceIndex(buffers.faceAt(x, y)));
-        auto p = [&](VertexIndex v) {
-            const Point3& a = mesh.point(v);
-            return Eigen::Vector3d(a.x(), a.y(), a.z());
-        };
-        const Eigen::Vector3d a = p(mesh.source(h)), b = p(mesh.target(h)), c = p(mesh.target(mesh.next(h)));
-        const Eigen::Vector3d n = (b - a).cross(c - a);
-        const Ray ray = (*rays)(q.x(), q.y());
-        const double dn = n.dot(ray.direction);
-        if (!(std::abs(dn) > 1e-12 * n.norm())) return std::nullopt;
-        return Eigen::Vector3d(ray.origin + (n.dot(a - ray.origin) / dn) * ray.direction);
+        const SurfacePoint hit =
+            caster.intersect((*rays)(q.x(), q.y()), FaceIndex(buffers.faceAt(x, y)), search);
+        if (!hit) return std::nullopt;
+        return hit.point;
     };
     return [onSurface, &buffers](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
         const std::optional<Eigen::Vector3d> pa = onSurface(a), pb = onSurface(b);
@@ -660,7 +654,7 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
     if (backbone.samples.size() < 2)
         throw InvalidInputError("The fishbone backbone has fewer than two samples; pick a point on a longer "
                                 "feature or reduce h.");
-    if (options.isotropicRibs) options.surfaceLength = surfaceMetric(reference, buffers);
+    if (options.isotropicRibs) options.surfaceLength = surfaceMetric(buffers, caster, fb.raycast);
     if (!keyRibMode) {
         // The ribs are independent streamlines, traced on the scan threads (the grid is the same for any
         // thread count).
