@@ -5,16 +5,16 @@
 namespace fss::detail::stitching {
 
 bool ComponentStitcher::triangulate(Cdt& cdt, std::vector<CdtVertex>& vh, Attempt& a) {
-    vh.assign(L_.size(), CdtVertex());
+    vh.assign(cut_.L.size(), CdtVertex());
     std::vector<int> order;
-    for (std::size_t i = 0; i < L_.size(); ++i)
-        if (L_[i].alive) order.push_back(int(i));
+    for (std::size_t i = 0; i < cut_.L.size(); ++i)
+        if (cut_.L[i].alive) order.push_back(int(i));
     std::vector<int> bad;
     CdtFace hint;
     std::size_t inserted = 0;
     for (int i : order) {
         progress_.tick();
-        const CdtVertex v = cdt.insert(L_[std::size_t(i)].uv, hint);
+        const CdtVertex v = cdt.insert(cut_.L[std::size_t(i)].uv, hint);
         if (v->info().id >= 0) {
             addBad(bad, i);
             addBad(bad, v->info().id);
@@ -32,14 +32,14 @@ bool ComponentStitcher::triangulate(Cdt& cdt, std::vector<CdtVertex>& vh, Attemp
         for (std::size_t k = 0; k + 1 < line.size(); ++k) {
             const std::size_t p = std::size_t(line[k]), q = std::size_t(line[k + 1]);
             progress_.tick();
-            subEdges_.push_back({line[k], line[k + 1]});
+            cut_.subEdges.push_back({line[k], line[k + 1]});
             cdt.insert_constraint(vh[p], vh[q]);
         }
     };
-    for (const auto& re : redges_)
+    for (const auto& re : cut_.redges)
         constrain(re.line);
-    const std::size_t regionSubs = subEdges_.size();
-    for (const auto& pe : pedges_)
+    const std::size_t regionSubs = cut_.subEdges.size();
+    for (const auto& pe : comp_.pedges)
         constrain(pe.line);
     if (cdt.number_of_vertices() != inserted) {
         for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v)
@@ -48,8 +48,8 @@ bool ComponentStitcher::triangulate(Cdt& cdt, std::vector<CdtVertex>& vh, Attemp
             }
         return fail(a, "it or the mesh under it overlaps itself in the scan's view", std::move(bad));
     }
-    for (std::size_t k = 0; k < subEdges_.size(); ++k) {
-        const auto [p, q] = subEdges_[k];
+    for (std::size_t k = 0; k < cut_.subEdges.size(); ++k) {
+        const auto [p, q] = cut_.subEdges[k];
         CdtFace f;
         int i;
         if (!cdt.is_edge(vh[std::size_t(p)], vh[std::size_t(q)], f, i)) {
@@ -57,7 +57,7 @@ bool ComponentStitcher::triangulate(Cdt& cdt, std::vector<CdtVertex>& vh, Attemp
             addBad(bad, q);
             continue;
         }
-        (k < regionSubs ? regionSub_ : patchSub_).insert(edgeKey(std::uint32_t(p), std::uint32_t(q)));
+        (k < regionSubs ? cut_.regionSub : cut_.patchSub).insert(edgeKey(std::uint32_t(p), std::uint32_t(q)));
     }
     if (!bad.empty())
         return fail(a, "its boundary passes exactly through mesh vertices in the view", std::move(bad));
@@ -79,20 +79,20 @@ std::uint64_t ComponentStitcher::keyOf(CdtFace f, int i) const {
 bool ComponentStitcher::classify(Cdt& cdt, const std::vector<CdtVertex>& vh, Attempt& a) {
     std::vector<int> bad;
     std::vector<CdtFace> stack;
-    for (std::size_t r = 0; r < region_.size(); ++r) {
-        const auto vs = faceVertices(region_[r]);
+    for (std::size_t r = 0; r < reg_.faces.size(); ++r) {
+        const auto vs = faceVertices(reg_.faces[r]);
         double covered = 0;
         for (int k = 0; k < 3; ++k) {
-            const int u = lidOfCurrent_.at(std::uint32_t(vs[std::size_t(k)]));
+            const int u = cut_.lidOfCurrent.at(std::uint32_t(vs[std::size_t(k)]));
             const HalfedgeIndex he = M_.halfedge(vs[std::size_t(k)], vs[std::size_t((k + 1) % 3)]);
-            const auto& re = redges_[std::size_t(redgeIndex_.at(std::uint32_t(M_.edge(he))))];
+            const auto& re = cut_.redges[std::size_t(cut_.redgeIndex.at(std::uint32_t(M_.edge(he))))];
             std::vector<int> line = re.line;
             if (line.front() != u) std::reverse(line.begin(), line.end());
             for (std::size_t j = 0; j + 1 < line.size(); ++j) {
                 const CdtFace f = leftOf(cdt, vh[std::size_t(line[j])], vh[std::size_t(line[j + 1])]);
                 if (f->info().region == int(r)) continue;
                 if (f->info().region >= 0 || cdt.is_infinite(f)) {
-                    addNear(bad, L_[std::size_t(line[j])].uv);
+                    addNear(bad, cut_.L[std::size_t(line[j])].uv);
                     continue;
                 }
                 stack.push_back(f);
@@ -101,25 +101,25 @@ bool ComponentStitcher::classify(Cdt& cdt, const std::vector<CdtVertex>& vh, Att
                     stack.pop_back();
                     if (g->info().region == int(r)) continue;
                     if (g->info().region >= 0 || cdt.is_infinite(g)) {
-                        addNear(bad, L_[std::size_t(line[j])].uv);
+                        addNear(bad, cut_.L[std::size_t(line[j])].uv);
                         stack.clear();
                         break;
                     }
                     g->info().region = int(r);
                     covered += area2(g->vertex(0)->point(), g->vertex(1)->point(), g->vertex(2)->point());
                     for (int e = 0; e < 3; ++e)
-                        if (!regionSub_.count(keyOf(g, e))) stack.push_back(g->neighbor(e));
+                        if (!cut_.regionSub.count(keyOf(g, e))) stack.push_back(g->neighbor(e));
                 }
             }
         }
-        const Triangle2 t = faceTriangle(region_[r]);
+        const Triangle2 t = faceTriangle(reg_.faces[r]);
         const double full = area2(t[0], t[1], t[2]);
         if (std::abs(covered - full) > 1e-7 * full) addNear(bad, CGAL::centroid(t));
     }
     if (!bad.empty()) return fail(a, "the mesh under it overlaps itself in the scan's view", std::move(bad));
     // Inside / outside of the patch: the interior lies to the left of every boundary edge.
     std::vector<std::pair<CdtFace, std::int8_t>> fill;
-    for (const auto& pe : pedges_)
+    for (const auto& pe : comp_.pedges)
         for (std::size_t j = 0; j + 1 < pe.line.size(); ++j) {
             const CdtVertex s = vh[std::size_t(pe.line[j])], t = vh[std::size_t(pe.line[j + 1])];
             fill.emplace_back(leftOf(cdt, s, t), std::int8_t(1));
@@ -138,7 +138,7 @@ bool ComponentStitcher::classify(Cdt& cdt, const std::vector<CdtVertex>& vh, Att
         }
         f->info().inside = side;
         for (int e = 0; e < 3; ++e)
-            if (!patchSub_.count(keyOf(f, e))) fill.emplace_back(f->neighbor(e), side);
+            if (!cut_.patchSub.count(keyOf(f, e))) fill.emplace_back(f->neighbor(e), side);
     }
     if (!bad.empty()) return fail(a, "it overlaps itself in the scan's view", std::move(bad));
     return true;
@@ -146,8 +146,8 @@ bool ComponentStitcher::classify(Cdt& cdt, const std::vector<CdtVertex>& vh, Att
 
 bool ComponentStitcher::checkCoverage(Cdt& cdt, const std::vector<CdtVertex>& vh, Attempt& a) {
     std::vector<int> bad;
-    for (std::size_t i = 0; i < L_.size(); ++i) {
-        const LVert& l = L_[i];
+    for (std::size_t i = 0; i < cut_.L.size(); ++i) {
+        const LVert& l = cut_.L[i];
         if (!l.alive || !l.chain) continue;
         const CdtVertex v = vh[i];
         bool uncovered = false;
@@ -166,7 +166,7 @@ bool ComponentStitcher::checkCoverage(Cdt& cdt, const std::vector<CdtVertex>& vh
         if (uncovered && l.kind != LVert::Region) addBad(bad, int(i));
         if (l.kind == LVert::PatchBoundary && !uncovered) {
             // The patch must lie on the surface under it (not on an occluder or another sheet).
-            const FaceIndex f = region_[std::size_t(under->info().region)];
+            const FaceIndex f = reg_.faces[std::size_t(under->info().region)];
             if (gapTo(l.pos, f) > gapTolerance(f)) addBad(bad, int(i));
         }
     }
@@ -178,11 +178,11 @@ bool ComponentStitcher::checkCoverage(Cdt& cdt, const std::vector<CdtVertex>& vh
 bool ComponentStitcher::triangulatePolygon(const std::vector<int>& poly, const std::vector<unsigned>& edges,
                                            float q, std::int32_t sid, double floor) {
     const std::size_t n = poly.size();
-    auto P = [&](std::size_t i) -> const Point2& { return L_[std::size_t(poly[i])].uv; };
-    auto X = [&](std::size_t i) -> const Vec3& { return L_[std::size_t(poly[i])].pos; };
+    auto P = [&](std::size_t i) -> const Point2& { return cut_.L[std::size_t(poly[i])].uv; };
+    auto X = [&](std::size_t i) -> const Vec3& { return cut_.L[std::size_t(poly[i])].pos; };
     if (n == 3) {
         if (!leftTurn(P(0), P(1), P(2))) return false;
-        newFaces_.push_back({{poly[0], poly[1], poly[2]}, q, sid, true, Vec3(0, 0, 0), floor, false});
+        cut_.newFaces.push_back({{poly[0], poly[1], poly[2]}, q, sid, true, Vec3(0, 0, 0), floor, false});
         return true;
     }
     // diagonal[i][j]: the segment i–j lies inside the polygon and does not run along a triangle edge.
@@ -237,7 +237,7 @@ bool ComponentStitcher::triangulatePolygon(const std::vector<int>& poly, const s
         stack.pop_back();
         if (j == i + 1) continue;
         const std::size_t k = split[i * n + j];
-        newFaces_.push_back({{poly[i], poly[k], poly[j]}, q, sid, true, Vec3(0, 0, 0), floor, false});
+        cut_.newFaces.push_back({{poly[i], poly[k], poly[j]}, q, sid, true, Vec3(0, 0, 0), floor, false});
         stack.push_back({i, k});
         stack.push_back({k, j});
     }
@@ -245,37 +245,37 @@ bool ComponentStitcher::triangulatePolygon(const std::vector<int>& poly, const s
 }
 
 bool ComponentStitcher::assemble(Cdt& cdt, Attempt& a) {
-    replaced_ = interior_;
+    cut_.replaced = reg_.interior;
     // Region faces: unchanged when they are exactly one outside triangle, else replaced by their
     // outside triangles.
-    std::vector<std::vector<CdtFace>> pieces(region_.size());
+    std::vector<std::vector<CdtFace>> pieces(reg_.faces.size());
     double insideArea = 0;
     for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f) {
         if (f->info().region >= 0) pieces[std::size_t(f->info().region)].push_back(f);
         if (f->info().inside == 1)
             insideArea += area2(f->vertex(0)->point(), f->vertex(1)->point(), f->vertex(2)->point());
     }
-    for (std::size_t r = 0; r < region_.size(); ++r) {
-        const auto vs = faceVertices(region_[r]);
+    for (std::size_t r = 0; r < reg_.faces.size(); ++r) {
+        const auto vs = faceVertices(reg_.faces[r]);
         bool changed = pieces[r].size() != 1 || pieces[r][0]->info().inside != 0;
         if (!changed)
             for (int k = 0; k < 3; ++k) {
                 const int lid = pieces[r][0]->vertex(k)->info().id;
-                if (L_[std::size_t(lid)].kind != LVert::Region ||
-                    std::find(vs.begin(), vs.end(), VertexIndex(L_[std::size_t(lid)].cur)) == vs.end())
+                if (cut_.L[std::size_t(lid)].kind != LVert::Region ||
+                    std::find(vs.begin(), vs.end(), VertexIndex(cut_.L[std::size_t(lid)].cur)) == vs.end())
                     changed = true;
             }
         if (!changed) continue;
-        replaced_.push_back(region_[r]);
-        const float q = curHasQuality_ ? curQuality_[region_[r]] : kInputFaceQuality;
-        const std::int32_t sid = curHasScanId_ ? curScanId_[region_[r]] : -1;
+        cut_.replaced.push_back(reg_.faces[r]);
+        const float q = curHasQuality_ ? curQuality_[reg_.faces[r]] : kInputFaceQuality;
+        const std::int32_t sid = curHasScanId_ ? curScanId_[reg_.faces[r]] : -1;
         const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
         const Vec3 n = normalOf(A, B, C).normalized();
         const double floor = std::min(std::max(O_.minAngleFloorDeg, O_.outsideMinAngleFloorDeg) * kDeg,
                                       0.999 * minAngle(A, B, C));
         for (CdtFace f : pieces[r])
             if (f->info().inside == 0)
-                newFaces_.push_back(
+                cut_.newFaces.push_back(
                     {{f->vertex(0)->info().id, f->vertex(1)->info().id, f->vertex(2)->info().id},
                      q,
                      sid,
@@ -287,9 +287,9 @@ bool ComponentStitcher::assemble(Cdt& cdt, Attempt& a) {
     // Mesh faces outside the region whose edge got seam vertices (a patch boundary along a crease, the
     // face beyond it unseen): split along that edge in 3D, a fan from the opposite corner in the face's
     // own plane, so the patch boundary meets the crease without a sliver in front of it.
-    for (const auto& [fi, re] : outerSplits_) {
+    for (const auto& [fi, re] : cut_.outerSplits) {
         const FaceIndex face(fi);
-        const REdge& r = redges_[std::size_t(re)];
+        const REdge& r = cut_.redges[std::size_t(re)];
         if (r.line.size() <= 2) continue;
         const HalfedgeIndex he = M_.halfedge(r.edge);
         const bool forward = M_.face(he) == face;
@@ -300,28 +300,28 @@ bool ComponentStitcher::assemble(Cdt& cdt, Attempt& a) {
         const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
         const double floor = std::min(std::max(O_.minAngleFloorDeg, O_.outsideMinAngleFloorDeg) * kDeg,
                                       0.999 * minAngle(A, B, C));
-        replaced_.push_back(face);
+        cut_.replaced.push_back(face);
         for (std::size_t k = 0; k + 1 < line.size(); ++k)
-            newFaces_.push_back({{line[k], line[k + 1], apex},
-                                 curHasQuality_ ? curQuality_[face] : kInputFaceQuality,
-                                 curHasScanId_ ? curScanId_[face] : -1,
-                                 false,
-                                 normalOf(A, B, C).normalized(),
-                                 floor,
-                                 !acceptable(face)});
+            cut_.newFaces.push_back({{line[k], line[k + 1], apex},
+                                     curHasQuality_ ? curQuality_[face] : kInputFaceQuality,
+                                     curHasScanId_ ? curScanId_[face] : -1,
+                                     false,
+                                     normalOf(A, B, C).normalized(),
+                                     floor,
+                                     !acceptable(face)});
     }
     // Their other neighbours open to the seam optimisation too (flips in their planes), as themselves.
     {
         std::unordered_set<std::uint32_t> taken;
-        for (FaceIndex f : replaced_)
+        for (FaceIndex f : cut_.replaced)
             taken.insert(std::uint32_t(f));
-        for (FaceIndex f : interior_)
+        for (FaceIndex f : reg_.interior)
             taken.insert(std::uint32_t(f));
-        for (const auto& [fi, re] : outerSplits_) {
-            if (redges_[std::size_t(re)].line.size() <= 2) continue;
+        for (const auto& [fi, re] : cut_.outerSplits) {
+            if (cut_.redges[std::size_t(re)].line.size() <= 2) continue;
             for (HalfedgeIndex h : CGAL::halfedges_around_face(M_.halfedge(FaceIndex(fi)), M_)) {
                 const FaceIndex g = M_.face(M_.opposite(h));
-                if (g == Mesh::null_face() || regionIndex_.count(std::uint32_t(g)) ||
+                if (g == Mesh::null_face() || reg_.index.count(std::uint32_t(g)) ||
                     !taken.insert(std::uint32_t(g)).second)
                     continue;
                 if (M_.next(M_.next(M_.next(M_.halfedge(g)))) != M_.halfedge(g)) continue;
@@ -333,11 +333,11 @@ bool ComponentStitcher::assemble(Cdt& cdt, Attempt& a) {
     // they join the faces replaced (by themselves, to begin with).
     {
         std::unordered_set<std::uint32_t> taken;
-        for (FaceIndex f : replaced_)
+        for (FaceIndex f : cut_.replaced)
             taken.insert(std::uint32_t(f));
         std::vector<FaceIndex> ring;
-        for (FaceIndex f : replaced_)
-            if (regionIndex_.count(std::uint32_t(f))) ring.push_back(f);
+        for (FaceIndex f : cut_.replaced)
+            if (reg_.index.count(std::uint32_t(f))) ring.push_back(f);
         for (int k = 1; k < O_.seamRings; ++k) {
             std::vector<FaceIndex> next;
             for (FaceIndex f : ring)
@@ -355,9 +355,9 @@ bool ComponentStitcher::assemble(Cdt& cdt, Attempt& a) {
         // patch boundary runs along): flips among them (in their plane) bring those vertices' valence
         // down, where the patch's faces in front have raised it.
         std::vector<FaceIndex> unseen;
-        for (const auto& pe : pedges_)
+        for (const auto& pe : comp_.pedges)
             for (int id : pe.line) {
-                const LVert& l = L_[std::size_t(id)];
+                const LVert& l = cut_.L[std::size_t(id)];
                 if (l.kind != LVert::Region) continue;
                 const VertexIndex v(l.cur);
                 for (FaceIndex g : CGAL::faces_around_target(M_.halfedge(v), M_))
@@ -382,16 +382,16 @@ bool ComponentStitcher::assemble(Cdt& cdt, Attempt& a) {
             const int p = t[std::size_t(k)], q = t[std::size_t((k + 1) % 3)];
             poly.push_back(localOfPatch(p));
             edges.push_back((1u << k) | (1u << ((k + 2) % 3)));
-            auto it = pedgeIndex_.find(dirKey(std::uint32_t(p), std::uint32_t(q)));
-            if (it != pedgeIndex_.end()) {
-                const auto& line = pedges_[std::size_t(it->second)].line;
+            auto it = comp_.pedgeIndex.find(dirKey(std::uint32_t(p), std::uint32_t(q)));
+            if (it != comp_.pedgeIndex.end()) {
+                const auto& line = comp_.pedges[std::size_t(it->second)].line;
                 poly.insert(poly.end(), line.begin() + 1, line.end() - 1);
                 edges.insert(edges.end(), line.size() - 2, 1u << k);
             }
         }
         const float q = P_.hasQuality ? P_.quality[std::size_t(f)] : kInputFaceQuality;
         const std::int32_t sid = P_.hasScanId ? P_.scanId[std::size_t(f)] : -1;
-        const std::size_t before = newFaces_.size();
+        const std::size_t before = cut_.newFaces.size();
         const double floor = std::min(O_.minAngleFloorDeg * kDeg,
                                       0.999 * minAngle(P_.pos[std::size_t(t[0])], P_.pos[std::size_t(t[1])],
                                                        P_.pos[std::size_t(t[2])]));
@@ -400,10 +400,10 @@ bool ComponentStitcher::assemble(Cdt& cdt, Attempt& a) {
                 bad.push_back(v);
             continue;
         }
-        for (std::size_t i = before; i < newFaces_.size(); ++i) {
-            const auto& nf = newFaces_[i].v;
-            patchArea +=
-                area2(L_[std::size_t(nf[0])].uv, L_[std::size_t(nf[1])].uv, L_[std::size_t(nf[2])].uv);
+        for (std::size_t i = before; i < cut_.newFaces.size(); ++i) {
+            const auto& nf = cut_.newFaces[i].v;
+            patchArea += area2(cut_.L[std::size_t(nf[0])].uv, cut_.L[std::size_t(nf[1])].uv,
+                               cut_.L[std::size_t(nf[2])].uv);
         }
     }
     if (!bad.empty())
@@ -416,26 +416,26 @@ bool ComponentStitcher::assemble(Cdt& cdt, Attempt& a) {
 void ComponentStitcher::openAsItself(FaceIndex g, bool offView) {
     const auto vs = faceVertices(g);
     const Vec3 A = toVec(M_.point(vs[0])), B = toVec(M_.point(vs[1])), C = toVec(M_.point(vs[2]));
-    replaced_.push_back(g);
-    newFaces_.push_back({{regionVertex(vs[0]), regionVertex(vs[1]), regionVertex(vs[2])},
-                         curHasQuality_ ? curQuality_[g] : kInputFaceQuality,
-                         curHasScanId_ ? curScanId_[g] : -1,
-                         false,
-                         normalOf(A, B, C).normalized(),
-                         std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C)),
-                         offView});
+    cut_.replaced.push_back(g);
+    cut_.newFaces.push_back({{regionVertex(vs[0]), regionVertex(vs[1]), regionVertex(vs[2])},
+                             curHasQuality_ ? curQuality_[g] : kInputFaceQuality,
+                             curHasScanId_ ? curScanId_[g] : -1,
+                             false,
+                             normalOf(A, B, C).normalized(),
+                             std::min(O_.minAngleFloorDeg * kDeg, 0.999 * minAngle(A, B, C)),
+                             offView});
 }
 
 int ComponentStitcher::localOfPatch(int p) {
-    auto it = lidOfPatch_.find(p);
-    if (it != lidOfPatch_.end()) return it->second;
+    auto it = cut_.lidOfPatch.find(p);
+    if (it != cut_.lidOfPatch.end()) return it->second;
     LVert l;
     l.kind = LVert::PatchInterior;
     l.patchA = p;
     l.pos = P_.pos[std::size_t(p)];
     l.uv = P_.uv[std::size_t(p)];
     const int id = addLocal(l);
-    lidOfPatch_[p] = id;
+    cut_.lidOfPatch[p] = id;
     return id;
 }
 

@@ -58,7 +58,7 @@ bool ComponentStitcher::buildAndOptimise(Attempt& a) {
     Local loc;
     Mesh& S = loc.star.S;
     StageClock::lap("other");
-    if (!buildStar(M_, replaced_, loc.star)) return fail(a, "the mesh is not manifold near its seam");
+    if (!buildStar(M_, cut_.replaced, loc.star)) return fail(a, "the mesh is not manifold near its seam");
     StageClock::lap("star");
     // A copy is cheaper than building the star again (the copied maps address the copy's arrays).
     loc.pristine = loc.star;
@@ -77,13 +77,13 @@ bool ComponentStitcher::buildAndOptimise(Attempt& a) {
     // Border edges around the replaced faces before (must be the same after: no new holes).
     const auto bordersBefore = bordersAround(loc);
     // Map local ids to S vertices.
-    std::vector<VertexIndex> sv(L_.size());
+    std::vector<VertexIndex> sv(cut_.L.size());
     std::unordered_set<std::uint32_t> reusedCur;
-    for (const LFace& f : newFaces_)
+    for (const LFace& f : cut_.newFaces)
         for (int id : f.v)
-            if (L_[std::size_t(id)].kind == LVert::Region) reusedCur.insert(L_[std::size_t(id)].cur);
-    for (std::size_t i = 0; i < L_.size(); ++i) {
-        const LVert& l = L_[i];
+            if (cut_.L[std::size_t(id)].kind == LVert::Region) reusedCur.insert(cut_.L[std::size_t(id)].cur);
+    for (std::size_t i = 0; i < cut_.L.size(); ++i) {
+        const LVert& l = cut_.L[i];
         if (!l.alive) continue;
         if (l.kind == LVert::Region) {
             const VertexIndex* it = loc.star.fromCurrent.find(l.cur);
@@ -94,14 +94,14 @@ bool ComponentStitcher::buildAndOptimise(Attempt& a) {
     // Fresh vertices are created on use, in order.
     std::vector<std::array<VertexIndex, 3>> faceVs;
     std::vector<Vec3> freshPos;
-    for (const LFace& f : newFaces_) {
+    for (const LFace& f : cut_.newFaces) {
         std::array<VertexIndex, 3> vs;
         for (int k = 0; k < 3; ++k) {
             const int id = f.v[std::size_t(k)];
             if (sv[std::size_t(id)] == VertexIndex()) {
-                if (L_[std::size_t(id)].kind == LVert::Region)
+                if (cut_.L[std::size_t(id)].kind == LVert::Region)
                     return fail(a, "internal error: a seam vertex is missing from the local mesh");
-                sv[std::size_t(id)] = S.add_vertex(toPoint(L_[std::size_t(id)].pos));
+                sv[std::size_t(id)] = S.add_vertex(toPoint(cut_.L[std::size_t(id)].pos));
             }
             vs[std::size_t(k)] = sv[std::size_t(id)];
         }
@@ -114,13 +114,13 @@ bool ComponentStitcher::buildAndOptimise(Attempt& a) {
         Point2 uv(0, 0);
         if (loc.star.cur[v] != kNone && V_.project(pt(S, v), uv, w)) loc.uv[v] = uv;
     }
-    for (std::size_t i = 0; i < L_.size(); ++i)
+    for (std::size_t i = 0; i < cut_.L.size(); ++i)
         if (sv[i] != VertexIndex()) {
             loc.lid[sv[i]] = int(i);
-            loc.uv[sv[i]] = L_[i].uv;
+            loc.uv[sv[i]] = cut_.L[i].uv;
         }
     StageClock::lap("local:vertices");
-    for (FaceIndex f : replaced_)
+    for (FaceIndex f : cut_.replaced)
         removeFaceKeeping(S, loc.star.faceFromCurrent.at(std::uint32_t(f)),
                           [&](VertexIndex v) { return reusedCur.count(loc.star.cur[v]) > 0; });
     StageClock::lap("local:remove");
@@ -131,17 +131,17 @@ bool ComponentStitcher::buildAndOptimise(Attempt& a) {
         progress_.tick();
         const FaceIndex g = S.add_face(faceVs[i][0], faceVs[i][1], faceVs[i][2]);
         if (g == Mesh::null_face()) {
-            for (int id : newFaces_[i].v)
+            for (int id : cut_.newFaces[i].v)
                 addBad(bad, id);
             continue;
         }
         loc.star.kept[g] = false;
-        loc.quality[g] = newFaces_[i].quality;
-        loc.scanId[g] = newFaces_[i].scanId;
-        loc.patchSide[g] = newFaces_[i].patchSide;
-        loc.planeNormal[g] = newFaces_[i].planeNormal;
-        loc.minAllowed[g] = newFaces_[i].minAllowed;
-        loc.offView[g] = newFaces_[i].offView;
+        loc.quality[g] = cut_.newFaces[i].quality;
+        loc.scanId[g] = cut_.newFaces[i].scanId;
+        loc.patchSide[g] = cut_.newFaces[i].patchSide;
+        loc.planeNormal[g] = cut_.newFaces[i].planeNormal;
+        loc.minAllowed[g] = cut_.newFaces[i].minAllowed;
+        loc.offView[g] = cut_.newFaces[i].offView;
     }
     if (!bad.empty()) return fail(a, "its seam would not be manifold", std::move(bad));
     StageClock::lap("local:add_face");
@@ -151,7 +151,7 @@ bool ComponentStitcher::buildAndOptimise(Attempt& a) {
             if (f == Mesh::null_face() || loc.star.kept[f]) lockedV = true;
         loc.locked[v] = lockedV || S.halfedge(v) == Mesh::null_halfedge();
     }
-    for (const auto& pe : pedges_)
+    for (const auto& pe : comp_.pedges)
         for (std::size_t j = 0; j + 1 < pe.line.size(); ++j)
             loc.seam.insert(seamKey(sv[std::size_t(pe.line[j])], sv[std::size_t(pe.line[j + 1])]));
 
@@ -258,7 +258,7 @@ bool ComponentStitcher::remeshBand(Local& loc, Plan& plan) {
         const Vec3 a = pt(S, S.source(h)), b = pt(S, S.target(h)), c = pt(S, S.target(S.next(h)));
         return minAngle(a, b, c) >= 10.0 * kDeg ? Vec3(normalOf(a, b, c).normalized()) : Vec3(0, 0, 0);
     };
-    in.edgeLength = h3_;
+    in.edgeLength = comp_.h3;
     in.maxNormalTurnDeg = O_.maxNormalChangeDeg;
     const stitch::BandRemeshReport r = stitch::remeshBand(in);
     progress_.tick(in.band.size());

@@ -14,82 +14,90 @@ bool ComponentStitcher::fail(Attempt& a, std::string reason, std::vector<int> ba
         // Peel: of the vertices near the problem, only those on the component's boundary.
         std::vector<int> onBoundary;
         for (int v : bad)
-            if (boundary_.count(v)) onBoundary.push_back(v);
+            if (comp_.boundary.count(v)) onBoundary.push_back(v);
         if (!onBoundary.empty()) bad.swap(onBoundary);
     }
     a.bad = std::move(bad);
     return false;
 }
 
-bool ComponentStitcher::setupComponent(Attempt& a) {
+// Stage "setup": the component's boundary edges (interior on their left), its vertices, its median edge
+// lengths in the view and in 3D, the snapping radius of every boundary vertex and a grid over its
+// triangles. Returns why the component cannot be stitched, or nothing.
+std::string describeComponent(const PatchData& P, const std::vector<int>& faces, double collapseEdgeRatio,
+                              ComponentShape& c, ComponentProgress* progress) {
+    c = ComponentShape{};
     std::vector<std::uint64_t> directed;
-    directed.reserve(3 * faces_.size());
-    for (int f : faces_) {
-        progress_.tick();
-        const auto& t = P_.tri[std::size_t(f)];
+    directed.reserve(3 * faces.size());
+    for (int f : faces) {
+        if (progress) progress->tick();
+        const auto& t = P.tri[std::size_t(f)];
         for (int k = 0; k < 3; ++k) {
             directed.push_back(
                 dirKey(std::uint32_t(t[std::size_t(k)]), std::uint32_t(t[std::size_t((k + 1) % 3)])));
-            compVerts_.push_back(t[std::size_t(k)]);
+            c.verts.push_back(t[std::size_t(k)]);
         }
     }
     std::sort(directed.begin(), directed.end());
-    std::sort(compVerts_.begin(), compVerts_.end());
-    compVerts_.erase(std::unique(compVerts_.begin(), compVerts_.end()), compVerts_.end());
+    std::sort(c.verts.begin(), c.verts.end());
+    c.verts.erase(std::unique(c.verts.begin(), c.verts.end()), c.verts.end());
     std::vector<double> len2, len3;
-    for (int f : faces_) {
-        const auto& t = P_.tri[std::size_t(f)];
+    for (int f : faces) {
+        const auto& t = P.tri[std::size_t(f)];
         for (int k = 0; k < 3; ++k) {
             const int p = t[std::size_t(k)], q = t[std::size_t((k + 1) % 3)];
             const bool border = !std::binary_search(directed.begin(), directed.end(),
                                                     dirKey(std::uint32_t(q), std::uint32_t(p)));
             if (border) {
-                pedgeIndex_[dirKey(std::uint32_t(p), std::uint32_t(q))] = int(pedges_.size());
-                pedges_.push_back({p, q, t[std::size_t((k + 2) % 3)], {}, {}});
-                boundary_.insert(p);
+                c.pedgeIndex[dirKey(std::uint32_t(p), std::uint32_t(q))] = int(c.pedges.size());
+                c.pedges.push_back({p, q, t[std::size_t((k + 2) % 3)], {}, {}});
+                c.boundary.insert(p);
             }
             if (border || p < q) {
-                len2.push_back(std::sqrt(dist2(P_.uv[std::size_t(p)], P_.uv[std::size_t(q)])));
-                len3.push_back((P_.pos[std::size_t(p)] - P_.pos[std::size_t(q)]).norm());
+                len2.push_back(std::sqrt(dist2(P.uv[std::size_t(p)], P.uv[std::size_t(q)])));
+                len3.push_back((P.pos[std::size_t(p)] - P.pos[std::size_t(q)]).norm());
             }
         }
     }
-    if (pedges_.empty())
-        return fail(a, "it has no boundary in the scan's view (it would cover the whole view)");
-    for (int f : faces_)
-        for (int v : P_.tri[std::size_t(f)])
-            if (boundary_.count(v)) vertexFaces_[v].push_back(f);
+    if (c.pedges.empty()) return "it has no boundary in the scan's view (it would cover the whole view)";
+    for (int f : faces)
+        for (int v : P.tri[std::size_t(f)])
+            if (c.boundary.count(v)) c.vertexFaces[v].push_back(f);
     auto median = [](std::vector<double> v) {
         std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
         return v[v.size() / 2];
     };
-    h2_ = median(len2);
-    h3_ = median(len3);
-    if (!(h2_ > 0) || !(h3_ > 0)) return fail(a, "its triangles have no extent in the scan's view");
-    for (const auto& e : pedges_) {
-        const double l = std::sqrt(dist2(P_.uv[std::size_t(e.a)], P_.uv[std::size_t(e.b)]));
+    c.h2 = median(len2);
+    c.h3 = median(len3);
+    if (!(c.h2 > 0) || !(c.h3 > 0)) return "its triangles have no extent in the scan's view";
+    for (const auto& e : c.pedges) {
+        const double l = std::sqrt(dist2(P.uv[std::size_t(e.a)], P.uv[std::size_t(e.b)]));
         for (int v : {e.a, e.b}) {
-            auto [it, fresh] = snapRadius_.try_emplace(v, l);
+            auto [it, fresh] = c.snapRadius.try_emplace(v, l);
             if (!fresh) it->second = std::min(it->second, l);
         }
     }
-    for (auto& [v, r] : snapRadius_) {
-        r *= O_.collapseEdgeRatio;
-        margin_ = std::max(margin_, r);
+    for (auto& [v, r] : c.snapRadius) {
+        r *= collapseEdgeRatio;
+        c.margin = std::max(c.margin, r);
     }
-    margin_ *= 1.01;
-    compBox_ = CGAL::Bbox_2();
-    for (int v : compVerts_)
-        compBox_ += P_.uv[std::size_t(v)].bbox();
-    compGrid_ = BucketGrid(2.0 * h2_, faces_.size());
-    for (std::size_t i = 0; i < faces_.size(); ++i)
-        compGrid_.insert(int(i), triBox(faces_[i]));
-    return true;
+    c.margin *= 1.01;
+    c.box = CGAL::Bbox_2();
+    for (int v : c.verts)
+        c.box += P.uv[std::size_t(v)].bbox();
+    c.grid = BucketGrid(2.0 * c.h2, faces.size());
+    for (std::size_t i = 0; i < faces.size(); ++i)
+        c.grid.insert(int(i), patchTriangleBox(P, faces[i]));
+    return {};
+}
+
+bool ComponentStitcher::setupComponent(Attempt& a) {
+    const std::string why = describeComponent(P_, faces_, O_.collapseEdgeRatio, comp_, &progress_);
+    return why.empty() || fail(a, why);
 }
 
 CGAL::Bbox_2 ComponentStitcher::triBox(int f) const {
-    const auto& t = P_.tri[std::size_t(f)];
-    return bboxOf(P_.uv[std::size_t(t[0])], P_.uv[std::size_t(t[1])], P_.uv[std::size_t(t[2])]);
+    return patchTriangleBox(P_, f);
 }
 
 Triangle2 ComponentStitcher::patchTriangle(int f) const {
@@ -100,7 +108,7 @@ Triangle2 ComponentStitcher::patchTriangle(int f) const {
 std::vector<int> ComponentStitcher::patchVerticesNear(const Point2& q, double radius) {
     std::vector<int> out;
     const CGAL::Bbox_2 box = grown(q.bbox(), radius);
-    compGrid_.query(box, [&](int i) {
+    comp_.grid.query(box, [&](int i) {
         if (CGAL::do_overlap(box, triBox(faces_[std::size_t(i)])))
             for (int v : P_.tri[std::size_t(faces_[std::size_t(i)])])
                 out.push_back(v);
@@ -110,7 +118,7 @@ std::vector<int> ComponentStitcher::patchVerticesNear(const Point2& q, double ra
 
 void ComponentStitcher::addNear(std::vector<int>& bad, const Point2& q) {
     bad.push_back(-1);
-    for (double r = 1.5 * h2_; r < 100.0 * h2_; r *= 2.0) {
+    for (double r = 1.5 * comp_.h2; r < 100.0 * comp_.h2; r *= 2.0) {
         auto near = patchVerticesNear(q, r);
         if (near.empty()) continue;
         bad.insert(bad.end(), near.begin(), near.end());
@@ -120,7 +128,7 @@ void ComponentStitcher::addNear(std::vector<int>& bad, const Point2& q) {
 
 void ComponentStitcher::addBad(std::vector<int>& bad, int i) {
     bad.push_back(-1);
-    const LVert& l = L_[std::size_t(i)];
+    const LVert& l = cut_.L[std::size_t(i)];
     if (l.patchA >= 0 || l.patchB >= 0) {
         bad.push_back(l.patchA);
         bad.push_back(l.patchB);
@@ -130,13 +138,13 @@ void ComponentStitcher::addBad(std::vector<int>& bad, int i) {
 }
 
 auto ComponentStitcher::vproj(VertexIndex v) -> VProj {
-    auto [it, fresh] = vcache_.try_emplace(std::uint32_t(v));
+    auto [it, fresh] = search_.vcache.try_emplace(std::uint32_t(v));
     if (fresh) it->ok = V_.project(toVec(M_.point(v)), it->uv, it->w);
     return *it;
 }
 
 bool ComponentStitcher::acceptable(FaceIndex f) {
-    auto [it, fresh] = accept_.try_emplace(std::uint32_t(f), 0);
+    auto [it, fresh] = search_.accept.try_emplace(std::uint32_t(f), 0);
     if (!fresh) return *it != 0;
     const HalfedgeIndex h = M_.halfedge(f);
     if (M_.next(M_.next(M_.next(h))) != h) return false;
@@ -187,17 +195,17 @@ double ComponentStitcher::longestEdge(FaceIndex f) const {
 
 bool ComponentStitcher::meetsComponent(FaceIndex f) {
     const Triangle2 t = faceTriangle(f);
-    const double r2 = margin_ * margin_;
+    const double r2 = comp_.margin * comp_.margin;
     const double tolerance = gapTolerance(f);
     const auto fv = faceVertices(f);
     const Vec3 A = toVec(M_.point(fv[0]));
     const Vec3 n = normalOf(A, toVec(M_.point(fv[1])), toVec(M_.point(fv[2])));
-    const CGAL::Bbox_2 box = grown(t.bbox(), margin_);
+    const CGAL::Bbox_2 box = grown(t.bbox(), comp_.margin);
     bool hit = false;
     // Cheap tests first (this runs for every face under the patch): a patch triangle whose box misses
     // the face's box grown by the snapping distance is farther than that; the gaps along the view rays
     // need no triangle test; a corner of either triangle inside the other means they meet.
-    compGrid_.query(box, [&](int i) {
+    comp_.grid.query(box, [&](int i) {
         if (hit) return;
         const int pf = faces_[std::size_t(i)];
         if (!CGAL::do_overlap(box, triBox(pf))) return;
@@ -214,7 +222,7 @@ bool ComponentStitcher::meetsComponent(FaceIndex f) {
 
 double ComponentStitcher::gapToPatch(const Vec3& p, const Point2& uv) {
     double gap = std::numeric_limits<double>::infinity();
-    compGrid_.query(uv.bbox(), [&](int i) {
+    comp_.grid.query(uv.bbox(), [&](int i) {
         const auto& tri = P_.tri[std::size_t(faces_[std::size_t(i)])];
         const Triangle2 t = patchTriangle(faces_[std::size_t(i)]);
         if (!inTriangle(uv, t[0], t[1], t[2])) return;
@@ -247,13 +255,13 @@ void ComponentStitcher::candidatesAt(const Point2& uv, std::vector<FaceIndex>& o
             }
         return;
     }
-    if (!fallbackBuilt_) buildFallback();
-    fallbackGrid_.query(uv.bbox(), [&](int i) { out.push_back(fallback_[std::size_t(i)]); });
+    if (!search_.fallbackBuilt) buildFallback();
+    search_.fallbackGrid.query(uv.bbox(), [&](int i) { out.push_back(search_.fallback[std::size_t(i)]); });
 }
 
 void ComponentStitcher::buildFallback() {
-    fallbackBuilt_ = true;
-    const CGAL::Bbox_2 box = grown(compBox_, 2.0 * h2_);
+    search_.fallbackBuilt = true;
+    const CGAL::Bbox_2 box = grown(comp_.box, 2.0 * comp_.h2);
     std::vector<CGAL::Bbox_2> boxes;
     for (FaceIndex f : M_.faces()) {
         const HalfedgeIndex h = M_.halfedge(f);
@@ -271,25 +279,25 @@ void ComponentStitcher::buildFallback() {
         if (!ok || k != 3) continue;
         const CGAL::Bbox_2 fb = bboxOf(uv[0], uv[1], uv[2]);
         if (!CGAL::do_overlap(fb, box) || !leftTurn(uv[0], uv[1], uv[2])) continue;
-        fallback_.push_back(f);
+        search_.fallback.push_back(f);
         boxes.push_back(fb);
     }
     const double cell =
-        std::max(4.0 * h2_, std::max(box.xmax() - box.xmin(), box.ymax() - box.ymin()) / 64.0);
-    fallbackGrid_ = BucketGrid(cell, fallback_.size());
-    for (std::size_t i = 0; i < fallback_.size(); ++i)
-        fallbackGrid_.insert(int(i), boxes[i]);
+        std::max(4.0 * comp_.h2, std::max(box.xmax() - box.xmin(), box.ymax() - box.ymin()) / 64.0);
+    search_.fallbackGrid = BucketGrid(cell, search_.fallback.size());
+    for (std::size_t i = 0; i < search_.fallback.size(); ++i)
+        search_.fallbackGrid.insert(int(i), boxes[i]);
 }
 
 bool ComponentStitcher::findRegion(Attempt& a) {
     // Seeds: under every boundary vertex and a sample of the interior, the acceptable face containing
     // the vertex in the view whose plane is nearest to it along the view ray.
-    std::vector<int> samples(boundary_.begin(), boundary_.end());
+    std::vector<int> samples(comp_.boundary.begin(), comp_.boundary.end());
     std::sort(samples.begin(), samples.end());
     {
         std::vector<int> interior;
-        for (int v : compVerts_)
-            if (!boundary_.count(v)) interior.push_back(v);
+        for (int v : comp_.verts)
+            if (!comp_.boundary.count(v)) interior.push_back(v);
         std::sort(interior.begin(), interior.end());
         const std::size_t stride = std::max<std::size_t>(1, interior.size() / 2048);
         for (std::size_t i = 0; i < interior.size(); i += stride)
@@ -331,34 +339,34 @@ bool ComponentStitcher::findRegion(Attempt& a) {
         stack.pop_back();
         progress_.tick();
         if (!acceptable(f) || !meetsComponent(f)) continue;
-        regionIndex_[std::uint32_t(f)] = int(region_.size());
-        region_.push_back(f);
+        reg_.index[std::uint32_t(f)] = int(reg_.faces.size());
+        reg_.faces.push_back(f);
         for (VertexIndex v : faceVertices(f))
             for (FaceIndex g : CGAL::faces_around_target(M_.halfedge(v), M_))
                 if (g != Mesh::null_face() && visited.insert(std::uint32_t(g))) stack.push_back(g);
     }
-    if (region_.empty()) return fail(a, "no visible face of the mesh lies under it in the scan's view");
+    if (reg_.faces.empty()) return fail(a, "no visible face of the mesh lies under it in the scan's view");
     return true;
 }
 
 bool ComponentStitcher::preTrim(Attempt& a) {
     double edge = 0;
-    for (FaceIndex f : region_) {
+    for (FaceIndex f : reg_.faces) {
         const Triangle2 t = faceTriangle(f);
         edge += std::sqrt(dist2(t[0], t[1]));
     }
-    edge /= double(region_.size());
-    regionGrid_ = BucketGrid(std::max(2.0 * h2_, edge), region_.size());
-    for (std::size_t i = 0; i < region_.size(); ++i)
-        regionGrid_.insert(int(i), faceTriangle(region_[i]).bbox());
+    edge /= double(reg_.faces.size());
+    reg_.grid = BucketGrid(std::max(2.0 * comp_.h2, edge), reg_.faces.size());
+    for (std::size_t i = 0; i < reg_.faces.size(); ++i)
+        reg_.grid.insert(int(i), faceTriangle(reg_.faces[i]).bbox());
     std::vector<int> bad;
-    for (int v : compVerts_) {
+    for (int v : comp_.verts) {
         progress_.tick();
         const Point2& uv = P_.uv[std::size_t(v)];
         bool inside = false;
-        regionGrid_.query(uv.bbox(), [&](int i) {
+        reg_.grid.query(uv.bbox(), [&](int i) {
             if (inside) return;
-            const Triangle2 t = faceTriangle(region_[std::size_t(i)]);
+            const Triangle2 t = faceTriangle(reg_.faces[std::size_t(i)]);
             inside = inTriangle(uv, t[0], t[1], t[2]);
         });
         if (!inside) bad.push_back(v);
@@ -369,7 +377,7 @@ bool ComponentStitcher::preTrim(Attempt& a) {
 
 bool ComponentStitcher::insidePatch(const Point2& p) {
     bool in = false;
-    compGrid_.query(p.bbox(), [&](int i) {
+    comp_.grid.query(p.bbox(), [&](int i) {
         if (in) return;
         const Triangle2 t = patchTriangle(faces_[std::size_t(i)]);
         in = inTriangle(p, t[0], t[1], t[2]);
@@ -425,21 +433,22 @@ double ComponentStitcher::depthAt(FaceIndex f, const Point2& q) const {
 }
 
 bool ComponentStitcher::splitRegion(Attempt& a) {
-    BucketGrid segments(2.0 * h2_, pedges_.size());
-    for (std::size_t i = 0; i < pedges_.size(); ++i)
-        segments.insert(int(i), bboxOf(P_.uv[std::size_t(pedges_[i].a)], P_.uv[std::size_t(pedges_[i].b)]));
-    const double reach2 = margin_ * margin_; // the snapping distance
+    BucketGrid segments(2.0 * comp_.h2, comp_.pedges.size());
+    for (std::size_t i = 0; i < comp_.pedges.size(); ++i)
+        segments.insert(int(i),
+                        bboxOf(P_.uv[std::size_t(comp_.pedges[i].a)], P_.uv[std::size_t(comp_.pedges[i].b)]));
+    const double reach2 = comp_.margin * comp_.margin; // the snapping distance
     std::vector<FaceIndex> seam;
     std::vector<FaceIndex> stack;
     IndexSet isSeam, isInterior;
-    for (FaceIndex f : region_) {
+    for (FaceIndex f : reg_.faces) {
         progress_.tick();
         const Triangle2 t = faceTriangle(f);
         bool near = false;
-        segments.query(grown(t.bbox(), margin_), [&](int i) {
+        segments.query(grown(t.bbox(), comp_.margin), [&](int i) {
             if (near) return;
-            const Segment2 e(P_.uv[std::size_t(pedges_[std::size_t(i)].a)],
-                             P_.uv[std::size_t(pedges_[std::size_t(i)].b)]);
+            const Segment2 e(P_.uv[std::size_t(comp_.pedges[std::size_t(i)].a)],
+                             P_.uv[std::size_t(comp_.pedges[std::size_t(i)].b)]);
             near = CGAL::do_intersect(t, e) || CGAL::squared_distance(t, e) <= reach2;
         });
         if (near) {
@@ -455,16 +464,16 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
     // patch they are simply replaced; where the patch boundary crosses them there is no height field
     // to cut, so the patch is cut back around every fold that reaches its boundary.
     {
-        detail::DisjointSets clusters(region_.size());
+        detail::DisjointSets clusters(reg_.faces.size());
         auto find = [&](int x) { return int(clusters.find(std::size_t(x))); };
-        std::vector<char> folded(region_.size(), 0), hidden(region_.size(), 0);
+        std::vector<char> folded(reg_.faces.size(), 0), hidden(reg_.faces.size(), 0);
         // Only the clusters of overlapping faces that reach a seam face matter: found by a flood over
         // overlaps from the seam faces (work proportional to the seam and its folds, not to the faces
         // under the patch).
-        std::vector<char> reached(region_.size(), 0);
+        std::vector<char> reached(reg_.faces.size(), 0);
         std::vector<std::size_t> todo;
-        for (std::size_t i = 0; i < region_.size(); ++i)
-            if (isSeam.count(std::uint32_t(region_[i]))) {
+        for (std::size_t i = 0; i < reg_.faces.size(); ++i)
+            if (isSeam.count(std::uint32_t(reg_.faces[i]))) {
                 reached[i] = 1;
                 todo.push_back(i);
             }
@@ -472,17 +481,17 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
             const std::size_t i = todo.back();
             todo.pop_back();
             progress_.tick();
-            regionGrid_.query(faceTriangle(region_[i]).bbox(), [&](int jj) {
+            reg_.grid.query(faceTriangle(reg_.faces[i]).bbox(), [&](int jj) {
                 const std::size_t j = std::size_t(jj);
                 if (j == i) return;
                 // Each pair in the order (lower, higher index), as a scan over all pairs would.
                 const std::size_t lo = std::min(i, j), hi = std::max(i, j);
-                if (!interiorsOverlap(region_[lo], region_[hi])) return;
+                if (!interiorsOverlap(reg_.faces[lo], reg_.faces[hi])) return;
                 folded[lo] = folded[hi] = 1;
                 clusters.unite(lo, hi);
                 // The one farther from the eye where they overlap is hidden there.
-                const Point2 q = overlapCentre(faceTriangle(region_[lo]), faceTriangle(region_[hi]));
-                hidden[depthAt(region_[lo], q) > depthAt(region_[hi], q) ? lo : hi] = 1;
+                const Point2 q = overlapCentre(faceTriangle(reg_.faces[lo]), faceTriangle(reg_.faces[hi]));
+                hidden[depthAt(reg_.faces[lo], q) > depthAt(reg_.faces[hi], q) ? lo : hi] = 1;
                 if (!reached[j]) {
                     reached[j] = 1;
                     todo.push_back(j);
@@ -490,19 +499,19 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
             });
         }
         std::unordered_map<int, bool> clusterAtSeam;
-        for (std::size_t i = 0; i < region_.size(); ++i)
-            if (folded[i] && isSeam.count(std::uint32_t(region_[i]))) clusterAtSeam[find(int(i))] = true;
+        for (std::size_t i = 0; i < reg_.faces.size(); ++i)
+            if (folded[i] && isSeam.count(std::uint32_t(reg_.faces[i]))) clusterAtSeam[find(int(i))] = true;
         // Cut the patch back around the hidden faces, where it lies on their sheet; if that frees
         // nothing, around the whole fold.
         // (Peeling: only the patch triangles within snapping distance; the next round sees what is left.)
-        const double r = O_.peelTrim ? margin_ : margin_ + h2_;
+        const double r = O_.peelTrim ? comp_.margin : comp_.margin + comp_.h2;
         for (int pass = 0; pass < 2 && bad.empty(); ++pass)
-            for (std::size_t i = 0; i < region_.size(); ++i) {
+            for (std::size_t i = 0; i < reg_.faces.size(); ++i) {
                 if (!folded[i] || !clusterAtSeam.count(find(int(i))) || (pass == 0 && !hidden[i])) continue;
-                const FaceIndex g = region_[i];
+                const FaceIndex g = reg_.faces[i];
                 const Triangle2 t = faceTriangle(g);
                 const double tolerance = gapTolerance(g);
-                compGrid_.query(grown(t.bbox(), r), [&](int k) {
+                comp_.grid.query(grown(t.bbox(), r), [&](int k) {
                     const auto& tri = P_.tri[std::size_t(faces_[std::size_t(k)])];
                     const Triangle2 p = patchTriangle(faces_[std::size_t(k)]);
                     if (!CGAL::do_intersect(t, p) && CGAL::squared_distance(t, p) > r * r) return;
@@ -522,7 +531,7 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
         const FaceIndex f = stack.back();
         stack.pop_back();
         progress_.tick();
-        interior_.push_back(f);
+        reg_.interior.push_back(f);
         for (HalfedgeIndex h : CGAL::halfedges_around_face(M_.halfedge(f), M_)) {
             const FaceIndex g = M_.face(M_.opposite(h));
             if (g == Mesh::null_face()) {
@@ -555,11 +564,11 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
     }
     if (!bad.empty())
         return fail(a, "the mesh under it folds or has a hole in the scan's view", std::move(bad));
-    region_ = std::move(seam);
-    regionIndex_.clear();
-    for (std::size_t i = 0; i < region_.size(); ++i)
-        regionIndex_[std::uint32_t(region_[i])] = int(i);
-    if (region_.empty()) return fail(a, "no visible face of the mesh lies under its boundary");
+    reg_.faces = std::move(seam);
+    reg_.index.clear();
+    for (std::size_t i = 0; i < reg_.faces.size(); ++i)
+        reg_.index[std::uint32_t(reg_.faces[i])] = int(i);
+    if (reg_.faces.empty()) return fail(a, "no visible face of the mesh lies under its boundary");
     return true;
 }
 

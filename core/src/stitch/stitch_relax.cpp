@@ -7,13 +7,13 @@ namespace fss::detail::stitching {
 void ComponentStitcher::optimise(Local& loc, Plan& plan) {
     Mesh& S = loc.star.S;
     const double maxTurn = O_.maxNormalChangeDeg * kDeg;
-    const double shortEdge = O_.collapseEdgeRatio * h3_;
+    const double shortEdge = O_.collapseEdgeRatio * comp_.h3;
     auto isNewFace = [&](FaceIndex f) { return f != Mesh::null_face() && !loc.star.kept[f]; };
     auto removable = [&](VertexIndex v) {
         const int id = loc.lid[v];
         // Mesh vertices stay (they carry the old surface's shape); crossings, patch and Steiner vertices
         // may go.
-        return !loc.locked[v] && (id < 0 || L_[std::size_t(id)].kind != LVert::Region);
+        return !loc.locked[v] && (id < 0 || cut_.L[std::size_t(id)].kind != LVert::Region);
     };
     // -- collapses: remove a into b
     auto tryCollapse = [&](VertexIndex a, VertexIndex b, double& score) -> bool {
@@ -163,9 +163,9 @@ double ComponentStitcher::ringScore(const Local& loc,
 
 int ComponentStitcher::slideAlongEdge(Local& loc, VertexIndex v, bool search) {
     Mesh& S = loc.star.S;
-    const LVert& l = L_[std::size_t(loc.lid[v])];
+    const LVert& l = cut_.L[std::size_t(loc.lid[v])];
     if (l.edgeU < 0) return 0;
-    const Vec3 U = L_[std::size_t(l.edgeU)].pos, W = L_[std::size_t(l.edgeW)].pos;
+    const Vec3 U = cut_.L[std::size_t(l.edgeU)].pos, W = cut_.L[std::size_t(l.edgeW)].pos;
     Vec3 centre(0, 0, 0);
     std::vector<std::pair<VertexIndex, VertexIndex>> ring;
     std::vector<FaceIndex> faces;
@@ -222,7 +222,7 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
         if (S.halfedge(v) == Mesh::null_halfedge()) continue;
         // A seam vertex on a mesh edge slides along it; with `search`, one inside a mesh face (a patch
         // boundary vertex) moves like the points added outside, its patch side included.
-        const bool onEdge = loc.lid[v] >= 0 && L_[std::size_t(loc.lid[v])].edgeU >= 0;
+        const bool onEdge = loc.lid[v] >= 0 && cut_.L[std::size_t(loc.lid[v])].edgeU >= 0;
         if (onEdge || (loc.lid[v] >= 0 && !search)) {
             moved += slideAlongEdge(loc, v, search);
             continue;
@@ -286,7 +286,7 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
         std::vector<Triangle3> before;
         for (const auto& [p, q] : ring)
             before.emplace_back(toPoint(p0), S.point(p), S.point(q));
-        const double maxGap = kNearPlanarFlipGap * h3_;
+        const double maxGap = kNearPlanarFlipGap * comp_.h3;
         auto offSurface = [&](const Vec3& p1) {
             if (planes.size() == 1 && !withPatch) return false;
             double d2 = std::numeric_limits<double>::infinity();
@@ -362,7 +362,8 @@ std::size_t ComponentStitcher::refineOutside(Local& loc) {
         if (loc.patchSide[f] || loc.patchSide[g]) continue;
         const Vec3 a = pt(S, S.source(h)), b = pt(S, S.target(h));
         const double len = (a - b).norm();
-        const double target = h3_ + O_.seamGrading * 0.5 * (distance(S.source(h)) + distance(S.target(h)));
+        const double target =
+            comp_.h3 + O_.seamGrading * 0.5 * (distance(S.source(h)) + distance(S.target(h)));
         if (len > 4.0 / 3.0 * target) cands.push_back({len, e});
     }
     std::sort(cands.begin(), cands.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
@@ -388,7 +389,7 @@ std::size_t ComponentStitcher::refineOutside(Local& loc) {
             continue;
         // ... not put the new vertex nearer than a short seam edge to a neighbour of the edge's ends (two
         // vertices that close leave a thin piece no collapse can remove outside the patch) ...
-        const double shortEdge = O_.collapseEdgeRatio * h3_;
+        const double shortEdge = O_.collapseEdgeRatio * comp_.h3;
         bool crowded = false;
         for (VertexIndex end : {x, y})
             for (VertexIndex n : CGAL::vertices_around_target(S.halfedge(end), S))
@@ -466,7 +467,7 @@ bool ComponentStitcher::flipAllowed(const Local& loc, HalfedgeIndex h,
         // Pieces of two mesh faces that are nearly coplanar (a smoothly curved part of the mesh): the
         // flip moves the surface by the gap between the two diagonals, allowed up to a small
         // fraction of the patch's edge length (far below a pixel footprint).
-        nearPlanar = !allowed && turn <= maxTurn && segmentGap(X, Y, Z1, Z2) <= kNearPlanarFlipGap * h3_;
+        nearPlanar = !allowed && turn <= maxTurn && segmentGap(X, Y, Z1, Z2) <= kNearPlanarFlipGap * comp_.h3;
         if (!allowed && !nearPlanar) return false;
     }
     oldMin = std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2));

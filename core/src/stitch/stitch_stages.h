@@ -8,6 +8,84 @@
 
 namespace fss::detail::stitching {
 
+// ---- What the stages hand on (in the order of ComponentStitcher::run).
+
+// A patch boundary edge (interior on the left of a → b), with the seam vertices the cut puts on it.
+struct PEdge {
+    int a, b;     // patch vertices, interior on the left of a → b
+    int opposite; // third vertex of the patch triangle on this edge
+    std::vector<std::pair<double, int>> splits;
+    std::vector<int> line;
+};
+// An edge of the region's faces in the view, with the seam vertices the cut puts on it.
+struct REdge {
+    int u, w; // local ids of the mesh edge's halfedge source and target
+    EdgeIndex edge;
+    std::vector<std::pair<double, int>> splits;
+    std::vector<int> line;
+};
+
+// The component as the stages see it (setupComponent): its boundary, sizes and a grid over its triangles.
+struct ComponentShape {
+    std::vector<int> verts;                                // vertices of the component, sorted
+    std::unordered_map<int, std::vector<int>> vertexFaces; // faces around each boundary vertex
+    std::unordered_set<int> boundary;
+    std::vector<PEdge> pedges;
+    std::unordered_map<std::uint64_t, int> pedgeIndex;
+    std::unordered_map<int, double> snapRadius;
+    double h2 = 0, h3 = 0; // median edge length in the view and in 3D
+    double margin = 0;     // largest snapping distance in the view
+    CGAL::Bbox_2 box;
+    BucketGrid grid;
+};
+
+// A current-mesh vertex in the view (cached).
+struct VProj {
+    Point2 uv;
+    double w = 0;
+    bool ok = false;
+};
+// The region stage's caches over the current mesh (stage-local).
+struct RegionSearch {
+    IndexMap<VProj> vcache;
+    IndexMap<char> accept; // bool (a char: vector<bool> has no addressable elements)
+    bool fallbackBuilt = false;
+    std::vector<FaceIndex> fallback;
+    BucketGrid fallbackGrid;
+};
+
+// The faces of the current mesh under the component (findRegion, splitRegion).
+struct Region {
+    std::vector<FaceIndex> faces;    // faces re-triangulated in the view (near the seam)
+    std::vector<FaceIndex> interior; // faces under the patch, removed whole
+    IndexMap<int> index;
+    BucketGrid grid;
+};
+
+// The local problem in the view (cut: local vertices, snapping, crossings; gap triangulation: the faces).
+struct LocalProblem {
+    std::vector<LVert> L;
+    std::unordered_map<std::uint32_t, int> lidOfCurrent;
+    std::unordered_map<int, int> lidOfPatch;
+    std::vector<REdge> redges;
+    std::unordered_map<std::uint32_t, int> redgeIndex;
+    std::vector<std::pair<int, int>> subEdges;
+    std::unordered_set<std::uint64_t> regionSub, patchSub;
+    std::vector<FaceIndex> replaced;
+    std::vector<LFace> newFaces;
+    std::map<std::uint32_t, int> outerSplits; // face outside the region → the region edge of it split
+};
+
+// The box of patch triangle f in the view.
+inline CGAL::Bbox_2 patchTriangleBox(const PatchData& P, int f) {
+    const auto& t = P.tri[std::size_t(f)];
+    return bboxOf(P.uv[std::size_t(t[0])], P.uv[std::size_t(t[1])], P.uv[std::size_t(t[2])]);
+}
+// Stage "setup" (stitch_region.cpp): the shape of the component made of `faces` of P; an empty string, or
+// why the component cannot be stitched. `progress` may be null.
+std::string describeComponent(const PatchData& P, const std::vector<int>& faces, double collapseEdgeRatio,
+                              ComponentShape& c, ComponentProgress* progress);
+
 class ComponentStitcher {
 public:
     ComponentStitcher(const Mesh& m, const PatchData& p, const View& view, const StitchOptions& o,
@@ -70,11 +148,6 @@ private:
     void addBad(std::vector<int>& bad, int i);
 
     // ---- the current mesh in the view (cached per vertex / face)
-    struct VProj {
-        Point2 uv;
-        double w = 0;
-        bool ok = false;
-    };
     VProj vproj(VertexIndex v);
     // Triangle face, in front of the eye, counter-clockwise in the view and not grazing.
     bool acceptable(FaceIndex f);
@@ -86,7 +159,7 @@ private:
     double gapToPlane(const Vec3& p, const Vec3& A, const Vec3& n) const;
     double longestEdge(FaceIndex f) const;
     // The largest distance along view rays between the patch and a mesh face it belongs to.
-    double gapTolerance(FaceIndex f) const { return O_.maxGapRatio * (longestEdge(f) + h3_); }
+    double gapTolerance(FaceIndex f) const { return O_.maxGapRatio * (longestEdge(f) + comp_.h3); }
     // Does face f meet the component in the view (or come closer to it than snapping can move things), on
     // the same sheet: the patch triangles there lie on f's plane, not in front of it (an occluder) or
     // behind it (f occludes them)?
@@ -312,52 +385,11 @@ private:
     Mesh::Property_map<FaceIndex, float> curQuality_;
     Mesh::Property_map<FaceIndex, std::int32_t> curScanId_;
 
-    // ---- component
-    struct PEdge {
-        int a, b;     // patch vertices, interior on the left of a → b
-        int opposite; // third vertex of the patch triangle on this edge
-        std::vector<std::pair<double, int>> splits;
-        std::vector<int> line;
-    };
-    struct REdge {
-        int u, w; // local ids of the mesh edge's halfedge source and target
-        EdgeIndex edge;
-        std::vector<std::pair<double, int>> splits;
-        std::vector<int> line;
-    };
-    std::vector<int> compVerts_;                            // vertices of the component, sorted
-    std::unordered_map<int, std::vector<int>> vertexFaces_; // faces around each boundary vertex
-    std::unordered_set<int> boundary_;
-    std::vector<PEdge> pedges_;
-    std::unordered_map<std::uint64_t, int> pedgeIndex_;
-    std::unordered_map<int, double> snapRadius_;
-    double h2_ = 0, h3_ = 0;
-    double margin_ = 0; // largest snapping distance in the view
-    CGAL::Bbox_2 compBox_;
-    BucketGrid compGrid_;
-
-    // ---- current mesh
-    IndexMap<VProj> vcache_;
-    IndexMap<char> accept_; // bool (a char: vector<bool> has no addressable elements)
-    bool fallbackBuilt_ = false;
-    std::vector<FaceIndex> fallback_;
-    BucketGrid fallbackGrid_;
-    std::vector<FaceIndex> region_;   // faces re-triangulated in the view (near the seam)
-    std::vector<FaceIndex> interior_; // faces under the patch, removed whole
-    IndexMap<int> regionIndex_;
-    BucketGrid regionGrid_;
-
-    // ---- local problem
-    std::vector<LVert> L_;
-    std::unordered_map<std::uint32_t, int> lidOfCurrent_;
-    std::unordered_map<int, int> lidOfPatch_;
-    std::vector<REdge> redges_;
-    std::unordered_map<std::uint32_t, int> redgeIndex_;
-    std::vector<std::pair<int, int>> subEdges_;
-    std::unordered_set<std::uint64_t> regionSub_, patchSub_;
-    std::vector<FaceIndex> replaced_;
-    std::vector<LFace> newFaces_;
-    std::map<std::uint32_t, int> outerSplits_; // face outside the region → the region edge of it split
+    // ---- the stages' results (explicit structs, stitch_stages.h)
+    ComponentShape comp_; // setupComponent (region stage)
+    RegionSearch search_; // the region stage's caches over the current mesh
+    Region reg_;          // findRegion, splitRegion
+    LocalProblem cut_;    // cut, gap triangulation (buildLocalVertices … assemble)
 };
 
 } // namespace fss::detail::stitching

@@ -30,7 +30,7 @@ std::vector<FaceIndex> ComponentStitcher::intersectionCandidates(Local& loc) {
     std::vector<FaceIndex> out, kept;
     for (FaceIndex f : S.faces())
         if (loc.star.kept[f]) kept.push_back(f);
-    BucketGrid keptGrid(4.0 * h2_, S.num_faces());
+    BucketGrid keptGrid(4.0 * comp_.h2, S.num_faces());
     for (FaceIndex f : kept)
         keptGrid.insert(int(std::uint32_t(f)), faceBox(f));
     for (FaceIndex f : S.faces()) {
@@ -190,7 +190,7 @@ bool ComponentStitcher::extractPlan(Local& loc, Attempt& a) {
         std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
         return c;
     };
-    for (FaceIndex f : replaced_) {
+    for (FaceIndex f : cut_.replaced) {
         const auto vs = faceVertices(f);
         byCorners[corners({std::uint32_t(vs[0]), std::uint32_t(vs[1]), std::uint32_t(vs[2])})] = f;
     }
@@ -215,7 +215,7 @@ bool ComponentStitcher::extractPlan(Local& loc, Attempt& a) {
             faces.push_back(fv);
             sfaces.push_back(f);
         }
-    for (FaceIndex f : replaced_)
+    for (FaceIndex f : cut_.replaced)
         if (!unchanged.count(std::uint32_t(f))) plan.removed.push_back(f);
     std::unordered_set<std::uint32_t> reused;
     // Order faces for growth in the rehearsal mesh: the star as copied (same star, same removals).
