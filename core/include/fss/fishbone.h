@@ -84,8 +84,10 @@ struct FishboneOptions {
     /// up to 1/cos θ times longer one way than the other, and their triangles slivers). Automatic mode only
     /// (key-ribs are blended with the paper's constant h). false here and in files written before it.
     bool isotropicRibs = false;
-    /// The surface length of the screen segment a – b (set by the fishbone scan for isotropicRibs; empty: no
-    /// surface spacing). Must be safe to call from several threads. Not stored in session files.
+    /// The surface length of the screen segment a – b in pixel footprints (set by the fishbone scan for
+    /// isotropicRibs; empty: no surface spacing). A rib's surface spacing is capped at 2.5 h of it (the
+    /// triangulation drops edges longer than 3 h footprints). Must be safe to call from several threads. Not
+    /// stored in session files.
     std::function<double(const Eigen::Vector2d& a, const Eigen::Vector2d& b)> surfaceLength{};
 
     /// Checks the ranges: spacing finite and > 0, minRibGap in [0, 1), maxRibTurnDeg in (0, 180], and both

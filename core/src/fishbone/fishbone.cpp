@@ -421,7 +421,10 @@ std::vector<Rib> traceRibs(const DirectionField& ribField, const Backbone& backb
     std::vector<double> surface(count, 0.0);
     if (options.isotropicRibs && options.surfaceLength)
         for (std::size_t i = 0; i < count; ++i)
-            surface[i] = backboneSurfaceSpacing(backbone, first + i, options);
+            // At most 2.5 h: the triangulation drops edges longer than 3 h footprints (a backbone seen
+            // almost end-on is stretched on the surface; its quads stay long that way).
+            surface[i] =
+                std::min(backboneSurfaceSpacing(backbone, first + i, options), 2.5 * options.spacing);
     for (std::size_t k = 0; k < halves.size(); ++k) {
         const std::size_t i = owners[k];
         *targets[k] = surface[i] > 0 ? resampleOnSurface(halves[k].points, surface[i], 0.5 * options.spacing,

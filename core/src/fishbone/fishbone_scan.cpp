@@ -435,8 +435,9 @@ namespace {
 
 // FishboneOptions::surfaceLength on the sampling image: a screen point's surface point is where its viewing
 // ray hits the reference (RayCaster with the ID buffer's face under it as the hint, as the rib vertices are
-// cast); a segment's length is the distance of its ends' surface points. An end on the background: the other
-// end's pixel footprint times the screen length (both: 0, which the resampling skips).
+// cast); a segment's length is the distance of its ends' surface points in pixel footprints there (the unit
+// of the triangulation's edge limit). An end on the background: the screen length (both: 0, which the
+// resampling skips).
 std::function<double(const Eigen::Vector2d&, const Eigen::Vector2d&)>
 surfaceMetric(const FrameBuffers& buffers, const RayCaster& caster, const LocalSearchOptions& search) {
     auto rays = std::make_shared<RayFactory>(buffers.camera);
@@ -453,9 +454,9 @@ surfaceMetric(const FrameBuffers& buffers, const RayCaster& caster, const LocalS
     };
     return [onSurface, &buffers](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
         const std::optional<Eigen::Vector3d> pa = onSurface(a), pb = onSurface(b);
-        if (pa && pb) return (*pb - *pa).norm();
-        if (!pa && !pb) return 0.0;
-        return buffers.camera.pixelFootprint(pa ? *pa : *pb) * (b - a).norm();
+        if (!pa || !pb) return pa || pb ? (b - a).norm() : 0.0;
+        const double footprint = buffers.camera.pixelFootprint(0.5 * (*pa + *pb));
+        return footprint > 0 ? (*pb - *pa).norm() / footprint : (b - a).norm();
     };
 }
 
