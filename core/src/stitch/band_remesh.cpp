@@ -12,8 +12,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <numbers>
+#include <string>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -26,6 +28,10 @@ constexpr double kBandDeg = std::numbers::pi / 180.0;
 constexpr double kSliverDeg = 10.0;
 // A crease vertex between two crease edges that turn by at most this (degrees) may be collapsed along them.
 constexpr double kStraightCreaseDeg = 20.0;
+// ... and slid along them (the crease line moves off the surface by at most ~7 % of the edge).
+constexpr double kSlideCreaseDeg = 10.0;
+// No split makes a face below this (degrees) unless one of the two faces it splits was already below.
+constexpr double kSplitFloorDeg = 20.0;
 using V3 = Eigen::Vector3d;
 
 std::uint64_t bandKey(VertexIndex a, VertexIndex b) {
@@ -39,6 +45,13 @@ public:
     explicit BandRemesher(const BandRemeshInput& in) : in_(in), S_(*in.mesh) {}
 
     BandRemeshReport run() {
+        bandList_ = in_.band;
+        for (FaceIndex f : bandList_)
+            at(band_, std::size_t(f), char(0)) = 1;
+        grow();
+        if (in_.unseen)
+            for (FaceIndex f : bandList_)
+                at(unseen_, std::size_t(f), char(0)) = char(in_.unseen(f));
         setup();
         measure(report_.minAngleBeforeDeg, report_.fracAbove30Before);
         for (int it = 0; it < in_.iterations; ++it) {
@@ -54,6 +67,13 @@ public:
             improvePass();
             flipPass();
         }
+        for (int it = 0; it < 3; ++it) {
+            const bool changed = repairPass();
+            slidePass();
+            improvePass();
+            flipPass();
+            if (!changed) break;
+        }
         measure(report_.minAngleAfterDeg, report_.fracAbove30After);
         for (std::size_t f = 0; f < band_.size(); ++f)
             if (band_[f] && !S_.is_removed(FaceIndex(std::uint32_t(f))))
@@ -61,6 +81,7 @@ public:
         for (std::size_t v = 0; v < touched_.size(); ++v)
             if (touched_[v] && !S_.is_removed(VertexIndex(std::uint32_t(v))))
                 report_.touched.push_back(VertexIndex(std::uint32_t(v)));
+        countBelow20();
         return report_;
     }
 
@@ -73,6 +94,7 @@ private:
     bool inBand(FaceIndex f) {
         return f != Mesh::null_face() && std::size_t(f) < band_.size() && band_[std::size_t(f)];
     }
+    bool unseen(FaceIndex f) const { return std::size_t(f) < unseen_.size() && unseen_[std::size_t(f)]; }
     bool isFixed(VertexIndex v) { return at(fixed_, std::size_t(v), char(1)) != 0; }
     double sizeOf(VertexIndex v) { return at(size_, std::size_t(v), in_.edgeLength); }
     bool isCrease(VertexIndex a, VertexIndex b) const { return crease_.count(bandKey(a, b)) > 0; }
@@ -93,6 +115,11 @@ private:
     // The normal a face's replacement is compared with: its own where it is well shaped, else \p fallback
     // (an area-weighted normal around it: a sliver's own normal says nothing about the surface).
     V3 referenceNormal(FaceIndex f, const V3& fallback) const {
+        if (unseen(f) && in_.creaseNormal) {
+            // A piece of a face the view does not see: the plane of the face it was cut from.
+            const V3 n = in_.creaseNormal(f);
+            if (n.squaredNorm() > 0) return n;
+        }
         const HalfedgeIndex h = S_.halfedge(f);
         const V3 a = detail::pos(S_, S_.source(h)), b = detail::pos(S_, S_.target(h)),
                  c = detail::pos(S_, S_.target(S_.next(h)));
@@ -107,8 +134,9 @@ private:
         return n.dot(toViewer) > 0;
     }
     // A triangle that may replace one of normal n0: facing, not degenerate, turned by at most the bound.
-    bool acceptableFace(const V3& a, const V3& b, const V3& c, const V3& n0) const {
-        if (!facing(a, b, c)) return false;
+    // A face the view does not see (`seen` false) keeps its own orientation instead: the normal bound holds.
+    bool acceptableFace(const V3& a, const V3& b, const V3& c, const V3& n0, bool seen = true) const {
+        if (seen && !facing(a, b, c)) return false;
         const V3 n = detail::unitNormal(a, b, c);
         return n.squaredNorm() > 0 && detail::angleBetween(n, n0) <= in_.maxNormalTurnDeg * kBandDeg;
     }
@@ -125,12 +153,10 @@ private:
 
     // ---- setup: band marks, fixed vertices, creases, reference copy, sizes
     void setup() {
-        for (FaceIndex f : in_.band)
-            at(band_, std::size_t(f), char(0)) = 1;
         // Vertices of the band; border ones (a face around them outside the band) and the caller's are fixed.
         std::vector<VertexIndex> verts;
         std::unordered_set<std::uint32_t> seen;
-        for (FaceIndex f : in_.band)
+        for (FaceIndex f : bandList_)
             for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
                 if (seen.insert(std::uint32_t(v)).second) verts.push_back(v);
         std::sort(verts.begin(), verts.end());
@@ -147,7 +173,7 @@ private:
             return detail::minAngle(a, b, c) >= kSliverDeg * kBandDeg ? detail::unitNormal(a, b, c)
                                                                       : V3(0, 0, 0);
         };
-        for (FaceIndex f : in_.band)
+        for (FaceIndex f : bandList_)
             for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
                 if (!interiorEdge(h)) continue;
                 const V3 n1 = creaseNormal(S_.face(h)), n2 = creaseNormal(S_.face(S_.opposite(h)));
@@ -161,7 +187,7 @@ private:
         std::unordered_map<std::uint32_t, VertexIndex> toRef;
         for (VertexIndex v : verts)
             toRef[std::uint32_t(v)] = ref_.add_vertex(S_.point(v));
-        for (FaceIndex f : in_.band) {
+        for (FaceIndex f : bandList_) {
             std::array<VertexIndex, 3> r;
             int k = 0;
             for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
@@ -210,6 +236,82 @@ private:
                 size_[std::size_t(inner[i])] = next[i];
         }
     }
+    double faceMinAngle(FaceIndex f) const {
+        const HalfedgeIndex h = S_.halfedge(f);
+        return detail::minAngle(detail::pos(S_, S_.source(h)), detail::pos(S_, S_.target(h)),
+                                detail::pos(S_, S_.target(S_.next(h))));
+    }
+    bool growable(FaceIndex f) const { return f != Mesh::null_face() && in_.growable && in_.growable(f); }
+
+    // ---- growth: the band takes in the faces at and beyond its border that it would otherwise leave bad
+    void grow() {
+        // FSS_STITCH_BAND_GROW=0 keeps the band as given (for measuring what the growth brings).
+        static const bool off = [] {
+            const char* e = std::getenv("FSS_STITCH_BAND_GROW");
+            return e && std::string(e) == "0";
+        }();
+        if (!in_.growable || off) return;
+        const double aim = in_.growBelowDeg * kBandDeg, floor = 20.0 * kBandDeg;
+        for (int round = 0; round < in_.maxGrowRounds; ++round) {
+            std::vector<FaceIndex> add;
+            auto around = [&](VertexIndex v) {
+                for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
+                    const FaceIndex g = S_.face(h);
+                    if (!S_.is_border(h) && !inBand(g) && growable(g)) add.push_back(g);
+                }
+            };
+            auto touchesBand = [&](FaceIndex f) {
+                for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
+                    for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_))
+                        if (!S_.is_border(h) && inBand(S_.face(h))) return true;
+                return false;
+            };
+            for (FaceIndex f : S_.faces()) {
+                if (inBand(f) || !growable(f)) continue;
+                const double a = faceMinAngle(f);
+                if (a >= aim || (a >= floor && !touchesBand(f))) continue;
+                add.push_back(f);
+                for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
+                    around(v);
+            }
+            for (FaceIndex f : bandList_) {
+                if (faceMinAngle(f) >= aim) continue;
+                for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
+                    if (!(in_.fixed && in_.fixed(v)) && !wholeStarInBand(v)) around(v);
+            }
+            std::sort(add.begin(), add.end());
+            add.erase(std::unique(add.begin(), add.end()), add.end());
+            if (add.empty()) break;
+            for (FaceIndex f : add) {
+                at(band_, std::size_t(f), char(0)) = 1;
+                bandList_.push_back(f);
+            }
+            report_.grown += add.size();
+        }
+        std::sort(bandList_.begin(), bandList_.end());
+    }
+
+    // ---- diagnostics: where the new faces below 20 deg are after the remesh
+    void countBelow20() {
+        if (!bandDiagnostics()) return;
+        const double floor = 20.0 * kBandDeg;
+        for (FaceIndex f : S_.faces()) {
+            const bool band = inBand(f), unseen = in_.unseen && in_.unseen(f);
+            if (!band && !unseen && !growable(f)) continue;
+            if (faceMinAngle(f) >= floor) continue;
+            if (!band && unseen) {
+                ++report_.below20Unseen;
+            } else if (!band) {
+                ++report_.below20Beyond;
+            } else {
+                bool free = false;
+                for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
+                    free = free || !isFixed(v);
+                ++(free ? report_.below20Free : report_.below20Held);
+            }
+        }
+    }
+
     void addCrease(VertexIndex a, VertexIndex b) {
         if (crease_.insert(bandKey(a, b)).second) {
             ++creaseDeg_[std::uint32_t(a)];
@@ -290,8 +392,15 @@ private:
         const FaceIndex f1 = S_.face(h), f2 = S_.face(S_.opposite(h));
         const V3 quad = (areaVector(f1) + areaVector(f2)).normalized();
         const V3 n1 = referenceNormal(f1, quad), n2 = referenceNormal(f2, quad);
-        if (!acceptableFace(pa, q, pc, n1) || !acceptableFace(q, pb, pc, n1) ||
-            !acceptableFace(pb, q, pd, n2) || !acceptableFace(q, pa, pd, n2))
+        const bool s1 = !unseen(f1), s2 = !unseen(f2);
+        if (!acceptableFace(pa, q, pc, n1, s1) || !acceptableFace(q, pb, pc, n1, s1) ||
+            !acceptableFace(pb, q, pd, n2, s2) || !acceptableFace(q, pa, pd, n2, s2))
+            return false;
+        // No split makes a face below the floor that was not there (a split next to a small angle halves it).
+        const double oldMin = std::min(detail::minAngle(pa, pb, pc), detail::minAngle(pb, pa, pd));
+        const double newMin = std::min({detail::minAngle(pa, q, pc), detail::minAngle(q, pb, pc),
+                                        detail::minAngle(pb, q, pd), detail::minAngle(q, pa, pd)});
+        if (newMin < std::min(oldMin, kSplitFloorDeg * kBandDeg) || newMin < minSplitGain_ * oldMin)
             return false;
         const detail::EdgeSplit s = detail::splitEdge(S_, h, Point3(q.x(), q.y(), q.z()));
         const VertexIndex v = s.vertex;
@@ -304,6 +413,7 @@ private:
             for (FaceIndex g : {S_.face(e), S_.face(S_.opposite(e))})
                 if (g != parent) {
                     at(band_, std::size_t(g), char(0)) = 1;
+                    at(unseen_, std::size_t(g), char(0)) = char(unseen(parent));
                     if (in_.faceData) in_.faceData(g, parent);
                 }
         at(band_, std::size_t(f1), char(0)) = 1;
@@ -315,6 +425,92 @@ private:
         }
         ++report_.splits;
         return true;
+    }
+
+    // ---- repair of the faces still below the aim, whatever the sizes and valences: a flip of one of their
+    // edges, a collapse of their shortest edge, a split of the long edge of a cap (an angle above 120 deg),
+    // each only where it raises the smallest angle there. True when something changed.
+    bool repairPass() {
+        const double aim = in_.minAngleDeg * kBandDeg;
+        std::vector<std::pair<double, FaceIndex>> bad;
+        for (std::size_t f = 0; f < band_.size(); ++f) {
+            const FaceIndex g(static_cast<std::uint32_t>(f));
+            if (!band_[f] || S_.is_removed(g)) continue;
+            const double a = faceMinAngle(g);
+            if (a < aim) bad.push_back({a, g});
+        }
+        std::sort(bad.begin(), bad.end());
+        bool changed = false;
+        for (const auto& [angle, f] : bad) {
+            if (S_.is_removed(f) || !inBand(f) || faceMinAngle(f) >= aim) continue;
+            if (repairFlip(f) || repairCollapse(f) || repairCap(f)) {
+                changed = true;
+                ++report_.repairs;
+            }
+        }
+        return changed;
+    }
+    bool repairFlip(FaceIndex f) {
+        const double before = faceMinAngle(f);
+        for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
+            if (!interiorEdge(h)) continue;
+            const VertexIndex a = S_.source(h), b = S_.target(h);
+            if (isCrease(a, b) || !detail::canFlip(S_, h)) continue;
+            const FaceIndex g = S_.face(S_.opposite(h));
+            if (unseen(f) != unseen(g)) continue;
+            const VertexIndex c = S_.target(S_.next(h)), d = S_.target(S_.next(S_.opposite(h)));
+            const V3 pa = detail::pos(S_, a), pb = detail::pos(S_, b), pc = detail::pos(S_, c),
+                     pd = detail::pos(S_, d);
+            const double oldMin = std::min(before, faceMinAngle(g));
+            const double newMin = std::min(detail::minAngle(pa, pd, pc), detail::minAngle(pb, pc, pd));
+            if (!(newMin > oldMin + 0.5 * kBandDeg)) continue;
+            const V3 quad = (areaVector(f) + areaVector(g)).normalized();
+            const V3 n1 = referenceNormal(f, quad), n2 = referenceNormal(g, quad);
+            const bool seen = !unseen(f);
+            if (!acceptableFace(pa, pd, pc, n1, seen) || !acceptableFace(pa, pd, pc, n2, seen) ||
+                !acceptableFace(pb, pc, pd, n1, seen) || !acceptableFace(pb, pc, pd, n2, seen))
+                continue;
+            if (distanceToRef(0.5 * (pc + pd), c) > 0.1 * (pc - pd).norm()) continue;
+            CGAL::Euler::flip_edge(h, S_);
+            ++report_.flips;
+            return true;
+        }
+        return false;
+    }
+    bool repairCollapse(FaceIndex f) {
+        HalfedgeIndex shortest = Mesh::null_halfedge();
+        double len = std::numeric_limits<double>::infinity();
+        for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
+            const double l = (detail::pos(S_, S_.source(h)) - detail::pos(S_, S_.target(h))).norm();
+            if (l < len && interiorEdge(h)) {
+                len = l;
+                shortest = h;
+            }
+        }
+        if (shortest == Mesh::null_halfedge()) return false;
+        const VertexIndex a = S_.source(shortest), b = S_.target(shortest);
+        double sa = -1, sb = -1;
+        const bool okA = collapsible(a, b, sa, 2.0), okB = collapsible(b, a, sb, 2.0);
+        if (!okA && !okB) return false;
+        const VertexIndex from = (okA && (!okB || sa >= sb)) ? a : b, to = from == a ? b : a;
+        if (std::max(sa, sb) <= faceMinAngle(f)) return false;
+        collapse(from, to);
+        return true;
+    }
+    bool repairCap(FaceIndex f) {
+        const HalfedgeIndex h0 = S_.halfedge(f);
+        HalfedgeIndex opposite = Mesh::null_halfedge();
+        for (HalfedgeIndex h : CGAL::halfedges_around_face(h0, S_)) {
+            // The angle at the corner opposite h.
+            const V3 p = detail::pos(S_, S_.target(S_.next(h)));
+            const V3 u = detail::pos(S_, S_.source(h)) - p, w = detail::pos(S_, S_.target(h)) - p;
+            if (detail::angleBetween(u, w) > 120.0 * kBandDeg) opposite = h;
+        }
+        if (opposite == Mesh::null_halfedge() || !interiorEdge(opposite)) return false;
+        minSplitGain_ = 1.0 + 1e-6; // the split must raise the smallest angle of the two faces
+        const bool ok = split(opposite);
+        minSplitGain_ = 0;
+        return ok;
     }
 
     // ---- collapses of edges shorter than 4/5 of the local size
@@ -340,7 +536,7 @@ private:
         }
     }
     // Whether `from` may go into `to` (to keeps its place); score: the smallest angle after.
-    bool collapsible(VertexIndex from, VertexIndex to, double& score) {
+    bool collapsible(VertexIndex from, VertexIndex to, double& score, double limitFactor = 4.0 / 3.0) {
         if (isFixed(from) || !wholeStarInBand(from)) return false;
         if (creaseDegree(from) > 0) {
             // Only along a nearly straight crease, onto its neighbour on it: the crease keeps its line.
@@ -357,7 +553,7 @@ private:
         const HalfedgeIndex h = S_.halfedge(from, to);
         if (!detail::canCollapse(S_, S_.edge(h), true)) return false;
         const V3 pt = detail::pos(S_, to);
-        const double limit = 4.0 / 3.0 * sizeOf(to);
+        const double limit = limitFactor * sizeOf(to);
         V3 star(0, 0, 0);
         for (HalfedgeIndex g : CGAL::halfedges_around_target(S_.halfedge(from), S_))
             star += areaVector(S_.face(g));
@@ -368,7 +564,8 @@ private:
             const V3 pp = detail::pos(S_, p), pq = detail::pos(S_, q), pf = detail::pos(S_, from);
             oldMin = std::min(oldMin, detail::minAngle(pf, pp, pq));
             if (p == to || q == to) continue;
-            if (!acceptableFace(pt, pp, pq, referenceNormal(S_.face(g), star))) return false;
+            if (!acceptableFace(pt, pp, pq, referenceNormal(S_.face(g), star), !unseen(S_.face(g))))
+                return false;
             if ((pp - pt).norm() > limit) return false;
             newMin = std::min(newMin, detail::minAngle(pt, pp, pq));
         }
@@ -424,11 +621,13 @@ private:
                 const V3 pa = detail::pos(S_, a), pb = detail::pos(S_, b), pc = detail::pos(S_, c),
                          pd = detail::pos(S_, d);
                 const V3 quad = (areaVector(S_.face(h)) + areaVector(S_.face(S_.opposite(h)))).normalized();
+                if (unseen(S_.face(h)) != unseen(S_.face(S_.opposite(h)))) continue;
+                const bool seen = !unseen(S_.face(h));
                 const V3 n1 = referenceNormal(S_.face(h), quad),
                          n2 = referenceNormal(S_.face(S_.opposite(h)), quad);
                 // New faces (a, d, c) and (b, c, d).
-                if (!acceptableFace(pa, pd, pc, n1) || !acceptableFace(pa, pd, pc, n2) ||
-                    !acceptableFace(pb, pc, pd, n1) || !acceptableFace(pb, pc, pd, n2))
+                if (!acceptableFace(pa, pd, pc, n1, seen) || !acceptableFace(pa, pd, pc, n2, seen) ||
+                    !acceptableFace(pb, pc, pd, n1, seen) || !acceptableFace(pb, pc, pd, n2, seen))
                     continue;
                 // The new edge stays near the draft (a flip over a curved place would cut under it).
                 const double dev = distanceToRef(0.5 * (pc + pd), c);
@@ -559,6 +758,50 @@ private:
             }
         }
     }
+    // Crease vertices of faces below the aim slide along their (nearly straight) crease: candidates on the
+    // two crease edges, the one that maximises the star's smallest angle wins.
+    void slidePass() {
+        const double aim = in_.minAngleDeg * kBandDeg, maxTurn = in_.maxNormalTurnDeg * kBandDeg;
+        std::vector<VertexIndex> verts;
+        std::unordered_set<std::uint32_t> seen;
+        for (std::size_t f = 0; f < band_.size(); ++f) {
+            const FaceIndex g(static_cast<std::uint32_t>(f));
+            if (!band_[f] || S_.is_removed(g) || faceMinAngle(g) >= aim) continue;
+            for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_))
+                if (!isFixed(v) && creaseDegree(v) == 2 && wholeStarInBand(v) &&
+                    seen.insert(std::uint32_t(v)).second)
+                    verts.push_back(v);
+        }
+        std::sort(verts.begin(), verts.end());
+        for (VertexIndex v : verts) {
+            std::vector<VertexIndex> ends;
+            for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(v), S_))
+                if (isCrease(v, w)) ends.push_back(w);
+            if (ends.size() != 2) continue;
+            const V3 p = detail::pos(S_, v), e0 = detail::pos(S_, ends[0]), e1 = detail::pos(S_, ends[1]);
+            if (detail::angleBetween(p - e0, e1 - p) > kSlideCreaseDeg * kBandDeg) continue;
+            double best = starMinAngle(v, p);
+            V3 bestP = p;
+            for (const V3& e : {e0, e1})
+                for (double t : {0.1, 0.2, 0.3, 0.4}) {
+                    const V3 q = p + t * (e - p);
+                    const double a = starMinAngle(v, q);
+                    if (a > best + 1e-9 && starAcceptable(v, q, maxTurn)) {
+                        best = a;
+                        bestP = q;
+                    }
+                }
+            if (bestP == p) continue;
+            S_.point(v) = Point3(bestP.x(), bestP.y(), bestP.z());
+            const FaceIndex hint = at(hint_, std::size_t(v), Mesh::null_face());
+            if (hint != Mesh::null_face()) {
+                const SurfacePoint sp = closestPointNear(ref_, bestP, hint, LocalSearchOptions{.rings = 2});
+                if (sp) hint_[std::size_t(v)] = sp.face;
+            }
+            touch(v);
+            ++report_.moves;
+        }
+    }
     double starMinAngle(VertexIndex v, const V3& at) const {
         double m = std::numbers::pi;
         for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
@@ -575,7 +818,7 @@ private:
         star.normalize();
         for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
             const V3 b = detail::pos(S_, S_.source(h)), c = detail::pos(S_, S_.target(S_.next(h)));
-            if (!facing(b, at, c)) return false;
+            if (!unseen(S_.face(h)) && !facing(b, at, c)) return false;
             const V3 n = detail::unitNormal(b, at, c);
             if (detail::angleBetween(n, referenceNormal(S_.face(h), star)) > maxTurn) return false;
         }
@@ -584,8 +827,11 @@ private:
 
     const BandRemeshInput& in_;
     Mesh& S_;
-    Mesh ref_; // the draft band, onto which vertices are projected
+    Mesh ref_;                        // the draft band, onto which vertices are projected
+    std::vector<FaceIndex> bandList_; // the band as given and grown (descriptor order after growth)
     std::vector<char> band_, fixed_, touched_;
+    double minSplitGain_ = 0;  // a split must give a smallest angle of at least this times the one before
+    std::vector<char> unseen_; // per face: a new face the view does not see (BandRemeshInput::unseen)
     std::vector<double> size_;
     std::vector<FaceIndex> hint_; // per S vertex: a face of ref_ at it
     std::unordered_set<std::uint64_t> crease_;
@@ -594,6 +840,14 @@ private:
 };
 
 } // namespace
+
+bool bandDiagnostics() {
+    static const bool on = [] {
+        const char* e = std::getenv("FSS_STITCH_BAND_DIAG");
+        return e && std::string(e) == "1";
+    }();
+    return on;
+}
 
 BandRemeshReport remeshBand(const BandRemeshInput& input) {
     BandRemesher r(input);
