@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <numbers>
@@ -34,6 +35,16 @@ constexpr double kSlideCreaseDeg = 10.0;
 constexpr double kSplitFloorDeg = 20.0;
 using V3 = Eigen::Vector3d;
 
+// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide turns parts of the band remesh off (to measure what each
+// brings).
+bool stageOff(const char* name) {
+    static const std::string off = [] {
+        const char* e = std::getenv("FSS_STITCH_BAND_OFF");
+        return e ? std::string(",") + e + "," : std::string();
+    }();
+    return off.find(std::string(",") + name + ",") != std::string::npos;
+}
+
 std::uint64_t bandKey(VertexIndex a, VertexIndex b) {
     const std::uint32_t x = std::uint32_t(a), y = std::uint32_t(b); // (std::minmax of temporaries dangles)
     return x < y ? (std::uint64_t(x) << 32) | y : (std::uint64_t(y) << 32) | x;
@@ -49,7 +60,7 @@ public:
         for (FaceIndex f : bandList_)
             at(band_, std::size_t(f), char(0)) = 1;
         grow();
-        if (in_.unseen)
+        if (in_.unseen && !stageOff("unseen"))
             for (FaceIndex f : bandList_)
                 at(unseen_, std::size_t(f), char(0)) = char(in_.unseen(f));
         setup();
@@ -67,9 +78,9 @@ public:
             improvePass();
             flipPass();
         }
-        for (int it = 0; it < 3; ++it) {
+        for (int it = 0; it < 3 && !stageOff("repair"); ++it) {
             const bool changed = repairPass();
-            slidePass();
+            if (!stageOff("slide")) slidePass();
             improvePass();
             flipPass();
             if (!changed) break;
@@ -245,12 +256,7 @@ private:
 
     // ---- growth: the band takes in the faces at and beyond its border that it would otherwise leave bad
     void grow() {
-        // FSS_STITCH_BAND_GROW=0 keeps the band as given (for measuring what the growth brings).
-        static const bool off = [] {
-            const char* e = std::getenv("FSS_STITCH_BAND_GROW");
-            return e && std::string(e) == "0";
-        }();
-        if (!in_.growable || off) return;
+        if (!in_.growable || stageOff("grow")) return;
         const double aim = in_.growBelowDeg * kBandDeg, floor = 20.0 * kBandDeg;
         for (int round = 0; round < in_.maxGrowRounds; ++round) {
             std::vector<FaceIndex> add;
@@ -295,6 +301,8 @@ private:
     void countBelow20() {
         if (!bandDiagnostics()) return;
         const double floor = 20.0 * kBandDeg;
+        const char* e = std::getenv("FSS_STITCH_BAND_DIAG");
+        const bool verbose = e && std::string(e) == "2";
         for (FaceIndex f : S_.faces()) {
             const bool band = inBand(f), unseen = in_.unseen && in_.unseen(f);
             if (!band && !unseen && !growable(f)) continue;
@@ -308,6 +316,21 @@ private:
                 for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
                     free = free || !isFixed(v);
                 ++(free ? report_.below20Free : report_.below20Held);
+                if (verbose) {
+                    std::fprintf(stderr, "  face %u %.2f deg%s:", std::uint32_t(f),
+                                 faceMinAngle(f) / kBandDeg, unseen ? " unseen" : "");
+                    for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
+                        const VertexIndex v = S_.target(h);
+                        const V3 p = detail::pos(S_, v), a = detail::pos(S_, S_.source(h)),
+                                 b = detail::pos(S_, S_.target(S_.next(h)));
+                        std::fprintf(stderr, " [v%u %.1f deg%s%s crease %d deg %zu edge %.3g%s]",
+                                     std::uint32_t(v), detail::angleBetween(a - p, b - p) / kBandDeg,
+                                     isFixed(v) ? " fixed" : "", wholeStarInBand(v) ? "" : " rim",
+                                     creaseDegree(v), std::size_t(S_.degree(v)), (p - a).norm(),
+                                     isCrease(S_.source(h), v) ? " (crease)" : "");
+                    }
+                    std::fprintf(stderr, "\n");
+                }
             }
         }
     }
@@ -844,7 +867,7 @@ private:
 bool bandDiagnostics() {
     static const bool on = [] {
         const char* e = std::getenv("FSS_STITCH_BAND_DIAG");
-        return e && std::string(e) == "1";
+        return e && (std::string(e) == "1" || std::string(e) == "2");
     }();
     return on;
 }

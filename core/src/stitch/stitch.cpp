@@ -2367,8 +2367,13 @@ private:
         };
         in.edgeLength = h3_;
         in.maxNormalTurnDeg = O_.maxNormalChangeDeg;
-        in.growable = [&](FaceIndex f) { return f != Mesh::null_face() && !loc.star.kept[f]; };
+        // The band grows over new faces outside the patch only: moving the patch's samples beyond the first
+        // rings puts them on its chords, up to a footprint off the reference (measured: fandisk, 80² scan).
+        in.growable = [&](FaceIndex f) {
+            return f != Mesh::null_face() && !loc.star.kept[f] && !loc.patchSide[f];
+        };
         in.unseen = [&](FaceIndex f) { return !loc.star.kept[f] && loc.offView[f]; };
+        in.growBelowDeg = 20.0;
         const stitch::BandRemeshReport r = stitch::remeshBand(in);
         progress_.tick(in.band.size());
         const bool worse = r.minAngleAfterDeg < r.minAngleBeforeDeg &&
