@@ -504,14 +504,13 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
     fig.facesStart = ref.number_of_faces();
     std::mt19937 rng(cs.seed);
     // FSS_STITCH_REFILL=1 measures stitch v2's seam refill (StitchOptions::refillSeam, off by default);
-    // FSS_STITCH_REMESH=0 measures without stitch v2's seam band remesh (StitchOptions::remeshSeam, on by
-    // default): version 1's seam, for comparison.
+    // FSS_STITCH_REMESH=1 measures stitch v2's seam band remesh (StitchOptions::remeshSeam, off by default).
     const fss::StitchOptions options = [] {
         fss::StitchOptions o;
         const char* refill = std::getenv("FSS_STITCH_REFILL");
         o.refillSeam = refill && std::string(refill) == "1";
         const char* remesh = std::getenv("FSS_STITCH_REMESH");
-        o.remeshSeam = !(remesh && std::string(remesh) == "0");
+        o.remeshSeam = remesh && std::string(remesh) == "1";
         return o;
     }();
     using Clock = std::chrono::steady_clock;
