@@ -324,8 +324,9 @@ TEST(ScanPipeline, TriangularLatticeMakesRounderTrianglesThanThePixelGrid) {
     const fss::Mesh ref = load("fandisk.off");
     fss::CpuMeshRenderer renderer;
     renderer.setMesh(ref);
-    // The square pixel lattice stays the default until the stitch copes with the triangular one (issue 20).
-    EXPECT_EQ(fss::ScanParams{}.scan.lattice, fss::Lattice::Square);
+    // The default is the adaptive lattice with the lattice-angle mask at 35° (issue 20).
+    EXPECT_EQ(fss::ScanParams{}.scan.lattice, fss::Lattice::Adaptive);
+    EXPECT_EQ(fss::ScanParams{}.scan.minLatticeAngleDeg, 35.0);
     const auto tri = latticeScan(ref, renderer, fss::StandardView::Iso, 256, fss::Lattice::Triangular);
     const auto sq = latticeScan(ref, renderer, fss::StandardView::Iso, 256, fss::Lattice::Square);
     std::printf("fandisk iso 256²: triangular mean min angle %.1f°, %.1f %% < 30°, valence 6 %.3f, Hausdorff "
@@ -351,10 +352,10 @@ TEST(ScanPipeline, AdaptiveLatticeWithTheAngleMaskMakesRoundTrianglesOnFandiskIs
     renderer.setMesh(ref);
     fss::ScanParams params;
     params.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(ref), 256, 256);
+    const fss::ScanResult adaptive = fss::scanPatch(ref, renderer, ref, renderer, params); // the defaults
+    params.scan.lattice = fss::Lattice::Square;
+    params.scan.minLatticeAngleDeg = 0;
     const fss::ScanResult square = fss::scanPatch(ref, renderer, ref, renderer, params);
-    params.scan.lattice = fss::Lattice::Adaptive;
-    params.scan.minLatticeAngleDeg = 35;
-    const fss::ScanResult adaptive = fss::scanPatch(ref, renderer, ref, renderer, params);
     const fss::Metrics a = fss::computeMetrics(adaptive.patch.mesh, {.selfIntersections = false});
     const fss::Metrics s = fss::computeMetrics(square.patch.mesh, {.selfIntersections = false});
     std::printf("fandisk iso 256²: adaptive + mask 35°: mean smallest angle %.1f°, %.1f %% < 30°, valence 6 "
