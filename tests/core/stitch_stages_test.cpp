@@ -1,11 +1,13 @@
 // Stages of stitch v2 (DESIGN.md §6.2), each on its own: the gap triangulation (gap_triangulation.h), the
-// lift onto the reference (lift.h), the seam figures (seam_quality.h), the band remesh (band_remesh.h).
-// References are independent: polygon areas by the shoelace formula, the camera's own projection, angles of
-// known triangles, planes and crease lines of known shapes.
+// lift onto the reference (lift.h), the seam figures (seam_quality.h), the band remesh (band_remesh.h); and
+// stitch v1's shared pieces (stitch_common.h: the view, the bucket grid, the index map, the star, the
+// replay). References are independent: polygon areas by the shoelace formula, the camera's own projection,
+// angles of known triangles, planes and crease lines of known shapes.
 #include "stitch/band_remesh.h"
 #include "stitch/gap_triangulation.h"
 #include "stitch/lift.h"
 #include "stitch/seam_quality.h"
+#include "stitch/stitch_stages.h"
 
 #include "fss/shapes.h"
 #include "mesh/local_ops.h"
@@ -218,6 +220,211 @@ TEST(Lift, RayCastOntoReferenceTriangles) {
     EXPECT_GT(lifted, 50);
     EXPECT_FALSE(locator.lift({2, -2}).has_value());
     EXPECT_FALSE(locator.covers({2, -2}));
+}
+
+// ---- stitch v1's shared pieces (stitch_common.h), tested alone since the split of stitch.cpp
+
+// The view's projection is the camera's (Camera::project as the reference, y flipped), and
+// perspectiveParam inverts the projection along an edge: the 3D point at parameter t projects to the 2D
+// parameter s whose perspectiveParam is t again.
+TEST(StitchCommon, ViewProjectsLikeTheCameraAndInvertsEdgeParameters) {
+    namespace st = fss::detail::stitching;
+    fss::Camera cam;
+    cam.eye = {0.7, -0.4, 4};
+    cam.focal = {0, 0.1, 0};
+    cam.width = 320;
+    cam.height = 240;
+    const st::View view(cam);
+    int checked = 0;
+    for (int i = 0; i < 40; ++i) {
+        const Eigen::Vector3d u(std::sin(1.3 * i), std::cos(0.7 * i), 0.8 * std::sin(0.37 * i)),
+            w(std::cos(2.1 * i), 0.5 * std::sin(1.9 * i), -0.6 * std::cos(0.53 * i));
+        st::Point2 pu, pw, pm;
+        double wu = 0, ww = 0, wm = 0;
+        ASSERT_TRUE(view.project(u, pu, wu));
+        ASSERT_TRUE(view.project(w, pw, ww));
+        const Eigen::Vector3d s = cam.project(u);
+        EXPECT_NEAR(pu.x(), s.x(), 1e-9);
+        EXPECT_NEAR(pu.y(), -s.y(), 1e-9);
+        if (st::dist2(pu, pw) < 1.0) continue; // too short on screen for a parameter
+        const double t = 0.1 + 0.8 * (0.5 + 0.5 * std::sin(3.1 * i));
+        ASSERT_TRUE(view.project(u + t * (w - u), pm, wm));
+        const double s2 = st::lineParam(pm, pu, pw);
+        EXPECT_NEAR(st::View::perspectiveParam(s2, wu, ww), t, 1e-9);
+        ++checked;
+    }
+    EXPECT_GT(checked, 30);
+    // Behind the eye: refused.
+    st::Point2 p;
+    double w = 0;
+    EXPECT_FALSE(view.project(Eigen::Vector3d(1.4, -0.8, 8), p, w));
+}
+
+// The bucket grid reports exactly the boxes that overlap a query box, each once (brute force as the
+// reference), and the open-addressing IndexMap behaves like std::unordered_map under growth.
+TEST(StitchCommon, BucketGridAndIndexMapMatchBruteForce) {
+    namespace st = fss::detail::stitching;
+    std::vector<CGAL::Bbox_2> boxes;
+    for (int i = 0; i < 400; ++i) {
+        const double x = 10 * std::sin(0.91 * i), y = 10 * std::cos(1.37 * i);
+        const double dx = 0.05 + 1.5 * (0.5 + 0.5 * std::sin(2.3 * i)),
+                     dy = 0.05 + 0.8 * (0.5 + 0.5 * std::cos(i));
+        boxes.emplace_back(x, y, x + dx, y + dy);
+    }
+    st::BucketGrid grid(0.7, boxes.size());
+    for (std::size_t i = 0; i < boxes.size(); ++i)
+        grid.insert(int(i), boxes[i]);
+    std::size_t hits = 0;
+    for (int q = 0; q < 60; ++q) {
+        const double x = 9 * std::cos(0.77 * q), y = 9 * std::sin(1.11 * q), r = 0.2 + 0.05 * q;
+        const CGAL::Bbox_2 box(x - r, y - r, x + r, y + r);
+        std::vector<int> got;
+        grid.query(box, [&](int id) { got.push_back(id); });
+        std::vector<int> expected;
+        for (std::size_t i = 0; i < boxes.size(); ++i)
+            if (CGAL::do_overlap(box, boxes[i])) expected.push_back(int(i));
+        std::sort(got.begin(), got.end());
+        EXPECT_EQ(std::adjacent_find(got.begin(), got.end()), got.end()) << "an id reported twice";
+        // Cells are coarser than boxes: the grid may report more, never fewer.
+        std::vector<int> missed;
+        std::set_difference(expected.begin(), expected.end(), got.begin(), got.end(),
+                            std::back_inserter(missed));
+        EXPECT_TRUE(missed.empty()) << missed.size() << " overlapping boxes missed by query " << q;
+        hits += expected.size();
+    }
+    EXPECT_GT(hits, 100u);
+
+    st::IndexMap<int> map;
+    std::unordered_map<std::uint32_t, int> ref;
+    for (std::uint32_t i = 0; i < 5000; ++i) {
+        const std::uint32_t key = (i * 2654435761u) % 7919u;
+        auto [value, fresh] = map.try_emplace(key, -1);
+        auto [it, refFresh] = ref.try_emplace(key, -1);
+        ASSERT_EQ(fresh, refFresh);
+        *value += int(i);
+        it->second += int(i);
+    }
+    EXPECT_EQ(map.size(), ref.size());
+    for (const auto& [key, value] : ref)
+        EXPECT_EQ(map.at(key), value);
+    EXPECT_EQ(map.find(7919u), nullptr);
+    EXPECT_THROW(map.at(7920u), std::logic_error);
+}
+
+// The star of faces copies every face around their vertices (the vertices' degrees as in the mesh), and
+// replaying a plan on the mesh splits a face into three around a new vertex: faces +2, vertices +1, edges
+// +3 (Euler), the mesh still closed and valid; a plan whose face cannot be added is refused.
+TEST(StitchCommon, StarAndReplayEditTheMeshAsPlanned) {
+    namespace st = fss::detail::stitching;
+    fss::Mesh m = fss::shapes::icosphere(2);
+    const std::size_t faces = m.number_of_faces(), vertices = m.number_of_vertices(),
+                      edges = m.number_of_edges();
+    const fss::FaceIndex f = *m.faces().begin();
+    st::Star star;
+    ASSERT_TRUE(st::buildStar(m, {f}, star));
+    std::set<std::uint32_t> around;
+    for (fss::VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m))
+        for (fss::FaceIndex g : CGAL::faces_around_target(m.halfedge(v), m))
+            around.insert(std::uint32_t(g));
+    EXPECT_EQ(star.S.number_of_faces(), around.size());
+    EXPECT_EQ(star.full.size(), 3u);
+    for (fss::VertexIndex s : star.full)
+        EXPECT_EQ(star.S.degree(s), m.degree(fss::VertexIndex(star.cur[s])));
+
+    st::Plan plan;
+    plan.removed = {f};
+    std::array<fss::VertexIndex, 3> corner;
+    int k = 0;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (fss::VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m)) {
+        corner[std::size_t(k++)] = v;
+        centre += st::toVec(m.point(v)) / 3.0;
+        plan.reused.push_back(v);
+    }
+    plan.freshPositions = {centre};
+    for (int i = 0; i < 3; ++i)
+        plan.faces.push_back({st::PlanVertex{std::uint32_t(corner[std::size_t(i)]), false},
+                              st::PlanVertex{std::uint32_t(corner[std::size_t((i + 1) % 3)]), false},
+                              st::PlanVertex{0, true}});
+    std::vector<fss::FaceIndex> added;
+    const auto same = [](auto x) { return x; };
+    ASSERT_TRUE(st::replay(m, plan, same, same, [&](std::size_t, fss::FaceIndex g) { added.push_back(g); }));
+    EXPECT_EQ(added.size(), 3u);
+    EXPECT_EQ(m.number_of_faces(), faces + 2);
+    EXPECT_EQ(m.number_of_vertices(), vertices + 1);
+    EXPECT_EQ(m.number_of_edges(), edges + 3);
+    EXPECT_TRUE(CGAL::is_closed(m));
+    EXPECT_TRUE(CGAL::is_valid_polygon_mesh(m));
+
+    // Adding a face that is already there (same orientation) is refused.
+    st::Plan twice;
+    twice.faces.resize(1);
+    fss::Mesh copy = m;
+    const auto h = copy.halfedge(added[0]);
+    twice.faces[0] = {st::PlanVertex{std::uint32_t(copy.source(h)), false},
+                      st::PlanVertex{std::uint32_t(copy.target(h)), false},
+                      st::PlanVertex{std::uint32_t(copy.target(copy.next(h))), false}};
+    EXPECT_FALSE(st::replay(copy, twice, same, same, [](std::size_t, fss::FaceIndex) {}));
+}
+
+// Stage "setup" (describeComponent, stitch_region.cpp) alone: on a grid patch of 6×6 cells (spacing 1 in
+// the view, 2 in 3D) with a hole of 2×2 cells, the boundary is the outer square's 24 edges and the hole's
+// 8, every boundary edge has the component on its left, the median edge lengths are 1 and 2, every
+// boundary vertex's snapping radius is the ratio × 1 and the faces around each boundary vertex are those
+// a brute-force count finds; a set of faces without a boundary is refused with a reason.
+TEST(StitchStages, SetupDescribesTheComponentsBoundaryAndSizes) {
+    namespace st = fss::detail::stitching;
+    constexpr int n = 6;
+    st::PatchData P;
+    for (int y = 0; y <= n; ++y)
+        for (int x = 0; x <= n; ++x) {
+            P.uv.emplace_back(x, y);
+            P.pos.emplace_back(2.0 * x, 2.0 * y, 0.0);
+        }
+    auto id = [](int x, int y) { return y * (n + 1) + x; };
+    std::vector<int> faces;
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            if (x >= 2 && x < 4 && y >= 2 && y < 4) continue; // the hole
+            faces.push_back(int(P.tri.size()));
+            P.tri.push_back({id(x, y), id(x + 1, y), id(x + 1, y + 1)});
+            faces.push_back(int(P.tri.size()));
+            P.tri.push_back({id(x, y), id(x + 1, y + 1), id(x, y + 1)});
+        }
+    st::ComponentShape c;
+    ASSERT_EQ(st::describeComponent(P, faces, 0.4, c, nullptr), "");
+    EXPECT_EQ(c.pedges.size(), std::size_t(4 * n + 8));
+    EXPECT_EQ(c.boundary.size(), std::size_t(4 * n + 8));
+    for (std::size_t i = 0; i < c.pedges.size(); ++i) {
+        const auto& e = c.pedges[i];
+        const auto &a = P.uv[std::size_t(e.a)], &b = P.uv[std::size_t(e.b)];
+        EXPECT_TRUE(st::leftTurn(a, b, P.uv[std::size_t(e.opposite)]));
+        EXPECT_DOUBLE_EQ(st::dist2(a, b), 1.0);
+        EXPECT_EQ(c.pedgeIndex.at(st::dirKey(std::uint32_t(e.a), std::uint32_t(e.b))), int(i));
+    }
+    EXPECT_DOUBLE_EQ(c.h2, 1.0);
+    EXPECT_DOUBLE_EQ(c.h3, 2.0);
+    EXPECT_EQ(c.snapRadius.size(), c.boundary.size());
+    for (const auto& [v, r] : c.snapRadius)
+        EXPECT_DOUBLE_EQ(r, 0.4) << "vertex " << v;
+    EXPECT_DOUBLE_EQ(c.margin, 0.4 * 1.01);
+    EXPECT_EQ(c.verts.size(), std::size_t((n + 1) * (n + 1) - 1)); // the hole's one inner vertex is unused
+    EXPECT_EQ(c.box, CGAL::Bbox_2(0, 0, n, n));
+    for (int v : c.boundary) {
+        std::size_t around = 0;
+        for (int f : faces)
+            around += std::count(P.tri[std::size_t(f)].begin(), P.tri[std::size_t(f)].end(), v);
+        EXPECT_EQ(c.vertexFaces.at(v).size(), around) << "vertex " << v;
+    }
+
+    // Two faces glued along all three edges: no boundary, refused.
+    st::PatchData closed;
+    closed.uv = {{0, 0}, {1, 0}, {0, 1}};
+    closed.pos = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    closed.tri = {{0, 1, 2}, {0, 2, 1}};
+    st::ComponentShape none;
+    EXPECT_NE(st::describeComponent(closed, {0, 1}, 0.4, none, nullptr).find("no boundary"),
+              std::string::npos);
 }
 
 TEST(SeamQuality, AnglesAndValenceFigures) {
