@@ -367,6 +367,56 @@ TEST(StitchCommon, StarAndReplayEditTheMeshAsPlanned) {
     EXPECT_FALSE(st::replay(copy, twice, same, same, [](std::size_t, fss::FaceIndex) {}));
 }
 
+// minAngle passes one angle through atan2 when the order of the three is clear: it must return the very
+// same double as the minimum of the three atan2 values (the formula before, the reference here) on random,
+// near-equilateral, near-isosceles and nearly degenerate triangles, and the known angles of known ones.
+TEST(StitchCommon, MinAngleIsExactlyTheSmallestOfTheThreeAngles) {
+    namespace st = fss::detail::stitching;
+    auto reference = [](const st::Vec3& a, const st::Vec3& b, const st::Vec3& c) {
+        const st::Vec3 e[3] = {b - a, c - b, a - c};
+        double best = std::numbers::pi;
+        for (int i = 0; i < 3; ++i) {
+            const st::Vec3 u = -e[(i + 2) % 3], v = e[i];
+            if (!(u.norm() > 0) || !(v.norm() > 0)) return 0.0;
+            best = std::min(best, std::atan2(u.cross(v).norm(), u.dot(v)));
+        }
+        return best;
+    };
+    std::uint64_t state = 12345;
+    auto uniform = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return double(state >> 11) * 0x1.0p-53 - 0.5;
+    };
+    std::size_t checked = 0;
+    for (int i = 0; i < 100000; ++i) {
+        const st::Vec3 a(uniform(), uniform(), uniform());
+        st::Vec3 b(uniform(), uniform(), uniform()), c(uniform(), uniform(), uniform());
+        switch (i % 4) {
+        case 1: { // near-equilateral: ties between all three angles
+            const st::Vec3 u = st::Vec3(1, 0, 0), v = st::Vec3(0.5, std::sqrt(3.0) / 2, 0);
+            b = a + u + 1e-12 * b;
+            c = a + v + 1e-12 * c;
+            break;
+        }
+        case 2: // isosceles: two equal angles at the base, apex at the mid-perpendicular
+            c = 0.5 * (a + b) + st::Vec3(0, 0, 1e-3 * (1 + uniform()));
+            break;
+        case 3: // nearly degenerate: c almost on the line ab
+            c = a + (0.5 + uniform()) * (b - a) + 1e-14 * c;
+            break;
+        default:
+            break;
+        }
+        ASSERT_EQ(st::minAngle(a, b, c), reference(a, b, c)) << "triangle " << i;
+        ++checked;
+    }
+    EXPECT_EQ(checked, 100000u);
+    EXPECT_NEAR(st::minAngle({0, 0, 0}, {1, 0, 0}, {0.5, std::sqrt(3.0) / 2, 0}), std::numbers::pi / 3,
+                1e-15);
+    EXPECT_NEAR(st::minAngle({0, 0, 0}, {1, 0, 0}, {0, 1, 0}), std::numbers::pi / 4, 1e-15);
+    EXPECT_EQ(st::minAngle({0, 0, 0}, {0, 0, 0}, {0, 1, 0}), 0.0);
+}
+
 // Stage "setup" (describeComponent, stitch_region.cpp) alone: on a grid patch of 6×6 cells (spacing 1 in
 // the view, 2 in 3D) with a hole of 2×2 cells, the boundary is the outer square's 24 edges and the hole's
 // 8, every boundary edge has the component on its left, the median edge lengths are 1 and 2, every
