@@ -604,6 +604,67 @@ TEST(BandRemesh, PlanarSliverBandBecomesWellShaped) {
     EXPECT_EQ(created, r.splits * 2);
 }
 
+// The band's growth: given only the half of the sliver row below y = 6, the slivers above it (outside the
+// band, holding the vertices on y = 6) stay without growth; with the other faces of the region growable, the
+// band takes them in (only those: faces outside the region are untouched) and every face it ends with is >=
+// 30 deg.
+TEST(BandRemesh, BandGrowsOverTheSliversAtItsBorder) {
+    for (const bool grow : {false, true}) {
+        SliverGrid g;
+        fss::Mesh& m = g.mesh;
+        auto centroidY = [&](fss::FaceIndex f) {
+            double y = 0;
+            for (auto v : CGAL::vertices_around_face(m.halfedge(f), m))
+                y += m.point(v).y() / 3;
+            return y;
+        };
+        std::set<fss::FaceIndex> region(g.band.begin(), g.band.end());
+        std::vector<fss::FaceIndex> lower;
+        for (fss::FaceIndex f : g.band)
+            if (centroidY(f) < 6) lower.push_back(f);
+        std::map<fss::FaceIndex, std::array<fss::Point3, 3>> outside;
+        for (fss::FaceIndex f : m.faces())
+            if (!region.count(f)) {
+                std::array<fss::Point3, 3> p;
+                int k = 0;
+                for (auto v : CGAL::vertices_around_face(m.halfedge(f), m))
+                    p[std::size_t(k++)] = m.point(v);
+                outside[f] = p;
+            }
+        fss::stitch::BandRemeshInput in;
+        in.mesh = &m;
+        in.band = lower;
+        in.camera = &g.camera;
+        in.edgeLength = 1.0;
+        if (grow) in.growable = [&](fss::FaceIndex f) { return region.count(f) > 0; };
+        const auto r = fss::stitch::remeshBand(in);
+        EXPECT_TRUE(m.is_valid(false));
+        double inRegion = 180, inBand = 180;
+        for (fss::FaceIndex f : m.faces()) {
+            if (outside.count(f)) continue;
+            inRegion = std::min(inRegion, smallestAngleOf(m, f));
+        }
+        for (fss::FaceIndex f : r.faces)
+            inBand = std::min(inBand, smallestAngleOf(m, f));
+        for (const auto& [f, p] : outside) {
+            ASSERT_FALSE(m.is_removed(f));
+            int k = 0;
+            for (auto v : CGAL::vertices_around_face(m.halfedge(f), m))
+                EXPECT_EQ(m.point(v), p[std::size_t(k++)]);
+        }
+        std::printf(
+            "band %s growth: %zu faces grown, smallest angle in the band %.2f, in the region %.2f deg\n",
+            grow ? "with" : "without", r.grown, inBand, inRegion);
+        if (grow) {
+            EXPECT_GT(r.grown, 0u);
+            EXPECT_GE(inRegion, 30.0);
+        } else {
+            EXPECT_EQ(r.grown, 0u);
+            EXPECT_LT(inRegion, 5.0); // the slivers above y = 6 are still there
+        }
+    }
+}
+
 // Across a crease (a roof z = -0.6 |x - 6|, the faces' normals 62 deg apart): every vertex stays on the roof,
 // no edge crosses the ridge (the crease is kept as a line of edges), and the slivers are gone.
 TEST(BandRemesh, CreaseIsKept) {

@@ -189,7 +189,12 @@ QString RemeshWidget::acceptSummary(const StitchReport& report, double valence6B
                  .arg(100 * valence6Before, 0, 'f', 1)
                  .arg(100 * valence6After, 0, 'f', 1);
     parts << tr("min angle %1° → %2°").arg(minAngleBefore, 0, 'f', 1).arg(minAngleAfter, 0, 'f', 1);
-    if (report.seamFaces > 0) parts << tr("seam min angle %1°").arg(report.seamMinAngleDeg, 0, 'f', 1);
+    if (report.seamFaces > 0) {
+        parts << tr("seam min angle %1°").arg(report.seamMinAngleDeg, 0, 'f', 1);
+        parts << tr("seam faces ≥ 30° %1 %").arg(100 * report.seamFracMinAngleAbove30, 0, 'f', 1);
+    }
+    if (report.seamVertices > 0)
+        parts << tr("seam valence 5–7 %1 %").arg(100 * report.seamFracValence5To7, 0, 'f', 1);
     return parts.join(QStringLiteral("; "));
 }
 

@@ -1,602 +1,171 @@
 // Stitch v2, design B: the seam band remeshed in 3D on the draft surface. See band_remesh.h.
 #include "stitch/band_remesh.h"
+#include "stitch/band_remesher.h"
 
-#include "fss/raycast.h"
-
-#include "mesh/local_ops.h"
-#include "mesh/relax.h"
-#include "mesh/triangle_geometry.h"
-
-#include <CGAL/boost/graph/Euler_operations.h>
-#include <CGAL/boost/graph/iterator.h>
-
-#include <algorithm>
-#include <cmath>
-#include <limits>
-#include <numbers>
-#include <unordered_map>
-#include <unordered_set>
-#include <utility>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
 
 namespace fss::stitch {
-namespace {
+namespace band {
 
-constexpr double kBandDeg = std::numbers::pi / 180.0;
-// Faces with a smaller smallest angle (degrees) have no reliable normal for finding creases.
-constexpr double kSliverDeg = 10.0;
-// A crease vertex between two crease edges that turn by at most this (degrees) may be collapsed along them.
-constexpr double kStraightCreaseDeg = 20.0;
-using V3 = Eigen::Vector3d;
-
-std::uint64_t bandKey(VertexIndex a, VertexIndex b) {
-    const std::uint32_t x = std::uint32_t(a), y = std::uint32_t(b); // (std::minmax of temporaries dangles)
-    return x < y ? (std::uint64_t(x) << 32) | y : (std::uint64_t(y) << 32) | x;
-}
-
-// The state of one remeshing: the mesh, which faces are in the band, per-vertex sizes and reference hints.
-class BandRemesher {
-public:
-    explicit BandRemesher(const BandRemeshInput& in) : in_(in), S_(*in.mesh) {}
-
-    BandRemeshReport run() {
-        setup();
-        measure(report_.minAngleBeforeDeg, report_.fracAbove30Before);
-        for (int it = 0; it < in_.iterations; ++it) {
-            splitPass();
-            collapsePass();
-            flipPass();
-            relaxPass(2);
-        }
-        flipPass();
-        relaxPass(2);
-        flipPass();
-        for (int it = 0; it < 3; ++it) {
-            improvePass();
-            flipPass();
-        }
-        measure(report_.minAngleAfterDeg, report_.fracAbove30After);
-        for (std::size_t f = 0; f < band_.size(); ++f)
-            if (band_[f] && !S_.is_removed(FaceIndex(std::uint32_t(f))))
-                report_.faces.push_back(FaceIndex(std::uint32_t(f)));
-        for (std::size_t v = 0; v < touched_.size(); ++v)
-            if (touched_[v] && !S_.is_removed(VertexIndex(std::uint32_t(v))))
-                report_.touched.push_back(VertexIndex(std::uint32_t(v)));
-        return report_;
-    }
-
-private:
-    // ---- element data (vectors indexed by descriptor, grown on demand)
-    template <class T> static T& at(std::vector<T>& v, std::size_t i, const T& init = T()) {
-        if (v.size() <= i) v.resize(i + 1, init);
-        return v[i];
-    }
-    bool inBand(FaceIndex f) {
-        return f != Mesh::null_face() && std::size_t(f) < band_.size() && band_[std::size_t(f)];
-    }
-    bool isFixed(VertexIndex v) { return at(fixed_, std::size_t(v), char(1)) != 0; }
-    double sizeOf(VertexIndex v) { return at(size_, std::size_t(v), in_.edgeLength); }
-    bool isCrease(VertexIndex a, VertexIndex b) const { return crease_.count(bandKey(a, b)) > 0; }
-    int creaseDegree(VertexIndex v) const {
-        auto it = creaseDeg_.find(std::uint32_t(v));
-        return it == creaseDeg_.end() ? 0 : it->second;
-    }
-    V3 faceNormal(FaceIndex f) const {
-        const HalfedgeIndex h = S_.halfedge(f);
-        return detail::unitNormal(detail::pos(S_, S_.source(h)), detail::pos(S_, S_.target(h)),
-                                  detail::pos(S_, S_.target(S_.next(h))));
-    }
-    V3 areaVector(FaceIndex f) const {
-        const HalfedgeIndex h = S_.halfedge(f);
-        const V3 a = detail::pos(S_, S_.source(h));
-        return (detail::pos(S_, S_.target(h)) - a).cross(detail::pos(S_, S_.target(S_.next(h))) - a);
-    }
-    // The normal a face's replacement is compared with: its own where it is well shaped, else \p fallback
-    // (an area-weighted normal around it: a sliver's own normal says nothing about the surface).
-    V3 referenceNormal(FaceIndex f, const V3& fallback) const {
+void BandRemesher::setup() {
+    // Vertices of the band; border ones (a face around them outside the band) and the caller's are fixed.
+    std::vector<VertexIndex> verts;
+    std::unordered_set<std::uint32_t> seen;
+    for (FaceIndex f : bandList_)
+        for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
+            if (seen.insert(std::uint32_t(v)).second) verts.push_back(v);
+    std::sort(verts.begin(), verts.end());
+    for (VertexIndex v : verts)
+        at(fixed_, std::size_t(v), char(1)) = (!wholeStarInBand(v) || (in_.fixed && in_.fixed(v))) ? 1 : 0;
+    // Creases: band edges between band faces whose normals differ by more than the crease angle.
+    const double creaseCos = std::cos(in_.creaseAngleDeg * kBandDeg);
+    auto creaseNormal = [&](FaceIndex f) -> V3 {
+        if (in_.creaseNormal) return in_.creaseNormal(f);
         const HalfedgeIndex h = S_.halfedge(f);
         const V3 a = detail::pos(S_, S_.source(h)), b = detail::pos(S_, S_.target(h)),
                  c = detail::pos(S_, S_.target(S_.next(h)));
-        return detail::minAngle(a, b, c) >= kSliverDeg * kBandDeg ? detail::unitNormal(a, b, c) : fallback;
-    }
-    bool facing(const V3& a, const V3& b, const V3& c) const {
-        const V3 n = (b - a).cross(c - a);
-        if (!(n.norm() > 0)) return false;
-        const Camera& cam = *in_.camera;
-        const V3 centroid = (a + b + c) / 3.0;
-        const V3 toViewer = cam.parallel ? V3(-cam.viewDirection()) : V3(cam.eye - centroid);
-        return n.dot(toViewer) > 0;
-    }
-    // A triangle that may replace one of normal n0: facing, not degenerate, turned by at most the bound.
-    bool acceptableFace(const V3& a, const V3& b, const V3& c, const V3& n0) const {
-        if (!facing(a, b, c)) return false;
-        const V3 n = detail::unitNormal(a, b, c);
-        return n.squaredNorm() > 0 && detail::angleBetween(n, n0) <= in_.maxNormalTurnDeg * kBandDeg;
-    }
-    // Whether every face around v is a band face (and v is not on the mesh border).
-    bool wholeStarInBand(VertexIndex v) {
-        for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_))
-            if (S_.is_border(h) || !inBand(S_.face(h))) return false;
-        return true;
-    }
-    bool interiorEdge(HalfedgeIndex h) {
-        return !S_.is_border(S_.edge(h)) && inBand(S_.face(h)) && inBand(S_.face(S_.opposite(h)));
-    }
-    void touch(VertexIndex v) { at(touched_, std::size_t(v), char(0)) = 1; }
-
-    // ---- setup: band marks, fixed vertices, creases, reference copy, sizes
-    void setup() {
-        for (FaceIndex f : in_.band)
-            at(band_, std::size_t(f), char(0)) = 1;
-        // Vertices of the band; border ones (a face around them outside the band) and the caller's are fixed.
-        std::vector<VertexIndex> verts;
-        std::unordered_set<std::uint32_t> seen;
-        for (FaceIndex f : in_.band)
-            for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
-                if (seen.insert(std::uint32_t(v)).second) verts.push_back(v);
-        std::sort(verts.begin(), verts.end());
-        for (VertexIndex v : verts)
-            at(fixed_, std::size_t(v), char(1)) =
-                (!wholeStarInBand(v) || (in_.fixed && in_.fixed(v))) ? 1 : 0;
-        // Creases: band edges between band faces whose normals differ by more than the crease angle.
-        const double creaseCos = std::cos(in_.creaseAngleDeg * kBandDeg);
-        auto creaseNormal = [&](FaceIndex f) -> V3 {
-            if (in_.creaseNormal) return in_.creaseNormal(f);
-            const HalfedgeIndex h = S_.halfedge(f);
-            const V3 a = detail::pos(S_, S_.source(h)), b = detail::pos(S_, S_.target(h)),
-                     c = detail::pos(S_, S_.target(S_.next(h)));
-            return detail::minAngle(a, b, c) >= kSliverDeg * kBandDeg ? detail::unitNormal(a, b, c)
-                                                                      : V3(0, 0, 0);
-        };
-        for (FaceIndex f : in_.band)
-            for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
-                if (!interiorEdge(h)) continue;
-                const V3 n1 = creaseNormal(S_.face(h)), n2 = creaseNormal(S_.face(S_.opposite(h)));
-                if (n1.squaredNorm() > 0 && n2.squaredNorm() > 0 && n1.dot(n2) < creaseCos)
-                    addCrease(S_.source(h), S_.target(h));
-            }
-        // Crease corners and ends stay (a vertex with other than two crease edges).
-        for (const auto& [v, d] : creaseDeg_)
-            if (d != 2) at(fixed_, std::size_t(v), char(1)) = 1;
-        // The reference: a copy of the band (the draft surface), and each band vertex's face on it.
-        std::unordered_map<std::uint32_t, VertexIndex> toRef;
-        for (VertexIndex v : verts)
-            toRef[std::uint32_t(v)] = ref_.add_vertex(S_.point(v));
-        for (FaceIndex f : in_.band) {
-            std::array<VertexIndex, 3> r;
-            int k = 0;
-            for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
-                r[std::size_t(k++)] = toRef.at(std::uint32_t(v));
-            const FaceIndex g = ref_.add_face(r[0], r[1], r[2]);
-            if (g == Mesh::null_face()) continue; // cannot happen for faces of one manifold mesh
-            for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
-                at(hint_, std::size_t(v), Mesh::null_face()) = g;
+        return detail::minAngle(a, b, c) >= kSliverDeg * kBandDeg ? detail::unitNormal(a, b, c) : V3(0, 0, 0);
+    };
+    for (FaceIndex f : bandList_)
+        for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
+            if (!interiorEdge(h)) continue;
+            const V3 n1 = creaseNormal(S_.face(h)), n2 = creaseNormal(S_.face(S_.opposite(h)));
+            if (n1.squaredNorm() > 0 && n2.squaredNorm() > 0 && n1.dot(n2) < creaseCos)
+                addCrease(S_.source(h), S_.target(h));
         }
-        // Sizes: on the border the mean length of the border edges there (the patch's edges on one side,
-        // the old mesh's on the other), inside graded between them by Jacobi smoothing (a discrete harmonic
-        // interpolation; the band is a few rings wide, so a few sweeps suffice).
-        std::vector<VertexIndex> inner;
-        for (VertexIndex v : verts) {
-            double sum = 0, all = 0;
-            int n = 0, m = 0;
-            for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
-                const double len = (detail::pos(S_, S_.source(h)) - detail::pos(S_, v)).norm();
-                all += len;
-                ++m;
-                const bool borderEdge = !interiorEdge(h);
-                if (borderEdge) {
-                    sum += len;
-                    ++n;
-                }
-            }
-            if (!wholeStarInBand(v)) {
-                at(size_, std::size_t(v), in_.edgeLength) = n ? sum / n : (m ? all / m : in_.edgeLength);
-            } else {
-                at(size_, std::size_t(v), in_.edgeLength) = in_.edgeLength;
-                inner.push_back(v);
+    // Crease corners and ends stay (a vertex with other than two crease edges).
+    for (const auto& [v, d] : creaseDeg_)
+        if (d != 2) at(fixed_, std::size_t(v), char(1)) = 1;
+    // The reference: a copy of the band (the draft surface), and each band vertex's face on it.
+    std::unordered_map<std::uint32_t, VertexIndex> toRef;
+    for (VertexIndex v : verts)
+        toRef[std::uint32_t(v)] = ref_.add_vertex(S_.point(v));
+    for (FaceIndex f : bandList_) {
+        std::array<VertexIndex, 3> r;
+        int k = 0;
+        for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
+            r[std::size_t(k++)] = toRef.at(std::uint32_t(v));
+        const FaceIndex g = ref_.add_face(r[0], r[1], r[2]);
+        if (g == Mesh::null_face()) continue; // cannot happen for faces of one manifold mesh
+        for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
+            at(hint_, std::size_t(v), Mesh::null_face()) = g;
+    }
+    // Sizes: on the border the mean length of the border edges there (the patch's edges on one side,
+    // the old mesh's on the other), inside graded between them by Jacobi smoothing (a discrete harmonic
+    // interpolation; the band is a few rings wide, so a few sweeps suffice).
+    std::vector<VertexIndex> inner;
+    for (VertexIndex v : verts) {
+        double sum = 0, all = 0;
+        int n = 0, m = 0;
+        for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
+            const double len = (detail::pos(S_, S_.source(h)) - detail::pos(S_, v)).norm();
+            all += len;
+            ++m;
+            const bool borderEdge = !interiorEdge(h);
+            if (borderEdge) {
+                sum += len;
+                ++n;
             }
         }
-        for (int sweep = 0; sweep < 12; ++sweep) {
-            std::vector<double> next(inner.size());
-            for (std::size_t i = 0; i < inner.size(); ++i) {
-                double sum = 0;
-                int n = 0;
-                for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(inner[i]), S_)) {
-                    sum += sizeOf(w);
-                    ++n;
-                }
-                next[i] = n ? sum / n : in_.edgeLength;
+        if (!wholeStarInBand(v)) {
+            at(size_, std::size_t(v), in_.edgeLength) = n ? sum / n : (m ? all / m : in_.edgeLength);
+        } else {
+            at(size_, std::size_t(v), in_.edgeLength) = in_.edgeLength;
+            inner.push_back(v);
+        }
+    }
+    for (int sweep = 0; sweep < 12; ++sweep) {
+        std::vector<double> next(inner.size());
+        for (std::size_t i = 0; i < inner.size(); ++i) {
+            double sum = 0;
+            int n = 0;
+            for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(inner[i]), S_)) {
+                sum += sizeOf(w);
+                ++n;
             }
-            for (std::size_t i = 0; i < inner.size(); ++i)
-                size_[std::size_t(inner[i])] = next[i];
+            next[i] = n ? sum / n : in_.edgeLength;
         }
+        for (std::size_t i = 0; i < inner.size(); ++i)
+            size_[std::size_t(inner[i])] = next[i];
     }
-    void addCrease(VertexIndex a, VertexIndex b) {
-        if (crease_.insert(bandKey(a, b)).second) {
-            ++creaseDeg_[std::uint32_t(a)];
-            ++creaseDeg_[std::uint32_t(b)];
-        }
-    }
-    void removeCrease(VertexIndex a, VertexIndex b) {
-        if (crease_.erase(bandKey(a, b))) {
-            --creaseDeg_[std::uint32_t(a)];
-            --creaseDeg_[std::uint32_t(b)];
-        }
-    }
+}
 
-    void measure(double& minDeg, double& frac30) {
-        std::size_t n = 0, good = 0;
-        double smallest = 180;
-        for (std::size_t f = 0; f < band_.size(); ++f) {
-            const FaceIndex g(static_cast<std::uint32_t>(f));
-            if (!band_[f] || S_.is_removed(g)) continue;
-            const HalfedgeIndex h = S_.halfedge(g);
-            const double a = detail::minAngle(detail::pos(S_, S_.source(h)), detail::pos(S_, S_.target(h)),
-                                              detail::pos(S_, S_.target(S_.next(h)))) /
-                             kBandDeg;
-            smallest = std::min(smallest, a);
-            ++n;
-            good += a >= 30.0;
-        }
-        minDeg = smallest;
-        frac30 = n ? double(good) / double(n) : 1.0;
-    }
-
-    // Band edges (each once, by one halfedge), in descriptor order.
-    std::vector<HalfedgeIndex> bandEdges() {
-        std::vector<HalfedgeIndex> out;
-        for (std::size_t f = 0; f < band_.size(); ++f) {
-            const FaceIndex g(static_cast<std::uint32_t>(f));
-            if (!band_[f] || S_.is_removed(g)) continue;
-            for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(g), S_))
-                if (interiorEdge(h) && std::uint32_t(S_.face(S_.opposite(h))) > std::uint32_t(g))
-                    out.push_back(h);
-        }
-        return out;
-    }
-
-    // ---- splits of edges longer than 4/3 of the local size
-    void splitPass() {
-        std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
-        for (HalfedgeIndex h : bandEdges()) {
-            const VertexIndex a = S_.source(h), b = S_.target(h);
-            const double len = (detail::pos(S_, a) - detail::pos(S_, b)).norm();
-            const double target = 0.5 * (sizeOf(a) + sizeOf(b));
-            if (len > 4.0 / 3.0 * target) cands.push_back({-len / target, {a, b}});
-        }
-        std::sort(cands.begin(), cands.end());
-        for (const auto& c : cands) {
-            const auto [a, b] = c.second;
-            if (S_.is_removed(a) || S_.is_removed(b)) continue;
-            const HalfedgeIndex h = S_.halfedge(a, b);
-            if (h == Mesh::null_halfedge() || !interiorEdge(h)) continue;
-            split(h);
-        }
-    }
-    bool split(HalfedgeIndex h) {
-        const VertexIndex a = S_.source(h), b = S_.target(h);
-        const VertexIndex c = S_.target(S_.next(h)), d = S_.target(S_.next(S_.opposite(h)));
-        const V3 pa = detail::pos(S_, a), pb = detail::pos(S_, b), pc = detail::pos(S_, c),
-                 pd = detail::pos(S_, d);
-        const bool onCrease = isCrease(a, b);
-        V3 q = 0.5 * (pa + pb);
-        FaceIndex hint = at(hint_, std::size_t(a), Mesh::null_face());
-        if (!onCrease && hint != Mesh::null_face()) {
-            const SurfacePoint sp = closestPointNear(ref_, q, hint, LocalSearchOptions{.rings = 2});
-            if (sp && sp.distance <= 0.25 * (pa - pb).norm()) {
-                q = sp.point;
-                hint = sp.face;
-            }
-        }
-        const FaceIndex f1 = S_.face(h), f2 = S_.face(S_.opposite(h));
-        const V3 quad = (areaVector(f1) + areaVector(f2)).normalized();
-        const V3 n1 = referenceNormal(f1, quad), n2 = referenceNormal(f2, quad);
-        if (!acceptableFace(pa, q, pc, n1) || !acceptableFace(q, pb, pc, n1) ||
-            !acceptableFace(pb, q, pd, n2) || !acceptableFace(q, pa, pd, n2))
-            return false;
-        const detail::EdgeSplit s = detail::splitEdge(S_, h, Point3(q.x(), q.y(), q.z()));
-        const VertexIndex v = s.vertex;
-        at(fixed_, std::size_t(v), char(1)) = 0;
-        at(size_, std::size_t(v), in_.edgeLength) = 0.5 * (sizeOf(a) + sizeOf(b));
-        at(hint_, std::size_t(v), Mesh::null_face()) = hint;
-        at(touched_, std::size_t(v), char(0)) = 1;
-        if (in_.vertexData) in_.vertexData(v, Mesh::null_vertex());
-        for (const auto& [e, parent] : {std::pair{s.first, f1}, std::pair{s.second, f2}})
-            for (FaceIndex g : {S_.face(e), S_.face(S_.opposite(e))})
-                if (g != parent) {
-                    at(band_, std::size_t(g), char(0)) = 1;
-                    if (in_.faceData) in_.faceData(g, parent);
-                }
-        at(band_, std::size_t(f1), char(0)) = 1;
-        at(band_, std::size_t(f2), char(0)) = 1;
-        if (onCrease) {
-            removeCrease(a, b);
-            addCrease(a, v);
-            addCrease(v, b);
-        }
-        ++report_.splits;
-        return true;
-    }
-
-    // ---- collapses of edges shorter than 4/5 of the local size
-    void collapsePass() {
-        std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
-        for (HalfedgeIndex h : bandEdges()) {
-            const VertexIndex a = S_.source(h), b = S_.target(h);
-            const double len = (detail::pos(S_, a) - detail::pos(S_, b)).norm();
-            const double target = 0.5 * (sizeOf(a) + sizeOf(b));
-            if (len < 0.8 * target) cands.push_back({len / target, {a, b}});
-        }
-        std::sort(cands.begin(), cands.end());
-        for (const auto& c : cands) {
-            const auto [a, b] = c.second;
-            if (S_.is_removed(a) || S_.is_removed(b)) continue;
-            const HalfedgeIndex h = S_.halfedge(a, b);
-            if (h == Mesh::null_halfedge() || !interiorEdge(h)) continue;
-            double sa = -1, sb = -1;
-            const bool okA = collapsible(a, b, sa), okB = collapsible(b, a, sb);
-            if (!okA && !okB) continue;
-            const VertexIndex from = (okA && (!okB || sa >= sb)) ? a : b, to = from == a ? b : a;
-            collapse(from, to);
-        }
-    }
-    // Whether `from` may go into `to` (to keeps its place); score: the smallest angle after.
-    bool collapsible(VertexIndex from, VertexIndex to, double& score) {
-        if (isFixed(from) || !wholeStarInBand(from)) return false;
-        if (creaseDegree(from) > 0) {
-            // Only along a nearly straight crease, onto its neighbour on it: the crease keeps its line.
-            if (creaseDegree(from) != 2 || !isCrease(from, to)) return false;
-            VertexIndex other = Mesh::null_vertex();
-            for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(from), S_))
-                if (w != to && isCrease(from, w)) other = w;
-            if (other == Mesh::null_vertex()) return false;
-            const V3 pf = detail::pos(S_, from);
-            if (detail::angleBetween(pf - detail::pos(S_, to), detail::pos(S_, other) - pf) >
-                kStraightCreaseDeg * kBandDeg)
-                return false;
-        }
-        const HalfedgeIndex h = S_.halfedge(from, to);
-        if (!detail::canCollapse(S_, S_.edge(h), true)) return false;
-        const V3 pt = detail::pos(S_, to);
-        const double limit = 4.0 / 3.0 * sizeOf(to);
-        V3 star(0, 0, 0);
-        for (HalfedgeIndex g : CGAL::halfedges_around_target(S_.halfedge(from), S_))
-            star += areaVector(S_.face(g));
-        star.normalize();
-        double oldMin = std::numbers::pi, newMin = std::numbers::pi;
-        for (HalfedgeIndex g : CGAL::halfedges_around_target(S_.halfedge(from), S_)) {
-            const VertexIndex p = S_.target(S_.next(g)), q = S_.source(g);
-            const V3 pp = detail::pos(S_, p), pq = detail::pos(S_, q), pf = detail::pos(S_, from);
-            oldMin = std::min(oldMin, detail::minAngle(pf, pp, pq));
-            if (p == to || q == to) continue;
-            if (!acceptableFace(pt, pp, pq, referenceNormal(S_.face(g), star))) return false;
-            if ((pp - pt).norm() > limit) return false;
-            newMin = std::min(newMin, detail::minAngle(pt, pp, pq));
-        }
-        if (newMin < std::min(oldMin, in_.minAngleDeg * kBandDeg)) return false;
-        score = newMin;
-        return true;
-    }
-    void collapse(VertexIndex from, VertexIndex to) {
-        const HalfedgeIndex h = S_.halfedge(from, to);
-        const FaceIndex f1 = S_.face(h), f2 = S_.face(S_.opposite(h));
-        const V3 keep = detail::pos(S_, to);
-        const double keepSize = sizeOf(to);
-        const FaceIndex keepHint = at(hint_, std::size_t(to), Mesh::null_face());
-        const char keepFixed = char(isFixed(to));
-        const char keepTouched = at(touched_, std::size_t(to), char(0));
-        // Crease edges at either end go to the survivor (a crease through `from` continues from `to`).
-        std::vector<VertexIndex> creaseEnds;
-        for (VertexIndex x : {from, to})
-            for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(x), S_))
-                if (w != from && w != to && isCrease(x, w)) creaseEnds.push_back(w);
-        for (VertexIndex x : {from, to})
-            for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(x), S_))
-                removeCrease(x, w);
-        const VertexIndex kept = CGAL::Euler::collapse_edge(S_.edge(h), S_);
-        band_[std::size_t(f1)] = 0;
-        band_[std::size_t(f2)] = 0;
-        if (kept != to) {
-            S_.point(kept) = Point3(keep.x(), keep.y(), keep.z());
-            if (in_.vertexData) in_.vertexData(kept, to);
-            size_[std::size_t(kept)] = keepSize;
-            hint_[std::size_t(kept)] = keepHint;
-            fixed_[std::size_t(kept)] = keepFixed;
-            touched_[std::size_t(kept)] = keepTouched;
-        }
-        for (VertexIndex w : creaseEnds)
-            addCrease(kept, w);
-        ++report_.collapses;
-    }
-
-    // ---- flips towards valence 6 and larger angles
-    void flipPass() {
-        auto cost = [&](VertexIndex v, int delta) {
-            const int target = S_.is_border(v) ? 4 : 6;
-            return std::abs(int(S_.degree(v)) + delta - target);
-        };
-        for (int round = 0; round < 3; ++round) {
-            std::size_t flips = 0;
-            for (HalfedgeIndex h : bandEdges()) {
-                if (S_.is_removed(S_.edge(h)) || !interiorEdge(h)) continue;
-                const VertexIndex a = S_.source(h), b = S_.target(h);
-                if (isCrease(a, b) || !detail::canFlip(S_, h)) continue;
-                const VertexIndex c = S_.target(S_.next(h)), d = S_.target(S_.next(S_.opposite(h)));
-                const V3 pa = detail::pos(S_, a), pb = detail::pos(S_, b), pc = detail::pos(S_, c),
-                         pd = detail::pos(S_, d);
-                const V3 quad = (areaVector(S_.face(h)) + areaVector(S_.face(S_.opposite(h)))).normalized();
-                const V3 n1 = referenceNormal(S_.face(h), quad),
-                         n2 = referenceNormal(S_.face(S_.opposite(h)), quad);
-                // New faces (a, d, c) and (b, c, d).
-                if (!acceptableFace(pa, pd, pc, n1) || !acceptableFace(pa, pd, pc, n2) ||
-                    !acceptableFace(pb, pc, pd, n1) || !acceptableFace(pb, pc, pd, n2))
-                    continue;
-                // The new edge stays near the draft (a flip over a curved place would cut under it).
-                const double dev = distanceToRef(0.5 * (pc + pd), c);
-                if (dev > 0.1 * (pc - pd).norm()) continue;
-                const double oldMin = std::min(detail::minAngle(pa, pb, pc), detail::minAngle(pb, pa, pd));
-                const double newMin = std::min(detail::minAngle(pa, pd, pc), detail::minAngle(pb, pc, pd));
-                const int devOld = cost(a, 0) + cost(b, 0) + cost(c, 0) + cost(d, 0);
-                const int devNew = cost(a, -1) + cost(b, -1) + cost(c, 1) + cost(d, 1);
-                // Score (as version 1's flips): smallest angle in degrees minus 3 deg per unit of valence
-                // deviation; never below the smaller of the angle before and the aim.
-                const double gain = (newMin - oldMin) / kBandDeg - 3.0 * double(devNew - devOld);
-                if (!(gain > 0.5) || newMin < std::min(oldMin, in_.minAngleDeg * kBandDeg)) continue;
-                CGAL::Euler::flip_edge(h, S_);
-                ++flips;
-            }
-            report_.flips += flips;
-            if (!flips) break;
-        }
-    }
-    double distanceToRef(const V3& p, VertexIndex near) {
-        const FaceIndex hint = at(hint_, std::size_t(near), Mesh::null_face());
-        if (hint == Mesh::null_face()) return 0;
-        const SurfacePoint sp = closestPointNear(ref_, p, hint, LocalSearchOptions{.rings = 2});
-        return sp ? sp.distance : 0;
-    }
-
-    // ---- tangential relaxation with projection onto the draft (mesh/relax.h)
-    void relaxPass(int iterations) {
-        std::vector<VertexIndex> verts;
-        std::vector<FaceIndex> hints;
-        std::vector<double> sizes;
-        std::unordered_set<std::uint32_t> seen;
-        for (std::size_t f = 0; f < band_.size(); ++f) {
-            const FaceIndex g(static_cast<std::uint32_t>(f));
-            if (!band_[f] || S_.is_removed(g)) continue;
-            for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_)) {
-                // Crease vertices stay: the crease keeps its exact line (splits put new vertices on it).
-                if (isFixed(v) || creaseDegree(v) > 0 || !seen.insert(std::uint32_t(v)).second) continue;
-                const FaceIndex hf = at(hint_, std::size_t(v), Mesh::null_face());
-                if (hf == Mesh::null_face() || !wholeStarInBand(v)) continue;
+void BandRemesher::improvePass() {
+    std::vector<VertexIndex> verts;
+    std::unordered_set<std::uint32_t> seen;
+    for (std::size_t f = 0; f < band_.size(); ++f) {
+        const FaceIndex g(static_cast<std::uint32_t>(f));
+        if (!band_[f] || S_.is_removed(g)) continue;
+        const HalfedgeIndex h = S_.halfedge(g);
+        if (detail::minAngle(detail::pos(S_, S_.source(h)), detail::pos(S_, S_.target(h)),
+                             detail::pos(S_, S_.target(S_.next(h)))) >= in_.minAngleDeg * kBandDeg)
+            continue;
+        for (VertexIndex v : CGAL::vertices_around_face(h, S_))
+            if (!isFixed(v) && creaseDegree(v) == 0 && wholeStarInBand(v) &&
+                at(hint_, std::size_t(v), Mesh::null_face()) != Mesh::null_face() &&
+                seen.insert(std::uint32_t(v)).second)
                 verts.push_back(v);
-            }
-        }
-        std::sort(verts.begin(), verts.end()); // deterministic order (hints and sizes follow)
-        for (VertexIndex v : verts) {
-            hints.push_back(hint_[std::size_t(v)]);
-            sizes.push_back(sizeOf(v));
-        }
-        std::vector<V3> before;
-        for (VertexIndex v : verts)
-            before.push_back(detail::pos(S_, v));
-        detail::RelaxOptions o;
-        o.iterations = iterations;
-        o.step = 0.5;
-        o.creaseAngleDeg = in_.creaseAngleDeg;
-        o.maxNormalTurnDeg = in_.maxNormalTurnDeg;
-        o.maxOffFootprints = 0.5;
-        const detail::RelaxReport r = detail::relaxOnReference(S_, ref_, verts, hints, sizes, o, in_.camera);
-        report_.moves += r.moves;
-        for (std::size_t k = 0; k < verts.size(); ++k) {
-            hint_[std::size_t(verts[k])] = hints[k];
-            if (detail::pos(S_, verts[k]) != before[k]) touch(verts[k]);
-        }
     }
-
-    // ---- relocation of the free vertices of faces below the aim: the place on the draft around the vertex
-    // (a search over tangential offsets, each projected) that maximises the smallest angle of its star.
-    // Own search rather than a smoothing rule: near a fixed, irregular border the centroid is often not
-    // where the worst angle improves.
-    void improvePass() {
-        std::vector<VertexIndex> verts;
-        std::unordered_set<std::uint32_t> seen;
-        for (std::size_t f = 0; f < band_.size(); ++f) {
-            const FaceIndex g(static_cast<std::uint32_t>(f));
-            if (!band_[f] || S_.is_removed(g)) continue;
-            const HalfedgeIndex h = S_.halfedge(g);
-            if (detail::minAngle(detail::pos(S_, S_.source(h)), detail::pos(S_, S_.target(h)),
-                                 detail::pos(S_, S_.target(S_.next(h)))) >= in_.minAngleDeg * kBandDeg)
-                continue;
-            for (VertexIndex v : CGAL::vertices_around_face(h, S_))
-                if (!isFixed(v) && creaseDegree(v) == 0 && wholeStarInBand(v) &&
-                    at(hint_, std::size_t(v), Mesh::null_face()) != Mesh::null_face() &&
-                    seen.insert(std::uint32_t(v)).second)
-                    verts.push_back(v);
-        }
-        std::sort(verts.begin(), verts.end());
-        const double creaseCos = std::cos(in_.creaseAngleDeg * kBandDeg);
-        const double maxTurn = in_.maxNormalTurnDeg * kBandDeg;
-        for (VertexIndex v : verts) {
-            const V3 p = detail::pos(S_, v);
-            const FaceIndex hint = hint_[std::size_t(v)];
-            const HalfedgeIndex rh = ref_.halfedge(hint);
-            const V3 n0 =
-                detail::unitNormal(detail::pos(ref_, ref_.source(rh)), detail::pos(ref_, ref_.target(rh)),
-                                   detail::pos(ref_, ref_.target(ref_.next(rh))));
-            if (!(n0.squaredNorm() > 0)) continue;
-            const V3 u = (std::abs(n0.x()) < 0.9 ? V3(1, 0, 0) : V3(0, 1, 0)).cross(n0).normalized();
-            const V3 w = n0.cross(u);
-            double shortest = std::numeric_limits<double>::infinity();
-            for (VertexIndex x : CGAL::vertices_around_target(S_.halfedge(v), S_))
-                shortest = std::min(shortest, (detail::pos(S_, x) - p).norm());
-            double best = starMinAngle(v, p);
-            V3 bestP = p;
-            FaceIndex bestFace = hint;
-            for (double r : {0.4, 0.2, 0.1})
-                for (int k = 0; k < 12; ++k) {
-                    const double t = 2 * std::numbers::pi * k / 12;
-                    const V3 q = p + r * shortest * (std::cos(t) * u + std::sin(t) * w);
-                    const SurfacePoint sp = closestPointNear(ref_, q, hint, LocalSearchOptions{.rings = 1});
-                    if (!sp || sp.distance > 0.5 * r * shortest) continue;
-                    const HalfedgeIndex sh = ref_.halfedge(sp.face);
-                    const V3 n = detail::unitNormal(detail::pos(ref_, ref_.source(sh)),
-                                                    detail::pos(ref_, ref_.target(sh)),
-                                                    detail::pos(ref_, ref_.target(ref_.next(sh))));
-                    if (n.dot(n0) < creaseCos) continue;
-                    const double a = starMinAngle(v, sp.point);
-                    if (a > best + 1e-9 && starAcceptable(v, sp.point, maxTurn)) {
-                        best = a;
-                        bestP = sp.point;
-                        bestFace = sp.face;
-                    }
+    std::sort(verts.begin(), verts.end());
+    const double creaseCos = std::cos(in_.creaseAngleDeg * kBandDeg);
+    const double maxTurn = in_.maxNormalTurnDeg * kBandDeg;
+    for (VertexIndex v : verts) {
+        const V3 p = detail::pos(S_, v);
+        const FaceIndex hint = hint_[std::size_t(v)];
+        const HalfedgeIndex rh = ref_.halfedge(hint);
+        const V3 n0 =
+            detail::unitNormal(detail::pos(ref_, ref_.source(rh)), detail::pos(ref_, ref_.target(rh)),
+                               detail::pos(ref_, ref_.target(ref_.next(rh))));
+        if (!(n0.squaredNorm() > 0)) continue;
+        const V3 u = (std::abs(n0.x()) < 0.9 ? V3(1, 0, 0) : V3(0, 1, 0)).cross(n0).normalized();
+        const V3 w = n0.cross(u);
+        double shortest = std::numeric_limits<double>::infinity();
+        for (VertexIndex x : CGAL::vertices_around_target(S_.halfedge(v), S_))
+            shortest = std::min(shortest, (detail::pos(S_, x) - p).norm());
+        double best = starMinAngle(v, p);
+        V3 bestP = p;
+        FaceIndex bestFace = hint;
+        for (double r : {0.4, 0.2, 0.1})
+            for (int k = 0; k < 12; ++k) {
+                const double t = 2 * std::numbers::pi * k / 12;
+                const V3 q = p + r * shortest * (std::cos(t) * u + std::sin(t) * w);
+                const SurfacePoint sp = closestPointNear(ref_, q, hint, LocalSearchOptions{.rings = 1});
+                if (!sp || sp.distance > 0.5 * r * shortest) continue;
+                const HalfedgeIndex sh = ref_.halfedge(sp.face);
+                const V3 n =
+                    detail::unitNormal(detail::pos(ref_, ref_.source(sh)), detail::pos(ref_, ref_.target(sh)),
+                                       detail::pos(ref_, ref_.target(ref_.next(sh))));
+                if (n.dot(n0) < creaseCos) continue;
+                const double a = starMinAngle(v, sp.point);
+                if (a > best + 1e-9 && starAcceptable(v, sp.point, maxTurn)) {
+                    best = a;
+                    bestP = sp.point;
+                    bestFace = sp.face;
                 }
-            if (bestP != p) {
-                S_.point(v) = Point3(bestP.x(), bestP.y(), bestP.z());
-                hint_[std::size_t(v)] = bestFace;
-                touch(v);
-                ++report_.moves;
             }
+        if (bestP != p) {
+            S_.point(v) = Point3(bestP.x(), bestP.y(), bestP.z());
+            hint_[std::size_t(v)] = bestFace;
+            touch(v);
+            ++report_.moves;
         }
     }
-    double starMinAngle(VertexIndex v, const V3& at) const {
-        double m = std::numbers::pi;
-        for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
-            if (S_.is_border(h)) continue;
-            m = std::min(m, detail::minAngle(detail::pos(S_, S_.source(h)), at,
-                                             detail::pos(S_, S_.target(S_.next(h)))));
-        }
-        return m;
-    }
-    bool starAcceptable(VertexIndex v, const V3& at, double maxTurn) const {
-        V3 star(0, 0, 0);
-        for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_))
-            star += areaVector(S_.face(h));
-        star.normalize();
-        for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
-            const V3 b = detail::pos(S_, S_.source(h)), c = detail::pos(S_, S_.target(S_.next(h)));
-            if (!facing(b, at, c)) return false;
-            const V3 n = detail::unitNormal(b, at, c);
-            if (detail::angleBetween(n, referenceNormal(S_.face(h), star)) > maxTurn) return false;
-        }
-        return true;
-    }
+}
 
-    const BandRemeshInput& in_;
-    Mesh& S_;
-    Mesh ref_; // the draft band, onto which vertices are projected
-    std::vector<char> band_, fixed_, touched_;
-    std::vector<double> size_;
-    std::vector<FaceIndex> hint_; // per S vertex: a face of ref_ at it
-    std::unordered_set<std::uint64_t> crease_;
-    std::unordered_map<std::uint32_t, int> creaseDeg_;
-    BandRemeshReport report_;
-};
+} // namespace band
 
-} // namespace
+bool bandDiagnostics() {
+    static const bool on = [] {
+        const char* e = std::getenv("FSS_STITCH_BAND_DIAG");
+        return e && (std::string(e) == "1" || std::string(e) == "2");
+    }();
+    return on;
+}
 
 BandRemeshReport remeshBand(const BandRemeshInput& input) {
-    BandRemesher r(input);
+    band::BandRemesher r(input);
     return r.run();
 }
 

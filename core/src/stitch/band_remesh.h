@@ -46,6 +46,17 @@ struct BandRemeshInput {
     /// no crease). When empty: the face's own normal where its smallest angle is at least 10 deg (a sliver's
     /// normal says nothing about the surface), else unknown.
     std::function<Eigen::Vector3d(FaceIndex)> creaseNormal;
+    /// Faces outside `band` that the band may grow into (new faces). When set, the band grows
+    /// until the faces at and beyond its border are fine: a growable face below growBelowDeg that touches
+    /// the band, or one below 20 deg anywhere, joins it with the growable faces around its corners; so do
+    /// the growable faces around a band vertex that a bad band face would need to move but that is held by
+    /// a face outside. At most maxGrowRounds rounds.
+    std::function<bool(FaceIndex)> growable;
+    /// New faces the view does not see (pieces of old faces): they keep their own orientation (the normal
+    /// bound against their creaseNormal) instead of facing the camera.
+    std::function<bool(FaceIndex)> unseen;
+    double growBelowDeg = 30.0;
+    int maxGrowRounds = 6;
     double edgeLength = 0;          ///< initial target edge length inside the band (world units), > 0
     double creaseAngleDeg = 30.0;   ///< band edges whose faces' normals differ more are creases
     double maxNormalTurnDeg = 20.0; ///< no operation turns a face's normal by more
@@ -58,9 +69,17 @@ struct BandRemeshReport {
     std::vector<FaceIndex> faces;     ///< the band's faces afterwards
     std::vector<VertexIndex> touched; ///< vertices created or moved (live at the end)
     std::size_t splits = 0, collapses = 0, flips = 0, moves = 0;
+    std::size_t repairs = 0; ///< flips, collapses and splits of the last repair of faces below the aim
     double minAngleBeforeDeg = 180, minAngleAfterDeg = 180; ///< smallest angle over the band
     double fracAbove30Before = 1, fracAbove30After = 1;     ///< share of band faces ≥ 30 deg
+    std::size_t grown = 0; ///< faces the band grew by (BandRemeshInput::growable)
+    /// New faces below 20 deg afterwards, by where they are: in the band with a vertex free to move, in the
+    /// band with every vertex held (by a face outside or the caller), growable but outside the band, unseen.
+    std::size_t below20Free = 0, below20Held = 0, below20Beyond = 0, below20Unseen = 0;
 };
+
+/// Whether FSS_STITCH_BAND_DIAG=1: the stitch then prints, per band remesh, where the faces below 20 deg are.
+bool bandDiagnostics();
 
 /// Remeshes the band (see BandRemeshInput). \pre the band faces are triangles of *mesh.
 BandRemeshReport remeshBand(const BandRemeshInput& input);

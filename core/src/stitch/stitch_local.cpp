@@ -167,6 +167,8 @@ bool ComponentStitcher::buildAndOptimise(Attempt& a) {
     progress_.step(7, 8);
     if (!validate(loc, bordersBefore, a)) {
         if (loc.refilled) return retryWithoutRefill(a);
+        if (loc.remeshed && stitch::bandDiagnostics())
+            std::fprintf(stderr, "band: fails the checks (%s; v1 kept)\n", a.reason.c_str());
         if (loc.remeshed) return retryWithoutRemesh(a);
         return false;
     }
@@ -248,7 +250,7 @@ bool ComponentStitcher::remeshBand(Local& loc, Plan& plan) {
         loc.patchSide[to] = loc.patchSide[from];
         loc.planeNormal[to] = loc.planeNormal[from];
         loc.minAllowed[to] = loc.minAllowed[from];
-        loc.offView[to] = false;
+        loc.offView[to] = loc.offView[from];
     };
     // Creases: pieces of old faces outside the patch carry their face's plane (reliable even for a
     // sliver piece); other faces their own normal unless they are slivers.
@@ -260,10 +262,24 @@ bool ComponentStitcher::remeshBand(Local& loc, Plan& plan) {
     };
     in.edgeLength = comp_.h3;
     in.maxNormalTurnDeg = O_.maxNormalChangeDeg;
+    // The band grows over new faces outside the patch only: moving the patch's samples beyond the first
+    // rings puts them on its chords, up to a footprint off the reference (measured: fandisk, 80² scan).
+    in.growable = [&](FaceIndex f) {
+        return f != Mesh::null_face() && !loc.star.kept[f] && !loc.patchSide[f];
+    };
+    in.unseen = [&](FaceIndex f) { return !loc.star.kept[f] && loc.offView[f]; };
+    in.growBelowDeg = 20.0;
     const stitch::BandRemeshReport r = stitch::remeshBand(in);
     progress_.tick(in.band.size());
     const bool worse = r.minAngleAfterDeg < r.minAngleBeforeDeg &&
                        !(r.minAngleAfterDeg >= 20.0 && r.fracAbove30After >= r.fracAbove30Before);
+    if (stitch::bandDiagnostics())
+        std::fprintf(
+            stderr,
+            "band: %zu faces (+%zu grown), min %.2f -> %.2f%s; < 20 deg: %zu free, %zu held, %zu beyond, "
+            "%zu unseen\n",
+            in.band.size(), r.grown, r.minAngleBeforeDeg, r.minAngleAfterDeg, worse ? " WORSE (v1 kept)" : "",
+            r.below20Free, r.below20Held, r.below20Beyond, r.below20Unseen);
     if (worse) return false;
     // Moved and new vertices: their place in the view; a mesh vertex that moved becomes a new vertex
     // (the old one goes with the replaced faces around it: its whole star is in the band).

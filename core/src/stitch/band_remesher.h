@@ -1,0 +1,532 @@
+#pragma once
+// The state and operations of one seam band remesh (band_remesh.h): internal to band_remesh.cpp and
+// band_repair.cpp (the repair of faces still bad at the end, the band's growth and the diagnostics).
+#include "stitch/band_remesh.h"
+
+#include "fss/raycast.h"
+
+#include "mesh/local_ops.h"
+#include "mesh/relax.h"
+#include "mesh/triangle_geometry.h"
+
+#include <CGAL/boost/graph/Euler_operations.h>
+#include <CGAL/boost/graph/iterator.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <numbers>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+namespace fss::stitch::band {
+
+constexpr double kBandDeg = std::numbers::pi / 180.0;
+// Faces with a smaller smallest angle (degrees) have no reliable normal for finding creases.
+constexpr double kSliverDeg = 10.0;
+// A crease vertex between two crease edges that turn by at most this (degrees) may be collapsed along them.
+constexpr double kStraightCreaseDeg = 20.0;
+// ... and slid along them (the crease line moves off the surface by at most ~7 % of the edge).
+constexpr double kSlideCreaseDeg = 10.0;
+// No split makes a face below this (degrees) unless one of the two faces it splits was already below.
+constexpr double kSplitFloorDeg = 20.0;
+using V3 = Eigen::Vector3d;
+
+// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide turns parts of the band remesh off (to measure what each
+// brings).
+inline bool stageOff(const char* name) {
+    static const std::string off = [] {
+        const char* e = std::getenv("FSS_STITCH_BAND_OFF");
+        return e ? std::string(",") + e + "," : std::string();
+    }();
+    return off.find(std::string(",") + name + ",") != std::string::npos;
+}
+
+inline std::uint64_t bandKey(VertexIndex a, VertexIndex b) {
+    const std::uint32_t x = std::uint32_t(a), y = std::uint32_t(b); // (std::minmax of temporaries dangles)
+    return x < y ? (std::uint64_t(x) << 32) | y : (std::uint64_t(y) << 32) | x;
+}
+
+// The state of one remeshing: the mesh, which faces are in the band, per-vertex sizes and reference hints.
+class BandRemesher {
+public:
+    explicit BandRemesher(const BandRemeshInput& in) : in_(in), S_(*in.mesh) {}
+
+    BandRemeshReport run() {
+        bandList_ = in_.band;
+        for (FaceIndex f : bandList_)
+            at(band_, std::size_t(f), char(0)) = 1;
+        grow();
+        if (in_.unseen && !stageOff("unseen"))
+            for (FaceIndex f : bandList_)
+                at(unseen_, std::size_t(f), char(0)) = char(in_.unseen(f));
+        setup();
+        measure(report_.minAngleBeforeDeg, report_.fracAbove30Before);
+        for (int it = 0; it < in_.iterations; ++it) {
+            splitPass();
+            collapsePass();
+            flipPass();
+            relaxPass(2);
+        }
+        flipPass();
+        relaxPass(2);
+        flipPass();
+        for (int it = 0; it < 3; ++it) {
+            improvePass();
+            flipPass();
+        }
+        for (int it = 0; it < 3 && !stageOff("repair"); ++it) {
+            const bool changed = repairPass();
+            if (!stageOff("slide")) slidePass();
+            improvePass();
+            flipPass();
+            if (!changed) break;
+        }
+        measure(report_.minAngleAfterDeg, report_.fracAbove30After);
+        for (std::size_t f = 0; f < band_.size(); ++f)
+            if (band_[f] && !S_.is_removed(FaceIndex(std::uint32_t(f))))
+                report_.faces.push_back(FaceIndex(std::uint32_t(f)));
+        for (std::size_t v = 0; v < touched_.size(); ++v)
+            if (touched_[v] && !S_.is_removed(VertexIndex(std::uint32_t(v))))
+                report_.touched.push_back(VertexIndex(std::uint32_t(v)));
+        countBelow20();
+        return report_;
+    }
+
+private:
+    // ---- element data (vectors indexed by descriptor, grown on demand)
+    template <class T> static T& at(std::vector<T>& v, std::size_t i, const T& init = T()) {
+        if (v.size() <= i) v.resize(i + 1, init);
+        return v[i];
+    }
+    bool inBand(FaceIndex f) {
+        return f != Mesh::null_face() && std::size_t(f) < band_.size() && band_[std::size_t(f)];
+    }
+    bool unseen(FaceIndex f) const { return std::size_t(f) < unseen_.size() && unseen_[std::size_t(f)]; }
+    bool isFixed(VertexIndex v) { return at(fixed_, std::size_t(v), char(1)) != 0; }
+    double sizeOf(VertexIndex v) { return at(size_, std::size_t(v), in_.edgeLength); }
+    bool isCrease(VertexIndex a, VertexIndex b) const { return crease_.count(bandKey(a, b)) > 0; }
+    int creaseDegree(VertexIndex v) const {
+        auto it = creaseDeg_.find(std::uint32_t(v));
+        return it == creaseDeg_.end() ? 0 : it->second;
+    }
+    V3 faceNormal(FaceIndex f) const {
+        const HalfedgeIndex h = S_.halfedge(f);
+        return detail::unitNormal(detail::pos(S_, S_.source(h)), detail::pos(S_, S_.target(h)),
+                                  detail::pos(S_, S_.target(S_.next(h))));
+    }
+    V3 areaVector(FaceIndex f) const {
+        const HalfedgeIndex h = S_.halfedge(f);
+        const V3 a = detail::pos(S_, S_.source(h));
+        return (detail::pos(S_, S_.target(h)) - a).cross(detail::pos(S_, S_.target(S_.next(h))) - a);
+    }
+    // The normal a face's replacement is compared with: its own where it is well shaped, else \p fallback
+    // (an area-weighted normal around it: a sliver's own normal says nothing about the surface).
+    V3 referenceNormal(FaceIndex f, const V3& fallback) const {
+        if (unseen(f) && in_.creaseNormal) {
+            // A piece of a face the view does not see: the plane of the face it was cut from.
+            const V3 n = in_.creaseNormal(f);
+            if (n.squaredNorm() > 0) return n;
+        }
+        const HalfedgeIndex h = S_.halfedge(f);
+        const V3 a = detail::pos(S_, S_.source(h)), b = detail::pos(S_, S_.target(h)),
+                 c = detail::pos(S_, S_.target(S_.next(h)));
+        return detail::minAngle(a, b, c) >= kSliverDeg * kBandDeg ? detail::unitNormal(a, b, c) : fallback;
+    }
+    bool facing(const V3& a, const V3& b, const V3& c) const {
+        const V3 n = (b - a).cross(c - a);
+        if (!(n.norm() > 0)) return false;
+        const Camera& cam = *in_.camera;
+        const V3 centroid = (a + b + c) / 3.0;
+        const V3 toViewer = cam.parallel ? V3(-cam.viewDirection()) : V3(cam.eye - centroid);
+        return n.dot(toViewer) > 0;
+    }
+    // A triangle that may replace one of normal n0: facing, not degenerate, turned by at most the bound.
+    // A face the view does not see (`seen` false) keeps its own orientation instead: the normal bound holds.
+    bool acceptableFace(const V3& a, const V3& b, const V3& c, const V3& n0, bool seen = true) const {
+        if (seen && !facing(a, b, c)) return false;
+        const V3 n = detail::unitNormal(a, b, c);
+        return n.squaredNorm() > 0 && detail::angleBetween(n, n0) <= in_.maxNormalTurnDeg * kBandDeg;
+    }
+    // Whether every face around v is a band face (and v is not on the mesh border).
+    bool wholeStarInBand(VertexIndex v) {
+        for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_))
+            if (S_.is_border(h) || !inBand(S_.face(h))) return false;
+        return true;
+    }
+    bool interiorEdge(HalfedgeIndex h) {
+        return !S_.is_border(S_.edge(h)) && inBand(S_.face(h)) && inBand(S_.face(S_.opposite(h)));
+    }
+    void touch(VertexIndex v) { at(touched_, std::size_t(v), char(0)) = 1; }
+
+    // ---- setup: band marks, fixed vertices, creases, reference copy, sizes
+    void setup();
+    double faceMinAngle(FaceIndex f) const {
+        const HalfedgeIndex h = S_.halfedge(f);
+        return detail::minAngle(detail::pos(S_, S_.source(h)), detail::pos(S_, S_.target(h)),
+                                detail::pos(S_, S_.target(S_.next(h))));
+    }
+    bool growable(FaceIndex f) const { return f != Mesh::null_face() && in_.growable && in_.growable(f); }
+
+    // ---- growth: the band takes in the faces at and beyond its border that it would otherwise leave bad
+    void grow();
+
+    // ---- diagnostics: where the new faces below 20 deg are after the remesh
+    void countBelow20();
+
+    void addCrease(VertexIndex a, VertexIndex b) {
+        if (crease_.insert(bandKey(a, b)).second) {
+            ++creaseDeg_[std::uint32_t(a)];
+            ++creaseDeg_[std::uint32_t(b)];
+        }
+    }
+    void removeCrease(VertexIndex a, VertexIndex b) {
+        if (crease_.erase(bandKey(a, b))) {
+            --creaseDeg_[std::uint32_t(a)];
+            --creaseDeg_[std::uint32_t(b)];
+        }
+    }
+
+    void measure(double& minDeg, double& frac30) {
+        std::size_t n = 0, good = 0;
+        double smallest = 180;
+        for (std::size_t f = 0; f < band_.size(); ++f) {
+            const FaceIndex g(static_cast<std::uint32_t>(f));
+            if (!band_[f] || S_.is_removed(g)) continue;
+            const HalfedgeIndex h = S_.halfedge(g);
+            const double a = detail::minAngle(detail::pos(S_, S_.source(h)), detail::pos(S_, S_.target(h)),
+                                              detail::pos(S_, S_.target(S_.next(h)))) /
+                             kBandDeg;
+            smallest = std::min(smallest, a);
+            ++n;
+            good += a >= 30.0;
+        }
+        minDeg = smallest;
+        frac30 = n ? double(good) / double(n) : 1.0;
+    }
+
+    // Band edges (each once, by one halfedge), in descriptor order.
+    std::vector<HalfedgeIndex> bandEdges() {
+        std::vector<HalfedgeIndex> out;
+        for (std::size_t f = 0; f < band_.size(); ++f) {
+            const FaceIndex g(static_cast<std::uint32_t>(f));
+            if (!band_[f] || S_.is_removed(g)) continue;
+            for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(g), S_))
+                if (interiorEdge(h) && std::uint32_t(S_.face(S_.opposite(h))) > std::uint32_t(g))
+                    out.push_back(h);
+        }
+        return out;
+    }
+
+    // ---- splits of edges longer than 4/3 of the local size
+    void splitPass() {
+        std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
+        for (HalfedgeIndex h : bandEdges()) {
+            const VertexIndex a = S_.source(h), b = S_.target(h);
+            const double len = (detail::pos(S_, a) - detail::pos(S_, b)).norm();
+            const double target = 0.5 * (sizeOf(a) + sizeOf(b));
+            if (len > 4.0 / 3.0 * target) cands.push_back({-len / target, {a, b}});
+        }
+        std::sort(cands.begin(), cands.end());
+        for (const auto& c : cands) {
+            const auto [a, b] = c.second;
+            if (S_.is_removed(a) || S_.is_removed(b)) continue;
+            const HalfedgeIndex h = S_.halfedge(a, b);
+            if (h == Mesh::null_halfedge() || !interiorEdge(h)) continue;
+            split(h);
+        }
+    }
+    bool split(HalfedgeIndex h) {
+        const VertexIndex a = S_.source(h), b = S_.target(h);
+        const VertexIndex c = S_.target(S_.next(h)), d = S_.target(S_.next(S_.opposite(h)));
+        const V3 pa = detail::pos(S_, a), pb = detail::pos(S_, b), pc = detail::pos(S_, c),
+                 pd = detail::pos(S_, d);
+        const bool onCrease = isCrease(a, b);
+        V3 q = 0.5 * (pa + pb);
+        FaceIndex hint = at(hint_, std::size_t(a), Mesh::null_face());
+        if (!onCrease && hint != Mesh::null_face()) {
+            const SurfacePoint sp = closestPointNear(ref_, q, hint, LocalSearchOptions{.rings = 2});
+            if (sp && sp.distance <= 0.25 * (pa - pb).norm()) {
+                q = sp.point;
+                hint = sp.face;
+            }
+        }
+        const FaceIndex f1 = S_.face(h), f2 = S_.face(S_.opposite(h));
+        const V3 quad = (areaVector(f1) + areaVector(f2)).normalized();
+        const V3 n1 = referenceNormal(f1, quad), n2 = referenceNormal(f2, quad);
+        const bool s1 = !unseen(f1), s2 = !unseen(f2);
+        if (!acceptableFace(pa, q, pc, n1, s1) || !acceptableFace(q, pb, pc, n1, s1) ||
+            !acceptableFace(pb, q, pd, n2, s2) || !acceptableFace(q, pa, pd, n2, s2))
+            return false;
+        // No split makes a face below the floor that was not there (a split next to a small angle halves it).
+        const double oldMin = std::min(detail::minAngle(pa, pb, pc), detail::minAngle(pb, pa, pd));
+        const double newMin = std::min({detail::minAngle(pa, q, pc), detail::minAngle(q, pb, pc),
+                                        detail::minAngle(pb, q, pd), detail::minAngle(q, pa, pd)});
+        if (newMin < std::min(oldMin, kSplitFloorDeg * kBandDeg) || newMin < minSplitGain_ * oldMin)
+            return false;
+        const detail::EdgeSplit s = detail::splitEdge(S_, h, Point3(q.x(), q.y(), q.z()));
+        const VertexIndex v = s.vertex;
+        at(fixed_, std::size_t(v), char(1)) = 0;
+        at(size_, std::size_t(v), in_.edgeLength) = 0.5 * (sizeOf(a) + sizeOf(b));
+        at(hint_, std::size_t(v), Mesh::null_face()) = hint;
+        at(touched_, std::size_t(v), char(0)) = 1;
+        if (in_.vertexData) in_.vertexData(v, Mesh::null_vertex());
+        for (const auto& [e, parent] : {std::pair{s.first, f1}, std::pair{s.second, f2}})
+            for (FaceIndex g : {S_.face(e), S_.face(S_.opposite(e))})
+                if (g != parent) {
+                    at(band_, std::size_t(g), char(0)) = 1;
+                    at(unseen_, std::size_t(g), char(0)) = char(unseen(parent));
+                    if (in_.faceData) in_.faceData(g, parent);
+                }
+        at(band_, std::size_t(f1), char(0)) = 1;
+        at(band_, std::size_t(f2), char(0)) = 1;
+        if (onCrease) {
+            removeCrease(a, b);
+            addCrease(a, v);
+            addCrease(v, b);
+        }
+        ++report_.splits;
+        return true;
+    }
+
+    // ---- repair of the faces still below the aim, whatever the sizes and valences: a flip of one of their
+    // edges, a collapse of their shortest edge, a split of the long edge of a cap (an angle above 120 deg),
+    // each only where it raises the smallest angle there. True when something changed.
+    bool repairPass();
+    bool repairFlip(FaceIndex f);
+    bool repairCollapse(FaceIndex f);
+    bool repairCap(FaceIndex f);
+
+    // ---- collapses of edges shorter than 4/5 of the local size
+    void collapsePass() {
+        std::vector<std::pair<double, std::pair<VertexIndex, VertexIndex>>> cands;
+        for (HalfedgeIndex h : bandEdges()) {
+            const VertexIndex a = S_.source(h), b = S_.target(h);
+            const double len = (detail::pos(S_, a) - detail::pos(S_, b)).norm();
+            const double target = 0.5 * (sizeOf(a) + sizeOf(b));
+            if (len < 0.8 * target) cands.push_back({len / target, {a, b}});
+        }
+        std::sort(cands.begin(), cands.end());
+        for (const auto& c : cands) {
+            const auto [a, b] = c.second;
+            if (S_.is_removed(a) || S_.is_removed(b)) continue;
+            const HalfedgeIndex h = S_.halfedge(a, b);
+            if (h == Mesh::null_halfedge() || !interiorEdge(h)) continue;
+            double sa = -1, sb = -1;
+            const bool okA = collapsible(a, b, sa), okB = collapsible(b, a, sb);
+            if (!okA && !okB) continue;
+            const VertexIndex from = (okA && (!okB || sa >= sb)) ? a : b, to = from == a ? b : a;
+            collapse(from, to);
+        }
+    }
+    // Whether `from` may go into `to` (to keeps its place); score: the smallest angle after.
+    bool collapsible(VertexIndex from, VertexIndex to, double& score, double limitFactor = 4.0 / 3.0) {
+        if (isFixed(from) || !wholeStarInBand(from)) return false;
+        if (creaseDegree(from) > 0) {
+            // Only along a nearly straight crease, onto its neighbour on it: the crease keeps its line.
+            if (creaseDegree(from) != 2 || !isCrease(from, to)) return false;
+            VertexIndex other = Mesh::null_vertex();
+            for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(from), S_))
+                if (w != to && isCrease(from, w)) other = w;
+            if (other == Mesh::null_vertex()) return false;
+            const V3 pf = detail::pos(S_, from);
+            if (detail::angleBetween(pf - detail::pos(S_, to), detail::pos(S_, other) - pf) >
+                kStraightCreaseDeg * kBandDeg)
+                return false;
+        }
+        const HalfedgeIndex h = S_.halfedge(from, to);
+        if (!detail::canCollapse(S_, S_.edge(h), true)) return false;
+        const V3 pt = detail::pos(S_, to);
+        const double limit = limitFactor * sizeOf(to);
+        V3 star(0, 0, 0);
+        for (HalfedgeIndex g : CGAL::halfedges_around_target(S_.halfedge(from), S_))
+            star += areaVector(S_.face(g));
+        star.normalize();
+        double oldMin = std::numbers::pi, newMin = std::numbers::pi;
+        for (HalfedgeIndex g : CGAL::halfedges_around_target(S_.halfedge(from), S_)) {
+            const VertexIndex p = S_.target(S_.next(g)), q = S_.source(g);
+            const V3 pp = detail::pos(S_, p), pq = detail::pos(S_, q), pf = detail::pos(S_, from);
+            oldMin = std::min(oldMin, detail::minAngle(pf, pp, pq));
+            if (p == to || q == to) continue;
+            if (!acceptableFace(pt, pp, pq, referenceNormal(S_.face(g), star), !unseen(S_.face(g))))
+                return false;
+            if ((pp - pt).norm() > limit) return false;
+            newMin = std::min(newMin, detail::minAngle(pt, pp, pq));
+        }
+        if (newMin < std::min(oldMin, in_.minAngleDeg * kBandDeg)) return false;
+        score = newMin;
+        return true;
+    }
+    void collapse(VertexIndex from, VertexIndex to) {
+        const HalfedgeIndex h = S_.halfedge(from, to);
+        const FaceIndex f1 = S_.face(h), f2 = S_.face(S_.opposite(h));
+        const V3 keep = detail::pos(S_, to);
+        const double keepSize = sizeOf(to);
+        const FaceIndex keepHint = at(hint_, std::size_t(to), Mesh::null_face());
+        const char keepFixed = char(isFixed(to));
+        const char keepTouched = at(touched_, std::size_t(to), char(0));
+        // Crease edges at either end go to the survivor (a crease through `from` continues from `to`).
+        std::vector<VertexIndex> creaseEnds;
+        for (VertexIndex x : {from, to})
+            for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(x), S_))
+                if (w != from && w != to && isCrease(x, w)) creaseEnds.push_back(w);
+        for (VertexIndex x : {from, to})
+            for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(x), S_))
+                removeCrease(x, w);
+        const VertexIndex kept = CGAL::Euler::collapse_edge(S_.edge(h), S_);
+        band_[std::size_t(f1)] = 0;
+        band_[std::size_t(f2)] = 0;
+        if (kept != to) {
+            S_.point(kept) = Point3(keep.x(), keep.y(), keep.z());
+            if (in_.vertexData) in_.vertexData(kept, to);
+            size_[std::size_t(kept)] = keepSize;
+            hint_[std::size_t(kept)] = keepHint;
+            fixed_[std::size_t(kept)] = keepFixed;
+            touched_[std::size_t(kept)] = keepTouched;
+        }
+        for (VertexIndex w : creaseEnds)
+            addCrease(kept, w);
+        ++report_.collapses;
+    }
+
+    // ---- flips towards valence 6 and larger angles
+    void flipPass() {
+        auto cost = [&](VertexIndex v, int delta) {
+            const int target = S_.is_border(v) ? 4 : 6;
+            return std::abs(int(S_.degree(v)) + delta - target);
+        };
+        for (int round = 0; round < 3; ++round) {
+            std::size_t flips = 0;
+            for (HalfedgeIndex h : bandEdges()) {
+                if (S_.is_removed(S_.edge(h)) || !interiorEdge(h)) continue;
+                const VertexIndex a = S_.source(h), b = S_.target(h);
+                if (isCrease(a, b) || !detail::canFlip(S_, h)) continue;
+                const VertexIndex c = S_.target(S_.next(h)), d = S_.target(S_.next(S_.opposite(h)));
+                const V3 pa = detail::pos(S_, a), pb = detail::pos(S_, b), pc = detail::pos(S_, c),
+                         pd = detail::pos(S_, d);
+                const V3 quad = (areaVector(S_.face(h)) + areaVector(S_.face(S_.opposite(h)))).normalized();
+                if (unseen(S_.face(h)) != unseen(S_.face(S_.opposite(h)))) continue;
+                const bool seen = !unseen(S_.face(h));
+                const V3 n1 = referenceNormal(S_.face(h), quad),
+                         n2 = referenceNormal(S_.face(S_.opposite(h)), quad);
+                // New faces (a, d, c) and (b, c, d).
+                if (!acceptableFace(pa, pd, pc, n1, seen) || !acceptableFace(pa, pd, pc, n2, seen) ||
+                    !acceptableFace(pb, pc, pd, n1, seen) || !acceptableFace(pb, pc, pd, n2, seen))
+                    continue;
+                // The new edge stays near the draft (a flip over a curved place would cut under it).
+                const double dev = distanceToRef(0.5 * (pc + pd), c);
+                if (dev > 0.1 * (pc - pd).norm()) continue;
+                const double oldMin = std::min(detail::minAngle(pa, pb, pc), detail::minAngle(pb, pa, pd));
+                const double newMin = std::min(detail::minAngle(pa, pd, pc), detail::minAngle(pb, pc, pd));
+                const int devOld = cost(a, 0) + cost(b, 0) + cost(c, 0) + cost(d, 0);
+                const int devNew = cost(a, -1) + cost(b, -1) + cost(c, 1) + cost(d, 1);
+                // Score (as version 1's flips): smallest angle in degrees minus 3 deg per unit of valence
+                // deviation; never below the smaller of the angle before and the aim.
+                const double gain = (newMin - oldMin) / kBandDeg - 3.0 * double(devNew - devOld);
+                if (!(gain > 0.5) || newMin < std::min(oldMin, in_.minAngleDeg * kBandDeg)) continue;
+                CGAL::Euler::flip_edge(h, S_);
+                ++flips;
+            }
+            report_.flips += flips;
+            if (!flips) break;
+        }
+    }
+    double distanceToRef(const V3& p, VertexIndex near) {
+        const FaceIndex hint = at(hint_, std::size_t(near), Mesh::null_face());
+        if (hint == Mesh::null_face()) return 0;
+        const SurfacePoint sp = closestPointNear(ref_, p, hint, LocalSearchOptions{.rings = 2});
+        return sp ? sp.distance : 0;
+    }
+
+    // ---- tangential relaxation with projection onto the draft (mesh/relax.h)
+    void relaxPass(int iterations) {
+        std::vector<VertexIndex> verts;
+        std::vector<FaceIndex> hints;
+        std::vector<double> sizes;
+        std::unordered_set<std::uint32_t> seen;
+        for (std::size_t f = 0; f < band_.size(); ++f) {
+            const FaceIndex g(static_cast<std::uint32_t>(f));
+            if (!band_[f] || S_.is_removed(g)) continue;
+            for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_)) {
+                // Crease vertices stay: the crease keeps its exact line (splits put new vertices on it).
+                if (isFixed(v) || creaseDegree(v) > 0 || !seen.insert(std::uint32_t(v)).second) continue;
+                const FaceIndex hf = at(hint_, std::size_t(v), Mesh::null_face());
+                if (hf == Mesh::null_face() || !wholeStarInBand(v)) continue;
+                verts.push_back(v);
+            }
+        }
+        std::sort(verts.begin(), verts.end()); // deterministic order (hints and sizes follow)
+        for (VertexIndex v : verts) {
+            hints.push_back(hint_[std::size_t(v)]);
+            sizes.push_back(sizeOf(v));
+        }
+        std::vector<V3> before;
+        for (VertexIndex v : verts)
+            before.push_back(detail::pos(S_, v));
+        detail::RelaxOptions o;
+        o.iterations = iterations;
+        o.step = 0.5;
+        o.creaseAngleDeg = in_.creaseAngleDeg;
+        o.maxNormalTurnDeg = in_.maxNormalTurnDeg;
+        o.maxOffFootprints = 0.5;
+        const detail::RelaxReport r = detail::relaxOnReference(S_, ref_, verts, hints, sizes, o, in_.camera);
+        report_.moves += r.moves;
+        for (std::size_t k = 0; k < verts.size(); ++k) {
+            hint_[std::size_t(verts[k])] = hints[k];
+            if (detail::pos(S_, verts[k]) != before[k]) touch(verts[k]);
+        }
+    }
+
+    // ---- relocation of the free vertices of faces below the aim: the place on the draft around the vertex
+    // (a search over tangential offsets, each projected) that maximises the smallest angle of its star.
+    // Own search rather than a smoothing rule: near a fixed, irregular border the centroid is often not
+    // where the worst angle improves.
+    void improvePass();
+    // Crease vertices of faces below the aim slide along their (nearly straight) crease: candidates on the
+    // two crease edges, the one that maximises the star's smallest angle wins.
+    void slidePass();
+    double starMinAngle(VertexIndex v, const V3& at) const {
+        double m = std::numbers::pi;
+        for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
+            if (S_.is_border(h)) continue;
+            m = std::min(m, detail::minAngle(detail::pos(S_, S_.source(h)), at,
+                                             detail::pos(S_, S_.target(S_.next(h)))));
+        }
+        return m;
+    }
+    bool starAcceptable(VertexIndex v, const V3& at, double maxTurn) const {
+        V3 star(0, 0, 0);
+        for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_))
+            star += areaVector(S_.face(h));
+        star.normalize();
+        for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
+            const V3 b = detail::pos(S_, S_.source(h)), c = detail::pos(S_, S_.target(S_.next(h)));
+            if (!unseen(S_.face(h)) && !facing(b, at, c)) return false;
+            const V3 n = detail::unitNormal(b, at, c);
+            if (detail::angleBetween(n, referenceNormal(S_.face(h), star)) > maxTurn) return false;
+        }
+        return true;
+    }
+
+    const BandRemeshInput& in_;
+    Mesh& S_;
+    Mesh ref_;                        // the draft band, onto which vertices are projected
+    std::vector<FaceIndex> bandList_; // the band as given and grown (descriptor order after growth)
+    std::vector<char> band_, fixed_, touched_;
+    double minSplitGain_ = 0;  // a split must give a smallest angle of at least this times the one before
+    std::vector<char> unseen_; // per face: a new face the view does not see (BandRemeshInput::unseen)
+    std::vector<double> size_;
+    std::vector<FaceIndex> hint_; // per S vertex: a face of ref_ at it
+    std::unordered_set<std::uint64_t> crease_;
+    std::unordered_map<std::uint32_t, int> creaseDeg_;
+    BandRemeshReport report_;
+};
+
+} // namespace fss::stitch::band

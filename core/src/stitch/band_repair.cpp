@@ -1,0 +1,219 @@
+// Stitch v2, design B: the repair of the band's faces still below the aim, the band's growth, the
+// diagnostics (band_remesher.h).
+#include "stitch/band_remesher.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+namespace fss::stitch::band {
+
+void BandRemesher::grow() {
+    if (!in_.growable || stageOff("grow")) return;
+    const double aim = in_.growBelowDeg * kBandDeg, floor = 20.0 * kBandDeg;
+    for (int round = 0; round < in_.maxGrowRounds; ++round) {
+        std::vector<FaceIndex> add;
+        auto around = [&](VertexIndex v) {
+            for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
+                const FaceIndex g = S_.face(h);
+                if (!S_.is_border(h) && !inBand(g) && growable(g)) add.push_back(g);
+            }
+        };
+        auto touchesBand = [&](FaceIndex f) {
+            for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
+                for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_))
+                    if (!S_.is_border(h) && inBand(S_.face(h))) return true;
+            return false;
+        };
+        for (FaceIndex f : S_.faces()) {
+            if (inBand(f) || !growable(f)) continue;
+            const double a = faceMinAngle(f);
+            if (a >= aim || (a >= floor && !touchesBand(f))) continue;
+            add.push_back(f);
+            for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
+                around(v);
+        }
+        for (FaceIndex f : bandList_) {
+            if (faceMinAngle(f) >= aim) continue;
+            for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
+                if (!(in_.fixed && in_.fixed(v)) && !wholeStarInBand(v)) around(v);
+        }
+        std::sort(add.begin(), add.end());
+        add.erase(std::unique(add.begin(), add.end()), add.end());
+        if (add.empty()) break;
+        for (FaceIndex f : add) {
+            at(band_, std::size_t(f), char(0)) = 1;
+            bandList_.push_back(f);
+        }
+        report_.grown += add.size();
+    }
+    std::sort(bandList_.begin(), bandList_.end());
+}
+
+void BandRemesher::countBelow20() {
+    if (!bandDiagnostics()) return;
+    const double floor = 20.0 * kBandDeg;
+    const char* e = std::getenv("FSS_STITCH_BAND_DIAG");
+    const bool verbose = e && std::string(e) == "2";
+    for (FaceIndex f : S_.faces()) {
+        const bool band = inBand(f), unseen = in_.unseen && in_.unseen(f);
+        if (!band && !unseen && !growable(f)) continue;
+        if (faceMinAngle(f) >= floor) continue;
+        if (!band && unseen) {
+            ++report_.below20Unseen;
+        } else if (!band) {
+            ++report_.below20Beyond;
+        } else {
+            bool free = false;
+            for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
+                free = free || !isFixed(v);
+            ++(free ? report_.below20Free : report_.below20Held);
+            if (verbose) {
+                std::fprintf(stderr, "  face %u %.2f deg%s:", std::uint32_t(f), faceMinAngle(f) / kBandDeg,
+                             unseen ? " unseen" : "");
+                for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
+                    const VertexIndex v = S_.target(h);
+                    const V3 p = detail::pos(S_, v), a = detail::pos(S_, S_.source(h)),
+                             b = detail::pos(S_, S_.target(S_.next(h)));
+                    std::fprintf(stderr, " [v%u %.1f deg%s%s crease %d deg %zu edge %.3g%s]",
+                                 std::uint32_t(v), detail::angleBetween(a - p, b - p) / kBandDeg,
+                                 isFixed(v) ? " fixed" : "", wholeStarInBand(v) ? "" : " rim",
+                                 creaseDegree(v), std::size_t(S_.degree(v)), (p - a).norm(),
+                                 isCrease(S_.source(h), v) ? " (crease)" : "");
+                }
+                std::fprintf(stderr, "\n");
+            }
+        }
+    }
+}
+
+bool BandRemesher::repairPass() {
+    const double aim = in_.minAngleDeg * kBandDeg;
+    std::vector<std::pair<double, FaceIndex>> bad;
+    for (std::size_t f = 0; f < band_.size(); ++f) {
+        const FaceIndex g(static_cast<std::uint32_t>(f));
+        if (!band_[f] || S_.is_removed(g)) continue;
+        const double a = faceMinAngle(g);
+        if (a < aim) bad.push_back({a, g});
+    }
+    std::sort(bad.begin(), bad.end());
+    bool changed = false;
+    for (const auto& [angle, f] : bad) {
+        if (S_.is_removed(f) || !inBand(f) || faceMinAngle(f) >= aim) continue;
+        if (repairFlip(f) || repairCollapse(f) || repairCap(f)) {
+            changed = true;
+            ++report_.repairs;
+        }
+    }
+    return changed;
+}
+
+bool BandRemesher::repairFlip(FaceIndex f) {
+    const double before = faceMinAngle(f);
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
+        if (!interiorEdge(h)) continue;
+        const VertexIndex a = S_.source(h), b = S_.target(h);
+        if (isCrease(a, b) || !detail::canFlip(S_, h)) continue;
+        const FaceIndex g = S_.face(S_.opposite(h));
+        if (unseen(f) != unseen(g)) continue;
+        const VertexIndex c = S_.target(S_.next(h)), d = S_.target(S_.next(S_.opposite(h)));
+        const V3 pa = detail::pos(S_, a), pb = detail::pos(S_, b), pc = detail::pos(S_, c),
+                 pd = detail::pos(S_, d);
+        const double oldMin = std::min(before, faceMinAngle(g));
+        const double newMin = std::min(detail::minAngle(pa, pd, pc), detail::minAngle(pb, pc, pd));
+        if (!(newMin > oldMin + 0.5 * kBandDeg)) continue;
+        const V3 quad = (areaVector(f) + areaVector(g)).normalized();
+        const V3 n1 = referenceNormal(f, quad), n2 = referenceNormal(g, quad);
+        const bool seen = !unseen(f);
+        if (!acceptableFace(pa, pd, pc, n1, seen) || !acceptableFace(pa, pd, pc, n2, seen) ||
+            !acceptableFace(pb, pc, pd, n1, seen) || !acceptableFace(pb, pc, pd, n2, seen))
+            continue;
+        if (distanceToRef(0.5 * (pc + pd), c) > 0.1 * (pc - pd).norm()) continue;
+        CGAL::Euler::flip_edge(h, S_);
+        ++report_.flips;
+        return true;
+    }
+    return false;
+}
+
+bool BandRemesher::repairCollapse(FaceIndex f) {
+    HalfedgeIndex shortest = Mesh::null_halfedge();
+    double len = std::numeric_limits<double>::infinity();
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
+        const double l = (detail::pos(S_, S_.source(h)) - detail::pos(S_, S_.target(h))).norm();
+        if (l < len && interiorEdge(h)) {
+            len = l;
+            shortest = h;
+        }
+    }
+    if (shortest == Mesh::null_halfedge()) return false;
+    const VertexIndex a = S_.source(shortest), b = S_.target(shortest);
+    double sa = -1, sb = -1;
+    const bool okA = collapsible(a, b, sa, 2.0), okB = collapsible(b, a, sb, 2.0);
+    if (!okA && !okB) return false;
+    const VertexIndex from = (okA && (!okB || sa >= sb)) ? a : b, to = from == a ? b : a;
+    if (std::max(sa, sb) <= faceMinAngle(f)) return false;
+    collapse(from, to);
+    return true;
+}
+
+bool BandRemesher::repairCap(FaceIndex f) {
+    const HalfedgeIndex h0 = S_.halfedge(f);
+    HalfedgeIndex opposite = Mesh::null_halfedge();
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(h0, S_)) {
+        // The angle at the corner opposite h.
+        const V3 p = detail::pos(S_, S_.target(S_.next(h)));
+        const V3 u = detail::pos(S_, S_.source(h)) - p, w = detail::pos(S_, S_.target(h)) - p;
+        if (detail::angleBetween(u, w) > 120.0 * kBandDeg) opposite = h;
+    }
+    if (opposite == Mesh::null_halfedge() || !interiorEdge(opposite)) return false;
+    minSplitGain_ = 1.0 + 1e-6; // the split must raise the smallest angle of the two faces
+    const bool ok = split(opposite);
+    minSplitGain_ = 0;
+    return ok;
+}
+
+void BandRemesher::slidePass() {
+    const double aim = in_.minAngleDeg * kBandDeg, maxTurn = in_.maxNormalTurnDeg * kBandDeg;
+    std::vector<VertexIndex> verts;
+    std::unordered_set<std::uint32_t> seen;
+    for (std::size_t f = 0; f < band_.size(); ++f) {
+        const FaceIndex g(static_cast<std::uint32_t>(f));
+        if (!band_[f] || S_.is_removed(g) || faceMinAngle(g) >= aim) continue;
+        for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_))
+            if (!isFixed(v) && creaseDegree(v) == 2 && wholeStarInBand(v) &&
+                seen.insert(std::uint32_t(v)).second)
+                verts.push_back(v);
+    }
+    std::sort(verts.begin(), verts.end());
+    for (VertexIndex v : verts) {
+        std::vector<VertexIndex> ends;
+        for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(v), S_))
+            if (isCrease(v, w)) ends.push_back(w);
+        if (ends.size() != 2) continue;
+        const V3 p = detail::pos(S_, v), e0 = detail::pos(S_, ends[0]), e1 = detail::pos(S_, ends[1]);
+        if (detail::angleBetween(p - e0, e1 - p) > kSlideCreaseDeg * kBandDeg) continue;
+        double best = starMinAngle(v, p);
+        V3 bestP = p;
+        for (const V3& e : {e0, e1})
+            for (double t : {0.1, 0.2, 0.3, 0.4}) {
+                const V3 q = p + t * (e - p);
+                const double a = starMinAngle(v, q);
+                if (a > best + 1e-9 && starAcceptable(v, q, maxTurn)) {
+                    best = a;
+                    bestP = q;
+                }
+            }
+        if (bestP == p) continue;
+        S_.point(v) = Point3(bestP.x(), bestP.y(), bestP.z());
+        const FaceIndex hint = at(hint_, std::size_t(v), Mesh::null_face());
+        if (hint != Mesh::null_face()) {
+            const SurfacePoint sp = closestPointNear(ref_, bestP, hint, LocalSearchOptions{.rings = 2});
+            if (sp) hint_[std::size_t(v)] = sp.face;
+        }
+        touch(v);
+        ++report_.moves;
+    }
+}
+
+} // namespace fss::stitch::band
