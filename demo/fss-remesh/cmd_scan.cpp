@@ -337,12 +337,19 @@ void requireRemeshingOf(const Mesh& current, const std::string& currentPath, con
     }
 }
 
+const char* latticeName(Lattice lattice) {
+    return lattice == Lattice::Square ? "square" : lattice == Lattice::Adaptive ? "adaptive" : "triangular";
+}
+
+// The lattice options' defaults are the core's (ScanParams{}: issue #20).
 struct ScanOptions {
-    std::string meshPath, outPath, view = "iso", intoPath, rendererKind = "auto", lattice = "triangular";
+    std::string meshPath, outPath, view = "iso", intoPath, rendererKind = "auto",
+                                   lattice = latticeName(fss::ScanOptions{}.lattice);
     std::vector<double> camera; // --camera's numbers
     int w = 256, h = 256, erode = 1, dilate = 1, scanId = 0;
     double zoom = 1, maxEdge = 3, maxAngle = 80, margin = 0.1, spacing = 1, spacingWorld = 0,
-           minQuadAngle = 20, minLatticeAngle = 0;
+           minQuadAngle = TriangulateOptions{}.minQuadAngleDeg,
+           minLatticeAngle = fss::ScanOptions{}.minLatticeAngleDeg;
     Lasso lasso;                             // normalised
     FishboneParams fishbone;                 // normalised
     const CLI::Option* viewOption = nullptr; // the options below are given when their count() > 0
@@ -516,16 +523,17 @@ Subcommand addScan(CLI::App& app) {
              "full resolution, finer direction fields at up to h^2 times the render cost). Points in "
              "normalised image coordinates as for --lasso. --max-edge-footprints is multiplied by h/K.")
             ->type_name("SPEC");
-    p->add_option("--lattice", o->lattice,
-                  "Sample lattice of a regular scan: triangular (default; rows offset by half a spacing, "
-                  "equilateral triangles on the screen) or square (one sample per pixel centre, the paper's "
-                  "pixel grid) or adaptive (a triangular lattice compressed and turned per view so that the "
-                  "most of the visible surface gets round triangles despite its slant).")
+    p->add_option(
+         "--lattice", o->lattice,
+         "Sample lattice of a regular scan: adaptive (default; a triangular lattice compressed and "
+         "turned per view so that the most of the visible surface gets round triangles despite its "
+         "slant), triangular (rows offset by half a spacing, equilateral triangles on the screen) or "
+         "square (one sample per pixel centre, the paper's pixel grid).")
         ->type_name("L")
         ->check(oneOf("--lattice", {"triangular", "square", "adaptive"}));
     addDouble(*p, "--min-lattice-angle", o->minLatticeAngle, false, "DEG",
               "Leave to other views the surface where the lattice's triangles would have a smallest angle "
-              "below DEG degrees (its slant), in [0, 60) (default 0 = keep all).");
+              "below DEG degrees (its slant), in [0, 60) (default 35; 0 = keep all).");
     addDouble(*p, "--spacing", o->spacing, true, "PX",
               "Sample spacing of a regular scan's lattice in pixels, 0.25 to 1024 (default 1).");
     addDouble(*p, "--spacing-world", o->spacingWorld, true, "D",
@@ -540,7 +548,7 @@ Subcommand addScan(CLI::App& app) {
               "Drop triangles seen at more than DEG degrees from frontal (default 80).");
     addDouble(*p, "--min-quad-angle", o->minQuadAngle, false, "DEG",
               "Drop both triangles of a grid quad with a 3D corner angle below DEG degrees, in [0, 90) "
-              "(default 20; 0 = no bound).");
+              "(default 0 = no bound).");
     addDouble(*p, "--quality-margin", o->margin, false, "M",
               "A sample replaces a face only when better by this fraction (default 0.1).");
     p->add_flag("--force-replace", o->force,

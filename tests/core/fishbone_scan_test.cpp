@@ -348,6 +348,10 @@ AliasingRun runAliasing(const CreaseScene& scene, const char* name) {
     fss::ScanParams params;
     params.camera = scene.camera;
     params.lasso = scene.lasso;
+    // The paper's pixel grid, which the fishbone is measured against (the default adaptive lattice with its
+    // angle mask, issue #20, drops the steep flanks of the ridge and samples more densely).
+    params.scan.lattice = fss::Lattice::Square;
+    params.scan.minLatticeAngleDeg = 0;
     const fss::ScanResult grid = fss::scanPatch(scene.ring, renderer, scene.ring, renderer, params);
 
     fss::FishboneParams traced;

@@ -55,7 +55,11 @@ TEST(ScanPipeline, IsoScanOfFandiskIsARegularManifoldPatch) {
 
     EXPECT_EQ(r.counts.pixels, 256u * 256u);
     EXPECT_GT(r.counts.covered, 256u * 256u / 5);
-    EXPECT_EQ(r.counts.afterLasso, r.counts.frontFacing);  // no lasso
+    // The default lattice-angle mask (35°, issue #20) leaves the slanted part to other views (measured:
+    // 23944 of 39360 front-facing samples kept), then no lasso.
+    EXPECT_LT(r.counts.wellShaped, r.counts.frontFacing);
+    EXPECT_GT(r.counts.wellShaped, r.counts.frontFacing / 2);
+    EXPECT_EQ(r.counts.afterLasso, r.counts.wellShaped);   // no lasso
     EXPECT_EQ(r.counts.afterQuality, r.counts.afterLasso); // first scan: input faces always lose
     EXPECT_LE(r.counts.afterMorphology, r.counts.afterQuality);
     // Triangles across silhouettes are dropped, so a few valid samples end up in no triangle.
@@ -324,22 +328,21 @@ TEST(ScanPipeline, TriangularLatticeMakesRounderTrianglesThanThePixelGrid) {
     const fss::Mesh ref = load("fandisk.off");
     fss::CpuMeshRenderer renderer;
     renderer.setMesh(ref);
-    // The square pixel lattice stays the default until the stitch copes with the triangular one (issue 20).
-    EXPECT_EQ(fss::ScanParams{}.scan.lattice, fss::Lattice::Square);
+    // The default is the adaptive lattice with the lattice-angle mask at 35° (issue 20).
+    EXPECT_EQ(fss::ScanParams{}.scan.lattice, fss::Lattice::Adaptive);
+    EXPECT_EQ(fss::ScanParams{}.scan.minLatticeAngleDeg, 35.0);
     const auto tri = latticeScan(ref, renderer, fss::StandardView::Iso, 256, fss::Lattice::Triangular);
     const auto sq = latticeScan(ref, renderer, fss::StandardView::Iso, 256, fss::Lattice::Square);
     std::printf("fandisk iso 256²: triangular mean min angle %.1f°, %.1f %% < 30°, valence 6 %.3f, Hausdorff "
                 "%.2e (%zu faces); square %.1f°, %.1f %%, %.3f, %.2e (%zu faces)\n",
                 tri.meanMinAngle, 100 * tri.below30, tri.valence6, tri.hausdorff, tri.faces, sq.meanMinAngle,
                 100 * sq.below30, sq.valence6, sq.hausdorff, sq.faces);
-    // Measured (issue #20 report): 36.2° against 29.9°, 3.4 % against 63.7 % below 30°, Hausdorff 2.43e-3
-    // against 2.16e-3 — 12 % larger (the lattice's: without the relaxation it is the same 2.43e-3 here;
-    // over 28 scans of four meshes the triangular lattice's Hausdorff was lower in 19): the issue's "no
-    // worse" is not met on this view, and this bound records where it stands.
+    // Measured (issue #20 report): 36.4° against 29.9°, 1.2 % against 63.7 % below 30°, Hausdorff 1.84e-3
+    // against 2.16e-3 (2.43e-3 before the edge limit scaled with the lattice's screen edges, scanPatch).
     EXPECT_GE(tri.meanMinAngle, sq.meanMinAngle + 5);
     EXPECT_LE(tri.below30, 0.1 * sq.below30);
     EXPECT_GE(tri.valence6, 0.98);
-    EXPECT_LE(tri.hausdorff, 1.15 * sq.hausdorff);
+    EXPECT_LE(tri.hausdorff, sq.hausdorff);
 }
 
 // The adaptive lattice with the lattice-angle mask at 35° (issue #20) on the view where the screen lattice
@@ -351,10 +354,10 @@ TEST(ScanPipeline, AdaptiveLatticeWithTheAngleMaskMakesRoundTrianglesOnFandiskIs
     renderer.setMesh(ref);
     fss::ScanParams params;
     params.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(ref), 256, 256);
+    const fss::ScanResult adaptive = fss::scanPatch(ref, renderer, ref, renderer, params); // the defaults
+    params.scan.lattice = fss::Lattice::Square;
+    params.scan.minLatticeAngleDeg = 0;
     const fss::ScanResult square = fss::scanPatch(ref, renderer, ref, renderer, params);
-    params.scan.lattice = fss::Lattice::Adaptive;
-    params.scan.minLatticeAngleDeg = 35;
-    const fss::ScanResult adaptive = fss::scanPatch(ref, renderer, ref, renderer, params);
     const fss::Metrics a = fss::computeMetrics(adaptive.patch.mesh, {.selfIntersections = false});
     const fss::Metrics s = fss::computeMetrics(square.patch.mesh, {.selfIntersections = false});
     std::printf("fandisk iso 256²: adaptive + mask 35°: mean smallest angle %.1f°, %.1f %% < 30°, valence 6 "
@@ -467,6 +470,11 @@ TEST(ScanPipeline, RelaxationMovesVerticesOnTheReferenceOnly) {
     renderer.setMesh(ref);
     fss::ScanParams params;
     params.camera = fss::Camera::standardView(fss::StandardView::Iso, bbox(ref), 128, 128);
+    // On the pixel lattice, where the relaxation has the most to do and the bounds below were measured (on
+    // the default adaptive lattice six sweeps move the mean smallest angle 55.01° -> 55.06° at a Hausdorff
+    // cost of 1.215e-3 -> 1.688e-3, issue #20 report: the relaxation stays off by default).
+    params.scan.lattice = fss::Lattice::Square;
+    params.scan.minLatticeAngleDeg = 0;
     params.relaxIterations = 0;
     const fss::ScanResult plain = fss::scanPatch(ref, renderer, ref, renderer, params);
     params.relaxIterations = 6;

@@ -512,8 +512,8 @@ TEST_F(BadSessionFile, LatticeAndRelaxationAreOptionalAndOffWhenAbsent) {
     j = good_;
     j["events"][0]["step"]["scan"]["lattice"] = "adaptive";
     EXPECT_EQ(stepOf(j).params.scan.lattice, fss::Lattice::Adaptive);
-    // Written back, a step on the pixel lattice without relaxation has none of the fields: old files
-    // round-trip to the same text.
+    // Written back, a step on the pixel lattice without relaxation writes the lattice and its mask (the
+    // defaults are no longer those, issue #20), and none of the other fields; it reads back the same.
     fss::SessionFile f = sampleFile(mesh_);
     f.events.at(0).step.params.scan.lattice = fss::Lattice::Square;
     f.events.at(0).step.params.scan.spacingPixels = 1;
@@ -522,10 +522,20 @@ TEST_F(BadSessionFile, LatticeAndRelaxationAreOptionalAndOffWhenAbsent) {
     f.events.at(0).step.params.triangulate.minQuadAngleDeg = 0;
     f.events.at(0).step.params.scan.minLatticeAngleDeg = 0;
     const Json written = Json::parse(fss::sessionFileToJson(f));
-    EXPECT_FALSE(written["events"][0]["step"]["scan"].contains("lattice"));
+    EXPECT_EQ(written["events"][0]["step"]["scan"]["lattice"], "square");
+    EXPECT_EQ(written["events"][0]["step"]["scan"]["min_lattice_angle_deg"], 0.0);
+    EXPECT_EQ(written["events"][0]["step"]["scan"]["spacing_px"], 1.0);
+    EXPECT_EQ(written["events"][0]["step"]["scan"]["spacing_world"], 0.0);
     EXPECT_FALSE(written["events"][0]["step"].contains("relax_iterations"));
     EXPECT_FALSE(written["events"][0]["step"]["triangulate"].contains("min_quad_angle_deg"));
-    EXPECT_FALSE(written["events"][0]["step"]["scan"].contains("min_lattice_angle_deg"));
+    const fss::ScanStep back = stepOf(written);
+    EXPECT_EQ(back.params.scan.lattice, fss::Lattice::Square);
+    EXPECT_EQ(back.params.scan.minLatticeAngleDeg, 0.0);
+    // A step with today's defaults writes them.
+    f.events.at(0).step.params.scan = fss::ScanOptions{};
+    const Json fresh = Json::parse(fss::sessionFileToJson(f));
+    EXPECT_EQ(fresh["events"][0]["step"]["scan"]["lattice"], "adaptive");
+    EXPECT_EQ(fresh["events"][0]["step"]["scan"]["min_lattice_angle_deg"], 35.0);
     j = good_;
     j["events"][0]["step"]["scan"]["lattice"] = "hexagonal";
     EXPECT_NE(load(j).find("events[0].step.scan.lattice must be"), std::string::npos) << load(j);

@@ -40,13 +40,14 @@ enum class Lattice {
     /// Rows √3/2 of a spacing apart, each row shifted by half a spacing against the one before: the
     /// triangulation's grid triangles are equilateral on the screen (and on a surface facing the camera).
     Triangular,
-    /// The pixel lattice of the paper: one sample per pixel centre (right isosceles triangles). Still the
-    /// default: with the triangular lattice the stitch seam and property tests failed (issue 20).
+    /// The pixel lattice of the paper: one sample per pixel centre (right isosceles triangles, 45° at best,
+    /// flatter on slanted surfaces). Session files without a lattice were recorded on it (issue #20).
     Square,
     /// A triangular lattice chosen per view (chooseAdaptiveLattice): the equilateral lattice compressed on
     /// the screen along one direction by cos θ0 and turned, so that its triangles are equilateral on a
     /// plane tilted by θ0 — the (θ0, direction, turn) for which the most of the visible surface gets round
     /// triangles. A fixed screen lattice is squashed by cos θ on surfaces seen at a slant θ (issue #20).
+    /// The default, with the lattice-angle mask at 35° (ScanOptions::minLatticeAngleDeg).
     Adaptive,
 };
 
@@ -61,7 +62,7 @@ struct ScanOptions {
     /// (a corrupted ID buffer), and the unprojected point is kept.
     double maxSnapFootprints = 2.0;
     /// The lattice of sampleLattice (scanPatch). sampleRegularGrid always samples the pixel centres.
-    Lattice lattice = Lattice::Square;
+    Lattice lattice = Lattice::Adaptive;
     /// Distance between neighbouring samples of sampleLattice, in pixels of the scan image; ≥ 0.25.
     double spacingPixels = 1.0;
     /// When > 0: the spacing in world units instead, converted to pixels with the pixel footprint at the
@@ -71,8 +72,9 @@ struct ScanOptions {
     /// the plane of the sample's reference face, has a smallest angle below this many degrees is not
     /// admissible — this view would sample that part of the surface too slanted for round triangles, and
     /// leaves it to another view (the paper's sampling-quality mask, on the triangles' shape). Also the
-    /// angle chooseAdaptiveLattice counts coverage at (35° when 0). In [0, 60); 0 = no mask.
-    double minLatticeAngleDeg = 0.0;
+    /// angle chooseAdaptiveLattice counts coverage at (35° when 0). In [0, 60); 0 = no mask. 35° by
+    /// default (issue #20: with it, the slanted rest of a view is left to views that see it rounder).
+    double minLatticeAngleDeg = 35.0;
 
     /// Checks the ranges: qualityAngleLimitDeg in (0, 90), maxSnapFootprints finite and ≥ 0, lattice one of
     /// the enumerators, spacingPixels finite and in [0.25, 1024], spacingWorld finite and ≥ 0,

@@ -21,9 +21,14 @@
 ///                     "width": 256, "height": 256 },
 ///         "lasso": null | [[x,y], ...],                    (pixels of the scan image)
 ///         "erode_radius": 1, "dilate_radius": 1,
-///         "scan": { "scan_id": 0, "quality_angle_limit_deg": 85, "max_snap_footprints": 2 },
+///         "relax_iterations": 6,                           (optional: written only when not 0, absent = 0)
+///         "scan": { "scan_id": 0, "quality_angle_limit_deg": 85, "max_snap_footprints": 2,
+///                   "lattice": "adaptive" | "triangular" | "square", "spacing_px": 1, "spacing_world": 0,
+///                   "min_lattice_angle_deg": 35 },  (the last four always written; each optional, absent =
+///                                                    "square", 1, 0, 0: files before issue #20)
 ///         "quality_mask": { "margin": 0.1, "force_replace": false, "search_rings": 2 },
-///         "triangulate": { "max_edge_footprints": 3, "max_sampling_angle_deg": 80 },
+///         "triangulate": { "max_edge_footprints": 3, "max_sampling_angle_deg": 80,
+///                          "min_quad_angle_deg": 20 },  (optional: written only when not 0, absent = 0)
 ///         "grid": "regular" | "fishbone",
 ///         "fishbone": {                                    (only with "grid": "fishbone")
 ///             "seed": null | [x,y], "direction": "min" | "max", "h": 4,

@@ -5,8 +5,11 @@
 
 #include "mesh/relax.h"
 
+#include <Eigen/Core>
+
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -45,6 +48,16 @@ void relaxPatch(Patch& patch, const SampleGrid& grid, const Mesh& reference, con
     detail::RelaxOptions options;
     options.iterations = params.relaxIterations;
     detail::relaxOnReference(mesh, reference, vertices, hints, footprints, options, &grid.camera);
+}
+
+// The longest screen edge, in pixels, of the grid triangles of a lattice other than the square pixel
+// lattice (sampleLattice: sample (r, c) at o + c·a + r·b, triangles with the edges a, b, a + b), relative to
+// the square pixel lattice's (√2, its diagonal); 1 for the square lattice and grids of fewer than 2×2.
+double edgeLimitScale(const SampleGrid& grid, Lattice lattice) {
+    if (lattice == Lattice::Square || grid.rows < 2 || grid.cols < 2) return 1.0;
+    const Eigen::Vector2d a = grid.at(0, 1).screen - grid.at(0, 0).screen;
+    const Eigen::Vector2d b = grid.at(1, 1).screen - grid.at(0, 1).screen;
+    return std::max({a.norm(), b.norm(), (a + b).norm()}) / std::sqrt(2.0);
 }
 
 } // namespace
@@ -153,6 +166,12 @@ ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, con
     stages.triangulate = params.triangulate;
     // The edge limit is in pixel footprints; the lattice's edges are `spacing` pixels long.
     stages.triangulate.maxEdgeFootprints *= std::max(1.0, latticeSpacingPixels(params.camera, params.scan));
+    // And no looser than on the pixel lattice relative to the triangles' screen size (issue #20): the
+    // triangular and adaptive lattices' edges are at most 1 px on the screen against the pixel lattice's
+    // √2 px diagonal, so the same limit in footprints let through their triangles stretched 2–3 times more
+    // in depth (across occlusion boundaries and at grazing slants): those made the adaptive lattice's
+    // Hausdorff distance worse than the square lattice's in 9 of 65 views (issue #20 report).
+    stages.triangulate.maxEdgeFootprints *= edgeLimitScale(result.grid, params.scan.lattice);
     MaskedPatch masked = maskAndTriangulate(result.grid, stages, workspace, progress);
     result.patch = std::move(masked.patch);
     result.counts.afterLasso = masked.counts.afterLasso;

@@ -168,17 +168,15 @@ struct Writer {
             {"quality_angle_limit_deg",
              number(p.scan.qualityAngleLimitDeg, f + ".scan.quality_angle_limit_deg")},
             {"max_snap_footprints", number(p.scan.maxSnapFootprints, f + ".scan.max_snap_footprints")}};
-        // The lattice only when it is not the pixel lattice, which files without it mean (issue #20).
-        if (p.scan.lattice != Lattice::Square || p.scan.spacingPixels != 1.0 || p.scan.spacingWorld != 0.0) {
-            j["scan"]["lattice"] = p.scan.lattice == Lattice::Triangular ? "triangular"
-                                   : p.scan.lattice == Lattice::Adaptive ? "adaptive"
-                                                                         : "square";
-            j["scan"]["spacing_px"] = number(p.scan.spacingPixels, f + ".scan.spacing_px");
-            j["scan"]["spacing_world"] = number(p.scan.spacingWorld, f + ".scan.spacing_world");
-        }
-        if (p.scan.minLatticeAngleDeg != 0) // absent: 0, as files written before it (issue #20)
-            j["scan"]["min_lattice_angle_deg"] =
-                number(p.scan.minLatticeAngleDeg, f + ".scan.min_lattice_angle_deg");
+        // The lattice and its mask always (issue #20): files without them mean the pixel lattice without
+        // the mask, which is no longer the default.
+        j["scan"]["lattice"] = p.scan.lattice == Lattice::Triangular ? "triangular"
+                               : p.scan.lattice == Lattice::Adaptive ? "adaptive"
+                                                                     : "square";
+        j["scan"]["spacing_px"] = number(p.scan.spacingPixels, f + ".scan.spacing_px");
+        j["scan"]["spacing_world"] = number(p.scan.spacingWorld, f + ".scan.spacing_world");
+        j["scan"]["min_lattice_angle_deg"] =
+            number(p.scan.minLatticeAngleDeg, f + ".scan.min_lattice_angle_deg");
         j["quality_mask"] = {{"margin", number(p.quality.margin, f + ".quality_mask.margin")},
                              {"force_replace", p.quality.forceReplace},
                              {"search_rings", p.quality.searchRings}};
