@@ -229,6 +229,10 @@ TEST(CliRun, ExampleSessionReplays) {
               j["input_metrics"]["frac_valence6_interior"].get<double>());
     EXPECT_LT(m["hausdorff_to_ref_rel"].get<double>(), 0.01);
     EXPECT_LT(m["hausdorff_from_ref_rel"].get<double>(), 0.01);
+    // Issue 20: round triangles — the whole mesh's mean smallest angle ≥ 50° (55.0° since the session was
+    // recorded on the adaptive lattice; 43.6° on the square pixel lattice), above the input's 43.5°.
+    EXPECT_GE(m["mean_min_angle_deg"].get<double>(), 50.0);
+    EXPECT_GT(m["mean_min_angle_deg"].get<double>(), j["input_metrics"]["mean_min_angle_deg"].get<double>());
 }
 
 } // namespace

@@ -52,6 +52,9 @@ private slots:
         w->view()->setStandardView(fss::StandardView::PosZ);
         QCOMPARE(w->view()->camera().width, 2 * view->width());
         w->scanPanel()->setResolution(300);
+        // One sample per scan pixel (the paper's lattice), so that the patch's sample count measures the
+        // disc's area in scan pixels; the default adaptive lattice puts 1–1/cos θ0 times as many.
+        w->scanPanel()->setLattice(fss::Lattice::Square);
         w->setActiveTool(w->lassoTool());
         // A circle of radius 60 DIP, centred 40 DIP right of the view's centre.
         const QPointF centre(view->width() / 2.0 + 40, view->height() / 2.0);

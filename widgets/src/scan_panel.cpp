@@ -1,6 +1,7 @@
 #include "fss/widgets/scan_panel.h"
 
 #include <QCheckBox>
+#include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QFormLayout>
 #include <QKeyEvent>
@@ -70,6 +71,26 @@ ScanPanel::ScanPanel(QWidget* parent) : QWidget(parent) {
     margin_ = doubleSpin(this, 0, 0.9, 0.1, 0.05, 2);
     margin_->setToolTip(tr("A sample replaces an existing face only when better by this fraction"));
     form->addRow(tr("Quality margin"), margin_);
+    lattice_ = new QComboBox(this);
+    lattice_->setObjectName(QStringLiteral("lattice"));
+    // Item data: the Lattice enumerator.
+    lattice_->addItem(tr("Adaptive"), int(Lattice::Adaptive));
+    lattice_->addItem(tr("Triangular"), int(Lattice::Triangular));
+    lattice_->addItem(tr("Square"), int(Lattice::Square));
+    lattice_->setToolTip(tr("Where a regular scan puts its samples: Adaptive, a triangular lattice chosen "
+                            "per view so that the triangles are equilateral on the surface; Triangular, "
+                            "equilateral on the screen; Square, one sample per pixel (the paper's grid)"));
+    // The panel's width stays what the spin boxes ask for (the view beside it keeps its size).
+    lattice_->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
+    lattice_->setMinimumContentsLength(6);
+    form->addRow(tr("Lattice"), lattice_);
+    minLatticeAngle_ = doubleSpin(this, 0, 59, ScanOptions{}.minLatticeAngleDeg, 1, 0);
+    minLatticeAngle_->setSuffix(QStringLiteral("°"));
+    minLatticeAngle_->setToolTip(
+        tr("Samples whose lattice triangle would have a smaller angle on the surface "
+           "(seen at a slant) are left to another view; 0 = keep them"));
+    form->addRow(tr("Min lattice angle"), minLatticeAngle_);
+    setLattice(ScanOptions{}.lattice);
     force_ = new QCheckBox(tr("Force replace"), this);
     force_->setToolTip(tr("Replace the mesh under the scan whatever its quality"));
     form->addRow(QString(), force_);
@@ -117,6 +138,8 @@ ScanPanel::ScanPanel(QWidget* parent) : QWidget(parent) {
     connect(maxAngle_, &QDoubleSpinBox::valueChanged, this, changed);
     connect(margin_, &QDoubleSpinBox::valueChanged, this, changed);
     connect(force_, &QCheckBox::toggled, this, changed);
+    connect(lattice_, &QComboBox::currentIndexChanged, this, changed);
+    connect(minLatticeAngle_, &QDoubleSpinBox::valueChanged, this, changed);
     connect(spacing_, &QDoubleSpinBox::valueChanged, this, changed);
     connect(fineField_, &QCheckBox::toggled, this, changed);
     refreshEdgeLength();
@@ -240,6 +263,18 @@ double ScanPanel::qualityMargin() const {
 void ScanPanel::setQualityMargin(double margin) {
     margin_->setValue(margin);
 }
+Lattice ScanPanel::lattice() const {
+    return Lattice(lattice_->currentData().toInt());
+}
+void ScanPanel::setLattice(Lattice lattice) {
+    lattice_->setCurrentIndex(lattice_->findData(int(lattice)));
+}
+double ScanPanel::minLatticeAngleDeg() const {
+    return minLatticeAngle_->value();
+}
+void ScanPanel::setMinLatticeAngleDeg(double degrees) {
+    minLatticeAngle_->setValue(degrees);
+}
 bool ScanPanel::forceReplace() const {
     return force_->isChecked();
 }
@@ -284,6 +319,8 @@ ScanParams ScanPanel::scanParams(const Camera& viewCamera) const {
     params.triangulate.maxSamplingAngleDeg = maxSamplingAngleDeg();
     params.quality.margin = qualityMargin();
     params.quality.forceReplace = forceReplace();
+    params.scan.lattice = lattice();
+    params.scan.minLatticeAngleDeg = minLatticeAngleDeg();
     return params;
 }
 

@@ -2,7 +2,8 @@
 /// \file scan_panel.h
 /// ScanPanel: the settings of the next scan — the target edge length in world units or the resolution
 /// (whichever was set last is held as the view changes; the edge length the resolution gives is shown),
-/// erosion / dilation radii, the triangulation and quality thresholds, force-replace, and the fishbone
+/// the sample lattice and its slant mask, erosion / dilation radii, the triangulation and quality
+/// thresholds, force-replace, and the fishbone
 /// grid's spacing — and the scan camera they make from the view's camera.
 
 #include "fss/camera.h"
@@ -15,6 +16,7 @@
 #include <optional>
 
 class QCheckBox;
+class QComboBox;
 class QDoubleSpinBox;
 class QLabel;
 class QSpinBox;
@@ -66,6 +68,14 @@ public:
     /// Quality margin (QualityMaskOptions::margin), [0, 0.9]; default 0.1.
     double qualityMargin() const;
     void setQualityMargin(double margin);
+    /// The sample lattice of regular scans (ScanOptions::lattice); default the core's (Lattice::Adaptive).
+    /// Lattice::Square is the paper's pixel lattice.
+    Lattice lattice() const;
+    void setLattice(Lattice lattice);
+    /// Lattice-angle mask in degrees (ScanOptions::minLatticeAngleDeg, 0 = off), [0, 59]; default the
+    /// core's (35).
+    double minLatticeAngleDeg() const;
+    void setMinLatticeAngleDeg(double degrees);
     /// Keep every sample regardless of the current mesh's quality (QualityMaskOptions::forceReplace).
     bool forceReplace() const;
     void setForceReplace(bool force);
@@ -85,8 +95,8 @@ public:
     QSize scanSize(QSizeF viewSize) const;
     /// The view's camera (as VtkView::camera()) with the scan image size of scanSize().
     Camera scanCamera(const Camera& viewCamera) const;
-    /// The scan parameters for \p viewCamera: scanCamera(), the radii, thresholds and force-replace; no
-    /// lasso (the caller adds it) and scan id −1.
+    /// The scan parameters for \p viewCamera: scanCamera(), the lattice, radii, thresholds and force-replace;
+    /// no lasso (the caller adds it) and scan id −1.
     ScanParams scanParams(const Camera& viewCamera) const;
 
     /// Updates the edge-length line for \p viewCamera, measured at world point \p at (e.g. the centre of
@@ -120,6 +130,8 @@ private:
     QDoubleSpinBox* maxAngle_ = nullptr;
     QDoubleSpinBox* margin_ = nullptr;
     QCheckBox* force_ = nullptr;
+    QComboBox* lattice_ = nullptr;
+    QDoubleSpinBox* minLatticeAngle_ = nullptr;
     QDoubleSpinBox* spacing_ = nullptr;
     QCheckBox* fineField_ = nullptr;
     QLabel* edgeLabel_ = nullptr;
