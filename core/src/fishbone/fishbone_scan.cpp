@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <numeric>
@@ -170,28 +171,19 @@ public:
     /// Whether the segment \p a – \p b crosses a crease segment (proper crossing: each segment's end
     /// points strictly on both sides of the other's line).
     bool crosses(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const {
-        if (!a.allFinite() || !b.allFinite()) return false;
-        auto side = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
-            const double v = (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x();
-            return v > 0 ? 1 : (v < 0 ? -1 : 0);
-        };
-        const int x0 = cellOf(std::min(a.x(), b.x()), cellsX_), x1 = cellOf(std::max(a.x(), b.x()), cellsX_),
-                  y0 = cellOf(std::min(a.y(), b.y()), cellsY_), y1 = cellOf(std::max(a.y(), b.y()), cellsY_);
-        for (int y = y0; y <= y1; ++y)
-            for (int x = x0; x <= x1; ++x)
-                for (std::size_t i : cells_[std::size_t(y) * std::size_t(cellsX_) + std::size_t(x)]) {
-                    const CreaseSegment& s = segments_[i];
-                    if (side(a, b, s.a) * side(a, b, s.b) < 0 && side(s.a, s.b, a) * side(s.a, s.b, b) < 0)
-                        return true;
-                }
-        return false;
+        return crossing(a, b, std::numeric_limits<double>::infinity());
     }
 
     /// Whether the segment \p a – \p b crosses a crease segment at more than 30° (a crease the segment runs
     /// along, such as the one a backbone follows, does not count).
     bool crossesAcross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const {
+        return crossing(a, b, std::cos(30.0 * std::numbers::pi / 180.0));
+    }
+
+    // A proper crossing of \p a – \p b with a crease segment that is not within acos(\p cosAlong) of its
+    // direction (cosAlong = ∞: any crease segment).
+    bool crossing(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double cosAlong) const {
         if (!a.allFinite() || !b.allFinite()) return false;
-        const double cosAlong = std::cos(30.0 * std::numbers::pi / 180.0);
         const Eigen::Vector2d d = b - a;
         auto side = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
             const double v = (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x();
