@@ -244,13 +244,8 @@ bool ComponentStitcher::remeshBand(Local& loc, Plan& plan) {
         }
     };
     in.faceData = [&](FaceIndex to, FaceIndex from) {
-        loc.star.kept[to] = false;
-        loc.quality[to] = loc.quality[from];
-        loc.scanId[to] = loc.scanId[from];
-        loc.patchSide[to] = loc.patchSide[from];
-        loc.planeNormal[to] = loc.planeNormal[from];
-        loc.minAllowed[to] = loc.minAllowed[from];
-        loc.offView[to] = loc.offView[from];
+        copyFace(loc, from, to);
+        loc.star.kept[to] = false; // a face the band made is new
     };
     // Creases: pieces of old faces outside the patch carry their face's plane (reliable even for a
     // sliver piece); other faces their own normal unless they are slivers.
