@@ -398,8 +398,8 @@ TEST_F(BadSessionFile, GoodFileLoads) {
 
 TEST_F(BadSessionFile, WrongFormatOrVersion) {
     Json j = good_;
-    j["version"] = 2;
-    EXPECT_EQ(load(j), ": version is 2, but this FSS reads version 1 only.");
+    j["version"] = 3;
+    EXPECT_EQ(load(j), ": version is 3, but this FSS reads versions 1 to 2 only.");
     j["version"] = "1";
     EXPECT_EQ(load(j), ": version must be a positive integer.");
     j = good_;
@@ -720,14 +720,18 @@ TEST_F(BadSessionFile, LaterStitchOptionsAreOptional) {
     j["events"][0]["step"]["stitch"].erase("peel_trim");
     EXPECT_EQ(stitchOf(j).outsideMinAngleFloorDeg, 0.0);
     EXPECT_FALSE(stitchOf(j).peelTrim);
-    // The band remesh (stitch v2, off by default): absent = off; written only when on, and read back so.
+    // The band remesh (stitch v2, on by default since version 2): absent = on, in a version 1 file too;
+    // written only when off, and read back so.
     EXPECT_FALSE(defaults.contains("remesh_seam"));
-    EXPECT_FALSE(stitchOf(j).remeshSeam);
-    fss::SessionFile on = sampleFile(mesh_);
-    on.events[0].step.stitch.remeshSeam = true;
-    const Json onJson = Json::parse(fss::sessionFileToJson(on));
-    EXPECT_EQ(onJson["events"][0]["step"]["stitch"]["remesh_seam"], true);
-    EXPECT_TRUE(stitchOf(onJson).remeshSeam);
+    EXPECT_TRUE(stitchOf(j).remeshSeam);
+    Json v1 = j;
+    v1["version"] = 1;
+    EXPECT_TRUE(stitchOf(v1).remeshSeam);
+    fss::SessionFile off = sampleFile(mesh_);
+    off.events[0].step.stitch.remeshSeam = false;
+    const Json offJson = Json::parse(fss::sessionFileToJson(off));
+    EXPECT_EQ(offJson["events"][0]["step"]["stitch"]["remesh_seam"], false);
+    EXPECT_FALSE(stitchOf(offJson).remeshSeam);
     // -0.0 is not 0 bit for bit: it is written, and comes back with its sign.
     fss::SessionFile f = sampleFile(mesh_);
     f.events[0].step.stitch.outsideMinAngleFloorDeg = -0.0;

@@ -302,9 +302,22 @@ TEST(Stitch, PatchInsideFlatGrid) {
     auto sid = grid.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId);
     ASSERT_TRUE(sid.second);
     std::size_t scanned = 0;
+    double scannedArea = 0;
     for (auto f : grid.faces())
-        scanned += sid.first[f] == 1;
-    EXPECT_GE(scanned, patch.number_of_faces());
+        if (sid.first[f] == 1) {
+            ++scanned;
+            scannedArea += PMP::face_area(f, grid);
+        }
+    // The faces with the scan id cover the patch: its interior as it was (above), and about its area. Not
+    // its face count: the seam band remesh (on by default, DESIGN.md §6.2) remeshes the patch's outer two
+    // rings towards the size graded to the grid's edges (fewer, larger faces: measured 2064 faces with the
+    // scan id for 2170 patch faces; version 1 only added pieces, so it had more). The band's faces take the
+    // label of the draft face under their centroid, so the scanned area stays (measured ratio: see below).
+    EXPECT_GE(scanned, interior);
+    const double ratio = scannedArea / PMP::area(patch);
+    std::printf("flat grid: %zu faces with the scan id for %zu patch faces, area ratio %.4f\n", scanned,
+                std::size_t(patch.number_of_faces()), ratio);
+    EXPECT_NEAR(ratio, 1.0, 0.02);
     EXPECT_GT(r.seamEdges, 100u);
     EXPECT_GT(r.seamMinAngleDeg, 0.0);
     std::printf("flat grid: %s\n", reportText(r).c_str());

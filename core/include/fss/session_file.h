@@ -47,8 +47,9 @@
 ///                     "collect_garbage": false, "peel_trim": true (optional: written only when true,
 ///                     absent = false), "outside_min_angle_floor_deg": 10 (optional: written only when
 ///                     not 0, absent = 0), "refill_seam": true (optional: written only when true,
-///                     absent = false; stitch v2's seam refill, DESIGN.md §6.2), "remesh_seam": true
-///                     (optional: written only when true, absent = false; stitch v2's band remesh) } } },
+///                     absent = false; stitch v2's seam refill, DESIGN.md §6.2), "remesh_seam": false
+///                     (optional: written only when false, absent = true, in version 1 files too; stitch
+///                     v2's band remesh) } } },
 ///     { "kind": "undo" }, { "kind": "redo" } ] }
 /// STREAMLINE = { "step": 0.25, "min_step": 0.015625, "max_length": null (unbounded) | L,
 ///                "min_anisotropy": 0.05,
@@ -73,8 +74,10 @@
 
 namespace fss {
 
-/// The session file format version this FSS writes and reads.
-inline constexpr int kSessionFileVersion = 1;
+/// The session file format version this FSS writes; it reads versions 1 to this. Version 2 (issue 19): the
+/// stitch's seam band remesh is on by default ("remesh_seam" absent = on, written only when off); version 1
+/// files load and replay with it, so their results differ from the ones they were recorded with.
+inline constexpr int kSessionFileVersion = 2;
 
 /// A session file in memory.
 struct SessionFile {

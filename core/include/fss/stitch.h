@@ -50,10 +50,9 @@ struct StitchOptions {
     /// the glued surface: splits, collapses and flips towards the local edge length (graded from the patch's
     /// to the mesh's) and valence 6, tangential relaxation with projection; the band's border and creases
     /// stay. Where the band comes out worse than version 1 left it (smallest angle) or fails the checks,
-    /// version 1's result is used. Off by default for now: better than version 1 on every untuned mesh
-    /// measured (DESIGN.md §6.2), but the tests whose figures it changes are not re-derived yet (issue 19).
-    /// Session files write it only when on ("remesh_seam": true).
-    bool remeshSeam = false;
+    /// version 1's result is used. On by default (issue 19): better than version 1 on every untuned mesh
+    /// measured (DESIGN.md §6.2). Session files (version 2) write it only when off ("remesh_seam": false).
+    bool remeshSeam = true;
     /// Seam edges shorter than this × the patch's median edge length are collapsed. The same fraction of
     /// the local patch edge length (in pixels) is the distance within which a patch boundary vertex is
     /// snapped onto a mesh vertex or edge, and a mesh vertex onto a patch boundary edge.

@@ -146,7 +146,8 @@ struct Writer {
         j["collect_garbage"] = s.collectGarbage;
         if (s.peelTrim) j["peel_trim"] = true;     // written only when on: older files stay byte-identical
         if (s.refillSeam) j["refill_seam"] = true; // written only when on: older files stay byte-identical
-        if (s.remeshSeam) j["remesh_seam"] = true; // written only when on: older files stay byte-identical
+        // The band remesh is on by default since version 2 (issue 19): written only when off.
+        if (!s.remeshSeam) j["remesh_seam"] = false;
         // Written only when not 0 (+0.0; -0.0 is written to keep the bits): older files, recorded with 0,
         // stay byte-identical.
         if (std::bit_cast<std::uint64_t>(s.outsideMinAngleFloorDeg) != 0)
@@ -508,7 +509,8 @@ StitchOptions readStitch(const Node& n) {
     // Optional, absent in files written before they were stored: what those files were recorded with.
     s.peelTrim = n.has("peel_trim") && n.at("peel_trim").boolean();
     s.refillSeam = n.has("refill_seam") && n.at("refill_seam").boolean();
-    s.remeshSeam = n.has("remesh_seam") && n.at("remesh_seam").boolean();
+    // Absent = on, in version 1 files too: they load and replay with the new stitch (README, DESIGN.md §7).
+    s.remeshSeam = !n.has("remesh_seam") || n.at("remesh_seam").boolean();
     s.outsideMinAngleFloorDeg =
         n.has("outside_min_angle_floor_deg") ? n.at("outside_min_angle_floor_deg").number() : 0.0;
     validated(n, [&] { s.validate(); });
@@ -671,8 +673,8 @@ SessionFile sessionFileFromJson(const std::string& text, const std::string& name
     if (root.at("format").string() != kFormatName)
         root.at("format").fail("must be \"fss-session\" (this is not an FSS session file)");
     const std::int64_t version = root.at("version").integer(1, kIntMax, "a positive integer");
-    if (version != kSessionFileVersion)
-        root.at("version").fail("is " + std::to_string(version) + ", but this FSS reads version " +
+    if (version > kSessionFileVersion)
+        root.at("version").fail("is " + std::to_string(version) + ", but this FSS reads versions 1 to " +
                                 std::to_string(kSessionFileVersion) + " only");
     root.onlyKeys({"format", "version", "description", "mesh", "renderer", "curvature", "events"});
 

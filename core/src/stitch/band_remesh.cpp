@@ -38,20 +38,24 @@ void BandRemesher::setup() {
     // Crease corners and ends stay (a vertex with other than two crease edges).
     for (const auto& [v, d] : creaseDeg_)
         if (d != 2) at(fixed_, std::size_t(v), char(1)) = 1;
+    buildCreaseChains();
     // The reference: a copy of the band (the draft surface), and each band vertex's face on it.
     std::unordered_map<std::uint32_t, VertexIndex> toRef;
     for (VertexIndex v : verts)
         toRef[std::uint32_t(v)] = ref_.add_vertex(S_.point(v));
-    for (FaceIndex f : bandList_) {
+    for (std::size_t i = 0; i < bandList_.size(); ++i) {
+        const FaceIndex f = bandList_[i];
         std::array<VertexIndex, 3> r;
         int k = 0;
         for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
             r[std::size_t(k++)] = toRef.at(std::uint32_t(v));
         const FaceIndex g = ref_.add_face(r[0], r[1], r[2]);
         if (g == Mesh::null_face()) continue; // cannot happen for faces of one manifold mesh
+        at(refOrigin_, std::size_t(g), std::size_t(-1)) = i;
         for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
             at(hint_, std::size_t(v), Mesh::null_face()) = g;
     }
+    smoothNormals();
     // Sizes: on the border the mean length of the border edges there (the patch's edges on one side,
     // the old mesh's on the other), inside graded between them by Jacobi smoothing (a discrete harmonic
     // interpolation; the band is a few rings wide, so a few sweeps suffice).
@@ -138,10 +142,11 @@ void BandRemesher::improvePass() {
                     detail::unitNormal(detail::pos(ref_, ref_.source(sh)), detail::pos(ref_, ref_.target(sh)),
                                        detail::pos(ref_, ref_.target(ref_.next(sh))));
                 if (n.dot(n0) < creaseCos) continue;
-                const double a = starMinAngle(v, sp.point);
-                if (a > best + 1e-9 && starAcceptable(v, sp.point, maxTurn)) {
+                const V3 lifted = smoothPoint(sp.face, sp.point);
+                const double a = starMinAngle(v, lifted);
+                if (a > best + 1e-9 && starAcceptable(v, lifted, maxTurn)) {
                     best = a;
-                    bestP = sp.point;
+                    bestP = lifted;
                     bestFace = sp.face;
                 }
             }

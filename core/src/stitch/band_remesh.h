@@ -55,6 +55,9 @@ struct BandRemeshInput {
     /// New faces the view does not see (pieces of old faces): they keep their own orientation (the normal
     /// bound against their creaseNormal) instead of facing the camera.
     std::function<bool(FaceIndex)> unseen;
+    /// Called once, after the growth and before any edit, with the band's faces as they are then (the draft);
+    /// BandRemeshReport::origin refers to this list.
+    std::function<void(const std::vector<FaceIndex>&)> draft;
     double growBelowDeg = 30.0;
     int maxGrowRounds = 6;
     double edgeLength = 0;          ///< initial target edge length inside the band (world units), > 0
@@ -66,7 +69,11 @@ struct BandRemeshInput {
 
 /// What the stage did.
 struct BandRemeshReport {
-    std::vector<FaceIndex> faces;     ///< the band's faces afterwards
+    std::vector<FaceIndex> faces; ///< the band's faces afterwards
+    /// Per face of `faces`: the index (in the list given to BandRemeshInput::draft) of the draft face under
+    /// its centroid (the closest point on the draft), or SIZE_MAX when none was found. Labels that say where
+    /// a face lies (a patch's scan id) follow the surface this way, not the split history (faceData).
+    std::vector<std::size_t> origin;
     std::vector<VertexIndex> touched; ///< vertices created or moved (live at the end)
     std::size_t splits = 0, collapses = 0, flips = 0, moves = 0;
     std::size_t repairs = 0; ///< flips, collapses and splits of the last repair of faces below the aim

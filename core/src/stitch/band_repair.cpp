@@ -100,7 +100,7 @@ bool BandRemesher::repairPass() {
     bool changed = false;
     for (const auto& [angle, f] : bad) {
         if (S_.is_removed(f) || !inBand(f) || faceMinAngle(f) >= aim) continue;
-        if (repairFlip(f) || repairCollapse(f) || repairCap(f)) {
+        if (repairFlip(f) || repairCollapse(f) || repairCap(f) || (!stageOff("split") && repairSplit(f))) {
             changed = true;
             ++report_.repairs;
         }
@@ -117,6 +117,7 @@ bool BandRemesher::repairFlip(FaceIndex f) {
         const FaceIndex g = S_.face(S_.opposite(h));
         if (unseen(f) != unseen(g)) continue;
         const VertexIndex c = S_.target(S_.next(h)), d = S_.target(S_.next(S_.opposite(h)));
+        if (!valenceOk(a, -1) || !valenceOk(b, -1) || !valenceOk(c, 1) || !valenceOk(d, 1)) continue;
         const V3 pa = detail::pos(S_, a), pb = detail::pos(S_, b), pc = detail::pos(S_, c),
                  pd = detail::pos(S_, d);
         const double oldMin = std::min(before, faceMinAngle(g));
@@ -171,49 +172,6 @@ bool BandRemesher::repairCap(FaceIndex f) {
     const bool ok = split(opposite);
     minSplitGain_ = 0;
     return ok;
-}
-
-void BandRemesher::slidePass() {
-    const double aim = in_.minAngleDeg * kBandDeg, maxTurn = in_.maxNormalTurnDeg * kBandDeg;
-    std::vector<VertexIndex> verts;
-    std::unordered_set<std::uint32_t> seen;
-    for (std::size_t f = 0; f < band_.size(); ++f) {
-        const FaceIndex g(static_cast<std::uint32_t>(f));
-        if (!band_[f] || S_.is_removed(g) || faceMinAngle(g) >= aim) continue;
-        for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_))
-            if (!isFixed(v) && creaseDegree(v) == 2 && wholeStarInBand(v) &&
-                seen.insert(std::uint32_t(v)).second)
-                verts.push_back(v);
-    }
-    std::sort(verts.begin(), verts.end());
-    for (VertexIndex v : verts) {
-        std::vector<VertexIndex> ends;
-        for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(v), S_))
-            if (isCrease(v, w)) ends.push_back(w);
-        if (ends.size() != 2) continue;
-        const V3 p = detail::pos(S_, v), e0 = detail::pos(S_, ends[0]), e1 = detail::pos(S_, ends[1]);
-        if (detail::angleBetween(p - e0, e1 - p) > kSlideCreaseDeg * kBandDeg) continue;
-        double best = starMinAngle(v, p);
-        V3 bestP = p;
-        for (const V3& e : {e0, e1})
-            for (double t : {0.1, 0.2, 0.3, 0.4}) {
-                const V3 q = p + t * (e - p);
-                const double a = starMinAngle(v, q);
-                if (a > best + 1e-9 && starAcceptable(v, q, maxTurn)) {
-                    best = a;
-                    bestP = q;
-                }
-            }
-        if (bestP == p) continue;
-        S_.point(v) = Point3(bestP.x(), bestP.y(), bestP.z());
-        const FaceIndex hint = at(hint_, std::size_t(v), Mesh::null_face());
-        if (hint != Mesh::null_face()) {
-            const SurfacePoint sp = closestPointNear(ref_, bestP, hint, LocalSearchOptions{.rings = 2});
-            if (sp) hint_[std::size_t(v)] = sp.face;
-        }
-        touch(v);
-        ++report_.moves;
-    }
 }
 
 } // namespace fss::stitch::band

@@ -1,0 +1,300 @@
+// Stitch v2, design B: the band's creases as polylines of the draft, and the operations on crease vertices
+// that use them (band_remesher.h): splits of crease edges and slides of crease vertices put the vertex on
+// the draft's crease line (the crease of the surface the band is remeshed on), not on a chord of it, so
+// crease vertices may move along curved creases too; and the repair split of faces below the aim whose
+// corners cannot move (faces between two creases or at a crease corner, DESIGN.md §6.2).
+#include "stitch/band_remesher.h"
+
+namespace fss::stitch::band {
+
+void BandRemesher::buildCreaseChains() {
+    // Crease graph over S_'s vertices (at setup S_'s band is the draft, ref_ its copy).
+    std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> adj;
+    for (std::uint64_t k : crease_) {
+        const auto a = std::uint32_t(k >> 32), b = std::uint32_t(k & 0xffffffffu);
+        adj[a].push_back(b);
+        adj[b].push_back(a);
+    }
+    std::vector<std::uint32_t> starts;
+    for (auto& [v, n] : adj) {
+        std::sort(n.begin(), n.end());
+        starts.push_back(v);
+    }
+    std::sort(starts.begin(), starts.end()); // deterministic chains
+    std::unordered_set<std::uint64_t> used;
+    auto walk = [&](std::uint32_t from, std::uint32_t next) {
+        const int chain = int(chainPts_.size());
+        std::vector<V3> pts{detail::pos(S_, VertexIndex(from))};
+        std::vector<double> arc{0.0};
+        creasePos_[from].push_back({chain, 0.0});
+        std::uint32_t prev = from, cur = next;
+        used.insert(bandKey(VertexIndex(prev), VertexIndex(cur)));
+        for (;;) {
+            const V3 p = detail::pos(S_, VertexIndex(cur));
+            arc.push_back(arc.back() + (p - pts.back()).norm());
+            pts.push_back(p);
+            creasePos_[cur].push_back({chain, arc.back()});
+            const auto& n = adj[cur];
+            if (n.size() != 2 || cur == from) break;
+            const std::uint32_t after = n[0] == prev ? n[1] : n[0];
+            if (!used.insert(bandKey(VertexIndex(cur), VertexIndex(after))).second) break;
+            prev = cur;
+            cur = after;
+        }
+        chainPts_.push_back(std::move(pts));
+        chainArc_.push_back(std::move(arc));
+    };
+    // Open chains from their ends and corners (other than two crease edges), then the closed loops.
+    for (int pass = 0; pass < 2; ++pass)
+        for (std::uint32_t v : starts) {
+            if (pass == 0 && adj[v].size() == 2) continue;
+            for (std::uint32_t w : adj[v])
+                if (!used.count(bandKey(VertexIndex(v), VertexIndex(w)))) walk(v, w);
+        }
+}
+
+void BandRemesher::smoothNormals() {
+    const double creaseCos = std::cos(in_.creaseAngleDeg * kBandDeg);
+    cornerNormal_.assign(ref_.num_halfedges(), V3(0, 0, 0));
+    auto area = [&](FaceIndex g) {
+        const HalfedgeIndex h = ref_.halfedge(g);
+        const V3 a = detail::pos(ref_, ref_.source(h));
+        return V3(
+            (detail::pos(ref_, ref_.target(h)) - a).cross(detail::pos(ref_, ref_.target(ref_.next(h))) - a));
+    };
+    auto reliable = [&](FaceIndex g) {
+        const HalfedgeIndex h = ref_.halfedge(g);
+        return detail::minAngle(detail::pos(ref_, ref_.source(h)), detail::pos(ref_, ref_.target(h)),
+                                detail::pos(ref_, ref_.target(ref_.next(h)))) >= kSliverDeg * kBandDeg;
+    };
+    for (FaceIndex f : ref_.faces()) {
+        const V3 nf = area(f).normalized();
+        const bool fReliable = reliable(f);
+        for (HalfedgeIndex h : CGAL::halfedges_around_face(ref_.halfedge(f), ref_)) {
+            // The faces around the corner on f's side of any crease (a sliver's own normal says nothing:
+            // then all faces around, unless they span a crease, when the corner keeps f's plane).
+            V3 sum(0, 0, 0), all(0, 0, 0);
+            bool spansCrease = false;
+            V3 first(0, 0, 0);
+            for (HalfedgeIndex g : CGAL::halfedges_around_target(h, ref_)) {
+                if (ref_.is_border(g)) continue;
+                const V3 ag = area(ref_.face(g));
+                if (!(ag.squaredNorm() > 0)) continue;
+                const V3 ng = ag.normalized();
+                all += ag;
+                if (reliable(ref_.face(g))) {
+                    if (first.squaredNorm() == 0) first = ng;
+                    spansCrease = spansCrease || ng.dot(first) < creaseCos;
+                }
+                if (fReliable && ng.dot(nf) >= creaseCos) sum += ag;
+            }
+            const V3 n = fReliable ? sum : (spansCrease ? nf : all);
+            cornerNormal_[std::size_t(h)] = n.squaredNorm() > 0 ? V3(n.normalized()) : nf;
+        }
+    }
+}
+
+V3 BandRemesher::smoothPoint(FaceIndex refFace, const V3& p) const {
+    if (stageOff("smooth") || refFace == Mesh::null_face()) return p;
+    const HalfedgeIndex h0 = ref_.halfedge(refFace);
+    const std::array<HalfedgeIndex, 3> h{h0, ref_.next(h0), ref_.next(ref_.next(h0))};
+    std::array<V3, 3> x, n;
+    for (std::size_t i = 0; i < 3; ++i) {
+        x[i] = detail::pos(ref_, ref_.target(h[i]));
+        n[i] = cornerNormal_[std::size_t(h[i])];
+        if (!(n[i].squaredNorm() > 0)) return p;
+    }
+    // Barycentric coordinates of p (on the face) by sub-areas, clamped into the face.
+    const V3 nf = (x[1] - x[0]).cross(x[2] - x[0]);
+    const double A = nf.squaredNorm();
+    if (!(A > 0)) return p;
+    std::array<double, 3> w{(x[2] - x[1]).cross(p - x[1]).dot(nf) / A,
+                            (x[0] - x[2]).cross(p - x[2]).dot(nf) / A, 0.0};
+    w[0] = std::max(0.0, w[0]);
+    w[1] = std::max(0.0, w[1]);
+    w[2] = std::max(0.0, 1.0 - w[0] - w[1]);
+    const double sum = w[0] + w[1] + w[2];
+    V3 lin(0, 0, 0), star(0, 0, 0);
+    for (std::size_t i = 0; i < 3; ++i)
+        lin += w[i] / sum * x[i];
+    for (std::size_t i = 0; i < 3; ++i)
+        star += w[i] / sum * (lin - (lin - x[i]).dot(n[i]) * n[i]);
+    return 0.5 * (lin + star);
+}
+
+void BandRemesher::findOrigins() {
+    report_.origin.clear();
+    for (FaceIndex f : report_.faces) {
+        const HalfedgeIndex h = S_.halfedge(f);
+        const V3 c = (detail::pos(S_, S_.source(h)) + detail::pos(S_, S_.target(h)) +
+                      detail::pos(S_, S_.target(S_.next(h)))) /
+                     3.0;
+        std::size_t o = std::size_t(-1);
+        for (VertexIndex v : CGAL::vertices_around_face(h, S_)) {
+            const FaceIndex hint = at(hint_, std::size_t(v), Mesh::null_face());
+            if (hint == Mesh::null_face()) continue;
+            const SurfacePoint sp = closestPointNear(ref_, c, hint, LocalSearchOptions{.rings = 2});
+            if (sp && std::size_t(sp.face) < refOrigin_.size()) o = refOrigin_[std::size_t(sp.face)];
+            break;
+        }
+        report_.origin.push_back(o);
+    }
+}
+
+void BandRemesher::liftRelaxed(const std::vector<VertexIndex>& verts, const std::vector<V3>& before) {
+    const double maxTurn = in_.maxNormalTurnDeg * kBandDeg;
+    for (std::size_t k = 0; k < verts.size(); ++k) {
+        const VertexIndex v = verts[k];
+        const V3 p = detail::pos(S_, v);
+        if (p == before[k]) continue;
+        const V3 q = smoothPoint(hint_[std::size_t(v)], p);
+        // Where the lift would turn or flatten the star (it moves the vertex along the normal by about the
+        // chord's sag), the relaxed place on the draft stays.
+        if (q == p || !starAcceptable(v, q, maxTurn) ||
+            starMinAngle(v, q) < starMinAngle(v, p) - 0.5 * kBandDeg)
+            continue;
+        S_.point(v) = Point3(q.x(), q.y(), q.z());
+    }
+}
+
+V3 BandRemesher::creasePoint(int chain, double s) const {
+    const auto& arc = chainArc_[std::size_t(chain)];
+    const auto& pts = chainPts_[std::size_t(chain)];
+    if (s <= 0) return pts.front();
+    if (s >= arc.back()) return pts.back();
+    const std::size_t i = std::size_t(std::upper_bound(arc.begin(), arc.end(), s) - arc.begin());
+    const double len = arc[i] - arc[i - 1];
+    const double t = len > 0 ? (s - arc[i - 1]) / len : 0.0;
+    return pts[i - 1] + t * (pts[i] - pts[i - 1]);
+}
+
+CreasePos BandRemesher::creaseBetween(VertexIndex a, VertexIndex b, double t, V3& q) const {
+    const auto ia = creasePos_.find(std::uint32_t(a)), ib = creasePos_.find(std::uint32_t(b));
+    if (ia == creasePos_.end() || ib == creasePos_.end()) return {};
+    // Their common chain, the nearest pair of places (a corner or a loop's start has several).
+    CreasePos best;
+    double bestGap = std::numeric_limits<double>::infinity(), sa = 0, sb = 0;
+    for (const CreasePos& x : ia->second)
+        for (const CreasePos& y : ib->second)
+            if (x.chain == y.chain && std::abs(x.s - y.s) < bestGap) {
+                bestGap = std::abs(x.s - y.s);
+                best.chain = x.chain;
+                sa = x.s;
+                sb = y.s;
+            }
+    if (best.chain < 0) return {};
+    // The polyline between them must be about as long as the edge (the same stretch of crease, not the
+    // way round a loop or along another crease).
+    const double edge = (detail::pos(S_, a) - detail::pos(S_, b)).norm();
+    if (!(bestGap <= 1.5 * edge + 1e-12)) return {};
+    best.s = sa + t * (sb - sa);
+    q = creasePoint(best.chain, best.s);
+    return best;
+}
+
+bool BandRemesher::creaseCollapseKeepsLine(VertexIndex from, VertexIndex to, VertexIndex other) const {
+    const V3 pf = detail::pos(S_, from), pt = detail::pos(S_, to), po = detail::pos(S_, other);
+    if (!stageOff("lift")) {
+        // On the draft's polyline: every point of it between `to` and `other` near the new edge.
+        V3 dummy;
+        const CreasePos x = creaseBetween(to, from, 0.0, dummy), y = creaseBetween(from, other, 1.0, dummy);
+        if (x.chain >= 0 && x.chain == y.chain) {
+            const auto& arc = chainArc_[std::size_t(x.chain)];
+            const auto& pts = chainPts_[std::size_t(x.chain)];
+            const double lo = std::min(x.s, y.s), hi = std::max(x.s, y.s);
+            const V3 d = po - pt;
+            const double len2 = d.squaredNorm();
+            if (!(len2 > 0)) return false;
+            double dev = 0;
+            for (std::size_t i = 0; i < pts.size(); ++i) {
+                if (arc[i] < lo || arc[i] > hi) continue;
+                const double u = std::clamp((pts[i] - pt).dot(d) / len2, 0.0, 1.0);
+                dev = std::max(dev, (pts[i] - (pt + u * d)).norm());
+            }
+            dev = std::max(dev, (pf - (pt + std::clamp((pf - pt).dot(d) / len2, 0.0, 1.0) * d)).norm());
+            return dev <= kCreaseChordDev * std::sqrt(len2);
+        }
+    }
+    return detail::angleBetween(pf - pt, po - pf) <= kStraightCreaseDeg * kBandDeg;
+}
+
+bool BandRemesher::repairSplit(FaceIndex f) {
+    // Only where the face's corners cannot be moved by the other repairs: crease vertices or held ones.
+    for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
+        if (!isFixed(v) && creaseDegree(v) == 0 && wholeStarInBand(v)) return false;
+    HalfedgeIndex bestH = Mesh::null_halfedge();
+    double bestT = 0.5, bestMin = -1;
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
+        if (!interiorEdge(h)) continue;
+        const double oldMin = std::min(faceMinAngle(f), faceMinAngle(S_.face(S_.opposite(h))));
+        for (double t : {0.5, 1.0 / 3.0, 2.0 / 3.0, 0.25, 0.75}) {
+            const SplitPoint sp = splitPoint(h, t);
+            const double m = splitMinAngle(h, sp.q);
+            if (m > oldMin + 0.5 * kBandDeg && m > bestMin) {
+                bestMin = m;
+                bestH = h;
+                bestT = t;
+            }
+        }
+    }
+    if (bestH == Mesh::null_halfedge()) return false;
+    minSplitGain_ = 1.0 + 1e-6;
+    const bool ok = split(bestH, bestT);
+    minSplitGain_ = 0;
+    return ok;
+}
+
+void BandRemesher::slidePass() {
+    const double aim = in_.minAngleDeg * kBandDeg, maxTurn = in_.maxNormalTurnDeg * kBandDeg;
+    std::vector<VertexIndex> verts;
+    std::unordered_set<std::uint32_t> seen;
+    for (std::size_t f = 0; f < band_.size(); ++f) {
+        const FaceIndex g(static_cast<std::uint32_t>(f));
+        if (!band_[f] || S_.is_removed(g) || faceMinAngle(g) >= aim) continue;
+        for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_))
+            if (!isFixed(v) && creaseDegree(v) == 2 && wholeStarInBand(v) &&
+                seen.insert(std::uint32_t(v)).second)
+                verts.push_back(v);
+    }
+    std::sort(verts.begin(), verts.end());
+    for (VertexIndex v : verts) {
+        std::vector<VertexIndex> ends;
+        for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(v), S_))
+            if (isCrease(v, w)) ends.push_back(w);
+        if (ends.size() != 2) continue;
+        const V3 p = detail::pos(S_, v), e0 = detail::pos(S_, ends[0]), e1 = detail::pos(S_, ends[1]);
+        // Along the draft's crease polyline where v has a place on it (a curved crease too); else along a
+        // nearly straight crease's chords.
+        const bool straight = detail::angleBetween(p - e0, e1 - p) <= kSlideCreaseDeg * kBandDeg;
+        double best = starMinAngle(v, p);
+        V3 bestP = p;
+        CreasePos bestPos;
+        for (VertexIndex e : ends)
+            for (double t : {0.1, 0.2, 0.3, 0.4}) {
+                V3 q = p + t * (detail::pos(S_, e) - p);
+                const CreasePos cp = stageOff("lift") ? CreasePos{} : creaseBetween(v, e, t, q);
+                if (cp.chain < 0 && !straight) continue;
+                const double a = starMinAngle(v, q);
+                if (a > best + 1e-9 && starAcceptable(v, q, maxTurn)) {
+                    best = a;
+                    bestP = q;
+                    bestPos = cp;
+                }
+            }
+        if (bestP == p) continue;
+        S_.point(v) = Point3(bestP.x(), bestP.y(), bestP.z());
+        if (bestPos.chain >= 0)
+            creasePos_[std::uint32_t(v)] = {bestPos};
+        else
+            creasePos_.erase(std::uint32_t(v));
+        const FaceIndex hint = at(hint_, std::size_t(v), Mesh::null_face());
+        if (hint != Mesh::null_face()) {
+            const SurfacePoint sp = closestPointNear(ref_, bestP, hint, LocalSearchOptions{.rings = 2});
+            if (sp) hint_[std::size_t(v)] = sp.face;
+        }
+        touch(v);
+        ++report_.moves;
+    }
+}
+
+} // namespace fss::stitch::band
