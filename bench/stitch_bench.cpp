@@ -9,6 +9,8 @@
 // time
 //                     in the counter wall_ms); copying the mesh before each stitch is not timed.
 //                     Counters: patch_faces, faces_removed, faces_added, seam_edges.
+// FSS_STITCH_REMESH=1 (0) turns the seam band remesh on (off), FSS_STITCH_CORE_BYPASS=0 the
+// core bypass off (DESIGN.md §6.1), FSS_STITCH_PROFILE=1 prints the stages' CPU time per stitch.
 // BM_Scan/faces:N     scanPatch of the same view and lasso on the sphere of N faces: time = CPU time of the
 //                     calling thread, wall_ms = wall time including the GL driver's own threads.
 // After the runs the program prints stitch(1M) / stitch(10k) and stitch / scan per size.
@@ -27,9 +29,11 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <map>
 #include <memory>
+#include <string>
 
 namespace {
 
@@ -111,6 +115,13 @@ Scene& sceneWith(int faces) {
     return *s;
 }
 
+// FSS_STITCH_REMESH=1 / 0: the seam band remesh on / off (StitchOptions::remeshSeam; unset: the default).
+fss::StitchOptions stitchOptions() {
+    fss::StitchOptions o;
+    if (const char* e = std::getenv("FSS_STITCH_REMESH")) o.remeshSeam = std::string(e) == "1";
+    return o;
+}
+
 std::map<int, double> stitchMs, stitchWallMs, scanMs, scanCpuMs;
 
 void BM_Stitch(benchmark::State& state) {
@@ -131,7 +142,7 @@ void BM_Stitch(benchmark::State& state) {
         }
         const auto t = Clock::now();
         const double c0 = threadCpuSeconds();
-        report = fss::stitchPatch(current, patch.mesh, scene.camera, {}, scene.ids);
+        report = fss::stitchPatch(current, patch.mesh, scene.camera, stitchOptions(), scene.ids);
         const double cpu = threadCpuSeconds() - c0;
         wall += std::chrono::duration<double>(Clock::now() - t).count();
         // The machine is shared: CPU time of this thread is the stable figure (stitching is single-threaded).

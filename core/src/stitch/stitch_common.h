@@ -379,6 +379,13 @@ struct Plan {
     std::vector<std::array<PlanVertex, 3>> faces; // new faces, added in this order
     std::vector<float> quality;
     std::vector<std::int32_t> scanId;
+    // The patch's core (faces deep inside the component, added after `faces` straight into the hole they
+    // leave, without the local mesh: DESIGN.md §6.1 "Core bypass"): corners, and for every face the bit k
+    // set when its edge k → k+1 lies on the core's border (the face beyond it is one of `faces`).
+    std::vector<std::array<PlanVertex, 3>> coreFaces;
+    std::vector<std::uint8_t> coreBorder;
+    std::vector<float> coreQuality;
+    std::vector<std::int32_t> coreScanId;
     std::size_t seamEdges = 0;
     double seamLength = 0;
     std::vector<double> seamFaceMinAngles; // degrees, one per face touching the seam
@@ -392,6 +399,65 @@ struct Attempt {
     std::vector<int> bad; // patch vertices near the problem: trim there and retry
     Plan plan;
 };
+
+// Adds the plan's core faces (after its other faces: their border is then a set of border halfedges of m,
+// each the core border edge of one core face) by linking halfedges directly, not through add_face: the
+// core is a piece of the scan's grid, valid and oriented by construction, and the stitcher checked that
+// the hole its border leaves is exactly the core's border (validate), so nothing here can fail half-way
+// except on an internal error (false, as replay). onFace gets indices after plan.faces.
+template <class VertexOf, class OnFace>
+inline bool fillCore(Mesh& m, const Plan& plan, const std::vector<VertexIndex>& fresh,
+                     const VertexOf& vertexOf, const OnFace& onFace) {
+    if (plan.coreFaces.empty()) return true;
+    auto vertex = [&](const PlanVertex& pv) {
+        return pv.fresh ? fresh[pv.index] : vertexOf(VertexIndex(pv.index));
+    };
+    // Core border: the border halfedges of m there (checked first, before any edit).
+    std::vector<HalfedgeIndex> border;
+    for (std::size_t i = 0; i < plan.coreFaces.size(); ++i)
+        for (int k = 0; k < 3; ++k)
+            if (plan.coreBorder[i] & (1u << k)) {
+                const HalfedgeIndex h = m.halfedge(vertex(plan.coreFaces[i][std::size_t(k)]),
+                                                   vertex(plan.coreFaces[i][std::size_t((k + 1) % 3)]));
+                if (h == Mesh::null_halfedge() || !m.is_border(h)) return false;
+                border.push_back(h);
+            }
+    std::size_t nextBorder = 0;
+    // Inner edges: the halfedge x → y made with the first face that uses the edge (y → x then waits).
+    IndexMap<HalfedgeIndex, std::uint64_t> waiting;
+    for (std::size_t i = 0; i < plan.coreFaces.size(); ++i) {
+        std::array<VertexIndex, 3> vs;
+        for (int k = 0; k < 3; ++k)
+            vs[std::size_t(k)] = vertex(plan.coreFaces[i][std::size_t(k)]);
+        std::array<HalfedgeIndex, 3> hs;
+        for (int k = 0; k < 3; ++k) {
+            const VertexIndex x = vs[std::size_t(k)], y = vs[std::size_t((k + 1) % 3)];
+            if (plan.coreBorder[i] & (1u << k)) {
+                hs[std::size_t(k)] = border[nextBorder++];
+                continue;
+            }
+            const std::uint64_t key = (std::uint64_t(std::uint32_t(x)) << 32) | std::uint32_t(y);
+            const HalfedgeIndex* h = waiting.find(key);
+            if (h) {
+                hs[std::size_t(k)] = *h;
+            } else {
+                hs[std::size_t(k)] = m.add_edge(x, y); // x → y; its opposite y → x for the face beyond
+                waiting[(std::uint64_t(std::uint32_t(y)) << 32) | std::uint32_t(x)] =
+                    m.opposite(hs[std::size_t(k)]);
+            }
+        }
+        const FaceIndex f = m.add_face();
+        for (int k = 0; k < 3; ++k) {
+            const HalfedgeIndex h = hs[std::size_t(k)];
+            m.set_face(h, f);
+            m.set_next(h, hs[std::size_t((k + 1) % 3)]);
+            m.set_halfedge(m.target(h), h); // every core vertex is interior once the core is in
+        }
+        m.set_halfedge(f, hs[0]);
+        onFace(plan.faces.size() + i, f);
+    }
+    return true;
+}
 
 // Applies the edits of a plan to a mesh whose vertices are addressed through `vertexOf` (current
 // vertices → vertices of m) and whose faces through `faceOf`. Returns false when a face cannot be added.
@@ -417,7 +483,7 @@ inline bool replay(Mesh& m, const Plan& plan, const VertexOf& vertexOf, const Fa
         if (f == Mesh::null_face()) return false;
         onFace(i, f);
     }
-    return true;
+    return fillCore(m, plan, fresh, vertexOf, onFace);
 }
 
 // ---------------------------------------------------------------------------------------------------
