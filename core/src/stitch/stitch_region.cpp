@@ -211,7 +211,10 @@ bool ComponentStitcher::meetsComponent(FaceIndex f) {
         if (!CGAL::do_overlap(box, triBox(pf))) return;
         bool onSheet = false;
         for (int v : P_.tri[std::size_t(pf)])
-            if (gapToPlane(P_.pos[std::size_t(v)], A, n) <= tolerance) onSheet = true;
+            if (gapToPlane(P_.pos[std::size_t(v)], A, n) <= tolerance) {
+                onSheet = true;
+                break;
+            }
         if (!onSheet) return;
         const Triangle2 p = patchTriangle(pf);
         hit = inTriangle(p[0], t[0], t[1], t[2]) || inTriangle(t[0], p[0], p[1], p[2]) ||
