@@ -215,21 +215,37 @@ private:
 };
 
 // ---------------------------------------------------------------------------------------------------
-// Uniform bucket grid over 2D boxes; queries report each id once.
+// Uniform bucket grid over 2D boxes; queries report each id once. With `bounds` (the box the inserted boxes
+// mostly lie in), the cells there are a dense array (no hashing: the searches over the faces under a patch
+// query this grid for every face); cells outside stay in a hash map. Either way the same ids are reported in
+// the same order (cells by x, then y; ids in insertion order).
 class BucketGrid {
 public:
     BucketGrid() = default;
     BucketGrid(double cell, std::size_t ids) : inv_(1.0 / cell), stamp_(ids, 0) {}
+    BucketGrid(double cell, std::size_t ids, const CGAL::Bbox_2& bounds) : BucketGrid(cell, ids) {
+        if (!(bounds.xmax() >= bounds.xmin()) || !(bounds.ymax() >= bounds.ymin())) return;
+        const double x0 = std::floor(bounds.xmin() * inv_), x1 = std::floor(bounds.xmax() * inv_);
+        const double y0 = std::floor(bounds.ymin() * inv_), y1 = std::floor(bounds.ymax() * inv_);
+        const double cells = (x1 - x0 + 1) * (y1 - y0 + 1);
+        // (Only where the array stays small next to the ids it holds.)
+        if (!(cells <= 4.0 * double(ids) + 4096.0) || std::abs(x0) > 1e15 || std::abs(y0) > 1e15) return;
+        x0_ = std::int64_t(x0);
+        y0_ = std::int64_t(y0);
+        nx_ = std::int64_t(x1 - x0) + 1;
+        ny_ = std::int64_t(y1 - y0) + 1;
+        dense_.resize(std::size_t(nx_ * ny_));
+    }
 
     void insert(int id, const CGAL::Bbox_2& b) {
-        forCells(b, [&](std::uint64_t key) { cells_[key].push_back(id); });
+        forCells(b, [&](std::int64_t x, std::int64_t y) { cellAt(x, y).push_back(id); });
     }
     template <class F> void query(const CGAL::Bbox_2& b, F&& f) {
         ++current_;
-        forCells(b, [&](std::uint64_t key) {
-            auto it = cells_.find(key);
-            if (it == cells_.end()) return;
-            for (int id : it->second)
+        forCells(b, [&](std::int64_t x, std::int64_t y) {
+            const std::vector<int>* cell = find(x, y);
+            if (!cell) return;
+            for (int id : *cell)
                 if (stamp_[std::size_t(id)] != current_) {
                     stamp_[std::size_t(id)] = current_;
                     f(id);
@@ -238,6 +254,25 @@ public:
     }
 
 private:
+    static std::uint64_t key(std::int64_t x, std::int64_t y) {
+        return (std::uint64_t(std::uint32_t(x)) << 32) | std::uint32_t(y);
+    }
+    bool inDense(std::int64_t x, std::int64_t y) const {
+        return x >= x0_ && x < x0_ + nx_ && y >= y0_ && y < y0_ + ny_;
+    }
+    std::vector<int>& cellAt(std::int64_t x, std::int64_t y) {
+        if (inDense(x, y)) return dense_[std::size_t((x - x0_) * ny_ + (y - y0_))];
+        return cells_[key(x, y)];
+    }
+    const std::vector<int>* find(std::int64_t x, std::int64_t y) const {
+        if (inDense(x, y)) {
+            const std::vector<int>& c = dense_[std::size_t((x - x0_) * ny_ + (y - y0_))];
+            return c.empty() ? nullptr : &c;
+        }
+        if (cells_.empty()) return nullptr;
+        auto it = cells_.find(key(x, y));
+        return it == cells_.end() ? nullptr : &it->second;
+    }
     template <class F> void forCells(const CGAL::Bbox_2& b, F&& f) const {
         const auto x0 = std::int64_t(std::floor(b.xmin() * inv_)),
                    x1 = std::int64_t(std::floor(b.xmax() * inv_));
@@ -245,10 +280,12 @@ private:
                    y1 = std::int64_t(std::floor(b.ymax() * inv_));
         for (std::int64_t x = x0; x <= x1; ++x)
             for (std::int64_t y = y0; y <= y1; ++y)
-                f((std::uint64_t(std::uint32_t(x)) << 32) | std::uint32_t(y));
+                f(x, y);
     }
     double inv_ = 1.0;
     std::unordered_map<std::uint64_t, std::vector<int>> cells_;
+    std::vector<std::vector<int>> dense_;
+    std::int64_t x0_ = 0, y0_ = 0, nx_ = 0, ny_ = 0;
     std::vector<unsigned> stamp_;
     unsigned current_ = 0;
 };
