@@ -27,6 +27,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -34,6 +35,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -122,7 +124,14 @@ fss::StitchOptions stitchOptions() {
     return o;
 }
 
-std::map<int, double> stitchMs, stitchWallMs, scanMs, scanCpuMs;
+// Per size, one figure per run of the benchmark (--benchmark_repetitions=N: N runs); the table after the runs
+// gives their medians (the machine is shared: one run can be off by a third).
+std::map<int, std::vector<double>> stitchMs, stitchWallMs, scanMs, scanCpuMs;
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
 
 void BM_Stitch(benchmark::State& state) {
     const int faces = int(state.range(0));
@@ -151,8 +160,8 @@ void BM_Stitch(benchmark::State& state) {
         benchmark::DoNotOptimize(current);
     }
     if (state.range(1)) {
-        stitchMs[faces] = 1e3 * total / double(state.iterations());
-        stitchWallMs[faces] = 1e3 * wall / double(state.iterations());
+        stitchMs[faces].push_back(1e3 * total / double(state.iterations()));
+        stitchWallMs[faces].push_back(1e3 * wall / double(state.iterations()));
     }
     state.counters["wall_ms"] = 1e3 * wall / double(state.iterations());
     state.counters["patch_faces"] = double(patch.mesh.number_of_faces());
@@ -179,8 +188,8 @@ void BM_Scan(benchmark::State& state) {
         patchFaces = r.patch.mesh.number_of_faces();
         benchmark::DoNotOptimize(patchFaces);
     }
-    scanMs[faces] = 1e3 * wall / double(state.iterations());
-    scanCpuMs[faces] = 1e3 * total / double(state.iterations());
+    scanMs[faces].push_back(1e3 * wall / double(state.iterations()));
+    scanCpuMs[faces].push_back(1e3 * total / double(state.iterations()));
     state.counters["wall_ms"] = 1e3 * wall / double(state.iterations());
     state.counters["patch_faces"] = double(patchFaces);
 }
@@ -207,16 +216,19 @@ int main(int argc, char** argv) {
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
     benchmark::RunSpecifiedBenchmarks();
     benchmark::Shutdown();
-    // Scan and stitch side by side (issue 19's targets: stitch ≤ 2 × scan at every size, 1M / 10k ≤ 1.5).
-    std::printf("\n%9s %13s %12s %14s %15s %18s %17s\n", "faces", "scan wall ms", "scan CPU ms",
-                "stitch CPU ms", "stitch wall ms", "stitch/scan wall", "stitch/scan CPU");
-    for (const auto& [faces, ms] : stitchMs)
-        if (scanMs.count(faces))
-            std::printf("%9d %13.1f %12.1f %14.1f %15.1f %18.2f %17.2f\n", faces, scanMs[faces],
-                        scanCpuMs[faces], ms, stitchWallMs[faces], stitchWallMs[faces] / scanMs[faces],
-                        ms / scanCpuMs[faces]);
+    // Scan and stitch side by side (issue 19's targets: stitch ≤ 2 × scan at every size, 1M / 10k ≤ 1.5);
+    // medians over the repetitions.
+    std::printf("\n%9s %13s %12s %14s %15s %18s %17s %5s\n", "faces", "scan wall ms", "scan CPU ms",
+                "stitch CPU ms", "stitch wall ms", "stitch/scan wall", "stitch/scan CPU", "runs");
+    for (const auto& [faces, runs] : stitchMs)
+        if (scanMs.count(faces)) {
+            const double st = median(runs), sw = median(stitchWallMs[faces]), cw = median(scanMs[faces]),
+                         cc = median(scanCpuMs[faces]);
+            std::printf("%9d %13.1f %12.1f %14.1f %15.1f %18.2f %17.2f %5zu\n", faces, cw, cc, st, sw,
+                        sw / cw, st / cc, runs.size());
+        }
     if (stitchMs.count(10000) && stitchMs.count(1000000))
         std::printf("stitch CPU time 1M / 10k faces: %.2f (target <= 1.5)\n",
-                    stitchMs[1000000] / stitchMs[10000]);
+                    median(stitchMs[1000000]) / median(stitchMs[10000]));
     return 0;
 }
