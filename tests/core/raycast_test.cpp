@@ -5,9 +5,12 @@
 #include "fss/raycast.h"
 #include "fss/shapes.h"
 
+#include "mesh/local_closest_point.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
 #include <vector>
@@ -226,6 +229,41 @@ TEST(RayCast, LocalClosestPointWalksToTheTreeAnswer) {
         EXPECT_NEAR(ref.distance, 0.05, 0.02);
     }
     EXPECT_THROW(fss::closestPointNear(torus, {0, 0, 0}, fss::FaceIndex(999999)), fss::InvalidInputError);
+}
+
+TEST(RayCast, CachedLocalClosestPointGivesTheSameAnswers) {
+    // LocalClosestPoint caches rings and skips faces already measured: every answer must be
+    // closestPointNear's face for face (also where the walk ends in a local minimum short of the tree's
+    // answer), and on the tree's answer where the walk reaches it.
+    const Mesh torus = fss::shapes::torus(48, 24, 2.0, 0.5);
+    const RayCaster caster(torus);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(0.0, 2 * 3.14159265358979), r(0.2, 0.9);
+    std::uniform_int_distribution<std::uint32_t> face(0, std::uint32_t(torus.num_faces() - 1));
+    for (int rings : {0, 1, 2}) {
+        fss::detail::LocalClosestPoint cached(torus, {.rings = rings});
+        int sameAsTree = 0;
+        for (int i = 0; i < 400; ++i) {
+            const double phi = u(rng), theta = u(rng), rho = r(rng);
+            const Eigen::Vector3d p((2.0 + rho * std::cos(theta)) * std::cos(phi),
+                                    (2.0 + rho * std::cos(theta)) * std::sin(phi), rho * std::sin(theta));
+            // Hints near the answer (the walk's use) and anywhere (long walks, local minima).
+            const fss::FaceIndex hint =
+                i % 2 ? caster.closestPoint(p + Eigen::Vector3d(0.1, 0, 0)).face : fss::FaceIndex(face(rng));
+            const SurfacePoint walk = fss::closestPointNear(torus, p, hint, {.rings = rings});
+            const SurfacePoint got = cached(p, hint);
+            ASSERT_TRUE(got);
+            EXPECT_EQ(got.face, walk.face);
+            EXPECT_EQ(got.point, walk.point);
+            EXPECT_EQ(got.distance, walk.distance);
+            sameAsTree += std::abs(got.distance - caster.closestPoint(p).distance) < 1e-12;
+        }
+        if (rings > 0) {
+            EXPECT_GT(sameAsTree, 150) << rings; // the walk gets there from the near hints
+        }
+    }
+    fss::detail::LocalClosestPoint cached(torus, {.rings = 2});
+    EXPECT_THROW(cached({0, 0, 0}, fss::FaceIndex(999999)), fss::InvalidInputError);
 }
 
 TEST(RayCast, RejectsPolygonsAndHandlesEmptyMeshes) {

@@ -3,6 +3,7 @@
 #include "fss/camera_projector.h"
 #include "fss/error.h"
 
+#include "mesh/local_closest_point.h"
 #include "mesh/triangle_geometry.h"
 
 #include <CGAL/AABB_face_graph_triangle_primitive.h>
@@ -300,6 +301,48 @@ SurfacePoint closestPointNear(const Mesh& mesh, const Eigen::Vector3d& p, FaceIn
             if (d < best.distance) best = {f, q, d};
         }
         if (best.face == centre) break;
+        centre = best.face;
+    }
+    return best;
+}
+
+const std::vector<FaceIndex>& detail::LocalClosestPoint::ringsOf(FaceIndex centre) {
+    const std::size_t i = std::size_t(centre.idx());
+    if (rings_.size() < mesh_->num_faces()) rings_.resize(mesh_->num_faces());
+    if (rings_[i].empty()) {
+        thread_local LocalFaceSet set;
+        collectRingsInto(*mesh_, centre, std::max(0, options_.rings), set);
+        rings_[i] = set.faces;
+    }
+    return rings_[i];
+}
+
+SurfacePoint detail::LocalClosestPoint::operator()(const Eigen::Vector3d& p, FaceIndex hint) {
+    requireFace(*mesh_, hint, "hint face");
+    {
+        const Eigen::Vector3d q = closestOnFace(*mesh_, hint, p);
+        const double d = (q - p).norm();
+        if (d == 0) return {hint, q, d};
+    }
+    if (measured_.size() < mesh_->num_faces()) measured_.resize(mesh_->num_faces(), 0u);
+    if (++query_ == 0) { // wrapped: forget every stamp
+        std::fill(measured_.begin(), measured_.end(), 0u);
+        query_ = 1;
+    }
+    SurfacePoint best;
+    best.distance = std::numeric_limits<double>::infinity();
+    FaceIndex centre = hint;
+    constexpr int kMaxRecentring = 16; // as closestPointNear
+    for (int iteration = 0; iteration <= kMaxRecentring; ++iteration) {
+        for (FaceIndex f : ringsOf(centre)) {
+            std::uint32_t& stamp = measured_[std::size_t(f.idx())];
+            if (stamp == query_) continue;
+            stamp = query_;
+            const Eigen::Vector3d q = closestOnFace(*mesh_, f, p);
+            const double d = (q - p).norm();
+            if (d < best.distance) best = {f, q, d};
+        }
+        if (best.face == centre || !best) break;
         centre = best.face;
     }
     return best;

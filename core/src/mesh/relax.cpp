@@ -2,6 +2,7 @@
 
 #include "fss/raycast.h"
 
+#include "mesh/local_closest_point.h"
 #include "mesh/triangle_geometry.h"
 
 #include <CGAL/boost/graph/iterator.h>
@@ -94,7 +95,8 @@ RelaxReport relaxOnReference(Mesh& mesh, const Mesh& reference, const std::vecto
         crease[k] = creaseUnder(reference, hints[k], pos(mesh, vertices[k]), cosCrease, 1e-6 * footprints[k]);
         report.onCrease += crease[k].has_value();
     }
-    const LocalSearchOptions search{.rings = 1};
+    // The reference does not change here: its rings are collected once (same results as closestPointNear).
+    LocalClosestPoint search(reference, LocalSearchOptions{.rings = 1});
     for (int sweep = 0; sweep < options.iterations; ++sweep) {
         for (std::size_t k = 0; k < vertices.size(); ++k) {
             const VertexIndex v = vertices[k];
@@ -117,7 +119,7 @@ RelaxReport relaxOnReference(Mesh& mesh, const Mesh& reference, const std::vecto
             } else {
                 const Eigen::Vector3d normal = unitFaceNormal(reference, hints[k]);
                 const Eigen::Vector3d moved = p + options.step * (d - d.dot(normal) * normal);
-                const SurfacePoint onRef = closestPointNear(reference, moved, hints[k], search);
+                const SurfacePoint onRef = search(moved, hints[k]);
                 if (!onRef || onRef.distance > options.maxOffFootprints * footprints[k] ||
                     unitFaceNormal(reference, onRef.face).dot(firstNormal[k]) < cosCrease) {
                     ++report.refused;

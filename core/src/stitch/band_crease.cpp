@@ -133,7 +133,7 @@ void BandRemesher::findOrigins() {
         for (VertexIndex v : CGAL::vertices_around_face(h, S_)) {
             const FaceIndex hint = at(hint_, std::size_t(v), Mesh::null_face());
             if (hint == Mesh::null_face()) continue;
-            const SurfacePoint sp = closestPointNear(ref_, c, hint, LocalSearchOptions{.rings = 2});
+            const SurfacePoint sp = near2_(c, hint);
             if (sp && std::size_t(sp.face) < refOrigin_.size()) o = refOrigin_[std::size_t(sp.face)];
             break;
         }
@@ -289,7 +289,7 @@ void BandRemesher::slidePass() {
             creasePos_.erase(std::uint32_t(v));
         const FaceIndex hint = at(hint_, std::size_t(v), Mesh::null_face());
         if (hint != Mesh::null_face()) {
-            const SurfacePoint sp = closestPointNear(ref_, bestP, hint, LocalSearchOptions{.rings = 2});
+            const SurfacePoint sp = near2_(bestP, hint);
             if (sp) hint_[std::size_t(v)] = sp.face;
         }
         touch(v);

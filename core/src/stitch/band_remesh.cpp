@@ -135,7 +135,7 @@ void BandRemesher::improvePass() {
             for (int k = 0; k < 12; ++k) {
                 const double t = 2 * std::numbers::pi * k / 12;
                 const V3 q = p + r * shortest * (std::cos(t) * u + std::sin(t) * w);
-                const SurfacePoint sp = closestPointNear(ref_, q, hint, LocalSearchOptions{.rings = 1});
+                const SurfacePoint sp = near1_(q, hint);
                 if (!sp || sp.distance > 0.5 * r * shortest) continue;
                 const HalfedgeIndex sh = ref_.halfedge(sp.face);
                 const V3 n =

@@ -5,6 +5,7 @@
 
 #include "fss/raycast.h"
 
+#include "mesh/local_closest_point.h"
 #include "mesh/local_ops.h"
 #include "mesh/relax.h"
 #include "mesh/triangle_geometry.h"
@@ -277,7 +278,7 @@ private:
         if (isCrease(a, b)) {
             if (!stageOff("lift")) sp.crease = creaseBetween(a, b, t, sp.q);
         } else if (sp.hint != Mesh::null_face()) {
-            const SurfacePoint r = closestPointNear(ref_, sp.q, sp.hint, LocalSearchOptions{.rings = 2});
+            const SurfacePoint r = near2_(sp.q, sp.hint);
             if (r && r.distance <= 0.25 * (pa - pb).norm()) {
                 sp.q = smoothPoint(r.face, r.point);
                 sp.hint = r.face;
@@ -531,7 +532,7 @@ private:
     double distanceToRef(const V3& p, VertexIndex near) {
         const FaceIndex hint = at(hint_, std::size_t(near), Mesh::null_face());
         if (hint == Mesh::null_face()) return 0;
-        const SurfacePoint sp = closestPointNear(ref_, p, hint, LocalSearchOptions{.rings = 2});
+        const SurfacePoint sp = near2_(p, hint);
         return sp ? sp.distance : 0;
     }
 
@@ -608,7 +609,11 @@ private:
 
     const BandRemeshInput& in_;
     Mesh& S_;
-    Mesh ref_;                        // the draft band, onto which vertices are projected
+    Mesh ref_; // the draft band, onto which vertices are projected
+    // closestPointNear on ref_ (which does not change after setup) with 1 and 2 rings: the same results,
+    // each face's rings collected once.
+    detail::LocalClosestPoint near1_{ref_, LocalSearchOptions{.rings = 1}},
+        near2_{ref_, LocalSearchOptions{.rings = 2}};
     std::vector<FaceIndex> bandList_; // the band as given and grown (descriptor order after growth)
     std::vector<char> band_, fixed_, touched_;
     double minSplitGain_ = 0;  // a split must give a smallest angle of at least this times the one before
