@@ -1096,10 +1096,11 @@ static std::string closedText(const fss::FishboneScanResult& r) {
 // The figures of issue #20's fishbone criteria on shapes and meshes: for each case, h = 2 px, with and
 // without a lasso (a square of 0.6 W around the seed), the paper's fishbone ("paper") and the issue-20 set
 // ("issue20": closeLoops, stopBackboneAtCreases, minRibGap 0.5, maxRibTurnDeg 60, stopRibsAtCreases,
-// minQuadAngleDeg 20) and "+iso" (that and isotropicRibs): the patch's smallest angle, the share of faces
-// below 30°, the mean normal error of the faces within 2h of the crease near the backbone (screen distance ≤
-// 3h to a backbone sample) against the regular grid's at the same spacing (the scan at W/2 × H/2), and
-// whether the grid closed. Printed only. FSS_LONG_TESTS=1 build/bin/core_tests
+// minQuadAngleDeg 20), "+iso" (that and isotropicRibs) and "+aspect" (that and maxRibAspect 1.7): the patch's
+// smallest angle, the share of faces below 30°, the mean normal error of the faces within 2h of the crease
+// near the backbone (screen distance ≤ 3h to a backbone sample) against the regular grid's at the same
+// spacing (the scan at W/2 × H/2), and whether the grid closed. Printed only. FSS_LONG_TESTS=1
+// build/bin/core_tests
 // --gtest_filter='FishboneScan.SliverTable'
 TEST(FishboneScan, SliverTable) {
     if (!std::getenv("FSS_LONG_TESTS")) GTEST_SKIP() << "set FSS_LONG_TESTS=1";
@@ -1179,9 +1180,12 @@ TEST(FishboneScan, SliverTable) {
         }
         const double h = 2, hWorld = h * c.camera.pixelFootprint(seedHit.point);
         for (const bool lasso : {false, true})
-            for (const int set : {0, 1, 2}) {
+            for (const int set : {0, 1, 2, 3}) {
                 const bool issue20 = set > 0;
-                const char* setName = set == 0 ? "paper" : set == 1 ? "issue20" : "+iso";
+                const char* setName = set == 0   ? "paper"
+                                      : set == 1 ? "issue20"
+                                      : set == 2 ? "+iso"
+                                                 : "+aspect";
                 fss::ScanParams params;
                 params.camera = c.camera;
                 const double half = 0.3 * c.camera.width;
@@ -1197,7 +1201,8 @@ TEST(FishboneScan, SliverTable) {
                         true;
                     fb.tracing.minRibGap = 0.5;
                     fb.tracing.maxRibTurnDeg = 60;
-                    fb.tracing.isotropicRibs = set == 2;
+                    fb.tracing.isotropicRibs = set >= 2;
+                    fb.tracing.maxRibAspect = set == 3 ? 1.7 : 0.0;
                     params.triangulate.minQuadAngleDeg = 20;
                 }
                 fss::FishboneScanResult r;
@@ -1271,10 +1276,11 @@ TEST(FishboneScan, SliverTable) {
                             smallest = std::min(smallest, std::acos(std::clamp(u.dot(w), -1.0, 1.0)) * 180 /
                                                               std::numbers::pi);
                         }
-                        return smallest < 10   ? Vector3d(1.0, 0.1, 0.1)
-                               : smallest < 20 ? Vector3d(1.0, 0.55, 0.1)
-                               : smallest < 30 ? Vector3d(1.0, 0.95, 0.2)
-                                               : Vector3d(0.8, 0.85, 0.9);
+                        // Bright: the flat shading darkens faces turned from its light.
+                        return 3.0 * (smallest < 10   ? Vector3d(1.0, 0.1, 0.1)
+                                      : smallest < 20 ? Vector3d(1.0, 0.55, 0.1)
+                                      : smallest < 30 ? Vector3d(1.0, 0.95, 0.2)
+                                                      : Vector3d(0.8, 0.85, 0.9));
                     };
                     fss::test::renderShaded(pm, view, rgb, zbuf, W, 0, tint);
                     fss::test::renderShaded(pm, close, rgb, zbuf, W, view.width, tint);
