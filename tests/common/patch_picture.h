@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -81,7 +82,8 @@ inline void writePng(const std::string& path, int w, int h, const std::vector<st
 // Flat-shaded z-buffered rendering of \p mesh with \p camera into the rgb image at x offset \p x0, with
 // the mesh edges darkened (so the grid's alignment with the crease is visible).
 inline void renderShaded(const fss::Mesh& mesh, const fss::Camera& camera, std::vector<std::uint8_t>& rgb,
-                         std::vector<double>& zbuf, int imageWidth, int x0, const Eigen::Vector3d& tint) {
+                         std::vector<double>& zbuf, int imageWidth, int x0,
+                         const std::function<Eigen::Vector3d(fss::FaceIndex)>& tintOf) {
     const Eigen::Vector3d light = Eigen::Vector3d(1.0, 0.25, 0.6).normalized();
     const Eigen::Matrix4d vp = camera.viewProjectionMatrix();
     auto project = [&](const Eigen::Vector3d& p) {
@@ -99,6 +101,7 @@ inline void renderShaded(const fss::Mesh& mesh, const fss::Camera& camera, std::
         }
         const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]).normalized();
         const double shade = 0.15 + 0.85 * std::max(0.0, n.dot(light));
+        const Eigen::Vector3d tint = tintOf(f);
         const int xmin = std::max(0, int(std::floor(std::min({s[0].x(), s[1].x(), s[2].x()}))));
         const int xmax = std::min(camera.width - 1, int(std::ceil(std::max({s[0].x(), s[1].x(), s[2].x()}))));
         const int ymin = std::max(0, int(std::floor(std::min({s[0].y(), s[1].y(), s[2].y()}))));
@@ -132,6 +135,12 @@ inline void renderShaded(const fss::Mesh& mesh, const fss::Camera& camera, std::
                         std::uint8_t(std::clamp(255.0 * shade * tint[c] * (edge ? 0.75 : 1.0), 0.0, 255.0));
             }
     }
+}
+
+// As above, every face in \p tint.
+inline void renderShaded(const fss::Mesh& mesh, const fss::Camera& camera, std::vector<std::uint8_t>& rgb,
+                         std::vector<double>& zbuf, int imageWidth, int x0, const Eigen::Vector3d& tint) {
+    renderShaded(mesh, camera, rgb, zbuf, imageWidth, x0, [&](fss::FaceIndex) { return tint; });
 }
 
 } // namespace fss::test

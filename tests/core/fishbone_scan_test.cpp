@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -1023,6 +1024,61 @@ std::vector<SliverCase> cgalCases(const std::string& name, const Mesh& m, fss::F
 
 } // namespace
 
+// Where the faces below 30° of a fishbone patch are (issue #20: where the slivers come from), each counted
+// under the first that applies: "crease" (its corner samples' reference normals differ by more than 30°:
+// it spans a crease), "ribEnd" (a corner is the last sample of its half-rib: the rib's next vertex is not
+// in the patch), "bbEnd" (a corner within 2 rows of an open grid's first or last row), "border" (a corner on
+// the patch's border: lasso, masks, silhouettes), "near" (within 2 columns of the backbone), "inside".
+static std::string sliverSources(const fss::FishboneScanResult& r) {
+    const Mesh& m = r.patch.mesh;
+    const auto [gi, found] = m.property_map<fss::VertexIndex, fss::GridIndex>(fss::props::vertexGridIndex);
+    if (!found) return "";
+    const fss::SampleGrid& g = r.grid;
+    const int bc = r.fishbone.backboneColumn;
+    std::vector<char> inPatch(g.samples.size(), 0);
+    for (auto v : m.vertices())
+        inPatch[g.index(gi[v].row, gi[v].col)] = 1;
+    int counts[6] = {0, 0, 0, 0, 0, 0};
+    for (auto f : m.faces()) {
+        std::array<Vector3d, 3> p;
+        std::array<fss::VertexIndex, 3> vs;
+        int k = 0;
+        for (auto v : CGAL::vertices_around_face(m.halfedge(f), m)) {
+            vs[std::size_t(k)] = v;
+            p[std::size_t(k++)] = pt(m, v);
+        }
+        double smallest = 180;
+        for (int i = 0; i < 3; ++i) {
+            const Vector3d u = (p[std::size_t((i + 1) % 3)] - p[std::size_t(i)]).normalized();
+            const Vector3d w = (p[std::size_t((i + 2) % 3)] - p[std::size_t(i)]).normalized();
+            smallest =
+                std::min(smallest, std::acos(std::clamp(u.dot(w), -1.0, 1.0)) * 180 / std::numbers::pi);
+        }
+        if (smallest >= 30) continue;
+        bool crease = false, ribEnd = false, bbEnd = false, border = false, near = false;
+        for (int i = 0; i < 3; ++i) {
+            const fss::GridIndex a = gi[vs[std::size_t(i)]];
+            for (int j = 0; j < 3; ++j) {
+                const fss::GridIndex b = gi[vs[std::size_t(j)]];
+                crease =
+                    crease || g.at(a.row, a.col).normal.dot(g.at(b.row, b.col).normal) < std::cos(0.5236);
+            }
+            if (a.col != bc) {
+                const int out = a.col + (a.col > bc ? 1 : -1);
+                ribEnd = ribEnd || out < 0 || out >= g.cols || !inPatch[g.index(a.row, out)];
+            }
+            bbEnd = bbEnd || (!r.fishbone.closed && (a.row < 2 || a.row >= g.rows - 2));
+            border = border || m.is_border(vs[std::size_t(i)]);
+            near = near || std::abs(a.col - bc) <= 2;
+        }
+        ++counts[crease ? 0 : ribEnd ? 1 : bbEnd ? 2 : border ? 3 : near ? 4 : 5];
+    }
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "crease %d ribEnd %d bbEnd %d border %d near %d inside %d", counts[0],
+                  counts[1], counts[2], counts[3], counts[4], counts[5]);
+    return buf;
+}
+
 // "open", or for a closed grid the border edges along its first and last rib (the seam) against the mean
 // along any other two neighbouring ribs (ribs of unequal length leave some anywhere).
 static std::string closedText(const fss::FishboneScanResult& r) {
@@ -1040,10 +1096,11 @@ static std::string closedText(const fss::FishboneScanResult& r) {
 // The figures of issue #20's fishbone criteria on shapes and meshes: for each case, h = 2 px, with and
 // without a lasso (a square of 0.6 W around the seed), the paper's fishbone ("paper") and the issue-20 set
 // ("issue20": closeLoops, stopBackboneAtCreases, minRibGap 0.5, maxRibTurnDeg 60, stopRibsAtCreases,
-// minQuadAngleDeg 20) and "+iso" (that and isotropicRibs): the patch's smallest angle, the share of faces
-// below 30°, the mean normal error of the faces within 2h of the crease near the backbone (screen distance ≤
-// 3h to a backbone sample) against the regular grid's at the same spacing (the scan at W/2 × H/2), and
-// whether the grid closed. Printed only. FSS_LONG_TESTS=1 build/bin/core_tests
+// minQuadAngleDeg 20), "+iso" (that and isotropicRibs) and "+aspect" (that and maxRibAspect 1.7): the patch's
+// smallest angle, the share of faces below 30°, the mean normal error of the faces within 2h of the crease
+// near the backbone (screen distance ≤ 3h to a backbone sample) against the regular grid's at the same
+// spacing (the scan at W/2 × H/2), and whether the grid closed. Printed only. FSS_LONG_TESTS=1
+// build/bin/core_tests
 // --gtest_filter='FishboneScan.SliverTable'
 TEST(FishboneScan, SliverTable) {
     if (!std::getenv("FSS_LONG_TESTS")) GTEST_SKIP() << "set FSS_LONG_TESTS=1";
@@ -1123,9 +1180,12 @@ TEST(FishboneScan, SliverTable) {
         }
         const double h = 2, hWorld = h * c.camera.pixelFootprint(seedHit.point);
         for (const bool lasso : {false, true})
-            for (const int set : {0, 1, 2}) {
+            for (const int set : {0, 1, 2, 3}) {
                 const bool issue20 = set > 0;
-                const char* setName = set == 0 ? "paper" : set == 1 ? "issue20" : "+iso";
+                const char* setName = set == 0   ? "paper"
+                                      : set == 1 ? "issue20"
+                                      : set == 2 ? "+iso"
+                                                 : "+aspect";
                 fss::ScanParams params;
                 params.camera = c.camera;
                 const double half = 0.3 * c.camera.width;
@@ -1141,7 +1201,8 @@ TEST(FishboneScan, SliverTable) {
                         true;
                     fb.tracing.minRibGap = 0.5;
                     fb.tracing.maxRibTurnDeg = 60;
-                    fb.tracing.isotropicRibs = set == 2;
+                    fb.tracing.isotropicRibs = set >= 2;
+                    fb.tracing.maxRibAspect = set == 3 ? 1.7 : 0.0;
                     params.triangulate.minQuadAngleDeg = 20;
                 }
                 fss::FishboneScanResult r;
@@ -1187,10 +1248,47 @@ TEST(FishboneScan, SliverTable) {
                 };
                 const AngleFigures a = angleFigures(r.patch.mesh);
                 const double fishError = nearError(r.patch.mesh), gridError = nearError(regular.patch.mesh);
-                std::printf("%-26s %-7s %-6s %-7s | %5zu %6.1f %6.1f | %6.2f %6.2f %5.2f | %s\n",
+                std::printf("%-26s %-7s %-6s %-7s | %5zu %6.1f %6.1f | %6.2f %6.2f %5.2f | %s | %s\n",
                             c.name.c_str(), setName, lasso ? "lasso" : "-", c.tuned.c_str(), a.faces,
                             a.minDeg, 100 * a.below30, fishError, gridError, fishError / gridError,
-                            closedText(r).c_str());
+                            closedText(r).c_str(), sliverSources(r).c_str());
+                if (const char* dir = std::getenv("FSS_SLIVER_PICTURES")) {
+                    // The patch coloured by its faces' smallest angle (grey ≥ 30°, yellow < 30°, orange <
+                    // 20°, red < 10°): the whole view left, three times closer around the seed right.
+                    fss::Camera view = c.camera, close = c.camera;
+                    view.width = view.height = close.width = close.height = 512;
+                    close.focal = seedHit.point;
+                    close.zoom(3.0);
+                    const int W = 2 * view.width;
+                    std::vector<std::uint8_t> rgb(std::size_t(W) * std::size_t(view.height) * 3, 255);
+                    std::vector<double> zbuf(std::size_t(W) * std::size_t(view.height),
+                                             std::numeric_limits<double>::infinity());
+                    const Mesh& pm = r.patch.mesh;
+                    auto tint = [&](fss::FaceIndex f) {
+                        std::array<Vector3d, 3> q;
+                        int k = 0;
+                        for (auto v : CGAL::vertices_around_face(pm.halfedge(f), pm))
+                            q[std::size_t(k++)] = pt(pm, v);
+                        double smallest = 180;
+                        for (int i = 0; i < 3; ++i) {
+                            const Vector3d u = (q[std::size_t((i + 1) % 3)] - q[std::size_t(i)]).normalized();
+                            const Vector3d w = (q[std::size_t((i + 2) % 3)] - q[std::size_t(i)]).normalized();
+                            smallest = std::min(smallest, std::acos(std::clamp(u.dot(w), -1.0, 1.0)) * 180 /
+                                                              std::numbers::pi);
+                        }
+                        // Bright: the flat shading darkens faces turned from its light.
+                        return 3.0 * (smallest < 10   ? Vector3d(1.0, 0.1, 0.1)
+                                      : smallest < 20 ? Vector3d(1.0, 0.55, 0.1)
+                                      : smallest < 30 ? Vector3d(1.0, 0.95, 0.2)
+                                                      : Vector3d(0.8, 0.85, 0.9));
+                    };
+                    fss::test::renderShaded(pm, view, rgb, zbuf, W, 0, tint);
+                    fss::test::renderShaded(pm, close, rgb, zbuf, W, view.width, tint);
+                    std::string file = c.name + "_" + setName + (lasso ? "_lasso" : "");
+                    for (char& ch : file)
+                        if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+                    fss::test::writePng(std::string(dir) + "/" + file + ".png", W, view.height, rgb);
+                }
                 EXPECT_GT(a.faces, 0u);
             }
     }

@@ -596,3 +596,61 @@ TEST(Fishbone, BackboneLoopsCloseOrStop) {
     EXPECT_EQ(a.seedIndex, b.seedIndex);
     EXPECT_FALSE(a.closed);
 }
+
+// FishboneOptions::maxRibAspect (issue #20): ribs that fan out from a curved backbone make quads wider than
+// long (1:2 gives triangles of 26.6°): each half-rib stops before its first vertex whose quad with a
+// neighbouring rib is longer one way than maxRibAspect times the other (here on the screen). The positive
+// halves radiate from (5, −8) through the backbone samples (i, 0): at vertex k the neighbours are about
+// h·(8 + k)/8 · 1/√(1 + ((i − 5)/8)²)… apart — checked against the bound directly.
+TEST(Fishbone, RibsStopWhereTheirQuadsGetTooLong) {
+    const double h = 1.0;
+    fss::Backbone backbone;
+    for (int i = 0; i <= 10; ++i)
+        backbone.samples.emplace_back(double(i), 0.0);
+    std::vector<fss::Rib> ribs;
+    for (int i = 0; i <= 10; ++i) {
+        fss::Rib rib;
+        const Eigen::Vector2d p0(double(i), 0.0), d = (p0 - Eigen::Vector2d(5, -8)).normalized();
+        for (int k = 0; k <= 12; ++k)
+            rib.positive.push_back(p0 + k * h * d);
+        rib.negative.push_back(p0);
+        ribs.push_back(rib);
+    }
+    const fss::FishboneGrid untrimmed = fss::assembleFishboneGrid(backbone, ribs, h, 0, 0);
+    fss::FishboneOptions options;
+    options.spacing = h;
+    options.maxRibAspect = 1.7;
+    fss::FishboneGrid g = untrimmed;
+    const std::size_t removed = fss::trimRibs(g, backbone, options);
+    EXPECT_GT(removed, 0u);
+    EXPECT_EQ(g.presentCount() + removed, untrimmed.presentCount());
+    const int bc = g.backboneColumn;
+    int longest = 0;
+    for (int r = 0; r < g.rows; ++r) {
+        int kept = 0;
+        while (g.isPresent(r, bc + kept + 1))
+            ++kept;
+        // The last rib keeps its tail: its neighbour ended there already, no quad is left to judge.
+        if (r + 1 < g.rows) longest = std::max(longest, kept);
+        EXPECT_GE(kept, 4) << "rib " << r; // the quads near the backbone are nearly square
+        for (int k = 1; k <= kept; ++k)
+            for (const int n : {r - 1, r + 1}) {
+                if (!g.isPresent(n, bc + k)) continue;
+                const double gap = (g.at(n, bc + k) - g.at(r, bc + k)).norm();
+                EXPECT_LE(gap, 1.7 * h) << "rib " << r << " vertex " << k;
+            }
+        // The first vertex beyond the kept ones (if the rib had one) breaks the bound with a neighbour.
+        if (kept < 12) {
+            double widest = 0;
+            for (const int n : {r - 1, r + 1})
+                if (untrimmed.isPresent(n, bc + kept + 1))
+                    widest = std::max(
+                        widest, (untrimmed.at(n, bc + kept + 1) - untrimmed.at(r, bc + kept + 1)).norm());
+            EXPECT_GT(widest, 1.7 * h) << "rib " << r;
+        }
+    }
+    EXPECT_LT(longest, 12);
+    options.maxRibAspect = 0; // no bound: nothing changes
+    fss::FishboneGrid same = untrimmed;
+    EXPECT_EQ(fss::trimRibs(same, backbone, options), 0u);
+}

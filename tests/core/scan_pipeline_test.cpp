@@ -10,10 +10,12 @@
 #include <CGAL/boost/graph/Euler_operations.h>
 #include <CGAL/boost/graph/IO/polygon_mesh_io.h>
 #include <CGAL/boost/graph/helpers.h>
+#include <CGAL/boost/graph/iterator.h>
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -251,6 +253,7 @@ struct LatticeFigures {
     double meanMinAngle = 0, below30 = 0, valence6 = 0, hausdorff = 0, area = 0;
     std::size_t faces = 0;
     fss::Mesh patch;
+    std::string worst; // FSS_WORST: where the patch is farthest from the reference
 };
 
 struct LatticeSetting {
@@ -258,6 +261,7 @@ struct LatticeSetting {
     double minLatticeAngleDeg = 0;
     double minQuadAngleDeg = 20;
     int relaxIterations = 6;
+    bool warpToSurface = false;
 };
 
 LatticeFigures latticeScan(const fss::Mesh& ref, fss::MeshRenderer& renderer, fss::StandardView view, int res,
@@ -268,10 +272,55 @@ LatticeFigures latticeScan(const fss::Mesh& ref, fss::MeshRenderer& renderer, fs
     params.scan.minLatticeAngleDeg = setting.minLatticeAngleDeg;
     params.triangulate.minQuadAngleDeg = setting.minQuadAngleDeg;
     params.relaxIterations = setting.relaxIterations;
+    params.scan.warpToSurface = setting.warpToSurface;
     fss::ScanResult r = fss::scanPatch(ref, renderer, ref, renderer, params);
     const fss::Metrics m = fss::computeMetrics(r.patch.mesh, {.selfIntersections = false, .reference = &ref});
-    return {m.meanMinAngleDeg, m.fracMinAngleBelow30,  m.fracValence6Interior, *m.hausdorffToRefRel, m.area,
-            m.faces,           std::move(r.patch.mesh)};
+    LatticeFigures out{m.meanMinAngleDeg,
+                       m.fracMinAngleBelow30,
+                       m.fracValence6Interior,
+                       *m.hausdorffToRefRel,
+                       m.area,
+                       m.faces,
+                       std::move(r.patch.mesh),
+                       {}};
+    if (std::getenv("FSS_WORST")) { // the face farthest from the reference (centroid and edge midpoints)
+        const fss::RayCaster caster(ref);
+        const fss::Mesh& pm = out.patch;
+        const auto gi = pm.property_map<fss::VertexIndex, fss::GridIndex>(fss::props::vertexGridIndex).first;
+        double worst = -1;
+        std::string where;
+        for (const auto f : pm.faces()) {
+            std::array<Eigen::Vector3d, 3> p;
+            std::array<fss::VertexIndex, 3> vs;
+            int k = 0;
+            for (const auto v : CGAL::vertices_around_face(pm.halfedge(f), pm)) {
+                vs[std::size_t(k)] = v;
+                p[std::size_t(k++)] = Eigen::Vector3d(pm.point(v).x(), pm.point(v).y(), pm.point(v).z());
+            }
+            double d = 0;
+            for (const Eigen::Vector3d& q :
+                 {Eigen::Vector3d((p[0] + p[1] + p[2]) / 3), Eigen::Vector3d((p[0] + p[1]) / 2),
+                  Eigen::Vector3d((p[1] + p[2]) / 2), Eigen::Vector3d((p[2] + p[0]) / 2)})
+                d = std::max(d, caster.closestPoint(q).distance);
+            if (d <= worst) continue;
+            worst = d;
+            const fss::Sample& s0 = r.grid.at(gi[vs[0]].row, gi[vs[0]].col);
+            double longest = 0;
+            for (int i = 0; i < 3; ++i)
+                longest = std::max(longest, (p[std::size_t(i)] - p[std::size_t((i + 1) % 3)]).norm());
+            char buf[200];
+            std::snprintf(buf, sizeof buf,
+                          "worst face %.2e of diag at screen (%.0f, %.0f): longest edge %.2f footprints, "
+                          "sampling angle %.0f deg, faces %u %u %u",
+                          d / bbox(ref).diagonal().norm(), s0.screen.x(), s0.screen.y(),
+                          longest / double(s0.footprint), double(s0.samplingAngle) * 180 / std::numbers::pi,
+                          unsigned(s0.face), unsigned(r.grid.at(gi[vs[1]].row, gi[vs[1]].col).face),
+                          unsigned(r.grid.at(gi[vs[2]].row, gi[vs[2]].col).face));
+            where = buf;
+        }
+        out.worst = where;
+    }
+    return out;
 }
 
 LatticeFigures latticeScan(const fss::Mesh& ref, fss::MeshRenderer& renderer, fss::StandardView view, int res,
@@ -304,6 +353,37 @@ double unionCoverage(const fss::Mesh& ref, const std::vector<const fss::Mesh*>& 
             }
     }
     return total > 0 ? covered / total : 0;
+}
+
+// How far the umbrella step of a relaxation (mesh/relax.h: each interior vertex towards its neighbours'
+// centroid) would move the vertices of \p m: the mean distance to the centroid over the mean edge length.
+// On an affine image of the valence-6 lattice every interior vertex *is* its neighbours' centroid (the
+// neighbours come in opposite pairs ±a, ±b, ±(a + b)), so only the curvature of the surface and the
+// variation of the slant across the patch give it something to do.
+double umbrellaShare(const fss::Mesh& m) {
+    double moves = 0, edges = 0;
+    std::size_t nv = 0, ne = 0;
+    for (const auto e : m.edges()) {
+        edges += std::sqrt(CGAL::squared_distance(m.point(m.vertex(e, 0)), m.point(m.vertex(e, 1))));
+        ++ne;
+    }
+    for (const auto v : m.vertices()) {
+        if (m.is_border(v)) continue;
+        double x = 0, y = 0, z = 0;
+        int k = 0;
+        for (const auto w : CGAL::vertices_around_target(m.halfedge(v), m)) {
+            x += m.point(w).x();
+            y += m.point(w).y();
+            z += m.point(w).z();
+            ++k;
+        }
+        if (k == 0) continue;
+        const auto& p = m.point(v);
+        moves += std::sqrt((x / k - p.x()) * (x / k - p.x()) + (y / k - p.y()) * (y / k - p.y()) +
+                           (z / k - p.z()) * (z / k - p.z()));
+        ++nv;
+    }
+    return nv && ne ? (moves / double(nv)) / (edges / double(ne)) : 0;
 }
 
 fss::Lattice latticeFromEnv(const char* name, fss::Lattice fallback) {
@@ -371,12 +451,47 @@ TEST(ScanPipeline, AdaptiveLatticeWithTheAngleMaskMakesRoundTrianglesOnFandiskIs
     EXPECT_GE(a.area, 0.5 * s.area); // measured 0.63
 }
 
+// The lattice warped to the surface (ScanOptions::warpToSurface, issue #20) on a sphere seen from the
+// front: one affine lattice is equilateral only where the sphere is seen at the lattice's tilt (here
+// frontally), the 35° mask then drops the ring beyond about 50° of slant; the warped lattice is equilateral
+// on the surface under every sample, so the mask keeps most of the visible hemisphere with round triangles,
+// the same interior valence 6 and the surface sampled at the same spacing.
+TEST(ScanPipeline, LatticeWarpedToTheSurfaceKeepsRoundTrianglesOnASphere) {
+    const fss::Mesh ref = fss::shapes::icosphere(5);
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(ref);
+    fss::ScanParams params;
+    params.camera = fss::Camera::standardView(fss::StandardView::PosZ, bbox(ref), 128, 128);
+    const fss::ScanResult affine = fss::scanPatch(ref, renderer, ref, renderer, params); // the defaults
+    params.scan.warpToSurface = true;
+    const fss::ScanResult warped = fss::scanPatch(ref, renderer, ref, renderer, params);
+    const fss::Metrics a =
+        fss::computeMetrics(affine.patch.mesh, {.selfIntersections = false, .reference = &ref});
+    const fss::Metrics w =
+        fss::computeMetrics(warped.patch.mesh, {.selfIntersections = false, .reference = &ref});
+    std::printf(
+        "sphere +z 128²: affine lattice: area %.3f, mean smallest angle %.1f°, %.1f %% < 30°, valence 6 "
+        "%.3f, Hausdorff %.2e; warped: area %.3f, %.1f°, %.1f %%, %.3f, %.2e\n",
+        a.area, a.meanMinAngleDeg, 100 * a.fracMinAngleBelow30, a.fracValence6Interior, *a.hausdorffToRefRel,
+        w.area, w.meanMinAngleDeg, 100 * w.fracMinAngleBelow30, w.fracValence6Interior, *w.hausdorffToRefRel);
+    // The visible hemisphere has area 2π; a cap up to the slant θ has 2π(1 − cos θ). Measured: area 2.31 ->
+    // 3.99 (the cap to 55° -> to 76°), mean smallest angle 50.4° -> 53.9°, 0 % below 30°, Hausdorff 1.56e-4
+    // -> 1.00e-4.
+    EXPECT_GE(w.area, 1.5 * a.area);
+    EXPECT_GE(w.area, 2 * std::numbers::pi * (1 - std::cos(65 * std::numbers::pi / 180)));
+    EXPECT_GE(w.meanMinAngleDeg, 50.0);
+    EXPECT_LE(w.fracMinAngleBelow30, 0.02);
+    EXPECT_GE(w.fracValence6Interior, 0.98);
+    EXPECT_LE(*w.hausdorffToRefRel, 1.5 * *a.hausdorffToRefRel);
+}
+
 // FSS_LONG_TESTS=1: single 256² scans of CGAL meshes from the seven standard views, a lattice setting
 // against the square pixel lattice of today's defaults (the figures of issue #20; the report lists which
 // meshes were tuned on). The setting from the environment: FSS_LATTICE = triangular | adaptive | square,
 // FSS_MIN_LATTICE_ANGLE (degrees, default 0), FSS_MIN_QUAD_ANGLE (default 20), FSS_RELAX (sweeps, default
-// 6). Coverage: the patch's area over the square-lattice patch's area from the same view ("cov"), and per
-// mesh the share of the reference's area covered by the seven patches together, for both settings.
+// 6), FSS_WARP=1 (ScanOptions::warpToSurface). Coverage: the patch's area over the square-lattice patch's
+// area from the same view ("cov"), and per mesh the share of the reference's area covered by the seven
+// patches together, for both settings.
 TEST(ScanPipeline, LatticeTableOverCgalMeshesLong) {
     const char* env = std::getenv("FSS_LONG_TESTS");
     if (!env || std::string(env) != "1") GTEST_SKIP() << "set FSS_LONG_TESTS=1";
@@ -398,6 +513,7 @@ TEST(ScanPipeline, LatticeTableOverCgalMeshesLong) {
     setting.minLatticeAngleDeg = numberFromEnv("FSS_MIN_LATTICE_ANGLE", 0);
     setting.minQuadAngleDeg = numberFromEnv("FSS_MIN_QUAD_ANGLE", 20);
     setting.relaxIterations = int(numberFromEnv("FSS_RELAX", 6));
+    setting.warpToSurface = numberFromEnv("FSS_WARP", 0) != 0;
     const LatticeSetting square{.lattice = fss::Lattice::Square, .minQuadAngleDeg = 0, .relaxIterations = 0};
     const fss::StandardView views[] = {
         fss::StandardView::Iso,  fss::StandardView::PosX, fss::StandardView::NegX, fss::StandardView::PosY,
@@ -405,8 +521,9 @@ TEST(ScanPipeline, LatticeTableOverCgalMeshesLong) {
     const char* viewNames[] = {"iso", "+x", "-x", "+y", "-y", "+z", "-z"};
     double worstMean = 90, worstBelow = 0, worstValence = 1, worstHausdorffRatio = 0, sumMean = 0, sumCov = 0;
     int scans = 0, missed = 0, hausdorffWorse = 0;
-    std::printf("%-14s %-4s | new: mean<  <30%%  val6   hausd    cov  | sq: mean<  <30%%  val6   hausd\n",
-                "mesh", "view");
+    std::printf(
+        "%-14s %-4s | new: mean<  <30%%  val6   hausd    cov  umb%% | sq: mean<  <30%%  val6   hausd\n",
+        "mesh", "view");
     for (const std::string& name : names) {
         const fss::Mesh ref = load(name);
         fss::CpuMeshRenderer renderer;
@@ -423,10 +540,12 @@ TEST(ScanPipeline, LatticeTableOverCgalMeshesLong) {
             }
             const double cov = sq.area > 0 ? tri.area / sq.area : 0;
             const bool miss = tri.meanMinAngle < 50 || tri.below30 > 0.02;
-            std::printf("%-14s %-4s | %9.1f %5.1f %6.3f %8.2e %5.2f | %8.1f %5.1f %6.3f %8.2e%s\n",
+            std::printf("%-14s %-4s | %9.1f %5.1f %6.3f %8.2e %5.2f %5.1f | %8.1f %5.1f %6.3f %8.2e%s\n",
                         name.c_str(), viewNames[v], tri.meanMinAngle, 100 * tri.below30, tri.valence6,
-                        tri.hausdorff, cov, sq.meanMinAngle, 100 * sq.below30, sq.valence6, sq.hausdorff,
-                        miss ? "  MISSED" : "");
+                        tri.hausdorff, cov, 100 * umbrellaShare(tri.patch), sq.meanMinAngle, 100 * sq.below30,
+                        sq.valence6, sq.hausdorff, miss ? "  MISSED" : "");
+            if (!tri.worst.empty())
+                std::printf("    new %s\n    sq  %s\n", tri.worst.c_str(), sq.worst.c_str());
             worstMean = std::min(worstMean, tri.meanMinAngle);
             worstBelow = std::max(worstBelow, tri.below30);
             worstValence = std::min(worstValence, tri.valence6 - sq.valence6);

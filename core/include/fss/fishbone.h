@@ -62,6 +62,13 @@ struct FishboneOptions {
     /// (a rib that bends to follow the backbone makes slivers). Degrees in (0, 180]; 180 = no bound (the
     /// default here; 60 is the value measured in issue 20, not yet the default).
     double maxRibTurnDeg = 180.0;
+    /// A half-rib also stops where its quad with a neighbouring rib is longer one way than this many times
+    /// the other: the distance to the neighbouring rib's vertex at the same position against the rib's own
+    /// edge there (ribs that fan out on the outer side of a curved backbone, or pile up on the inner side,
+    /// make quads whose triangles are slivers even with right corners: 1:2 gives 26.6°). Measured on the
+    /// surface when surfaceLength is set (isotropicRibs), else on the screen. 0 = no bound (the default;
+    /// not yet stored in session files, issue 20), else ≥ 1.
+    double maxRibAspect = 0.0;
     /// The fishbone scan stops a half-rib where an edge after its first crosses a visible crease of the
     /// reference (FishboneParams::creaseAngleDeg > 0; a rib running onto a neighbouring face of a CAD part).
     /// false here and in files written before it (true is not yet the default, issue 20).
@@ -90,8 +97,8 @@ struct FishboneOptions {
     /// stored in session files.
     std::function<double(const Eigen::Vector2d& a, const Eigen::Vector2d& b)> surfaceLength{};
 
-    /// Checks the ranges: spacing finite and > 0, minRibGap in [0, 1), maxRibTurnDeg in (0, 180], and both
-    /// tracings (StreamlineOptions::validate, named
+    /// Checks the ranges: spacing finite and > 0, minRibGap in [0, 1), maxRibTurnDeg in (0, 180],
+    /// maxRibAspect 0 or in [1, 100], and both tracings (StreamlineOptions::validate, named
     /// "FishboneOptions::backboneTracing.step" ...).
     /// \throw InvalidOptionError naming the field.
     void validate() const;
@@ -153,11 +160,11 @@ struct FishboneGrid {
     std::size_t presentCount() const;
 };
 
-/// Stops the half-ribs of \p grid (rows = the samples of \p backbone) where \p options' minRibGap or
-/// maxRibTurnDeg says (FishboneOptions): rows in order, each half outwards from the backbone; a vertex and
-/// every one beyond it on its half-rib become absent. Of two ribs that converge the one of the lower row
-/// stops first, so the other goes on. Returns the number of vertices removed.
-/// \pre grid.rows == backbone.samples.size() ≥ 2.
+/// Stops the half-ribs of \p grid (rows = the samples of \p backbone) where \p options' minRibGap,
+/// maxRibTurnDeg or maxRibAspect says (FishboneOptions): rows in order, each half outwards from the backbone;
+/// a vertex and every one beyond it on its half-rib become absent. Of two ribs that converge the one of the
+/// lower row stops first, so the other goes on. Returns the number of vertices removed. \pre grid.rows ==
+/// backbone.samples.size() ≥ 2.
 std::size_t trimRibs(FishboneGrid& grid, const Backbone& backbone, const FishboneOptions& options);
 
 /// The loop handling of FishboneOptions::closeLoops on a traced streamline \p line (not yet resampled):

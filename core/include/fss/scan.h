@@ -32,6 +32,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 namespace fss {
 
@@ -75,6 +76,11 @@ struct ScanOptions {
     /// angle chooseAdaptiveLattice counts coverage at (35° when 0). In [0, 60); 0 = no mask. 35° by
     /// default (issue #20: with it, the slanted rest of a view is left to views that see it rounder).
     double minLatticeAngleDeg = 35.0;
+    /// Lattice::Adaptive only: the chosen lattice is then warped on the screen so that its triangles are
+    /// equilateral *on the surface* under every sample, not only on the plane tilted by the lattice's θ0
+    /// (warpLatticeToSurface): a view of a curved surface sees it at many slants, and one affine lattice
+    /// fits only one of them. Off by default; session files do not record it (issue #20).
+    bool warpToSurface = false;
 
     /// Checks the ranges: qualityAngleLimitDeg in (0, 90), maxSnapFootprints finite and ≥ 0, lattice one of
     /// the enumerators, spacingPixels finite and in [0.25, 1024], spacingWorld finite and ≥ 0,
@@ -184,11 +190,25 @@ double latticeAngleOnPlane(const CameraProjector& camera, const Eigen::Vector3d&
 LatticeBasis chooseAdaptiveLattice(const FrameBuffers& referenceBuffers, const Mesh& reference,
                                    double spacing, double countFromDeg);
 
+/// The screen positions of a lattice warped to the surface (ScanOptions::warpToSurface), row by row
+/// (\p rows × \p cols, sample (r, c) at index r·cols + c), starting from the affine lattice origin + c·a +
+/// r·b. At every covered front-facing pixel the wanted local basis (a', b') is the one whose triangle is
+/// equilateral with side spacing × the pixel footprint on the plane of the face under the pixel (the
+/// linearised map of latticeAngleOnPlane), turned to be closest to the affine basis; the positions are
+/// the weighted least-squares fit of the grid's edges (a, b, a + b in (row, column)) to those local
+/// bases (a Poisson problem, solved by conjugate gradients, three times with the bases re-read under the
+/// moved edges). Uncovered pixels keep the affine basis with a small weight. Deterministic.
+std::vector<Eigen::Vector2d> warpLatticeToSurface(const FrameBuffers& referenceBuffers, const Mesh& reference,
+                                                  double spacing, const LatticeBasis& basis,
+                                                  const Eigen::Vector2d& origin, int rows, int cols);
+
 /// The lattice-angle mask (ScanOptions::minLatticeAngleDeg): every admissible sample of \p grid (a
 /// regular lattice: its basis is read from the screen positions of samples (0, 0), (0, 1), (1, 1)) whose
 /// latticeAngleOnPlane on its reference face is below \p minAngleDeg becomes not admissible and not
 /// valid. Returns how many. Nothing for \p minAngleDeg ≤ 0 or a grid with fewer than 2 rows or columns.
-std::size_t applyLatticeAngleMask(SampleGrid& grid, double minAngleDeg);
+/// With \p localBasis (a warped lattice, ScanOptions::warpToSurface) each sample's basis is read from its
+/// own neighbours' screen positions ((r, c + 1) and (r + 1, c + 1), or the ones before at the grid's end).
+std::size_t applyLatticeAngleMask(SampleGrid& grid, double minAngleDeg, bool localBasis = false);
 
 /// Where the viewing ray \p ray through screen position \p screen meets the reference, found from the
 /// ID buffer (DESIGN.md §1, shared by sampleLattice and the fishbone scan).

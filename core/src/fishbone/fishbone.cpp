@@ -516,7 +516,12 @@ std::size_t trimRibs(FishboneGrid& grid, const Backbone& backbone, const Fishbon
     const double minGap = options.minRibGap * grid.spacing;
     const double cosTurn = std::cos(options.maxRibTurnDeg * std::numbers::pi / 180.0);
     const bool turnBound = options.maxRibTurnDeg < 180.0;
-    if (!(minGap > 0) && !turnBound) return 0;
+    const double maxAspect = options.maxRibAspect;
+    if (!(minGap > 0) && !turnBound && !(maxAspect >= 1)) return 0;
+    // Lengths for the aspect bound: on the surface (isotropicRibs), else on the screen.
+    auto length = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+        return options.surfaceLength ? options.surfaceLength(a, b) : (a - b).norm();
+    };
     std::size_t removed = 0;
     for (int r = 0; r < grid.rows; ++r) {
         const Eigen::Vector2d normal = backbone.normal(std::size_t(r));
@@ -539,6 +544,12 @@ std::size_t trimRibs(FishboneGrid& grid, const Backbone& backbone, const Fishbon
                     if (!stopped && minGap > 0 && grid.isPresent(n, c) &&
                         (grid.at(n, c) - grid.at(r, c)).norm() < minGap)
                         stopped = true;
+                    if (!stopped && maxAspect >= 1 && grid.isPresent(n, c) && grid.isPresent(r, c - side)) {
+                        const double gap = length(grid.at(n, c), grid.at(r, c));
+                        const double edge = length(grid.at(r, c), grid.at(r, c - side));
+                        if (gap > 0 && edge > 0 && (gap > maxAspect * edge || edge > maxAspect * gap))
+                            stopped = true;
+                    }
                 }
                 if (stopped) {
                     grid.present[i] = 0;

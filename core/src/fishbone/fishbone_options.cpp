@@ -64,6 +64,7 @@ void FishboneOptions::validate() const {
     check.positive("spacing", spacing);
     check.inRange("minRibGap", minRibGap, 0, 1, false, true);
     check.inRange("maxRibTurnDeg", maxRibTurnDeg, 0, 180, true, false);
+    if (maxRibAspect != 0) check.inRange("maxRibAspect", maxRibAspect, 1, 100, false, false);
     detail::nestedOptions(owner, "backboneTracing.", [&] { backboneTracing.validate(); });
     detail::nestedOptions(owner, "ribTracing.", [&] { ribTracing.validate(); });
 }

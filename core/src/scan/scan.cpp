@@ -8,6 +8,9 @@
 #include "scan/scan_workspace_impl.h"
 
 #include <Eigen/Geometry>
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SVD>
+#include <Eigen/SparseCore>
 
 #include <algorithm>
 #include <atomic>
@@ -215,7 +218,7 @@ LatticeBasis chooseAdaptiveLattice(const FrameBuffers& referenceBuffers, const M
     return best;
 }
 
-std::size_t applyLatticeAngleMask(SampleGrid& grid, double minAngleDeg) {
+std::size_t applyLatticeAngleMask(SampleGrid& grid, double minAngleDeg, bool localBasis) {
     if (!(minAngleDeg > 0) || grid.rows < 2 || grid.cols < 2) return 0;
     const Eigen::Vector2d o = grid.at(0, 0).screen;
     LatticeBasis basis;
@@ -223,13 +226,159 @@ std::size_t applyLatticeAngleMask(SampleGrid& grid, double minAngleDeg) {
     basis.b = grid.at(1, 1).screen - o - basis.a;
     const CameraProjector projector(grid.camera);
     std::size_t masked = 0;
-    for (Sample& s : grid.samples) {
-        if (!s.admissible) continue;
-        if (latticeAngleOnPlane(projector, s.point, s.normal, basis) >= minAngleDeg) continue;
-        s.admissible = s.valid = false;
-        ++masked;
-    }
+    for (int r = 0; r < grid.rows; ++r)
+        for (int c = 0; c < grid.cols; ++c) {
+            Sample& s = grid.at(r, c);
+            if (!s.admissible) continue;
+            if (localBasis) { // the triangle (r, c), (r, c + 1), (r + 1, c + 1), or the one before at the end
+                const int r0 = std::min(r, grid.rows - 2), c0 = std::min(c, grid.cols - 2);
+                basis.a = grid.at(r0, c0 + 1).screen - grid.at(r0, c0).screen;
+                basis.b = grid.at(r0 + 1, c0 + 1).screen - grid.at(r0, c0 + 1).screen;
+            }
+            if (latticeAngleOnPlane(projector, s.point, s.normal, basis) >= minAngleDeg) continue;
+            s.admissible = s.valid = false;
+            ++masked;
+        }
     return masked;
+}
+
+std::vector<Eigen::Vector2d> warpLatticeToSurface(const FrameBuffers& referenceBuffers, const Mesh& reference,
+                                                  double spacing, const LatticeBasis& basis,
+                                                  const Eigen::Vector2d& origin, int rows, int cols) {
+    checkBuffers(referenceBuffers);
+    std::vector<Eigen::Vector2d> out(std::size_t(std::max(rows, 0)) * std::size_t(std::max(cols, 0)));
+    for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < cols; ++c)
+            out[std::size_t(r) * std::size_t(cols) + std::size_t(c)] =
+                origin + double(c) * basis.a + double(r) * basis.b;
+    if (rows < 2 || cols < 2) return out;
+    const Camera& camera = referenceBuffers.camera;
+    const CameraProjector projector(camera);
+    const int w = camera.width, h = camera.height;
+    // The wanted basis [a' b'] per pixel (column-major 2 × 2) and its weight.
+    Eigen::Matrix2d affine;
+    affine.col(0) = basis.a;
+    affine.col(1) = basis.b;
+    Eigen::Matrix2d equilateral;
+    equilateral.col(0) = spacing * Eigen::Vector2d(1, 0);
+    equilateral.col(1) = spacing * Eigen::Vector2d(-0.5, std::sqrt(3.0) / 2.0);
+    const Eigen::Matrix2d towardsEquilateral = affine * equilateral.inverse(); // K·R of the chosen lattice
+    std::vector<Eigen::Matrix2d> wanted(std::size_t(w) * std::size_t(h), affine);
+    std::vector<double> weight(wanted.size(), 0.01);
+    const std::size_t faceCount = reference.number_of_faces() + reference.number_of_removed_faces();
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const std::uint32_t id = referenceBuffers.faceAt(x, y);
+            if (id == FrameBuffers::kNoFace || id >= faceCount || reference.is_removed(FaceIndex(id)) ||
+                reference.degree(FaceIndex(id)) != 3)
+                continue;
+            const FaceGeometry g = faceGeometry(reference, FaceIndex(id));
+            const auto [point, ray] =
+                projector.unprojectPixelCentreWithRay(x, y, referenceBuffers.depthAt(x, y));
+            if (!(g.normal.squaredNorm() > 0) || !(g.normal.dot(ray.direction) < 0)) continue;
+            Eigen::Matrix2d m; // screen pixels -> tangent coordinates, world units
+            if (!planeFromScreen(projector, point, g.normal, m)) continue;
+            const double footprint = projector.pixelFootprint(point);
+            // In footprints, and no slant beyond 75° (the mask drops what is steeper anyway).
+            Eigen::Matrix2d mf = m / footprint;
+            const Eigen::JacobiSVD<Eigen::Matrix2d> mSvd(mf, Eigen::ComputeFullU | Eigen::ComputeFullV);
+            Eigen::Vector2d sv = mSvd.singularValues();
+            sv = sv.cwiseMin(1.0 / std::cos(75.0 * kDegToRad));
+            mf = mSvd.matrixU() * sv.asDiagonal() * mSvd.matrixV().transpose();
+            // The orthogonal Q closest to mf·K·R (polar decomposition): the wanted basis mf⁻¹·Q·E is then
+            // equilateral on the plane and as near the affine one as the plane allows. (Q is a reflection
+            // where mf reverses the orientation — the tangent basis's handedness against the screen's — so
+            // that the wanted basis keeps the affine one's.)
+            const Eigen::JacobiSVD<Eigen::Matrix2d> svd(mf * towardsEquilateral,
+                                                        Eigen::ComputeFullU | Eigen::ComputeFullV);
+            const Eigen::Matrix2d q = svd.matrixU() * svd.matrixV().transpose();
+            const Eigen::Matrix2d local = mf.inverse() * q * equilateral;
+            if (!local.allFinite() || !(local.determinant() * affine.determinant() > 0)) continue;
+            const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+            wanted[i] = local;
+            weight[i] = 1.0;
+        }
+    auto wantedAt = [&](const Eigen::Vector2d& p, double& wt) -> const Eigen::Matrix2d& {
+        const int x = int(std::floor(p.x())), y = int(std::floor(p.y()));
+        if (x < 0 || y < 0 || x >= w || y >= h) {
+            wt = 0.01;
+            return affine;
+        }
+        const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+        wt = weight[i];
+        return wanted[i];
+    };
+    // The fit is made on a coarse grid, every kCoarse-th row and column (the warp is smooth; the solve
+    // costs ~1/16 of the fine grid's), and the fine positions interpolated bilinearly in (row, column).
+    constexpr int kCoarse = 4;
+    const int cr = (rows - 1 + kCoarse - 1) / kCoarse + 1, cc = (cols - 1 + kCoarse - 1) / kCoarse + 1;
+    const int n = cr * cc;
+    Eigen::MatrixX2d phi(n, 2), anchor(n, 2);
+    for (int r = 0; r < cr; ++r)
+        for (int c = 0; c < cc; ++c)
+            anchor.row(r * cc + c) =
+                (origin + double(kCoarse * c) * basis.a + double(kCoarse * r) * basis.b).transpose();
+    phi = anchor;
+    // A weak pull towards the affine lattice keeps the system definite and the grid in place.
+    constexpr double kAnchor = 1e-5;
+    const int steps[3][2] = {{0, 1}, {1, 0}, {1, 1}}; // (dr, dc) of the grid's edges a, b, a + b
+    for (int outer = 0; outer < 3; ++outer) {
+        std::vector<Eigen::Triplet<double>> triplets;
+        triplets.reserve(std::size_t(n) * 7);
+        Eigen::MatrixX2d rhs = kAnchor * anchor;
+        Eigen::VectorXd diagonal = Eigen::VectorXd::Constant(n, kAnchor);
+        for (int r = 0; r < cr; ++r)
+            for (int c = 0; c < cc; ++c)
+                for (const auto& st : steps) {
+                    const int r2 = r + st[0], c2 = c + st[1];
+                    if (r2 >= cr || c2 >= cc) continue;
+                    const int i = r * cc + c, j = r2 * cc + c2;
+                    // The wanted bases along the edge, averaged with their weights.
+                    Eigen::Matrix2d local = Eigen::Matrix2d::Zero();
+                    double wt = 0;
+                    for (int k = 0; k < kCoarse; ++k) {
+                        const double t = (double(k) + 0.5) / double(kCoarse);
+                        double wk = 0;
+                        const Eigen::Matrix2d& m =
+                            wantedAt(((1 - t) * phi.row(i) + t * phi.row(j)).transpose(), wk);
+                        local += wk * m;
+                        wt += wk;
+                    }
+                    local /= wt;
+                    wt /= double(kCoarse);
+                    // Sample (r, c) sits at o + c·a + r·b: a step of dc columns and dr rows is dc·a + dr·b.
+                    const Eigen::Vector2d target =
+                        double(kCoarse) * (double(st[1]) * local.col(0) + double(st[0]) * local.col(1));
+                    triplets.emplace_back(i, j, -wt);
+                    triplets.emplace_back(j, i, -wt);
+                    diagonal[i] += wt;
+                    diagonal[j] += wt;
+                    rhs.row(j) += wt * target.transpose();
+                    rhs.row(i) -= wt * target.transpose();
+                }
+        for (int i = 0; i < n; ++i)
+            triplets.emplace_back(i, i, diagonal[i]);
+        Eigen::SparseMatrix<double> a(n, n);
+        a.setFromTriplets(triplets.begin(), triplets.end());
+        Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> cg;
+        cg.setMaxIterations(2000);
+        cg.setTolerance(1e-7);
+        cg.compute(a);
+        for (int k = 0; k < 2; ++k) {
+            const Eigen::VectorXd x = cg.solveWithGuess(rhs.col(k), phi.col(k));
+            if (x.allFinite()) phi.col(k) = x;
+        }
+    }
+    for (int r = 0; r < rows; ++r)
+        for (int c = 0; c < cols; ++c) {
+            const int i = std::min(r / kCoarse, cr - 2), j = std::min(c / kCoarse, cc - 2);
+            const double u = double(r - kCoarse * i) / kCoarse, v = double(c - kCoarse * j) / kCoarse;
+            out[std::size_t(r) * std::size_t(cols) + std::size_t(c)] =
+                ((1 - u) * (1 - v) * phi.row(i * cc + j) + (1 - u) * v * phi.row(i * cc + j + 1) +
+                 u * (1 - v) * phi.row((i + 1) * cc + j) + u * v * phi.row((i + 1) * cc + j + 1))
+                    .transpose();
+        }
+    return out;
 }
 
 float sampleQuality(double footprint, double samplingAngle, double qualityAngleLimitDeg) {
@@ -405,6 +554,7 @@ SampleGrid sampleLattice(const FrameBuffers& referenceBuffers, const Mesh& refer
     // x = x0 + (c − r/2)·s, y = y0 + r·(√3/2)·s; the square one x = x0 + c·s, y = y0 + r·s.
     Eigen::Vector2d origin, a, b;
     int rows = 0, cols = 0;
+    std::vector<Eigen::Vector2d> warped; // ScanOptions::warpToSurface: every sample's screen position
     if (options.lattice == Lattice::Adaptive) {
         const LatticeBasis basis =
             chooseAdaptiveLattice(referenceBuffers, reference, spacing,
@@ -426,10 +576,16 @@ SampleGrid sampleLattice(const FrameBuffers& referenceBuffers, const Mesh& refer
             rMin = std::min(rMin, cr.y());
             rMax = std::max(rMax, cr.y());
         }
-        const double c0 = std::floor(cMin), r0 = std::floor(rMin);
-        cols = int(std::ceil(cMax) - c0) + 1;
-        rows = int(std::ceil(rMax) - r0) + 1;
+        // A warped lattice may gather its rows and columns where the surface is slanted: a margin of a
+        // quarter of them on each side keeps the image covered (samples outside it miss).
+        const double margin = options.warpToSurface ? 0.25 : 0.0;
+        const double c0 = std::floor(cMin - margin * (cMax - cMin)),
+                     r0 = std::floor(rMin - margin * (rMax - rMin));
+        cols = int(std::ceil(cMax + margin * (cMax - cMin)) - c0) + 1;
+        rows = int(std::ceil(rMax + margin * (rMax - rMin)) - r0) + 1;
         origin = centre + c0 * a + r0 * b;
+        if (options.warpToSurface)
+            warped = warpLatticeToSurface(referenceBuffers, reference, spacing, basis, origin, rows, cols);
     } else {
         const bool triangular = options.lattice == Lattice::Triangular;
         const double shear = triangular ? 0.5 : 0.0;
@@ -463,7 +619,8 @@ SampleGrid sampleLattice(const FrameBuffers& referenceBuffers, const Mesh& refer
                 for (int c = 0; c < cols; ++c) {
                     Sample& s = grid.at(r, c);
                     s = Sample{};
-                    s.screen = adaptive
+                    s.screen = !warped.empty() ? warped[std::size_t(r) * std::size_t(cols) + std::size_t(c)]
+                               : adaptive
                                    ? Eigen::Vector2d(origin + double(c) * a + double(r) * b)
                                    : Eigen::Vector2d(origin.x() + (double(c) - shear * double(r)) * spacing,
                                                      origin.y() + double(r) * dy);

@@ -53,8 +53,12 @@ void relaxPatch(Patch& patch, const SampleGrid& grid, const Mesh& reference, con
 // The longest screen edge, in pixels, of the grid triangles of a lattice other than the square pixel
 // lattice (sampleLattice: sample (r, c) at o + c·a + r·b, triangles with the edges a, b, a + b), relative to
 // the square pixel lattice's (√2, its diagonal); 1 for the square lattice and grids of fewer than 2×2.
-double edgeLimitScale(const SampleGrid& grid, Lattice lattice) {
+double edgeLimitScale(const SampleGrid& grid, const ScanOptions& options) {
+    const Lattice lattice = options.lattice;
     if (lattice == Lattice::Square || grid.rows < 2 || grid.cols < 2) return 1.0;
+    // A lattice warped to the surface has edges of about one spacing on the surface wherever it is slanted;
+    // its screen edges say nothing: the triangular lattice's scale (1 px edges).
+    if (lattice == Lattice::Adaptive && options.warpToSurface) return 1.0 / std::sqrt(2.0);
     const Eigen::Vector2d a = grid.at(0, 1).screen - grid.at(0, 0).screen;
     const Eigen::Vector2d b = grid.at(1, 1).screen - grid.at(0, 1).screen;
     return std::max({a.norm(), b.norm(), (a + b).norm()}) / std::sqrt(2.0);
@@ -152,7 +156,8 @@ ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, con
     if (result.counts.frontFacing == 0)
         throw InvalidInputError(
             "The scan camera sees only the back of the surface; it is probably inside the mesh.");
-    applyLatticeAngleMask(result.grid, params.scan.minLatticeAngleDeg);
+    applyLatticeAngleMask(result.grid, params.scan.minLatticeAngleDeg,
+                          params.scan.warpToSurface && params.scan.lattice == Lattice::Adaptive);
     result.counts.wellShaped = result.grid.admissibleCount();
 
     MaskStages stages;
@@ -171,7 +176,7 @@ ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, con
     // √2 px diagonal, so the same limit in footprints let through their triangles stretched 2–3 times more
     // in depth (across occlusion boundaries and at grazing slants): those made the adaptive lattice's
     // Hausdorff distance worse than the square lattice's in 9 of 65 views (issue #20 report).
-    stages.triangulate.maxEdgeFootprints *= edgeLimitScale(result.grid, params.scan.lattice);
+    stages.triangulate.maxEdgeFootprints *= edgeLimitScale(result.grid, params.scan);
     MaskedPatch masked = maskAndTriangulate(result.grid, stages, workspace, progress);
     result.patch = std::move(masked.patch);
     result.counts.afterLasso = masked.counts.afterLasso;

@@ -458,9 +458,9 @@ bool ComponentStitcher::remeshBand(Local& loc, Plan& plan) {
     in.unseen = [&](FaceIndex f) { return !loc.star.kept[f] && loc.offView[f]; };
     in.growBelowDeg = 20.0;
     // The labels of where a face lies (the scan that made it, its quality) follow the surface: each band face
-    // takes those of the draft face under its centroid, so the scanned area (auto's coverage) stays where the
-    // patch put it whatever the splits, flips and moves did (measured: a cube's sides, 0.706 with the split
-    // parents' labels, AutoRemesh.CubeSidesAreScannedOnceEachByTheirOwnView).
+    // takes those of the draft face under its centroid, so the scanned area stays where the patch put it
+    // whatever the splits, flips and moves did (Stitch.PatchInsideFlatGrid: the faces with the scan id cover
+    // the patch's area within 0.5 %).
     std::vector<std::pair<float, std::int32_t>> draftLabels;
     in.draft = [&](const std::vector<FaceIndex>& faces) {
         for (FaceIndex f : faces)
