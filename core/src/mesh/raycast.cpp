@@ -325,6 +325,24 @@ SurfacePoint detail::LocalClosestPoint::operator()(const Eigen::Vector3d& p, Fac
         if (d == 0) return {hint, q, d};
     }
     if (measured_.size() < mesh_->num_faces()) measured_.resize(mesh_->num_faces(), 0u);
+    if (spheres_.size() < mesh_->num_faces()) {
+        const std::size_t from = spheres_.size();
+        spheres_.resize(mesh_->num_faces());
+        for (std::size_t i = from; i < spheres_.size(); ++i) {
+            const FaceIndex f(static_cast<std::uint32_t>(i));
+            if (mesh_->is_removed(f)) {
+                spheres_[i] = Eigen::Vector4d(0, 0, 0, std::numeric_limits<double>::infinity());
+                continue;
+            }
+            const HalfedgeIndex h = mesh_->halfedge(f);
+            const Eigen::Vector3d a = toEigen(mesh_->point(mesh_->source(h))),
+                                  b = toEigen(mesh_->point(mesh_->target(h))),
+                                  c = toEigen(mesh_->point(mesh_->target(mesh_->next(h))));
+            const Eigen::Vector3d m = (a + b + c) / 3.0;
+            const double r = std::max({(a - m).norm(), (b - m).norm(), (c - m).norm()});
+            spheres_[i] = Eigen::Vector4d(m.x(), m.y(), m.z(), r);
+        }
+    }
     if (++query_ == 0) { // wrapped: forget every stamp
         std::fill(measured_.begin(), measured_.end(), 0u);
         query_ = 1;
@@ -338,6 +356,11 @@ SurfacePoint detail::LocalClosestPoint::operator()(const Eigen::Vector3d& p, Fac
             std::uint32_t& stamp = measured_[std::size_t(f.idx())];
             if (stamp == query_) continue;
             stamp = query_;
+            // No point of f is nearer than its sphere: skip it where that is clearly farther than the best
+            // (the margin dwarfs the rounding of both distances, so no face that could win is skipped).
+            const Eigen::Vector4d& s = spheres_[std::size_t(f.idx())];
+            const double toCentre = (p - s.head<3>()).norm();
+            if (toCentre - s.w() > best.distance + 1e-9 * (toCentre + s.w() + s.head<3>().norm())) continue;
             const Eigen::Vector3d q = closestOnFace(*mesh_, f, p);
             const double d = (q - p).norm();
             if (d < best.distance) best = {f, q, d};
