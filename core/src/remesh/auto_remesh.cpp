@@ -474,6 +474,10 @@ std::vector<int> partitionSurface(const Mesh& reference, const std::vector<Frame
     return partitionAmongViews(reference, views, maxAngleDeg, beta, minIslandArea, rounds);
 }
 
+std::size_t flipSliverFaces(Mesh& mesh, double belowDeg, double maxDihedralDeg, int rounds) {
+    return flipSlivers(mesh, belowDeg, maxDihedralDeg, rounds);
+}
+
 std::vector<Eigen::Vector3d> planViews(const Mesh& reference, double servedAngleDeg, double minAreaFraction,
                                        int maxViews) {
     const double servedCos = std::cos(servedAngleDeg * std::numbers::pi / 180.0);

@@ -27,6 +27,10 @@ std::vector<int> partitionSurface(const Mesh& reference, const std::vector<Frame
 std::vector<Eigen::Vector3d> planViews(const Mesh& reference, double servedAngleDeg, double minAreaFraction,
                                        int maxViews);
 
+/// Flips edges between nearly coplanar faces where that raises the smaller smallest angle of faces whose
+/// smallest angle is below \p belowDeg (auto_remesh.cpp, flipSlivers). Returns the flips.
+std::size_t flipSliverFaces(Mesh& mesh, double belowDeg, double maxDihedralDeg, int rounds);
+
 /// autoRemesh with AutoEngine::V2 (auto_v2.cpp). Throws what autoRemesh throws; returns a result whose
 /// engineUsed is V1 (and engineNote the reason) when the V2 mesh failed validation and \p fallback ran.
 AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const Progress& progress);
