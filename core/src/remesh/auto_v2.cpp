@@ -256,8 +256,8 @@ private:
     std::priority_queue<Candidate> queue_;
 };
 
-/// Fills every boundary cycle of \p mesh left by the gap closing with CGAL's hole triangulation (no new
-/// vertex); the new faces take the scan id and quality of a face next to them.
+/// Fills every boundary cycle of \p mesh left by the gap closing with CGAL's hole triangulation and
+/// refinement; the new faces take the scan id and quality of a face next to them.
 void fillHoles(Mesh& mesh) {
     auto ids = mesh.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1).first;
     auto quality = mesh.add_property_map<FaceIndex, float>(props::faceQuality, 0.f).first;
@@ -267,7 +267,11 @@ void fillHoles(Mesh& mesh) {
         if (!mesh.is_border(h)) continue;
         const FaceIndex next = mesh.face(mesh.opposite(h));
         std::vector<FaceIndex> added;
-        CGAL::Polygon_mesh_processing::triangulate_hole(mesh, h, std::back_inserter(added));
+        std::vector<VertexIndex> newVertices;
+        // Refined (vertices inserted at the edge length of the hole's border), so that the seam relaxation
+        // can move the fill onto the reference (it projects zone vertices that lie off it).
+        CGAL::Polygon_mesh_processing::triangulate_and_refine_hole(mesh, h, std::back_inserter(added),
+                                                                   std::back_inserter(newVertices));
         for (FaceIndex f : added) {
             ids[f] = next != Mesh::null_face() ? ids[next] : 0;
             quality[f] = next != Mesh::null_face() ? quality[next] : 0.f;
