@@ -9,6 +9,8 @@
 // time
 //                     in the counter wall_ms); copying the mesh before each stitch is not timed.
 //                     Counters: patch_faces, faces_removed, faces_added, seam_edges.
+// FSS_STITCH_REMESH=1 (0) turns the seam band remesh on (off), FSS_STITCH_CORE_BYPASS=0 the
+// core bypass off (DESIGN.md §6.1), FSS_STITCH_PROFILE=1 prints the stages' CPU time per stitch.
 // BM_Scan/faces:N     scanPatch of the same view and lasso on the sphere of N faces: time = CPU time of the
 //                     calling thread, wall_ms = wall time including the GL driver's own threads.
 // After the runs the program prints stitch(1M) / stitch(10k) and stitch / scan per size.
@@ -25,11 +27,15 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <map>
 #include <memory>
+#include <string>
+#include <vector>
 
 namespace {
 
@@ -111,7 +117,21 @@ Scene& sceneWith(int faces) {
     return *s;
 }
 
-std::map<int, double> stitchMs, stitchWallMs, scanMs, scanCpuMs;
+// FSS_STITCH_REMESH=1 / 0: the seam band remesh on / off (StitchOptions::remeshSeam; unset: the default).
+fss::StitchOptions stitchOptions() {
+    fss::StitchOptions o;
+    if (const char* e = std::getenv("FSS_STITCH_REMESH")) o.remeshSeam = std::string(e) == "1";
+    return o;
+}
+
+// Per size, one figure per run of the benchmark (--benchmark_repetitions=N: N runs); the table after the runs
+// gives their medians (the machine is shared: one run can be off by a third).
+std::map<int, std::vector<double>> stitchMs, stitchWallMs, scanMs, scanCpuMs;
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
 
 void BM_Stitch(benchmark::State& state) {
     const int faces = int(state.range(0));
@@ -131,7 +151,7 @@ void BM_Stitch(benchmark::State& state) {
         }
         const auto t = Clock::now();
         const double c0 = threadCpuSeconds();
-        report = fss::stitchPatch(current, patch.mesh, scene.camera, {}, scene.ids);
+        report = fss::stitchPatch(current, patch.mesh, scene.camera, stitchOptions(), scene.ids);
         const double cpu = threadCpuSeconds() - c0;
         wall += std::chrono::duration<double>(Clock::now() - t).count();
         // The machine is shared: CPU time of this thread is the stable figure (stitching is single-threaded).
@@ -140,8 +160,8 @@ void BM_Stitch(benchmark::State& state) {
         benchmark::DoNotOptimize(current);
     }
     if (state.range(1)) {
-        stitchMs[faces] = 1e3 * total / double(state.iterations());
-        stitchWallMs[faces] = 1e3 * wall / double(state.iterations());
+        stitchMs[faces].push_back(1e3 * total / double(state.iterations()));
+        stitchWallMs[faces].push_back(1e3 * wall / double(state.iterations()));
     }
     state.counters["wall_ms"] = 1e3 * wall / double(state.iterations());
     state.counters["patch_faces"] = double(patch.mesh.number_of_faces());
@@ -168,8 +188,8 @@ void BM_Scan(benchmark::State& state) {
         patchFaces = r.patch.mesh.number_of_faces();
         benchmark::DoNotOptimize(patchFaces);
     }
-    scanMs[faces] = 1e3 * wall / double(state.iterations());
-    scanCpuMs[faces] = 1e3 * total / double(state.iterations());
+    scanMs[faces].push_back(1e3 * wall / double(state.iterations()));
+    scanCpuMs[faces].push_back(1e3 * total / double(state.iterations()));
     state.counters["wall_ms"] = 1e3 * wall / double(state.iterations());
     state.counters["patch_faces"] = double(patchFaces);
 }
@@ -196,16 +216,19 @@ int main(int argc, char** argv) {
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
     benchmark::RunSpecifiedBenchmarks();
     benchmark::Shutdown();
-    // Scan and stitch side by side (issue 19's targets: stitch ≤ 2 × scan at every size, 1M / 10k ≤ 1.5).
-    std::printf("\n%9s %13s %12s %14s %15s %18s %17s\n", "faces", "scan wall ms", "scan CPU ms",
-                "stitch CPU ms", "stitch wall ms", "stitch/scan wall", "stitch/scan CPU");
-    for (const auto& [faces, ms] : stitchMs)
-        if (scanMs.count(faces))
-            std::printf("%9d %13.1f %12.1f %14.1f %15.1f %18.2f %17.2f\n", faces, scanMs[faces],
-                        scanCpuMs[faces], ms, stitchWallMs[faces], stitchWallMs[faces] / scanMs[faces],
-                        ms / scanCpuMs[faces]);
+    // Scan and stitch side by side (issue 19's targets: stitch ≤ 2 × scan at every size, 1M / 10k ≤ 1.5);
+    // medians over the repetitions.
+    std::printf("\n%9s %13s %12s %14s %15s %18s %17s %5s\n", "faces", "scan wall ms", "scan CPU ms",
+                "stitch CPU ms", "stitch wall ms", "stitch/scan wall", "stitch/scan CPU", "runs");
+    for (const auto& [faces, runs] : stitchMs)
+        if (scanMs.count(faces)) {
+            const double st = median(runs), sw = median(stitchWallMs[faces]), cw = median(scanMs[faces]),
+                         cc = median(scanCpuMs[faces]);
+            std::printf("%9d %13.1f %12.1f %14.1f %15.1f %18.2f %17.2f %5zu\n", faces, cw, cc, st, sw,
+                        sw / cw, st / cc, runs.size());
+        }
     if (stitchMs.count(10000) && stitchMs.count(1000000))
         std::printf("stitch CPU time 1M / 10k faces: %.2f (target <= 1.5)\n",
-                    stitchMs[1000000] / stitchMs[10000]);
+                    median(stitchMs[1000000]) / median(stitchMs[10000]));
     return 0;
 }

@@ -293,6 +293,19 @@ TEST(StitchCommon, BucketGridAndIndexMapMatchBruteForce) {
         hits += expected.size();
     }
     EXPECT_GT(hits, 100u);
+    // With bounds (dense cells inside, hashed outside: the bounds cover part of the boxes only), the same
+    // ids in the same order as without.
+    st::BucketGrid dense(0.7, boxes.size(), CGAL::Bbox_2(-6, -8, 7, 5));
+    for (std::size_t i = 0; i < boxes.size(); ++i)
+        dense.insert(int(i), boxes[i]);
+    for (int q = 0; q < 60; ++q) {
+        const double x = 11 * std::cos(0.53 * q), y = 11 * std::sin(1.29 * q), r = 0.3 + 0.07 * q;
+        const CGAL::Bbox_2 box(x - r, y - r, x + r, y + r);
+        std::vector<int> a, b;
+        grid.query(box, [&](int id) { a.push_back(id); });
+        dense.query(box, [&](int id) { b.push_back(id); });
+        EXPECT_EQ(a, b) << "query " << q;
+    }
 
     st::IndexMap<int> map;
     std::unordered_map<std::uint32_t, int> ref;

@@ -1011,3 +1011,57 @@ TEST(Stitch, DenseMeshStitchesInOneRoundWithoutTrimming) {
     EXPECT_EQ(r.patchFacesTrimmed, 0u);
     expectValid(m, {true, 0}, false);
 }
+
+// The core bypass (DESIGN.md §6.1): the patch faces deep inside a component go straight into the mesh, not
+// through the local mesh. The reference is the stitch with the bypass off (FSS_STITCH_CORE_BYPASS=0): into
+// the same mesh, the same faces (in another order: the core's come last); a second patch over the first one
+// then meets the same surface indexed otherwise (the seam optimisation visits vertices and edges in index
+// order), so its seam may differ slightly: as valid, its seam as good, the same faces away from it. With
+// version 1's seam and with the band remesh.
+TEST(Stitch, CoreBypassKeepsTheSurfaceAndTheSeam) {
+    for (const bool remesh : {false, true}) {
+        Mesh with = fss::shapes::uvSphere(100, 51), without = with;
+        fss::StitchOptions o;
+        o.remeshSeam = remesh;
+        const Vec3 dirs[] = {{1, 0.3, 0.2}, {1, -0.2, 0.5}};
+        for (std::size_t i = 0; i < 2; ++i) {
+            SCOPED_TRACE(std::string(remesh ? "band remesh" : "version 1") + ", patch " + std::to_string(i));
+            const Camera cam = orbitCamera(dirs[i], 3.0, 128);
+            const Mesh patch = makePatch(cam, disk(64, 64, 48), sphere(1.0), std::int32_t(i + 1));
+            ASSERT_GT(patch.number_of_faces(), 8000u); // components from 2048 faces have a core
+            ::setenv("FSS_STITCH_CORE_BYPASS", "0", 1);
+            const fss::StitchReport r0 = fss::stitchPatch(without, patch, cam, o);
+            ::unsetenv("FSS_STITCH_CORE_BYPASS");
+            const fss::StitchReport r1 = fss::stitchPatch(with, patch, cam, o);
+            std::printf("core bypass (%s, patch %zu): faces added %zu / %zu, seam min angle %.2f / %.2f deg, "
+                        ">= 25 deg %.3f / %.3f (bypass / reference)\n",
+                        remesh ? "band remesh" : "version 1", i, r1.facesAdded, r0.facesAdded,
+                        r1.seamMinAngleDeg, r0.seamMinAngleDeg, r1.seamFracMinAngleAbove25,
+                        r0.seamFracMinAngleAbove25);
+            EXPECT_EQ(r1.piecesStitched, r0.piecesStitched);
+            EXPECT_EQ(r1.patchFacesTrimmed, r0.patchFacesTrimmed);
+            EXPECT_NEAR(double(r1.facesAdded), double(r0.facesAdded), 0.01 * double(r0.facesAdded));
+            EXPECT_GE(r1.seamMinAngleDeg, 0.75 * r0.seamMinAngleDeg);
+            EXPECT_GE(r1.seamFracMinAngleAbove25, r0.seamFracMinAngleAbove25 - 0.02);
+            expectValid(with, {true, 0});
+            std::vector<FaceKey> a, b;
+            for (auto f : with.faces())
+                a.push_back(faceKey(with, f));
+            for (auto f : without.faces())
+                b.push_back(faceKey(without, f));
+            const bool sameOrder = a == b;
+            EXPECT_FALSE(sameOrder); // the bypass was taken: the core's faces come last
+            std::sort(a.begin(), a.end());
+            std::sort(b.begin(), b.end());
+            std::vector<FaceKey> common;
+            std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(common));
+            // Into the same mesh, the same faces; into the same surface indexed otherwise (after the first
+            // patch), the same faces away from the seam: all but a band along it (~10 faces per seam edge).
+            if (i == 0) {
+                EXPECT_EQ(common.size(), a.size());
+            }
+            EXPECT_GE(double(common.size()), double(a.size()) - 10.0 * double(r0.seamEdges));
+            EXPECT_GE(common.size(), std::size_t(0.75 * double(patch.number_of_faces())));
+        }
+    }
+}

@@ -226,8 +226,9 @@ StitchReport detail::stitchPatch(Mesh& current, const Mesh& patch, const Camera&
         const bool applied = replay(
             current, plan, [](VertexIndex v) { return v; }, [](FaceIndex f) { return f; },
             [&](std::size_t i, FaceIndex f) {
-                if (q.second) q.first[f] = plan.quality[i];
-                if (s.second) s.first[f] = plan.scanId[i];
+                const std::size_t n = plan.faces.size();
+                if (q.second) q.first[f] = i < n ? plan.quality[i] : plan.coreQuality[i - n];
+                if (s.second) s.first[f] = i < n ? plan.scanId[i] : plan.coreScanId[i - n];
             });
         if (!applied) throw Error("Internal error: a rehearsed stitch could not be applied to the mesh.");
         StageClock::lap("apply");
@@ -238,7 +239,7 @@ StitchReport detail::stitchPatch(Mesh& current, const Mesh& patch, const Camera&
         facesDone += w.faces.size();
         ++report.piecesStitched;
         report.facesRemoved += plan.removed.size();
-        report.facesAdded += plan.faces.size();
+        report.facesAdded += plan.faces.size() + plan.coreFaces.size();
         report.seamEdges += plan.seamEdges;
         report.seamLength += plan.seamLength;
         report.collapses += plan.collapses;

@@ -370,10 +370,15 @@ bool ComponentStitcher::assemble(Cdt& cdt, Attempt& a) {
         for (FaceIndex g : unseen)
             openAsItself(g, true);
     }
-    // Patch faces, the boundary ones re-triangulated over the seam vertices of their edges.
-    double patchArea = 0;
+    // Patch faces, the boundary ones re-triangulated over the seam vertices of their edges; the core's
+    // (findCore) go straight into the mesh after the others (Plan::coreFaces).
+    const std::vector<char> core = findCore();
+    StageClock::lap("assemble:core");
+    double patchArea = cut_.coreArea;
     std::vector<int> bad;
-    for (int f : faces_) {
+    for (std::size_t i = 0; i < faces_.size(); ++i) {
+        if (!core.empty() && core[i]) continue;
+        const int f = faces_[i];
         progress_.tick();
         const auto& t = P_.tri[std::size_t(f)];
         std::vector<int> poly;

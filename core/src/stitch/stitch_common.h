@@ -215,21 +215,37 @@ private:
 };
 
 // ---------------------------------------------------------------------------------------------------
-// Uniform bucket grid over 2D boxes; queries report each id once.
+// Uniform bucket grid over 2D boxes; queries report each id once. With `bounds` (the box the inserted boxes
+// mostly lie in), the cells there are a dense array (no hashing: the searches over the faces under a patch
+// query this grid for every face); cells outside stay in a hash map. Either way the same ids are reported in
+// the same order (cells by x, then y; ids in insertion order).
 class BucketGrid {
 public:
     BucketGrid() = default;
     BucketGrid(double cell, std::size_t ids) : inv_(1.0 / cell), stamp_(ids, 0) {}
+    BucketGrid(double cell, std::size_t ids, const CGAL::Bbox_2& bounds) : BucketGrid(cell, ids) {
+        if (!(bounds.xmax() >= bounds.xmin()) || !(bounds.ymax() >= bounds.ymin())) return;
+        const double x0 = std::floor(bounds.xmin() * inv_), x1 = std::floor(bounds.xmax() * inv_);
+        const double y0 = std::floor(bounds.ymin() * inv_), y1 = std::floor(bounds.ymax() * inv_);
+        const double cells = (x1 - x0 + 1) * (y1 - y0 + 1);
+        // (Only where the array stays small next to the ids it holds.)
+        if (!(cells <= 4.0 * double(ids) + 4096.0) || std::abs(x0) > 1e15 || std::abs(y0) > 1e15) return;
+        x0_ = std::int64_t(x0);
+        y0_ = std::int64_t(y0);
+        nx_ = std::int64_t(x1 - x0) + 1;
+        ny_ = std::int64_t(y1 - y0) + 1;
+        dense_.resize(std::size_t(nx_ * ny_));
+    }
 
     void insert(int id, const CGAL::Bbox_2& b) {
-        forCells(b, [&](std::uint64_t key) { cells_[key].push_back(id); });
+        forCells(b, [&](std::int64_t x, std::int64_t y) { cellAt(x, y).push_back(id); });
     }
     template <class F> void query(const CGAL::Bbox_2& b, F&& f) {
         ++current_;
-        forCells(b, [&](std::uint64_t key) {
-            auto it = cells_.find(key);
-            if (it == cells_.end()) return;
-            for (int id : it->second)
+        forCells(b, [&](std::int64_t x, std::int64_t y) {
+            const std::vector<int>* cell = find(x, y);
+            if (!cell) return;
+            for (int id : *cell)
                 if (stamp_[std::size_t(id)] != current_) {
                     stamp_[std::size_t(id)] = current_;
                     f(id);
@@ -238,6 +254,25 @@ public:
     }
 
 private:
+    static std::uint64_t key(std::int64_t x, std::int64_t y) {
+        return (std::uint64_t(std::uint32_t(x)) << 32) | std::uint32_t(y);
+    }
+    bool inDense(std::int64_t x, std::int64_t y) const {
+        return x >= x0_ && x < x0_ + nx_ && y >= y0_ && y < y0_ + ny_;
+    }
+    std::vector<int>& cellAt(std::int64_t x, std::int64_t y) {
+        if (inDense(x, y)) return dense_[std::size_t((x - x0_) * ny_ + (y - y0_))];
+        return cells_[key(x, y)];
+    }
+    const std::vector<int>* find(std::int64_t x, std::int64_t y) const {
+        if (inDense(x, y)) {
+            const std::vector<int>& c = dense_[std::size_t((x - x0_) * ny_ + (y - y0_))];
+            return c.empty() ? nullptr : &c;
+        }
+        if (cells_.empty()) return nullptr;
+        auto it = cells_.find(key(x, y));
+        return it == cells_.end() ? nullptr : &it->second;
+    }
     template <class F> void forCells(const CGAL::Bbox_2& b, F&& f) const {
         const auto x0 = std::int64_t(std::floor(b.xmin() * inv_)),
                    x1 = std::int64_t(std::floor(b.xmax() * inv_));
@@ -245,10 +280,12 @@ private:
                    y1 = std::int64_t(std::floor(b.ymax() * inv_));
         for (std::int64_t x = x0; x <= x1; ++x)
             for (std::int64_t y = y0; y <= y1; ++y)
-                f((std::uint64_t(std::uint32_t(x)) << 32) | std::uint32_t(y));
+                f(x, y);
     }
     double inv_ = 1.0;
     std::unordered_map<std::uint64_t, std::vector<int>> cells_;
+    std::vector<std::vector<int>> dense_;
+    std::int64_t x0_ = 0, y0_ = 0, nx_ = 0, ny_ = 0;
     std::vector<unsigned> stamp_;
     unsigned current_ = 0;
 };
@@ -379,6 +416,13 @@ struct Plan {
     std::vector<std::array<PlanVertex, 3>> faces; // new faces, added in this order
     std::vector<float> quality;
     std::vector<std::int32_t> scanId;
+    // The patch's core (faces deep inside the component, added after `faces` straight into the hole they
+    // leave, without the local mesh: DESIGN.md §6.1 "Core bypass"): corners, and for every face the bit k
+    // set when its edge k → k+1 lies on the core's border (the face beyond it is one of `faces`).
+    std::vector<std::array<PlanVertex, 3>> coreFaces;
+    std::vector<std::uint8_t> coreBorder;
+    std::vector<float> coreQuality;
+    std::vector<std::int32_t> coreScanId;
     std::size_t seamEdges = 0;
     double seamLength = 0;
     std::vector<double> seamFaceMinAngles; // degrees, one per face touching the seam
@@ -392,6 +436,65 @@ struct Attempt {
     std::vector<int> bad; // patch vertices near the problem: trim there and retry
     Plan plan;
 };
+
+// Adds the plan's core faces (after its other faces: their border is then a set of border halfedges of m,
+// each the core border edge of one core face) by linking halfedges directly, not through add_face: the
+// core is a piece of the scan's grid, valid and oriented by construction, and the stitcher checked that
+// the hole its border leaves is exactly the core's border (validate), so nothing here can fail half-way
+// except on an internal error (false, as replay). onFace gets indices after plan.faces.
+template <class VertexOf, class OnFace>
+inline bool fillCore(Mesh& m, const Plan& plan, const std::vector<VertexIndex>& fresh,
+                     const VertexOf& vertexOf, const OnFace& onFace) {
+    if (plan.coreFaces.empty()) return true;
+    auto vertex = [&](const PlanVertex& pv) {
+        return pv.fresh ? fresh[pv.index] : vertexOf(VertexIndex(pv.index));
+    };
+    // Core border: the border halfedges of m there (checked first, before any edit).
+    std::vector<HalfedgeIndex> border;
+    for (std::size_t i = 0; i < plan.coreFaces.size(); ++i)
+        for (int k = 0; k < 3; ++k)
+            if (plan.coreBorder[i] & (1u << k)) {
+                const HalfedgeIndex h = m.halfedge(vertex(plan.coreFaces[i][std::size_t(k)]),
+                                                   vertex(plan.coreFaces[i][std::size_t((k + 1) % 3)]));
+                if (h == Mesh::null_halfedge() || !m.is_border(h)) return false;
+                border.push_back(h);
+            }
+    std::size_t nextBorder = 0;
+    // Inner edges: the halfedge x → y made with the first face that uses the edge (y → x then waits).
+    IndexMap<HalfedgeIndex, std::uint64_t> waiting;
+    for (std::size_t i = 0; i < plan.coreFaces.size(); ++i) {
+        std::array<VertexIndex, 3> vs;
+        for (int k = 0; k < 3; ++k)
+            vs[std::size_t(k)] = vertex(plan.coreFaces[i][std::size_t(k)]);
+        std::array<HalfedgeIndex, 3> hs;
+        for (int k = 0; k < 3; ++k) {
+            const VertexIndex x = vs[std::size_t(k)], y = vs[std::size_t((k + 1) % 3)];
+            if (plan.coreBorder[i] & (1u << k)) {
+                hs[std::size_t(k)] = border[nextBorder++];
+                continue;
+            }
+            const std::uint64_t key = (std::uint64_t(std::uint32_t(x)) << 32) | std::uint32_t(y);
+            const HalfedgeIndex* h = waiting.find(key);
+            if (h) {
+                hs[std::size_t(k)] = *h;
+            } else {
+                hs[std::size_t(k)] = m.add_edge(x, y); // x → y; its opposite y → x for the face beyond
+                waiting[(std::uint64_t(std::uint32_t(y)) << 32) | std::uint32_t(x)] =
+                    m.opposite(hs[std::size_t(k)]);
+            }
+        }
+        const FaceIndex f = m.add_face();
+        for (int k = 0; k < 3; ++k) {
+            const HalfedgeIndex h = hs[std::size_t(k)];
+            m.set_face(h, f);
+            m.set_next(h, hs[std::size_t((k + 1) % 3)]);
+            m.set_halfedge(m.target(h), h); // every core vertex is interior once the core is in
+        }
+        m.set_halfedge(f, hs[0]);
+        onFace(plan.faces.size() + i, f);
+    }
+    return true;
+}
 
 // Applies the edits of a plan to a mesh whose vertices are addressed through `vertexOf` (current
 // vertices → vertices of m) and whose faces through `faceOf`. Returns false when a face cannot be added.
@@ -417,7 +520,7 @@ inline bool replay(Mesh& m, const Plan& plan, const VertexOf& vertexOf, const Fa
         if (f == Mesh::null_face()) return false;
         onFace(i, f);
     }
-    return true;
+    return fillCore(m, plan, fresh, vertexOf, onFace);
 }
 
 // ---------------------------------------------------------------------------------------------------

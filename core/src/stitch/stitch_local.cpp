@@ -54,6 +54,180 @@ std::vector<std::size_t> ComponentStitcher::growthOrder(const std::vector<std::a
     return order;
 }
 
+std::vector<char> ComponentStitcher::findCore() {
+    // Components smaller than this, or cores smaller than that, go whole through the local mesh.
+    constexpr std::size_t kMinComponentFaces = 2048, kMinCoreFaces = 512;
+    std::vector<char> core;
+    cut_.coreFaces.clear();
+    cut_.coreBorder.clear();
+    cut_.coreChords.clear();
+    cut_.coreArea = 0;
+    if (!bypass_ || faces_.size() < kMinComponentFaces) return core;
+    const std::size_t n = P_.pos.size();
+    // The faces around every vertex of the component (compressed rows: positions in faces_).
+    std::vector<std::uint32_t> start(n + 1, 0);
+    for (int f : faces_)
+        for (int v : P_.tri[std::size_t(f)])
+            ++start[std::size_t(v) + 1];
+    for (std::size_t v = 0; v < n; ++v)
+        start[v + 1] += start[v];
+    std::vector<std::uint32_t> around(start[n]), fill(start.begin(), start.end() - 1);
+    for (std::size_t i = 0; i < faces_.size(); ++i)
+        for (int v : P_.tri[std::size_t(faces_[i])])
+            around[fill[std::size_t(v)]++] = std::uint32_t(i);
+    // Rings from the boundary, breadth first, up to coreRings() − 1; unreached vertices lie deeper.
+    const int rings = coreRings();
+    std::vector<int> depth(n, -1);
+    std::vector<int> queue(comp_.boundary.begin(), comp_.boundary.end());
+    for (int v : queue)
+        depth[std::size_t(v)] = 0;
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+        const int v = queue[q];
+        if (depth[std::size_t(v)] + 1 >= rings) continue;
+        for (std::uint32_t j = start[std::size_t(v)]; j < start[std::size_t(v) + 1]; ++j)
+            for (int w : P_.tri[std::size_t(faces_[around[j]])])
+                if (depth[std::size_t(w)] < 0) {
+                    depth[std::size_t(w)] = depth[std::size_t(v)] + 1;
+                    queue.push_back(w);
+                }
+    }
+    core.assign(faces_.size(), 0);
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < faces_.size(); ++i) {
+        const auto& t = P_.tri[std::size_t(faces_[i])];
+        core[i] =
+            depth[std::size_t(t[0])] < 0 && depth[std::size_t(t[1])] < 0 && depth[std::size_t(t[2])] < 0;
+        count += std::size_t(core[i]);
+    }
+    if (count < kMinCoreFaces) return {};
+    // A face degenerate in 3D (the view's rounding can hide it) would fail the checks: no bypass then.
+    for (std::size_t i = 0; i < faces_.size(); ++i) {
+        if (!core[i]) continue;
+        const auto& t = P_.tri[std::size_t(faces_[i])];
+        if (CGAL::collinear(toPoint(P_.pos[std::size_t(t[0])]), toPoint(P_.pos[std::size_t(t[1])]),
+                            toPoint(P_.pos[std::size_t(t[2])])))
+            return {};
+    }
+    // The core's border: edges whose other face (b → a, in the component: the core's vertices are not on
+    // its boundary) is not a core face.
+    for (std::size_t i = 0; i < faces_.size(); ++i) {
+        if (!core[i]) continue;
+        const int f = faces_[i];
+        const auto& t = P_.tri[std::size_t(f)];
+        std::uint8_t bits = 0;
+        for (int k = 0; k < 3; ++k) {
+            const int a = t[std::size_t(k)], b = t[std::size_t((k + 1) % 3)];
+            bool coreBeyond = false;
+            for (std::uint32_t j = start[std::size_t(b)]; j < start[std::size_t(b) + 1] && !coreBeyond; ++j) {
+                const auto& u = P_.tri[std::size_t(faces_[around[j]])];
+                for (int m = 0; m < 3; ++m)
+                    if (u[std::size_t(m)] == b && u[std::size_t((m + 1) % 3)] == a)
+                        coreBeyond = core[around[j]] != 0;
+            }
+            if (!coreBeyond) bits |= std::uint8_t(1u << k);
+        }
+        cut_.coreFaces.push_back(f);
+        cut_.coreBorder.push_back(bits);
+        for (int k = 0; k < 3; ++k)
+            if (bits & (1u << k))
+                depth[std::size_t(t[std::size_t(k)])] = depth[std::size_t(t[std::size_t((k + 1) % 3)])] = -2;
+        cut_.coreArea += area2(P_.uv[std::size_t(t[0])], P_.uv[std::size_t(t[1])], P_.uv[std::size_t(t[2])]);
+    }
+    // Inner edges of the core between two of its border vertices: S must not have them too (coreFits).
+    for (std::size_t i = 0; i < cut_.coreFaces.size(); ++i) {
+        const auto& t = P_.tri[std::size_t(cut_.coreFaces[i])];
+        for (int k = 0; k < 3; ++k) {
+            const int a = t[std::size_t(k)], b = t[std::size_t((k + 1) % 3)];
+            if (!(cut_.coreBorder[i] & (1u << k)) && a < b && depth[std::size_t(a)] == -2 &&
+                depth[std::size_t(b)] == -2)
+                cut_.coreChords.push_back({a, b});
+        }
+    }
+    coreMask_ = core;
+    return core;
+}
+
+void ComponentStitcher::dissolveCore() {
+    for (int f : cut_.coreFaces) {
+        const auto& t = P_.tri[std::size_t(f)];
+        const double floor = std::min(O_.minAngleFloorDeg * kDeg,
+                                      0.999 * minAngle(P_.pos[std::size_t(t[0])], P_.pos[std::size_t(t[1])],
+                                                       P_.pos[std::size_t(t[2])]));
+        cut_.newFaces.push_back({{localOfPatch(t[0]), localOfPatch(t[1]), localOfPatch(t[2])},
+                                 P_.hasQuality ? P_.quality[std::size_t(f)] : kInputFaceQuality,
+                                 P_.hasScanId ? P_.scanId[std::size_t(f)] : -1,
+                                 true,
+                                 Vec3(0, 0, 0),
+                                 floor,
+                                 false});
+    }
+    cut_.coreFaces.clear();
+    cut_.coreBorder.clear();
+    cut_.coreChords.clear();
+    coreMask_.clear();
+}
+
+bool ComponentStitcher::retryWithoutCore(Attempt& a) {
+    bypass_ = false;
+    dissolveCore();
+    a = Attempt{};
+    return buildAndOptimise(a);
+}
+
+bool ComponentStitcher::coreFits(Local& loc) {
+    const Mesh& S = loc.star.S;
+    // Every core border edge a → b is a border halfedge of S ...
+    std::vector<HalfedgeIndex> borders;
+    for (const auto& [x, y] : loc.coreEdges) {
+        if (S.is_removed(x) || S.is_removed(y)) return false;
+        const HalfedgeIndex h = S.halfedge(x, y);
+        if (h == Mesh::null_halfedge() || !S.is_border(h)) return false;
+    }
+    // ... and there is no other border halfedge at those vertices: the hole is exactly the core's.
+    for (std::size_t i = 0; i < loc.coreEdges.size(); ++i) {
+        const VertexIndex v = loc.coreEdges[i].first;
+        if (S.halfedge(v) == Mesh::null_halfedge()) return false;
+        for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(v), S))
+            for (HalfedgeIndex g : {h, S.opposite(h)})
+                if (S.is_border(g)) borders.push_back(g);
+    }
+    std::sort(borders.begin(), borders.end());
+    borders.erase(std::unique(borders.begin(), borders.end()), borders.end());
+    if (borders.size() != loc.coreEdges.size()) return false;
+    // The core's inner edges between border vertices are not edges of S (no edge twice).
+    for (const auto& [p, q] : cut_.coreChords) {
+        const VertexIndex *x = loc.coreVertex.find(std::uint32_t(p)),
+                          *y = loc.coreVertex.find(std::uint32_t(q));
+        if (!x || !y || S.halfedge(*x, *y) != Mesh::null_halfedge()) return false;
+    }
+    // No kept face overlaps a core face in the view (disjoint in the view, disjoint in 3D: the
+    // self-intersection test of the local mesh need not see the core).
+    for (FaceIndex f : S.faces()) {
+        if (!loc.star.kept[f]) continue;
+        std::array<Point2, 3> q;
+        int k = 0;
+        for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(f), S)) {
+            double w;
+            if (k == 3 || !V_.project(pt(S, v), q[std::size_t(k)], w)) return false;
+            ++k;
+        }
+        if (k != 3) return false;
+        const CGAL::Bbox_2 box = bboxOf(q[0], q[1], q[2]);
+        const bool flat = CGAL::collinear(q[0], q[1], q[2]);
+        const Triangle2 kept = CGAL::orientation(q[0], q[1], q[2]) == CGAL::RIGHT_TURN
+                                   ? Triangle2(q[0], q[2], q[1])
+                                   : Triangle2(q[0], q[1], q[2]);
+        bool overlap = false;
+        comp_.grid.query(box, [&](int i) {
+            if (overlap || !coreMask_[std::size_t(i)]) return;
+            if (!CGAL::do_overlap(box, triBox(faces_[std::size_t(i)]))) return;
+            overlap = flat || CGAL::do_intersect(kept, patchTriangle(faces_[std::size_t(i)]));
+        });
+        if (overlap) return false;
+    }
+    return true;
+}
+
 bool ComponentStitcher::buildAndOptimise(Attempt& a) {
     Local loc;
     Mesh& S = loc.star.S;
@@ -154,6 +328,24 @@ bool ComponentStitcher::buildAndOptimise(Attempt& a) {
     for (const auto& pe : comp_.pedges)
         for (std::size_t j = 0; j + 1 < pe.line.size(); ++j)
             loc.seam.insert(seamKey(sv[std::size_t(pe.line[j])], sv[std::size_t(pe.line[j + 1])]));
+    // The core's border in S (its vertices are border vertices of S, so locked above).
+    for (std::size_t i = 0; i < cut_.coreFaces.size(); ++i) {
+        const auto& t = P_.tri[std::size_t(cut_.coreFaces[i])];
+        for (int k = 0; k < 3; ++k) {
+            if (!(cut_.coreBorder[i] & (1u << k))) continue;
+            VertexIndex ends[2];
+            for (int e = 0; e < 2; ++e) {
+                const int p = t[std::size_t((k + e) % 3)];
+                const auto it = cut_.lidOfPatch.find(p);
+                if (it == cut_.lidOfPatch.end() || sv[std::size_t(it->second)] == VertexIndex())
+                    return retryWithoutCore(a);
+                ends[e] = sv[std::size_t(it->second)];
+                loc.coreVertex[std::uint32_t(p)] = ends[e];
+                loc.coreVertexSet.insert(std::uint32_t(ends[e]));
+            }
+            loc.coreEdges.push_back({ends[0], ends[1]});
+        }
+    }
 
     StageClock::lap("local mesh");
     progress_.step(6, 8);
@@ -166,6 +358,7 @@ bool ComponentStitcher::buildAndOptimise(Attempt& a) {
     StageClock::lap("optimise");
     progress_.step(7, 8);
     if (!validate(loc, bordersBefore, a)) {
+        if (loc.coreBroken) return retryWithoutCore(a);
         if (loc.refilled) return retryWithoutRefill(a);
         if (loc.remeshed && stitch::bandDiagnostics())
             std::fprintf(stderr, "band: fails the checks (%s; v1 kept)\n", a.reason.c_str());
@@ -391,7 +584,7 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> ComponentStitcher::bordersArou
         if (!loc.star.isFull(v) || S.halfedge(v) == Mesh::null_halfedge()) continue;
         for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(v), S))
             for (HalfedgeIndex g : {h, S.opposite(h)})
-                if (S.is_border(g))
+                if (S.is_border(g) && !(onCoreBorder(loc, S.source(g)) && onCoreBorder(loc, S.target(g))))
                     out.insert(std::minmax(loc.star.cur[S.source(g)], loc.star.cur[S.target(g)]));
     }
     return out;

@@ -85,7 +85,7 @@ std::string describeComponent(const PatchData& P, const std::vector<int>& faces,
     c.box = CGAL::Bbox_2();
     for (int v : c.verts)
         c.box += P.uv[std::size_t(v)].bbox();
-    c.grid = BucketGrid(2.0 * c.h2, faces.size());
+    c.grid = BucketGrid(2.0 * c.h2, faces.size(), c.box);
     for (std::size_t i = 0; i < faces.size(); ++i)
         c.grid.insert(int(i), patchTriangleBox(P, faces[i]));
     return {};
@@ -211,7 +211,10 @@ bool ComponentStitcher::meetsComponent(FaceIndex f) {
         if (!CGAL::do_overlap(box, triBox(pf))) return;
         bool onSheet = false;
         for (int v : P_.tri[std::size_t(pf)])
-            if (gapToPlane(P_.pos[std::size_t(v)], A, n) <= tolerance) onSheet = true;
+            if (gapToPlane(P_.pos[std::size_t(v)], A, n) <= tolerance) {
+                onSheet = true;
+                break;
+            }
         if (!onSheet) return;
         const Triangle2 p = patchTriangle(pf);
         hit = inTriangle(p[0], t[0], t[1], t[2]) || inTriangle(t[0], p[0], p[1], p[2]) ||
@@ -351,12 +354,14 @@ bool ComponentStitcher::findRegion(Attempt& a) {
 
 bool ComponentStitcher::preTrim(Attempt& a) {
     double edge = 0;
+    CGAL::Bbox_2 bounds;
     for (FaceIndex f : reg_.faces) {
         const Triangle2 t = faceTriangle(f);
         edge += std::sqrt(dist2(t[0], t[1]));
+        bounds += t.bbox();
     }
     edge /= double(reg_.faces.size());
-    reg_.grid = BucketGrid(std::max(2.0 * comp_.h2, edge), reg_.faces.size());
+    reg_.grid = BucketGrid(std::max(2.0 * comp_.h2, edge), reg_.faces.size(), bounds);
     for (std::size_t i = 0; i < reg_.faces.size(); ++i)
         reg_.grid.insert(int(i), faceTriangle(reg_.faces[i]).bbox());
     std::vector<int> bad;

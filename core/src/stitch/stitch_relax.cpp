@@ -496,12 +496,12 @@ void ComponentStitcher::flipPass(Local& loc, Plan& plan) {
         return std::abs(int(S.degree(v)) + delta - target);
     };
     std::deque<EdgeIndex> queue;
-    std::unordered_set<std::uint32_t> queued;
+    std::vector<char> queued(S.num_edges(), 0); // by edge index (a flip adds no edge)
     for (EdgeIndex e : edgesAround(S, near)) {
         const HalfedgeIndex h = S.halfedge(e);
         if (near.count(std::uint32_t(S.source(h))) && near.count(std::uint32_t(S.target(h)))) {
             queue.push_back(e);
-            queued.insert(std::uint32_t(e));
+            queued[std::uint32_t(e)] = 1;
         }
     }
     std::size_t flips = 0;
@@ -510,24 +510,38 @@ void ComponentStitcher::flipPass(Local& loc, Plan& plan) {
         const EdgeIndex e = queue.front();
         queue.pop_front();
         progress_.tick();
-        queued.erase(std::uint32_t(e));
+        queued[std::uint32_t(e)] = 0;
         if (S.is_removed(e)) continue;
         const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
-        double oldMin = 0, newMin = 0;
-        bool nearPlanar = false;
-        if (!flipAllowed(loc, h, near, oldMin, newMin, nearPlanar)) continue;
+        // The score first (flipAllowed's own angles, the same doubles), the checks only for a flip worth
+        // making: most edges near the seam fail the score, and the checks cost several times more.
+        const FaceIndex fh = S.face(h), fo = S.face(o);
+        if (fh == Mesh::null_face() || fo == Mesh::null_face() || loc.star.kept[fh] || loc.star.kept[fo])
+            continue;
         const VertexIndex x = S.source(h), y = S.target(h), z1 = S.target(S.next(h)),
                           z2 = S.target(S.next(o));
+        if (!near.count(std::uint32_t(x)) || !near.count(std::uint32_t(y))) continue;
+        const Vec3 X = pt(S, x), Y = pt(S, y), Z1 = pt(S, z1), Z2 = pt(S, z2);
+        const double before = std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2));
+        const double after = std::min(minAngle(X, Z2, Z1), minAngle(Z2, Y, Z1));
+        if (after < std::min(before, 20.0 * kDeg)) continue;
         const int devOld = valenceCost(x, 0) + valenceCost(y, 0) + valenceCost(z1, 0) + valenceCost(z2, 0);
         const int devNew = valenceCost(x, -1) + valenceCost(y, -1) + valenceCost(z1, 1) + valenceCost(z2, 1);
         // Score: smallest angle in degrees minus 3° per unit of valence deviation.
+        if (!((after - before) / kDeg - 3.0 * double(devNew - devOld) > 0.5)) continue;
+        double oldMin = 0, newMin = 0;
+        bool nearPlanar = false;
+        if (!flipAllowed(loc, h, near, oldMin, newMin, nearPlanar)) continue;
         const double gain = (newMin - oldMin) / kDeg - 3.0 * double(devNew - devOld);
         if (!(gain > 0.5) || newMin < std::min(oldMin, 20.0 * kDeg)) continue;
         flip(loc, h, nearPlanar);
         ++flips;
         for (HalfedgeIndex g : {S.next(h), S.prev(h), S.next(o), S.prev(o)}) {
             const EdgeIndex ge = S.edge(g);
-            if (queued.insert(std::uint32_t(ge)).second) queue.push_back(ge);
+            if (!queued[std::uint32_t(ge)]) {
+                queued[std::uint32_t(ge)] = 1;
+                queue.push_back(ge);
+            }
         }
     }
     plan.flips += flips;
@@ -640,12 +654,7 @@ void ComponentStitcher::valencePass(Local& loc, Plan& plan) {
 }
 
 bool ComponentStitcher::seamVertex(const Local& loc, VertexIndex v) const {
-    const std::uint32_t i = std::uint32_t(v);
-    auto it = loc.seam.lower_bound({i, 0});
-    if (it != loc.seam.end() && it->first == i) return true;
-    for (const auto& e : loc.seam)
-        if (e.second == i) return true;
-    return false;
+    return loc.seam.touches(std::uint32_t(v));
 }
 
 void ComponentStitcher::collapse(Local& loc, VertexIndex from, VertexIndex to) {
@@ -663,13 +672,29 @@ void ComponentStitcher::collapse(Local& loc, VertexIndex from, VertexIndex to) {
         loc.locked[v1] = loc.locked[to];
         loc.star.cur[v1] = loc.star.cur[to];
     }
-    std::set<std::pair<std::uint32_t, std::uint32_t>> seam;
-    for (auto [a, b] : loc.seam) {
-        if (a == std::uint32_t(v0)) a = std::uint32_t(v1);
-        if (b == std::uint32_t(v0)) b = std::uint32_t(v1);
-        if (a != b) seam.insert(std::minmax(a, b));
+    // The seam edges at v0 become edges at v1 (v0's neighbours are v1's now): renamed in place, not by
+    // rebuilding the whole set per collapse.
+    const std::uint32_t a0 = std::uint32_t(v0), a1 = std::uint32_t(v1);
+    int left = loc.seam.edgesAt(a0);
+    if (left == 0) return;
+    left -= int(loc.seam.erase(std::minmax(a0, a1)));
+    for (VertexIndex w : CGAL::vertices_around_target(S.halfedge(v1), S)) {
+        if (left == 0) break;
+        const std::uint32_t b = std::uint32_t(w);
+        if (b == a1 || !loc.seam.erase(std::minmax(a0, b))) continue;
+        --left;
+        loc.seam.insert(std::minmax(a1, b));
     }
-    loc.seam.swap(seam);
+    if (left == 0) return;
+    // A seam edge at v0 that is no edge of the mesh (not expected): rename every one of them.
+    std::vector<SeamEdges::Key> rest;
+    for (const auto& e : loc.seam)
+        if (e.first == a0 || e.second == a0) rest.push_back(e);
+    for (const auto& e : rest) {
+        loc.seam.erase(e);
+        const std::uint32_t b = e.first == a0 ? e.second : e.first;
+        if (b != a1) loc.seam.insert(std::minmax(a1, b));
+    }
 }
 
 } // namespace fss::detail::stitching

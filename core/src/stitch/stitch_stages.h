@@ -74,6 +74,52 @@ struct LocalProblem {
     std::vector<FaceIndex> replaced;
     std::vector<LFace> newFaces;
     std::map<std::uint32_t, int> outerSplits; // face outside the region → the region edge of it split
+    // The core (assemble, when the bypass is on): patch faces (indices into P) whose vertices all lie at
+    // least coreRings() rings inside the component's boundary, in the component's order; they do not pass
+    // through the local mesh but go straight into the hole the other new faces leave (Plan::coreFaces).
+    std::vector<int> coreFaces;
+    std::vector<std::uint8_t> coreBorder; // per core face: bit k when edge k → k+1 is on the core's border
+    std::vector<std::pair<int, int>> coreChords; // inner core edges between two of its border vertices
+    double coreArea = 0;                         // their area in the view (twice), for the coverage check
+};
+
+// The seam's edges (pairs of local-mesh vertices, smaller first), in order, with the number of seam edges at
+// each vertex so that "is v on the seam" is O(1) (it was a scan of the whole set, ~4 % of a stitch).
+class SeamEdges {
+public:
+    using Key = std::pair<std::uint32_t, std::uint32_t>;
+    using const_iterator = std::set<Key>::const_iterator;
+    bool insert(Key k) {
+        if (!set_.insert(k).second) return false;
+        ++ends_[k.first];
+        ++ends_[k.second];
+        return true;
+    }
+    bool erase(Key k) {
+        if (!set_.erase(k)) return false;
+        --ends_[k.first];
+        --ends_[k.second];
+        return true;
+    }
+    std::size_t count(Key k) const { return set_.count(k); }
+    // The number of seam edges at vertex v.
+    int edgesAt(std::uint32_t v) const {
+        const int* n = ends_.find(v);
+        return n ? *n : 0;
+    }
+    bool touches(std::uint32_t v) const { return edgesAt(v) > 0; }
+    void clear() {
+        set_.clear();
+        ends_.clear();
+    }
+    std::size_t size() const { return set_.size(); }
+    bool empty() const { return set_.empty(); }
+    const_iterator begin() const { return set_.begin(); }
+    const_iterator end() const { return set_.end(); }
+
+private:
+    std::set<Key> set_;
+    IndexMap<int> ends_;
 };
 
 // The box of patch triangle f in the view.
@@ -85,6 +131,13 @@ inline CGAL::Bbox_2 patchTriangleBox(const PatchData& P, int f) {
 // why the component cannot be stitched. `progress` may be null.
 std::string describeComponent(const PatchData& P, const std::vector<int>& faces, double collapseEdgeRatio,
                               ComponentShape& c, ComponentProgress* progress);
+
+// The core bypass (DESIGN.md §6.1) is on unless the environment variable FSS_STITCH_CORE_BYPASS is 0 (for
+// the tests that compare the two paths, and for measurements).
+inline bool coreBypassEnabled() {
+    const char* e = std::getenv("FSS_STITCH_CORE_BYPASS");
+    return !(e && std::string_view(e) == "0");
+}
 
 class ComponentStitcher {
 public:
@@ -250,11 +303,18 @@ private:
         Mesh::Property_map<FaceIndex, Vec3> planeNormal;  // outside pieces: normal of their mesh face
         Mesh::Property_map<FaceIndex, double> minAllowed; // smallest angle accepted (radians)
         Mesh::Property_map<FaceIndex, bool> offView;      // piece of a mesh face the view does not see
-        std::set<std::pair<std::uint32_t, std::uint32_t>> seam;
+        SeamEdges seam;
         Star pristine; // the star as copied from the current mesh, for the rehearsal
         // After a strip refill (v2): `seam` holds the fill's edges; the seam line's figures as glued.
         bool refilled = false;
         bool remeshed = false; // the seam band was remeshed in 3D (band_remesh.h): `seam` holds its edges
+        // Core bypass: the local mesh's vertices on the core's border (patch vertex → S vertex), the core's
+        // border edges in S (a → b: the core face has a → b, so S has a border halfedge a → b), and whether
+        // the checks found the hole in S not to be exactly the core's (then the core goes in the local mesh).
+        IndexMap<VertexIndex> coreVertex;
+        std::vector<std::pair<VertexIndex, VertexIndex>> coreEdges;
+        IndexSet coreVertexSet; // S vertices on the core's border
+        bool coreBroken = false;
         std::size_t seamLineEdges = 0;
         double seamLineLength = 0;
     };
@@ -264,6 +324,23 @@ private:
                                                 const Mesh& m);
 
     bool buildAndOptimise(Attempt& a);
+
+    // ---- core bypass (DESIGN.md §6.1): the patch faces deep inside the component skip the local mesh
+    // Rings of patch vertices between the component's boundary and its core: beyond every vertex the seam
+    // optimisation (seamRings, + 2 for the intersection candidates) or the band remesh (2 rings, grown only
+    // outside the patch) may touch.
+    int coreRings() const { return std::max(6, O_.seamRings + 4); }
+    // Marks the faces of faces_ in the core (by position in faces_); empty when there is no core worth it.
+    std::vector<char> findCore();
+    // Is v (an S vertex) on the core's border?
+    static bool onCoreBorder(const Local& loc, VertexIndex v) {
+        return loc.coreVertexSet.count(std::uint32_t(v)) > 0;
+    }
+    // The hole in S is exactly the core's border, and no kept face of S overlaps a core face in the view.
+    bool coreFits(Local& loc);
+    // Puts the core back among the new faces (they then pass through the local mesh like the others).
+    void dissolveCore();
+    bool retryWithoutCore(Attempt& a);
 
     // ---- v2: the seam strip filled anew by construction (strip_refill.h, DESIGN.md §6.2)
     enum class Refill { NotDone, Applied, Broken };
@@ -380,16 +457,18 @@ private:
     const std::vector<int>& faces_;
     bool curHasQuality_, curHasScanId_;
     ComponentProgress& progress_;
-    bool refill_ = O_.refillSeam; // v2 strip refill (off for the retry after a failed refill)
-    bool remesh_ = O_.remeshSeam; // v2 band remesh (off for the retry after a worse or failed one)
+    bool refill_ = O_.refillSeam;       // v2 strip refill (off for the retry after a failed refill)
+    bool remesh_ = O_.remeshSeam;       // v2 band remesh (off for the retry after a worse or failed one)
+    bool bypass_ = coreBypassEnabled(); // core bypass (off once the core did not fit, for the retries)
     Mesh::Property_map<FaceIndex, float> curQuality_;
     Mesh::Property_map<FaceIndex, std::int32_t> curScanId_;
 
     // ---- the stages' results (explicit structs, stitch_stages.h)
-    ComponentShape comp_; // setupComponent (region stage)
-    RegionSearch search_; // the region stage's caches over the current mesh
-    Region reg_;          // findRegion, splitRegion
-    LocalProblem cut_;    // cut, gap triangulation (buildLocalVertices … assemble)
+    ComponentShape comp_;        // setupComponent (region stage)
+    RegionSearch search_;        // the region stage's caches over the current mesh
+    Region reg_;                 // findRegion, splitRegion
+    LocalProblem cut_;           // cut, gap triangulation (buildLocalVertices … assemble)
+    std::vector<char> coreMask_; // findCore: the core's faces by position in faces_ (empty: no core)
 };
 
 } // namespace fss::detail::stitching

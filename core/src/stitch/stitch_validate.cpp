@@ -53,6 +53,11 @@ bool ComponentStitcher::validate(Local& loc,
                                  const std::set<std::pair<std::uint32_t, std::uint32_t>>& bordersBefore,
                                  Attempt& a) {
     Mesh& S = loc.star.S;
+    if (!loc.coreEdges.empty() && !coreFits(loc)) {
+        loc.coreBroken = true;
+        return fail(a, "internal: the core does not fit its hole");
+    }
+    StageClock::lap("validate:core");
     std::vector<int> bad;
     auto badFace = [&](FaceIndex f) {
         Point2 c(0, 0);
@@ -92,7 +97,8 @@ bool ComponentStitcher::validate(Local& loc,
             ++n;
             borders += S.is_border(h);
         }
-        if (n != incoming[std::uint32_t(v)] || borders > 1) {
+        // (A vertex on the core's border has a border gap per core fan: the core fills them, coreFits.)
+        if (n != incoming[std::uint32_t(v)] || (borders > 1 && !onCoreBorder(loc, v))) {
             addNear(bad, loc.uv[v]);
         }
     }
@@ -100,7 +106,7 @@ bool ComponentStitcher::validate(Local& loc,
     for (FaceIndex f : S.faces())
         if (!loc.star.kept[f])
             for (VertexIndex v : CGAL::vertices_around_face(S.halfedge(f), S))
-                if (loc.star.cur[v] == kNone && S.is_border(v)) badFace(f);
+                if (loc.star.cur[v] == kNone && S.is_border(v) && !onCoreBorder(loc, v)) badFace(f);
     const auto bordersAfter = bordersAround(loc);
     if (bordersAfter != bordersBefore) {
         // Locate the difference (a hole of the mesh under the patch, an edge left dangling).
@@ -289,6 +295,34 @@ bool ComponentStitcher::extractPlan(Local& loc, Attempt& a) {
     }
     for (std::uint32_t v : seamVerts)
         if (loc.star.isFull(VertexIndex(v))) plan.seamValences.push_back(S.degree(VertexIndex(v)));
+    // The core: its vertices on its border are fresh vertices of the plan, the others come after them.
+    IndexMap<std::uint32_t> planOf; // patch vertex → index among the plan's fresh vertices
+    for (std::size_t i = 0; i < cut_.coreFaces.size(); ++i) {
+        const int f = cut_.coreFaces[i];
+        const auto& t = P_.tri[std::size_t(f)];
+        std::array<PlanVertex, 3> p;
+        for (int k = 0; k < 3; ++k) {
+            const int v = t[std::size_t(k)];
+            auto [slot, isNew] = planOf.try_emplace(std::uint32_t(v));
+            if (isNew) {
+                if (const VertexIndex* s = loc.coreVertex.find(std::uint32_t(v))) {
+                    const auto it = freshIndex.find(std::uint32_t(*s));
+                    if (it == freshIndex.end())
+                        return fail(a, "internal error: a core vertex is not in the plan");
+                    *slot = it->second;
+                } else {
+                    *slot = std::uint32_t(plan.freshPositions.size());
+                    plan.freshPositions.push_back(P_.pos[std::size_t(v)]);
+                }
+            }
+            p[std::size_t(k)] = PlanVertex{*slot, true};
+        }
+        plan.coreFaces.push_back(p);
+        plan.coreBorder.push_back(cut_.coreBorder[i]);
+        plan.coreQuality.push_back(P_.hasQuality ? P_.quality[std::size_t(f)] : kInputFaceQuality);
+        plan.coreScanId.push_back(P_.hasScanId ? P_.scanId[std::size_t(f)] : -1);
+    }
+    StageClock::lap("plan:core");
     for (std::size_t i = 0; i < faces.size(); ++i) {
         const auto& fv = faces[i];
         if (!seamVerts.count(std::uint32_t(fv[0])) && !seamVerts.count(std::uint32_t(fv[1])) &&
