@@ -18,7 +18,9 @@
 //     non-manifold. A second pass with a longer reach closes what is left (junctions of three regions).
 //  4. Seam relaxation and crease recovery once, as v1 ends (seam_relax.h, crease_snap.h).
 //  5. Validation: closed when the reference is, no pinched vertex, no degenerate face, no self-intersection
-//     (computeMetrics), and a vertex count within 10 % of the target (else parts went unsampled).
+//     (computeMetrics), as many boundary loops as the reference, and a vertex count within 10 % of the
+//     target (else parts went unsampled). On an open reference the join adds no face whose centroid is
+//     farther than L/4 from the reference, so that the reference's own boundaries stay open.
 // FSS_AUTO_V2_DEBUG=1 in the environment prints the stages' figures to stderr. A result that fails is dropped
 // and v1 runs instead (AutoResult::engineNote). The advancing front is our own: CGAL's hole filling works on
 // one boundary cycle at a time, and the gaps between patches are one multiply-connected region bounded by
@@ -32,6 +34,7 @@
 #include "fss/error.h"
 #include "fss/mask_triangulate.h"
 #include "fss/metrics.h"
+#include "fss/raycast.h"
 #include "fss/scan.h"
 #include "fss/scan_workspace.h"
 
@@ -47,6 +50,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <numbers>
 #include <queue>
 #include <string>
@@ -133,8 +137,12 @@ void appendPatch(Mesh& out, const Mesh& patch) {
 /// border edges) before the others. Returns the number of faces added.
 class GapCloser {
 public:
-    GapCloser(Mesh& mesh, double reach, double maxFoldDeg, double minAngleDeg)
-        : m_(mesh), reach_(reach), cosFold_(std::cos(maxFoldDeg * std::numbers::pi / 180.0)),
+    /// With \p onSurface, a face whose centroid lies farther than \p maxGap from that surface is not added
+    /// (an open reference: its own boundaries must stay open).
+    GapCloser(Mesh& mesh, double reach, double maxFoldDeg, double minAngleDeg,
+              const RayCaster* onSurface = nullptr, double maxGap = 0)
+        : m_(mesh), onSurface_(onSurface), maxGap_(maxGap), reach_(reach),
+          cosFold_(std::cos(maxFoldDeg * std::numbers::pi / 180.0)),
           minAngle_(minAngleDeg * std::numbers::pi / 180.0) {
         ids_ = m_.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1).first;
         quality_ = m_.add_property_map<FaceIndex, float>(props::faceQuality, 0.f).first;
@@ -158,6 +166,9 @@ public:
             }
             const VertexIndex u = m_.source(c.h), w = m_.target(c.h);
             const FaceIndex f0 = m_.face(m_.opposite(c.h));
+            if (onSurface_ &&
+                onSurface_->closestPoint((at(m_, u) + at(m_, w) + at(m_, c.p)) / 3.0).distance > maxGap_)
+                continue;
             const FaceIndex f = m_.add_face(u, w, c.p);
             if (f == Mesh::null_face()) continue;
             ids_[f] = ids_[f0];
@@ -249,7 +260,8 @@ private:
     }
 
     Mesh& m_;
-    double reach_, cosFold_, minAngle_;
+    const RayCaster* onSurface_;
+    double maxGap_, reach_, cosFold_, minAngle_;
     Mesh::Property_map<FaceIndex, std::int32_t> ids_;
     Mesh::Property_map<FaceIndex, float> quality_;
     std::unordered_map<std::int64_t, std::vector<VertexIndex>> cells_;
@@ -380,9 +392,12 @@ std::vector<Unowned> unownedPieces(const Mesh& reference, const std::vector<int>
 }
 
 /// Why \p mesh is not an acceptable result (empty when it is).
-std::string validate(const Mesh& mesh, bool mustBeClosed, double targetVertices) {
+std::string validate(const Mesh& mesh, bool mustBeClosed, double targetVertices, std::size_t boundaryLoops) {
     MetricsOptions mo;
     const Metrics m = computeMetrics(mesh, mo);
+    if (m.boundaryLoops != boundaryLoops)
+        return "the joined mesh has " + std::to_string(m.boundaryLoops) + " boundary loops, the input " +
+               std::to_string(boundaryLoops);
     if (mesh.number_of_faces() == 0) return "the joined mesh has no face";
     // Parts of the surface no region sampled are bridged by the hole filling: far fewer vertices than a
     // regular triangulation of the whole surface means parts of it were cut off.
@@ -523,9 +538,11 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
     };
     const bool debug = std::getenv("FSS_AUTO_V2_DEBUG") != nullptr;
     if (debug) std::fprintf(stderr, "v2: %zu views, %zu border edges before the join\n", nv, borderEdges());
-    GapCloser(current, 2.5 * L, 80.0, 10.0).run();
+    std::unique_ptr<RayCaster> caster;
+    if (!closedInput) caster = std::make_unique<RayCaster>(reference);
+    GapCloser(current, 2.5 * L, 80.0, 10.0, caster.get(), 0.25 * L).run();
     if (debug) std::fprintf(stderr, "v2: %zu border edges after pass 1\n", borderEdges());
-    GapCloser(current, 6.0 * L, 85.0, 0.5).run();
+    GapCloser(current, 6.0 * L, 85.0, 0.5, caster.get(), 0.25 * L).run();
     if (debug) std::fprintf(stderr, "v2: %zu border edges after pass 2\n", borderEdges());
     if (closedInput) fillHoles(current);
     if (debug) std::fprintf(stderr, "v2: %zu border edges after the hole filling\n", borderEdges());
@@ -578,7 +595,11 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
     // 5. Validation; v1 when it fails.
     progress.report(0.95, "validate");
     t = Clock::now();
-    const std::string why = validate(current, closedInput, result.area / (std::sqrt(3.0) / 2.0 * L * L));
+    MetricsOptions referenceTopology;
+    referenceTopology.selfIntersections = false;
+    const std::size_t referenceLoops = computeMetrics(reference, referenceTopology).boundaryLoops;
+    const std::string why =
+        validate(current, closedInput, result.area / (std::sqrt(3.0) / 2.0 * L * L), referenceLoops);
     if (debug) std::fprintf(stderr, "v2: validation %.2f s\n", since(t));
     if (!why.empty() && !options.fallbackToV1) {
         result.engineNote = "auto v2 failed (" + why + ").";
