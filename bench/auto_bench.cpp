@@ -1,14 +1,17 @@
-// `fss-remesh auto` (fss::autoRemesh) against CGAL::Polygon_mesh_processing::isotropic_remeshing on four
-// closed CGAL sample meshes, at the same target edge length (the one that gives the input's vertex count,
-// auto_remesh.h edgeLengthForVertexCount). CGAL: sharp edges detected with detect_sharp_edges at the same
-// feature angle as FSS and passed as edge_is_constrained_map, 3 iterations. Each remesher runs once per
-// mesh (Iterations(1)); the quality of both results is measured with fss::computeMetrics against the input
-// (fraction of valence-6 interior vertices, minimum angle, Hausdorff distance both ways relative to the
-// bbox diagonal) and printed side by side after the benchmarks, with the time ratio FSS / CGAL, followed by
-// where FSS's irregular vertices are (next to input faces, on feature edges, on seams, inside a patch).
+// `fss-remesh auto` (fss::autoRemesh, engines v1 and v2) against CGAL::Polygon_mesh_processing::
+// isotropic_remeshing on the eight CGAL sample meshes of issue 23, at the same target edge length (the one
+// that gives the input's vertex count, auto_remesh.h edgeLengthForVertexCount). CGAL: sharp edges of 60° or
+// more detected with detect_sharp_edges, passed as edge_is_constrained_map and protected
+// (protect_constraints), 5 iterations. Each remesher runs once per mesh (Iterations(1)); the quality of
+// every result is measured with fss::computeMetrics against the input (closed, pinched vertices,
+// self-intersections, fraction of valence-6 interior vertices, smallest and mean smallest angle, Hausdorff
+// distance both ways relative to the bbox diagonal) and printed side by side after the benchmarks, with the
+// time ratio to CGAL, followed by where FSS's irregular vertices are (next to input faces, on feature
+// edges, on seams, inside a patch).
 //
-//   ./build/bin/bench_auto                       # the four default meshes, GPU renderer when available
-//   FSS_AUTO_BENCH_MESHES=fandisk,eight ./build/bin/bench_auto
+//   ./build/bin/bench_auto                       # all eight meshes, v1 and v2, GPU renderer when available
+//   FSS_AUTO_BENCH_MESHES=fandisk,bunny00 ./build/bin/bench_auto
+//   FSS_AUTO_BENCH_ENGINES=v2 ./build/bin/bench_auto   # one engine only
 //   FSS_AUTO_BENCH_FISHBONE=1 ./build/bin/bench_auto   # with --fishbone auto
 //
 // CGAL's isotropic remeshing is a heavy translation unit: it lives here only, never in core.
@@ -83,13 +86,14 @@ struct Row {
     double coverage = -1; // FSS only
     int scans = 0;
     Irregular irregular; // FSS only
+    std::string note;    // FSS only: why v2 fell back to v1
+    bool have = false;
 };
 
 struct MeshResults {
     double edgeLength = 0;
     std::size_t inputVertices = 0;
-    Row fss, cgal;
-    bool haveFss = false, haveCgal = false;
+    Row fss[2], cgal; // fss[0]: v1, fss[1]: v2
 };
 
 std::map<std::string, MeshResults>& results() {
@@ -140,36 +144,39 @@ fss::AutoOptions autoOptions() {
     return o;
 }
 
-void BM_FssAuto(benchmark::State& state, std::string name) {
+void BM_FssAuto(benchmark::State& state, std::string name, int engine) {
     const fss::Mesh& ref = input(name);
     MeshResults& r = results()[name];
     r.inputVertices = ref.number_of_vertices();
     r.edgeLength = fss::edgeLengthForVertexCount(area(ref), ref.number_of_vertices());
     fss::AutoOptions o = autoOptions();
     o.edgeLength = r.edgeLength;
+    o.engine = engine == 0 ? fss::AutoEngine::V1 : fss::AutoEngine::V2;
+    Row& row = r.fss[engine];
     for (auto _ : state) {
         const auto t = Clock::now();
         fss::AutoResult res = fss::autoRemesh(ref, o);
-        r.fss.seconds = std::chrono::duration<double>(Clock::now() - t).count();
+        row.seconds = std::chrono::duration<double>(Clock::now() - t).count();
         state.PauseTiming();
-        r.fss.metrics = measure(res.mesh, ref);
-        r.fss.coverage = res.coverage;
-        r.fss.scans = res.scansStitched;
-        r.fss.irregular = irregularVertices(res.mesh, o.featureAngleDeg);
-        r.haveFss = true;
+        row.metrics = measure(res.mesh, ref);
+        row.coverage = res.coverage;
+        row.scans = res.scansStitched;
+        row.irregular = irregularVertices(res.mesh, o.featureAngleDeg);
+        row.note = res.engineNote;
+        row.have = true;
         state.ResumeTiming();
     }
-    state.counters["vertices"] = double(r.fss.metrics.vertices);
-    state.counters["coverage"] = r.fss.coverage;
-    state.counters["valence6"] = r.fss.metrics.fracValence6Interior;
-    state.counters["min_angle"] = r.fss.metrics.minAngleDeg;
+    state.counters["vertices"] = double(row.metrics.vertices);
+    state.counters["coverage"] = row.coverage;
+    state.counters["valence6"] = row.metrics.fracValence6Interior;
+    state.counters["min_angle"] = row.metrics.minAngleDeg;
 }
 
 void BM_CgalIsotropic(benchmark::State& state, std::string name) {
     const fss::Mesh& ref = input(name);
     MeshResults& r = results()[name];
     const double L = fss::edgeLengthForVertexCount(area(ref), ref.number_of_vertices());
-    const double featureAngle = fss::AutoOptions{}.featureAngleDeg;
+    const double featureAngle = 60.0;
     for (auto _ : state) {
         state.PauseTiming();
         fss::Mesh m = ref;
@@ -177,13 +184,15 @@ void BM_CgalIsotropic(benchmark::State& state, std::string name) {
         const auto t = Clock::now();
         auto constrained = m.add_property_map<fss::EdgeIndex, bool>("e:is_feature", false).first;
         PMP::detect_sharp_edges(m, featureAngle, constrained);
-        PMP::isotropic_remeshing(
-            faces(m), L, m, PMP::parameters::number_of_iterations(3).edge_is_constrained_map(constrained));
+        PMP::isotropic_remeshing(faces(m), L, m,
+                                 PMP::parameters::number_of_iterations(5)
+                                     .edge_is_constrained_map(constrained)
+                                     .protect_constraints(true));
         m.collect_garbage();
         r.cgal.seconds = std::chrono::duration<double>(Clock::now() - t).count();
         state.PauseTiming();
         r.cgal.metrics = measure(m, ref);
-        r.haveCgal = true;
+        r.cgal.have = true;
         state.ResumeTiming();
     }
     state.counters["vertices"] = double(r.cgal.metrics.vertices);
@@ -199,51 +208,63 @@ std::string opt(const std::optional<double>& v) {
 
 void printTable() {
     std::printf(
-        "\nauto (FSS) vs CGAL isotropic_remeshing (3 iterations, sharp edges constrained), same target edge "
-        "length; renderer: %s, fishbone: %s\n",
+        "\nauto (FSS v1, v2) vs CGAL isotropic_remeshing (5 iterations, sharp edges >= 60 deg protected), "
+        "same target edge length; renderer: %s, fishbone: %s\n",
         gpuAvailable() ? "gpu" : "cpu", autoOptions().fishbone ? "auto" : "off");
-    std::printf("%-14s %-5s %8s %8s %8s %8s %8s %9s %9s %6s %5s %4s %4s\n", "mesh", "who", "L", "verts",
-                "time_s", "val6", "minang", "H_to_rel", "H_from_rel", "cover", "t/t", "clsd", "SI");
+    std::printf("%-16s %-4s %8s %7s %7s %6s %6s %4s %4s %4s %4s %6s %6s %6s %9s %9s\n", "mesh", "who", "L",
+                "verts", "time_s", "t/cgal", "cover", "clsd", "pnch", "SI", "dgn", "val6", "minang", "meanmn",
+                "H_to_rel", "H_from_rel");
     for (const std::string& name : meshOrder) {
         const MeshResults& r = results()[name];
-        if (!r.haveFss || !r.haveCgal) continue;
-        for (int who = 0; who < 2; ++who) {
-            const Row& row = who == 0 ? r.fss : r.cgal;
+        const char* who[3] = {"v1", "v2", "cgal"};
+        for (int w = 0; w < 3; ++w) {
+            const Row& row = w < 2 ? r.fss[w] : r.cgal;
+            if (!row.have) continue;
             const fss::Metrics& m = row.metrics;
-            std::printf("%-14s %-5s %8.5f %8zu %8.2f %8.4f %8.2f %9s %9s %6.4f %5.2f %4s %4zu\n",
-                        name.c_str(), who == 0 ? "fss" : "cgal", r.edgeLength, m.vertices, row.seconds,
-                        m.fracValence6Interior, m.minAngleDeg, opt(m.hausdorffToRefRel).c_str(),
-                        opt(m.hausdorffFromRefRel).c_str(), who == 0 ? row.coverage : 1.0,
-                        who == 0 ? r.fss.seconds / r.cgal.seconds : 1.0, m.closed ? "yes" : "no",
-                        m.selfIntersections.value_or(0));
+            std::printf(
+                "%-16s %-4s %8.5f %7zu %7.2f %6.2f %6.4f %4s %4zu %4zu %4zu %6.4f %6.2f %6.2f %9s %9s%s%s\n",
+                name.c_str(), who[w], r.edgeLength, m.vertices, row.seconds,
+                r.cgal.have ? row.seconds / r.cgal.seconds : 0.0, w < 2 ? row.coverage : 1.0,
+                m.closed ? "yes" : "no", m.nonManifoldVertices, m.selfIntersections.value_or(0),
+                m.degenerateFaces, m.fracValence6Interior, m.minAngleDeg, m.meanMinAngleDeg,
+                opt(m.hausdorffToRefRel).c_str(), opt(m.hausdorffFromRefRel).c_str(),
+                row.note.empty() ? "" : "  ", row.note.c_str());
         }
     }
     std::printf("\nFSS: irregular (valence != 6) / all vertices by where they are (first class that fits)\n");
-    std::printf("%-14s %15s %15s %15s %15s\n", "mesh", "input_faces", "feature_edge", "seam", "patch_inside");
-    for (const std::string& name : meshOrder) {
-        const MeshResults& r = results()[name];
-        if (!r.haveFss) continue;
-        std::printf("%-14s", name.c_str());
-        for (int c = 0; c < Irregular::Count; ++c)
-            std::printf(" %7zu/%-7zu", r.fss.irregular.irregular[c], r.fss.irregular.vertices[c]);
-        std::printf("\n");
-    }
+    std::printf("%-16s %-4s %15s %15s %15s %15s\n", "mesh", "who", "input_faces", "feature_edge", "seam",
+                "patch_inside");
+    for (const std::string& name : meshOrder)
+        for (int w = 0; w < 2; ++w) {
+            const Row& row = results()[name].fss[w];
+            if (!row.have) continue;
+            std::printf("%-16s %-4s", name.c_str(), w == 0 ? "v1" : "v2");
+            for (int c = 0; c < Irregular::Count; ++c)
+                std::printf(" %7zu/%-7zu", row.irregular.irregular[c], row.irregular.vertices[c]);
+            std::printf("\n");
+        }
     std::fflush(stdout);
 }
 
 } // namespace
 
 int main(int argc, char** argv) {
-    std::string list = "fandisk,elephant,couplingdown,bunny00";
+    std::string list = "fandisk,bunny00,elephant,couplingdown,armadillo,blade,rotor_small,mech-holes-shark";
     if (const char* env = std::getenv("FSS_AUTO_BENCH_MESHES")) list = env;
+    std::string engines = "v1,v2";
+    if (const char* env = std::getenv("FSS_AUTO_BENCH_ENGINES")) engines = env;
     std::stringstream ss(list);
     for (std::string name; std::getline(ss, name, ',');)
         if (!name.empty()) meshOrder.push_back(name);
     for (const std::string& name : meshOrder) {
-        benchmark::RegisterBenchmark(("BM_FssAuto/" + name).c_str(), BM_FssAuto, name)
-            ->Iterations(1)
-            ->Unit(benchmark::kSecond)
-            ->UseRealTime();
+        for (int engine = 0; engine < 2; ++engine) {
+            const std::string e = engine == 0 ? "v1" : "v2";
+            if (engines.find(e) == std::string::npos) continue;
+            benchmark::RegisterBenchmark(("BM_FssAuto/" + e + "/" + name).c_str(), BM_FssAuto, name, engine)
+                ->Iterations(1)
+                ->Unit(benchmark::kSecond)
+                ->UseRealTime();
+        }
         benchmark::RegisterBenchmark(("BM_CgalIsotropic/" + name).c_str(), BM_CgalIsotropic, name)
             ->Iterations(1)
             ->Unit(benchmark::kSecond)

@@ -1,5 +1,5 @@
 // fss-remesh auto MESH -o OUT [--edge-length L | --target-vertices N] [--fishbone auto] [--json]
-//                  [--renderer auto|gpu|cpu] [--max-views N] [--no-metrics]
+//                  [--renderer auto|gpu|cpu] [--max-views N] [--engine v1|v2] [--no-metrics]
 #include "command_line.h"
 #include "commands.h"
 #include "mesh_files.h"
@@ -35,7 +35,7 @@ const char* kindName(AutoStep::Kind kind) {
 }
 
 struct CliAutoOptions {
-    std::string meshPath, outPath, fishbone, rendererKind = "auto";
+    std::string meshPath, outPath, fishbone, rendererKind = "auto", engine = "v1";
     double edgeLength = 0;
     int targetVertices = 0, maxViews = 80;
     const CLI::Option* edge = nullptr;     // --edge-length, given when count() > 0
@@ -52,6 +52,8 @@ int runAuto(const CliAutoOptions& o) {
     if (o.vertices->count() > 0) options.targetVertices = std::size_t(o.targetVertices);
     options.maxViews = o.maxViews;
     options.fishbone = !o.fishbone.empty();
+    options.engine = o.engine == "v1" ? AutoEngine::V1 : AutoEngine::V2;
+    options.fallbackToV1 = o.engine != "v2-nofallback";
 
     const Mesh reference = readInputMesh(o.meshPath);
     const render::RendererSelection renderer =
@@ -94,6 +96,8 @@ int runAuto(const CliAutoOptions& o) {
         j["crease_flips"] = result.creaseFlips;
         j["crease_removals"] = result.creaseRemovals;
         j["crease_repairs"] = result.creaseRepairs;
+        j["engine"] = result.engineUsed == AutoEngine::V2 ? "v2" : "v1";
+        j["engine_note"] = result.engineNote;
         j["scans_stitched"] = result.scansStitched;
         j["scans_skipped"] = result.scansSkipped;
         nlohmann::json steps = nlohmann::json::array();
@@ -126,6 +130,7 @@ int runAuto(const CliAutoOptions& o) {
                   << " % of the area (" << result.inputFacesLeft << " input faces left), "
                   << result.mesh.number_of_vertices() << " vertices, " << result.mesh.number_of_faces()
                   << " faces in " << result.seconds << " s, written to " << o.outPath << "\n";
+        if (!result.engineNote.empty()) std::cout << result.engineNote << "\n";
         if (metrics) std::cout << metricsToText(*metrics);
     }
     return 0;
@@ -160,6 +165,13 @@ Subcommand addAuto(CLI::App& app) {
                   "along it first.")
         ->type_name("auto")
         ->check(oneOf("--fishbone", {"auto"}));
+    p->add_option(
+         "--engine", o->engine,
+         "v1: scan and stitch view after view (default); v2: sample every region of the partition once "
+         "and join all regions in one pass (issue 23; falls back to v1 when its result fails "
+         "validation).")
+        ->type_name("v1|v2")
+        ->check(oneOf("--engine", {"v1", "v2", "v2-nofallback"}));
     addInt(*p, "--max-views", o->maxViews, 1, 10000, "N", "Largest number of scans (default 80).");
     addRenderer(*p, o->rendererKind, {},
                 "auto (GPU, else CPU), gpu (head-less OpenGL) or cpu (ray casting).");

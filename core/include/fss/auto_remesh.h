@@ -83,8 +83,26 @@
 
 namespace fss {
 
+/// Which design autoRemesh runs.
+enum class AutoEngine {
+    /// Scan and stitch view after view (the file comment's steps 1-7): cost grows as views x stitch.
+    V1,
+    /// Issue 23: every region of the partition is sampled once with the triangular lattice at the same world
+    /// spacing (regions in parallel), the patches are joined in ONE pass (the gaps between them closed by an
+    /// advancing front over their boundaries, a zipper), then seams relaxed and creases recovered once. The
+    /// result is validated (closed when the reference is, manifold, no self-intersections, no degenerate
+    /// faces); when it fails, V1 runs instead and AutoResult::engineNote says why.
+    V2,
+};
+
 /// Options of autoRemesh. Defaults are the command line's.
 struct AutoOptions {
+    /// The design to run (AutoEngine).
+    AutoEngine engine = AutoEngine::V1;
+    /// V2 only: run V1 when the V2 result fails validation (true), or return the V2 result with
+    /// AutoResult::engineNote saying what is wrong with it (false: for diagnosis; the mesh may then be open,
+    /// pinched or self-intersecting).
+    bool fallbackToV1 = true;
     /// Target edge length in world units; 0 = derive it from targetVertices.
     double edgeLength = 0;
     /// Target vertex count when edgeLength is 0; 0 = the reference's vertex count.
@@ -230,6 +248,10 @@ struct AutoResult {
     std::size_t creaseRepairs = 0;
     /// True when a stage of the seam relaxation was undone because its result intersected itself.
     bool seamRelaxDiscarded = false;
+    /// The design that made `mesh` (AutoOptions::engine, or V1 after a V2 run that failed validation).
+    AutoEngine engineUsed = AutoEngine::V1;
+    /// Why V2 fell back to V1 (empty otherwise).
+    std::string engineNote;
     double seconds = 0;       ///< total wall time
     double planSeconds = 0;   ///< of which: view planning and coverage bookkeeping
     double scanSeconds = 0;   ///< of which: rendering, masks, triangulation

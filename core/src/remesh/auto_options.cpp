@@ -8,6 +8,7 @@ namespace fss {
 void AutoOptions::validate() const {
     const char* owner = "AutoOptions";
     const detail::OptionCheck check(owner);
+    check.intRange("engine", int(engine), int(AutoEngine::V1), int(AutoEngine::V2));
     check.nonNegative("edgeLength", edgeLength);
     check.inRange("servedAngleDeg", servedAngleDeg, 0, 80, true, false);
     check.inRange("maxSamplingAngleDeg", maxSamplingAngleDeg, servedAngleDeg, 85, true, false);

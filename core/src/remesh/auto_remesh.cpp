@@ -2,6 +2,7 @@
 
 #include "mesh/features.h"
 #include "mesh/local_ops.h"
+#include "remesh/auto_v2.h"
 #include "remesh/crease_snap.h"
 #include "remesh/seam_relax.h"
 
@@ -461,6 +462,78 @@ Patch regionScan(const Mesh& reference, const FrameBuffers& ref, const std::vect
 
 } // namespace
 
+namespace detail {
+
+Camera frameParallelView(const Eigen::Vector3d& from, const std::vector<Eigen::Vector3d>& points,
+                         double footprint, double margin) {
+    return frameParallel(from, points, footprint, margin);
+}
+
+std::vector<int> partitionSurface(const Mesh& reference, const std::vector<FrameBuffers>& views,
+                                  double maxAngleDeg, double beta, double minIslandArea, int rounds) {
+    return partitionAmongViews(reference, views, maxAngleDeg, beta, minIslandArea, rounds);
+}
+
+std::size_t flipSliverFaces(Mesh& mesh, double belowDeg, double maxDihedralDeg, int rounds) {
+    return flipSlivers(mesh, belowDeg, maxDihedralDeg, rounds);
+}
+
+std::vector<Eigen::Vector3d> planViews(const Mesh& reference, double servedAngleDeg, double minAreaFraction,
+                                       int maxViews) {
+    const double servedCos = std::cos(servedAngleDeg * std::numbers::pi / 180.0);
+    double area = 0;
+    for (FaceIndex f : reference.faces())
+        area += faceGeometry(reference, f).area;
+    const std::vector<Eigen::Vector3d> candidates = candidateDirections(600);
+    std::vector<double> binArea(candidates.size(), 0);
+    std::vector<Eigen::Vector3d> binNormalSum(candidates.size(), Eigen::Vector3d::Zero());
+    for (FaceIndex f : reference.faces()) {
+        const FaceGeometry g = faceGeometry(reference, f);
+        if (g.area <= 0) continue;
+        std::size_t best = 0;
+        double bestDot = -2;
+        for (std::size_t i = 0; i < candidates.size(); ++i) {
+            const double d = candidates[i].dot(g.normal);
+            if (d > bestDot) bestDot = d, best = i;
+        }
+        binArea[best] += g.area;
+        binNormalSum[best] += g.area * g.normal;
+    }
+    std::vector<Eigen::Vector3d> binNormal(candidates.size());
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+        binNormal[i] =
+            binNormalSum[i].norm() > 0 ? Eigen::Vector3d(binNormalSum[i].normalized()) : candidates[i];
+    std::vector<char> served(candidates.size(), 0);
+    auto servedArea = [&](const Eigen::Vector3d& d) {
+        double a = 0;
+        for (std::size_t b = 0; b < candidates.size(); ++b)
+            if (!served[b] && binArea[b] > 0 && binNormal[b].dot(d) >= servedCos) a += binArea[b];
+        return a;
+    };
+    std::vector<Eigen::Vector3d> views;
+    while (int(views.size()) < maxViews) {
+        double bestArea = 0;
+        Eigen::Vector3d bestDir;
+        for (const Eigen::Vector3d& d : candidates) {
+            const double a = servedArea(d);
+            if (a > bestArea * 1.0001) bestArea = a, bestDir = d;
+        }
+        if (bestArea < minAreaFraction * area) break;
+        // Centre the view on what it serves (a single plane gets an exactly frontal view).
+        Eigen::Vector3d mean(0, 0, 0);
+        for (std::size_t b = 0; b < candidates.size(); ++b)
+            if (!served[b] && binArea[b] > 0 && binNormal[b].dot(bestDir) >= servedCos)
+                mean += binNormalSum[b];
+        if (mean.norm() > 0 && servedArea(mean.normalized()) >= 0.95 * bestArea) bestDir = mean.normalized();
+        for (std::size_t b = 0; b < candidates.size(); ++b)
+            if (binArea[b] > 0 && binNormal[b].dot(bestDir) >= servedCos) served[b] = 1;
+        views.push_back(bestDir);
+    }
+    return views;
+}
+
+} // namespace detail
+
 double edgeLengthForVertexCount(double area, std::size_t vertices) {
     if (!(area > 0) || !std::isfinite(area)) throw InvalidInputError("The surface area must be positive.");
     if (vertices == 0) throw InvalidInputError("The target vertex count must be positive.");
@@ -473,6 +546,7 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
     if (!CGAL::is_triangle_mesh(reference))
         throw InvalidInputError("The mesh to remesh is not a triangle mesh.");
     options.validate();
+    if (options.engine == AutoEngine::V2) return detail::autoRemeshV2(reference, options, progress);
 
     AutoResult result;
     // Reference geometry: per-face normals and areas, bounding box.
@@ -507,7 +581,6 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
     currentRenderer->setMesh(current);
 
     std::int32_t nextScanId = 0;
-    const double servedCos = std::cos(options.servedAngleDeg * std::numbers::pi / 180.0);
 
     // Runs one stitch of a patch; on failure the mesh is unchanged and the step says why.
     auto stitchInto = [&](AutoStep& step, const Mesh& patch, const Camera& camera,
@@ -603,50 +676,8 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
     // 2. The initial views: greedy cover of the Gauss map, normals binned on a fine set of directions.
     progress.report(0.3, "plan");
     auto tPlan = Clock::now();
-    const std::vector<Eigen::Vector3d> candidates = candidateDirections(600);
-    std::vector<double> binArea(candidates.size(), 0);
-    std::vector<Eigen::Vector3d> binNormalSum(candidates.size(), Eigen::Vector3d::Zero());
-    for (const FaceGeometry& g : faces) {
-        if (g.area <= 0) continue;
-        std::size_t best = 0;
-        double bestDot = -2;
-        for (std::size_t i = 0; i < candidates.size(); ++i) {
-            const double d = candidates[i].dot(g.normal);
-            if (d > bestDot) bestDot = d, best = i;
-        }
-        binArea[best] += g.area;
-        binNormalSum[best] += g.area * g.normal;
-    }
-    std::vector<Eigen::Vector3d> binNormal(candidates.size());
-    for (std::size_t i = 0; i < candidates.size(); ++i)
-        binNormal[i] =
-            binNormalSum[i].norm() > 0 ? Eigen::Vector3d(binNormalSum[i].normalized()) : candidates[i];
-    std::vector<char> served(candidates.size(), 0);
-    auto servedArea = [&](const Eigen::Vector3d& d) {
-        double a = 0;
-        for (std::size_t b = 0; b < candidates.size(); ++b)
-            if (!served[b] && binArea[b] > 0 && binNormal[b].dot(d) >= servedCos) a += binArea[b];
-        return a;
-    };
-    std::vector<Eigen::Vector3d> views;
-    while (int(views.size()) < options.maxViews) {
-        double bestArea = 0;
-        Eigen::Vector3d bestDir;
-        for (const Eigen::Vector3d& d : candidates) {
-            const double a = servedArea(d);
-            if (a > bestArea * 1.0001) bestArea = a, bestDir = d;
-        }
-        if (bestArea < options.minViewAreaFraction * result.area) break;
-        // Centre the view on what it serves (a single plane gets an exactly frontal view).
-        Eigen::Vector3d mean(0, 0, 0);
-        for (std::size_t b = 0; b < candidates.size(); ++b)
-            if (!served[b] && binArea[b] > 0 && binNormal[b].dot(bestDir) >= servedCos)
-                mean += binNormalSum[b];
-        if (mean.norm() > 0 && servedArea(mean.normalized()) >= 0.95 * bestArea) bestDir = mean.normalized();
-        for (std::size_t b = 0; b < candidates.size(); ++b)
-            if (binArea[b] > 0 && binNormal[b].dot(bestDir) >= servedCos) served[b] = 1;
-        views.push_back(bestDir);
-    }
+    const std::vector<Eigen::Vector3d> views =
+        detail::planViews(reference, options.servedAngleDeg, options.minViewAreaFraction, options.maxViews);
     result.planSeconds += secondsSince(tPlan);
 
     // The partition of the surface among the views: each region is scanned once, by its own view.
