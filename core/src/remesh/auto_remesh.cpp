@@ -540,6 +540,12 @@ double edgeLengthForVertexCount(double area, std::size_t vertices) {
     return std::sqrt(area / (double(vertices) * std::sqrt(3.0) / 2.0));
 }
 
+double detail::targetEdgeLength(double area, const AutoOptions& options, std::size_t inputVertices) {
+    if (options.edgeLength > 0) return options.edgeLength;
+    return edgeLengthForVertexCount(area,
+                                    options.targetVertices > 0 ? options.targetVertices : inputVertices);
+}
+
 AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const Progress& progress) {
     const auto start = Clock::now();
     if (reference.number_of_faces() == 0) throw InvalidInputError("The mesh to remesh has no faces.");
@@ -561,11 +567,7 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
     const Eigen::AlignedBox3d box = boundingBox(reference);
     for (int i = 0; i < 8; ++i)
         corners.push_back(box.corner(Eigen::AlignedBox3d::CornerType(i)));
-    result.edgeLength = options.edgeLength > 0
-                            ? options.edgeLength
-                            : edgeLengthForVertexCount(result.area, options.targetVertices > 0
-                                                                        ? options.targetVertices
-                                                                        : reference.number_of_vertices());
+    result.edgeLength = detail::targetEdgeLength(result.area, options, reference.number_of_vertices());
     const double L = result.edgeLength;
     const double footprint = L * options.footprintRatio;
 

@@ -431,11 +431,7 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
     const Eigen::AlignedBox3d box = boundingBox(reference);
     for (int i = 0; i < 8; ++i)
         corners.push_back(box.corner(Eigen::AlignedBox3d::CornerType(i)));
-    result.edgeLength = options.edgeLength > 0
-                            ? options.edgeLength
-                            : edgeLengthForVertexCount(result.area, options.targetVertices > 0
-                                                                        ? options.targetVertices
-                                                                        : reference.number_of_vertices());
+    result.edgeLength = detail::targetEdgeLength(result.area, options, reference.number_of_vertices());
     const double L = result.edgeLength;
     // Pixels finer than the lattice: the ID buffer then places the lattice's samples and decides the
     // partition's visibility at a fraction of an edge length.

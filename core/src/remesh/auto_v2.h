@@ -35,4 +35,8 @@ std::size_t flipSliverFaces(Mesh& mesh, double belowDeg, double maxDihedralDeg, 
 /// engineUsed is V1 (and engineNote the reason) when the V2 mesh failed validation and \p fallback ran.
 AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const Progress& progress);
 
+/// The target edge length of both engines: options.edgeLength, else the one that gives
+/// options.targetVertices (else \p inputVertices) vertices on \p area (edgeLengthForVertexCount).
+double targetEdgeLength(double area, const AutoOptions& options, std::size_t inputVertices);
+
 } // namespace fss::detail
