@@ -22,13 +22,34 @@ inline Eigen::Vector3d pos(const Mesh& m, VertexIndex v) {
     return {p.x(), p.y(), p.z()};
 }
 
-/// Smallest corner angle of triangle (a, b, c), radians (0 for a degenerate one).
+/// Smallest corner angle of triangle (a, b, c), radians (0 for a degenerate one): the minimum of the three
+/// corners' atan2(|u × v|, u · v), usually through one atan2 only (the stitch and the band remesh spend much
+/// of their time here).
 inline double minAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-    auto corner = [](const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& r) {
-        const Eigen::Vector3d u = q - p, v = r - p;
-        return std::atan2(u.cross(v).norm(), u.dot(v));
+    // Corner i is atan2(y_i, x_i) with y_i = |u × v| ≥ 0, so it lies in [0, π] and the sign of
+    // y_i x_j − x_i y_j is the sign of sin(angle i − angle j). When that sign puts one angle below both
+    // others by more than 1e-9 rad (far above atan2's error of an ulp and the product's rounding), only
+    // that one goes through atan2: the result is the same double as the minimum of the three atan2 values,
+    // which is taken otherwise.
+    const Eigen::Vector3d e[3] = {b - a, c - b, a - c};
+    double y[3], x[3];
+    for (int i = 0; i < 3; ++i) {
+        const Eigen::Vector3d u = -e[(i + 2) % 3], v = e[i];
+        // (x > 0 exactly when sqrt(x) > 0: Eigen's norm() is the square root of squaredNorm().)
+        if (!(u.squaredNorm() > 0) || !(v.squaredNorm() > 0)) return 0;
+        y[i] = u.cross(v).norm();
+        x[i] = u.dot(v);
+    }
+    auto clearlyBelow = [&](int i, int j) {
+        const double d = y[i] * x[j] - x[i] * y[j];
+        return d < 0 && d * d > 1e-18 * (x[i] * x[i] + y[i] * y[i]) * (x[j] * x[j] + y[j] * y[j]);
     };
-    return std::min({corner(a, b, c), corner(b, c, a), corner(c, a, b)});
+    for (int k = 0; k < 3; ++k)
+        if (clearlyBelow(k, (k + 1) % 3) && clearlyBelow(k, (k + 2) % 3)) return std::atan2(y[k], x[k]);
+    double best = std::atan2(y[0], x[0]);
+    for (int i = 1; i < 3; ++i)
+        best = std::min(best, std::atan2(y[i], x[i]));
+    return best;
 }
 
 /// Unit normal of triangle (a, b, c); zero when degenerate.
@@ -42,6 +63,23 @@ inline Eigen::Vector3d unitNormal(const Eigen::Vector3d& a, const Eigen::Vector3
 /// Angle between the vectors \p u and \p v, radians.
 inline double angleBetween(const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
     return std::atan2(u.cross(v).norm(), u.dot(v));
+}
+
+/// An angle bound for angleAtMost (its cosine and sine computed once).
+struct AngleLimit {
+    explicit AngleLimit(double radians) : limit(radians), cos(std::cos(radians)), sin(std::sin(radians)) {}
+    double limit, cos, sin;
+};
+
+/// Whether angleBetween(u, v) <= \p bound.limit (0 < limit < π): the same answer for every input, mostly
+/// without atan2. With y = |u × v| and x = u · v the angle is atan2(y, x) in [0, π], and y cos(limit) −
+/// x sin(limit) = |(x, y)| sin(angle − limit) has the sign of angle − limit; where the two differ by more
+/// than 1e-9 rad (far above the rounding of either side) that sign decides, else atan2 does.
+inline bool angleAtMost(const Eigen::Vector3d& u, const Eigen::Vector3d& v, const AngleLimit& bound) {
+    const double y = u.cross(v).norm(), x = u.dot(v);
+    const double d = y * bound.cos - x * bound.sin;
+    if (d * d > 1e-18 * (x * x + y * y)) return d < 0;
+    return std::atan2(y, x) <= bound.limit;
 }
 
 } // namespace fss::detail

@@ -165,7 +165,7 @@ private:
     bool acceptableFace(const V3& a, const V3& b, const V3& c, const V3& n0, bool seen = true) const {
         if (seen && !facing(a, b, c)) return false;
         const V3 n = detail::unitNormal(a, b, c);
-        return n.squaredNorm() > 0 && detail::angleBetween(n, n0) <= in_.maxNormalTurnDeg * kBandDeg;
+        return n.squaredNorm() > 0 && detail::angleAtMost(n, n0, maxTurn_);
     }
     // Whether every face around v is a band face (and v is not on the mesh border).
     bool wholeStarInBand(VertexIndex v) {
@@ -500,17 +500,11 @@ private:
                 if (isCrease(a, b) || !detail::canFlip(S_, h)) continue;
                 const VertexIndex c = S_.target(S_.next(h)), d = S_.target(S_.next(S_.opposite(h)));
                 if (!valenceOk(a, -1) || !valenceOk(b, -1) || !valenceOk(c, 1) || !valenceOk(d, 1)) continue;
+                if (unseen(S_.face(h)) != unseen(S_.face(S_.opposite(h)))) continue;
                 const V3 pa = detail::pos(S_, a), pb = detail::pos(S_, b), pc = detail::pos(S_, c),
                          pd = detail::pos(S_, d);
-                const V3 quad = (areaVector(S_.face(h)) + areaVector(S_.face(S_.opposite(h)))).normalized();
-                if (unseen(S_.face(h)) != unseen(S_.face(S_.opposite(h)))) continue;
-                const bool seen = !unseen(S_.face(h));
-                const V3 n1 = referenceNormal(S_.face(h), quad),
-                         n2 = referenceNormal(S_.face(S_.opposite(h)), quad);
-                // New faces (a, d, c) and (b, c, d).
-                if (!acceptableFace(pa, pd, pc, n1, seen) || !acceptableFace(pa, pd, pc, n2, seen) ||
-                    !acceptableFace(pb, pc, pd, n1, seen) || !acceptableFace(pb, pc, pd, n2, seen))
-                    continue;
+                // New faces (a, d, c) and (b, c, d). The tests are pure: the cheap gain test comes first
+                // (most candidates fail it), then the faces' orientation and normals, then the projection.
                 const double oldMin = std::min(detail::minAngle(pa, pb, pc), detail::minAngle(pb, pa, pd));
                 const double newMin = std::min(detail::minAngle(pa, pd, pc), detail::minAngle(pb, pc, pd));
                 const int devOld = cost(a, 0) + cost(b, 0) + cost(c, 0) + cost(d, 0);
@@ -519,6 +513,13 @@ private:
                 // deviation; never below the smaller of the angle before and the aim.
                 const double gain = (newMin - oldMin) / kBandDeg - 3.0 * double(devNew - devOld);
                 if (!(gain > 0.5) || newMin < std::min(oldMin, in_.minAngleDeg * kBandDeg)) continue;
+                const V3 quad = (areaVector(S_.face(h)) + areaVector(S_.face(S_.opposite(h)))).normalized();
+                const bool seen = !unseen(S_.face(h));
+                const V3 n1 = referenceNormal(S_.face(h), quad),
+                         n2 = referenceNormal(S_.face(S_.opposite(h)), quad);
+                if (!acceptableFace(pa, pd, pc, n1, seen) || !acceptableFace(pa, pd, pc, n2, seen) ||
+                    !acceptableFace(pb, pc, pd, n1, seen) || !acceptableFace(pb, pc, pd, n2, seen))
+                    continue;
                 // The new edge stays near the draft (a flip over a curved place would cut under it). Tested
                 // last: the projection costs most, and most candidates fail the gain already.
                 if (distanceToRef(0.5 * (pc + pd), c) > 0.1 * (pc - pd).norm()) continue;
@@ -609,6 +610,7 @@ private:
 
     const BandRemeshInput& in_;
     Mesh& S_;
+    const detail::AngleLimit maxTurn_{in_.maxNormalTurnDeg * kBandDeg}; // acceptableFace's normal bound
     Mesh ref_; // the draft band, onto which vertices are projected
     // closestPointNear on ref_ (which does not change after setup) with 1 and 2 rings: the same results,
     // each face's rings collected once.

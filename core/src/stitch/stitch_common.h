@@ -4,6 +4,7 @@
 #include "base/disjoint_sets.h"
 #include "fss/stitch.h"
 #include "mesh/local_ops.h"
+#include "mesh/triangle_geometry.h"
 #include "stitch/band_remesh.h"
 #include "stitch/lift.h"
 #include "stitch/seam_quality.h"
@@ -103,32 +104,7 @@ inline CGAL::Bbox_2 grown(const CGAL::Bbox_2& b, double r) {
 }
 
 // Smallest corner angle of a 3D triangle (radians); 0 for degenerate ones.
-inline double minAngle(const Vec3& a, const Vec3& b, const Vec3& c) {
-    // Angle i is atan2(y_i, x_i) with y_i = |u × v| ≥ 0, so it lies in [0, π] and the sign of
-    // y_i x_j − x_i y_j is the sign of sin(angle i − angle j). When that sign puts one angle below both
-    // others by more than 1e-9 rad (far above atan2's error of an ulp and the product's rounding), only
-    // that one goes through atan2 (the stitch spends a sixth of its time here): the result is the same
-    // double as the minimum of the three atan2 values, which is taken otherwise.
-    const Vec3 e[3] = {b - a, c - b, a - c};
-    double y[3], x[3];
-    for (int i = 0; i < 3; ++i) {
-        const Vec3 u = -e[(i + 2) % 3], v = e[i];
-        // (x > 0 exactly when sqrt(x) > 0: Eigen's norm() is the square root of squaredNorm().)
-        if (!(u.squaredNorm() > 0) || !(v.squaredNorm() > 0)) return 0;
-        y[i] = u.cross(v).norm();
-        x[i] = u.dot(v);
-    }
-    auto clearlyBelow = [&](int i, int j) {
-        const double d = y[i] * x[j] - x[i] * y[j];
-        return d < 0 && d * d > 1e-18 * (x[i] * x[i] + y[i] * y[i]) * (x[j] * x[j] + y[j] * y[j]);
-    };
-    for (int k = 0; k < 3; ++k)
-        if (clearlyBelow(k, (k + 1) % 3) && clearlyBelow(k, (k + 2) % 3)) return std::atan2(y[k], x[k]);
-    double best = std::numbers::pi;
-    for (int i = 0; i < 3; ++i)
-        best = std::min(best, std::atan2(y[i], x[i]));
-    return best;
-}
+using detail::minAngle;
 // Distance between the segments pq and rs.
 inline double segmentGap(const Vec3& p, const Vec3& q, const Vec3& r, const Vec3& s) {
     const Vec3 d1 = q - p, d2 = s - r, w = p - r;
