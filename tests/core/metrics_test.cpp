@@ -242,6 +242,37 @@ TEST(Metrics, GarbageIsIgnored) {
     EXPECT_EQ(*z.selfIntersections, 0u);
 }
 
+// valenceAndMinAngle gives computeMetrics' two figures bit for bit, with garbage, borders, a pinched vertex
+// and a degenerate face too (the brute-force comparison is in MetricsOnSampleMesh).
+TEST(Metrics, ValenceAndMinAngleAreComputeMetricsFigures) {
+    std::vector<Mesh> meshes = {fss::shapes::icosphere(3), fss::shapes::uvSphere(40, 21),
+                                fss::shapes::torus(30, 12, 1.0, 0.3)};
+    Mesh holed = fss::shapes::icosphere(2);
+    CGAL::Euler::remove_face(holed.halfedge(*holed.faces().begin()), holed);
+    ASSERT_TRUE(holed.has_garbage());
+    meshes.push_back(holed);
+    Mesh pinched; // two triangles sharing one vertex only, plus a collinear one
+    const auto o = pinched.add_vertex({0, 0, 0}), a = pinched.add_vertex({1, 0, 0}),
+               b = pinched.add_vertex({0, 1, 0}), c = pinched.add_vertex({-1, 0, 0}),
+               d = pinched.add_vertex({0, -1, 0}), e = pinched.add_vertex({2, 0, 0}),
+               f = pinched.add_vertex({3, 0, 0});
+    pinched.add_face(o, a, b);
+    pinched.add_face(o, c, d);
+    pinched.add_face(a, e, f);
+    meshes.push_back(pinched);
+    meshes.push_back(Mesh{});
+    for (const Mesh& m : meshes) {
+        fss::MetricsOptions options;
+        options.selfIntersections = false;
+        const Metrics x = fss::computeMetrics(m, options);
+        const fss::ValenceAndMinAngle y = fss::valenceAndMinAngle(m);
+        EXPECT_EQ(y.fracValence6Interior, x.fracValence6Interior) << m.number_of_faces() << " faces";
+        EXPECT_EQ(y.minAngleDeg, x.minAngleDeg) << m.number_of_faces() << " faces";
+    }
+    EXPECT_EQ(fss::valenceAndMinAngle(pinched).minAngleDeg, 0.0);                      // the collinear face
+    EXPECT_EQ(fss::valenceAndMinAngle(meshes[0]).fracValence6Interior, 630.0 / 642.0); // 12 of valence 5
+}
+
 TEST(Metrics, PinchedVertexIsNonManifold) {
     // Two open fans of two triangles each, above and below the apex, sharing only the apex: Surface_mesh
     // accepts this (the apex is on the border of both) and keeps one vertex with two umbrellas.
@@ -671,6 +702,12 @@ TEST_P(MetricsOnSampleMesh, AgreesWithBruteForce) {
     EXPECT_NEAR(x.fracValence6Interior, double(e.interior6) / double(e.interior), 0.001);
     EXPECT_NEAR(x.minAngleDeg, e.minAngle, 0.05);
     EXPECT_NEAR(x.maxAngleDeg, e.maxAngle, 0.05);
+    // The lean figures (the widget's accept): against the brute force, and the same doubles as above.
+    const fss::ValenceAndMinAngle lean = fss::valenceAndMinAngle(mesh);
+    EXPECT_NEAR(lean.fracValence6Interior, double(e.interior6) / double(e.interior), 0.001);
+    EXPECT_NEAR(lean.minAngleDeg, e.minAngle, 0.05);
+    EXPECT_EQ(lean.fracValence6Interior, x.fracValence6Interior);
+    EXPECT_EQ(lean.minAngleDeg, x.minAngleDeg);
     EXPECT_NEAR(x.meanMinAngleDeg, e.meanMinAngle, 0.05);
     EXPECT_NEAR(x.area, e.area, 1e-9 * e.area);
     EXPECT_NEAR(x.edgeLengthMean, e.edgeMean, 1e-9 * e.edgeMean);

@@ -94,6 +94,36 @@ using detail::DisjointSets;
 
 // ---- topology --------------------------------------------------------------------------------------
 
+// Pinched vertices: the fan reached by circulating differs from all incident halfedges, or the circulation
+// meets more than one border (two fans linked through the border cycle). The others without a border are
+// interior: their valences and the share of valence 6.
+void countInteriorValences(const Mesh& m, Metrics& out) {
+    std::vector<std::size_t> incoming(m.number_of_vertices(), 0);
+    for (HalfedgeIndex h : m.halfedges())
+        ++incoming[idx(m.target(h))];
+    for (VertexIndex v : m.vertices()) {
+        const HalfedgeIndex h0 = m.halfedge(v);
+        if (h0 == Mesh::null_halfedge()) continue; // isolated vertex
+        std::size_t around = 0, borders = 0;
+        for (HalfedgeIndex h : m.halfedges_around_target(h0)) {
+            ++around;
+            if (m.is_border(h)) ++borders;
+        }
+        const bool pinched = borders > 1 || around != incoming[idx(v)];
+        if (pinched) {
+            ++out.nonManifoldVertices;
+        } else if (borders == 0) {
+            ++out.interiorVertices;
+            ++out.valenceHistogram[int(around)];
+        }
+    }
+    if (out.interiorVertices > 0) {
+        const auto six = out.valenceHistogram.find(6);
+        const std::size_t n6 = six == out.valenceHistogram.end() ? 0 : six->second;
+        out.fracValence6Interior = double(n6) / double(out.interiorVertices);
+    }
+}
+
 void measureTopology(const Mesh& m, Metrics& out) {
     out.vertices = m.number_of_vertices();
     out.faces = m.number_of_faces();
@@ -125,32 +155,7 @@ void measureTopology(const Mesh& m, Metrics& out) {
     for (FaceIndex f : m.faces())
         if (sets.find(idx(f)) == idx(f)) ++out.components;
 
-    // Pinched vertices: the fan reached by circulating differs from all incident halfedges, or the
-    // circulation meets more than one border (two fans linked through the border cycle).
-    std::vector<std::size_t> incoming(m.number_of_vertices(), 0);
-    for (HalfedgeIndex h : m.halfedges())
-        ++incoming[idx(m.target(h))];
-    for (VertexIndex v : m.vertices()) {
-        const HalfedgeIndex h0 = m.halfedge(v);
-        if (h0 == Mesh::null_halfedge()) continue; // isolated vertex
-        std::size_t around = 0, borders = 0;
-        for (HalfedgeIndex h : m.halfedges_around_target(h0)) {
-            ++around;
-            if (m.is_border(h)) ++borders;
-        }
-        const bool pinched = borders > 1 || around != incoming[idx(v)];
-        if (pinched) {
-            ++out.nonManifoldVertices;
-        } else if (borders == 0) {
-            ++out.interiorVertices;
-            ++out.valenceHistogram[int(around)];
-        }
-    }
-    if (out.interiorVertices > 0) {
-        const auto six = out.valenceHistogram.find(6);
-        const std::size_t n6 = six == out.valenceHistogram.end() ? 0 : six->second;
-        out.fracValence6Interior = double(n6) / double(out.interiorVertices);
-    }
+    countInteriorValences(m, out);
 }
 
 // ---- triangle shape ----------------------------------------------------------------------------------
@@ -485,6 +490,43 @@ Metrics computeMetrics(const Mesh& mesh, const MetricsOptions& options, const Pr
 
     if (denseRef) measureDistances(m, out.area, denseRef->get(), options, progress, out);
     progress.report(1.0, "done");
+    return out;
+}
+
+ValenceAndMinAngle valenceAndMinAngle(const Mesh& mesh) {
+    const DenseMesh dense(mesh);
+    const Mesh& m = dense.get();
+    requireTriangles(m, "mesh");
+    Metrics counts;
+    countInteriorValences(m, counts);
+    ValenceAndMinAngle out;
+    out.fracValence6Interior = counts.fracValence6Interior;
+    if (m.number_of_faces() == 0) return out;
+    // measureShape's minAngle is the smallest of all corners' angleBetween (times kRadToDeg, which keeps
+    // the order). A corner atan2(y, x) with y cos(best) − x sin(best) = |(x, y)| sin(angle − best) clearly
+    // positive (above 1e-9 rad, far beyond the rounding of either side) is wider than the best so far and
+    // cannot change it; the others go through angleBetween itself.
+    double best = std::numeric_limits<double>::infinity(), cosBest = 0, sinBest = 0;
+    auto corner = [&](const Vector3& u, const Vector3& v) {
+        if (best < std::numeric_limits<double>::infinity()) {
+            const double y = std::sqrt(CGAL::cross_product(u, v).squared_length()), x = u * v;
+            const double d = y * cosBest - x * sinBest;
+            if (d > 0 && d * d > 1e-18 * (x * x + y * y)) return;
+        }
+        const double a = angleBetween(u, v);
+        if (!(a < best)) return;
+        best = a;
+        cosBest = std::cos(best);
+        sinBest = std::sin(best);
+    };
+    for (FaceIndex f : m.faces()) {
+        const auto [a, b, c] = corners(m, f);
+        const Vector3 ab = b - a, bc = c - b, ca = a - c;
+        corner(ab, -ca);
+        corner(bc, -ab);
+        corner(ca, -bc);
+    }
+    out.minAngleDeg = best * kRadToDeg;
     return out;
 }
 

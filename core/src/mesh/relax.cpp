@@ -80,7 +80,7 @@ Ring ringOf(const Mesh& m, VertexIndex v, const Eigen::Vector3d& at, const Ring*
 
 RelaxReport relaxOnReference(Mesh& mesh, const Mesh& reference, const std::vector<VertexIndex>& vertices,
                              std::vector<FaceIndex>& hints, const std::vector<double>& footprints,
-                             const RelaxOptions& options, const Camera* facing) {
+                             const RelaxOptions& options, const Camera* facing, LocalClosestPoint* shared) {
     RelaxReport report;
     report.vertices = vertices.size();
     if (options.iterations <= 0 || vertices.empty()) return report;
@@ -96,7 +96,8 @@ RelaxReport relaxOnReference(Mesh& mesh, const Mesh& reference, const std::vecto
         report.onCrease += crease[k].has_value();
     }
     // The reference does not change here: its rings are collected once (same results as closestPointNear).
-    LocalClosestPoint search(reference, LocalSearchOptions{.rings = 1});
+    std::optional<LocalClosestPoint> own;
+    LocalClosestPoint& search = shared ? *shared : own.emplace(reference, LocalSearchOptions{.rings = 1});
     for (int sweep = 0; sweep < options.iterations; ++sweep) {
         for (std::size_t k = 0; k < vertices.size(); ++k) {
             const VertexIndex v = vertices[k];

@@ -18,6 +18,8 @@
 
 namespace fss::detail {
 
+class LocalClosestPoint;
+
 /// Options of relaxOnReference.
 struct RelaxOptions {
     int iterations = 6;             ///< sweeps over the vertices; 0 = nothing
@@ -50,9 +52,12 @@ struct RelaxReport {
 /// So no face turns over, every moved vertex lies on the reference and the connectivity is unchanged.
 /// \p hints[k] is a face of \p reference at vertices[k] (updated to the face it ends on); \p footprints[k]
 /// a length scale of vertices[k] (the scan's pixel footprint there).
+/// \p search, when given, is a LocalClosestPoint over \p reference with one ring (LocalSearchOptions{.rings
+/// = 1}) that the caller keeps across calls (its rings are collected once; the same results).
 /// \pre hints and footprints have one entry per vertex; \p mesh is a triangle mesh.
 RelaxReport relaxOnReference(Mesh& mesh, const Mesh& reference, const std::vector<VertexIndex>& vertices,
                              std::vector<FaceIndex>& hints, const std::vector<double>& footprints,
-                             const RelaxOptions& options, const Camera* facing = nullptr);
+                             const RelaxOptions& options, const Camera* facing = nullptr,
+                             LocalClosestPoint* search = nullptr);
 
 } // namespace fss::detail

@@ -568,7 +568,8 @@ private:
         o.creaseAngleDeg = in_.creaseAngleDeg;
         o.maxNormalTurnDeg = in_.maxNormalTurnDeg;
         o.maxOffFootprints = 0.5;
-        const detail::RelaxReport r = detail::relaxOnReference(S_, ref_, verts, hints, sizes, o, in_.camera);
+        const detail::RelaxReport r =
+            detail::relaxOnReference(S_, ref_, verts, hints, sizes, o, in_.camera, &near1_);
         report_.moves += r.moves;
         for (std::size_t k = 0; k < verts.size(); ++k)
             hint_[std::size_t(verts[k])] = hints[k];
