@@ -438,6 +438,9 @@ struct Case {
     std::uint32_t seed;
     int patches; // scans that produce a patch
     int maxRes;
+    // Issue 19's bound asserted on this mesh: every face a stitch created has a smallest angle of at least
+    // this (degrees; faces at a thin input angle exempt). 0: measured and printed only (not met there yet).
+    double createdMinDeg = 0;
 };
 
 struct Figures {
@@ -955,6 +958,7 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
                 fig.stitchesCreated98Above30, fig.stitched, fig.worstStitchFrac30, fig.stitchesValence90,
                 fig.stitched, fig.createdFaces ? double(fig.createdAbove30) / double(fig.createdFaces) : 1.0,
                 fig.createdFaces);
+    EXPECT_GE(fig.createdMinAngle, cs.createdMinDeg) << "a face a stitch created is below issue 19's bound";
     EXPECT_GE(fig.stitched + fig.refused, cs.patches) << "too few scans produced a patch";
     // Most patches stitch (a majority); the refused ones are listed above with their reasons.
     EXPECT_GT(fig.stitched, fig.refused) << "too many patches could not be stitched";
@@ -980,7 +984,8 @@ INSTANTIATE_TEST_SUITE_P(Meshes, StitchProperty,
                                            Case{"hand.off", 7707u, kPatches, 512},
                                            // analytic shapes (fss::shapes)
                                            Case{"shape:torus", 8818u, kPatches, 512},
-                                           Case{"shape:icosphere", 9909u, kPatches, 512}),
+                                           // created faces >= 20 deg (measured 30.28 deg at 25 scans)
+                                           Case{"shape:icosphere", 9909u, kPatches, 512, 20.0}),
                          [](const ::testing::TestParamInfo<Case>& info) {
                              std::string n = info.param.file;
                              if (n.rfind("shape:", 0) == 0) n = n.substr(6);
