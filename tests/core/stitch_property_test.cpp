@@ -438,6 +438,9 @@ struct Case {
     std::uint32_t seed;
     int patches; // scans that produce a patch
     int maxRes;
+    // Issue 19's bound asserted on this mesh: every face a stitch created has a smallest angle of at least
+    // this (degrees; faces at a thin input angle exempt). 0: measured and printed only (not met there yet).
+    double createdMinDeg = 0;
 };
 
 struct Figures {
@@ -505,7 +508,12 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
     std::map<std::int32_t, Camera> scanCameras;
     Figures fig;
     fig.facesStart = ref.number_of_faces();
-    std::mt19937 rng(cs.seed);
+    // FSS_STITCH_PROPERTY_SEED=N shifts every case's seed by N (other scans of the same meshes).
+    const std::uint32_t seed = [&] {
+        const char* e = std::getenv("FSS_STITCH_PROPERTY_SEED");
+        return cs.seed + (e ? std::uint32_t(std::strtoul(e, nullptr, 10)) : 0u);
+    }();
+    std::mt19937 rng(seed);
     // FSS_STITCH_REFILL=1 measures stitch v2's seam refill (StitchOptions::refillSeam, off by default);
     // FSS_STITCH_REMESH=0 measures without stitch v2's seam band remesh (StitchOptions::remeshSeam, on by
     // default): version 1's seam, for comparison.
@@ -616,7 +624,7 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
     while (fig.stitched + fig.refused < cs.patches && fig.attempts < 12 * cs.patches) {
         ++fig.attempts;
         const ScanSetup setup = randomSetup(rng, box, cs.maxRes);
-        const std::string trace = std::string(cs.file) + " seed " + std::to_string(cs.seed) + " attempt " +
+        const std::string trace = std::string(cs.file) + " seed " + std::to_string(seed) + " attempt " +
                                   std::to_string(fig.attempts) + " scan id " + std::to_string(scanId + 1) +
                                   ": " + setup.text;
         SCOPED_TRACE(trace);
@@ -932,7 +940,7 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
         "%s (seed %u): %d scan attempts, %d without a patch, %d patches stitched, %d refused; faces %zu -> "
         "%zu; worst Hausdorff / footprint: current->reference %.3f, reference->current %.3f; "
         "time scan %.1f s, stitch %.1f s, checks %.1f s\n",
-        cs.file, cs.seed, fig.attempts, fig.noPatch, fig.stitched, fig.refused, fig.facesStart, fig.facesEnd,
+        cs.file, seed, fig.attempts, fig.noPatch, fig.stitched, fig.refused, fig.facesStart, fig.facesEnd,
         fig.worstToRef, fig.worstFromRef, fig.scanSeconds, fig.stitchSeconds, fig.checkSeconds);
     for (const auto& [why, n] : fig.reasons)
         std::printf("  refused %d x: %s\n", n, why.c_str());
@@ -950,6 +958,7 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
                 fig.stitchesCreated98Above30, fig.stitched, fig.worstStitchFrac30, fig.stitchesValence90,
                 fig.stitched, fig.createdFaces ? double(fig.createdAbove30) / double(fig.createdFaces) : 1.0,
                 fig.createdFaces);
+    EXPECT_GE(fig.createdMinAngle, cs.createdMinDeg) << "a face a stitch created is below issue 19's bound";
     EXPECT_GE(fig.stitched + fig.refused, cs.patches) << "too few scans produced a patch";
     // Most patches stitch (a majority); the refused ones are listed above with their reasons.
     EXPECT_GT(fig.stitched, fig.refused) << "too many patches could not be stitched";
@@ -975,7 +984,8 @@ INSTANTIATE_TEST_SUITE_P(Meshes, StitchProperty,
                                            Case{"hand.off", 7707u, kPatches, 512},
                                            // analytic shapes (fss::shapes)
                                            Case{"shape:torus", 8818u, kPatches, 512},
-                                           Case{"shape:icosphere", 9909u, kPatches, 512}),
+                                           // created faces >= 20 deg (measured 30.28 deg at 25 scans)
+                                           Case{"shape:icosphere", 9909u, kPatches, 512, 20.0}),
                          [](const ::testing::TestParamInfo<Case>& info) {
                              std::string n = info.param.file;
                              if (n.rfind("shape:", 0) == 0) n = n.substr(6);

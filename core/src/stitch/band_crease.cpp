@@ -7,6 +7,70 @@
 
 namespace fss::stitch::band {
 
+void BandRemesher::findCreases() {
+    // Band edges between band faces whose normals differ by more than the crease angle, with two filters
+    // against false creases (finely cut curved surfaces, where one tilted face or a short stub of a crease
+    // would pin vertices that the band needs to move, DESIGN.md §6.2):
+    //  - a face whose normal differs by more than the crease angle from every band neighbour with a known
+    //    normal (at least two) is an outlier, not a feature: its normal counts as unknown;
+    //  - a crease edge that hangs off a crease (one end on no other crease edge, the other on two or more)
+    //    or stands alone is dropped unless its dihedral angle is at least twice the crease angle.
+    const double creaseCos = std::cos(in_.creaseAngleDeg * kBandDeg);
+    std::unordered_map<std::uint32_t, V3> normal;
+    auto creaseNormal = [&](FaceIndex f) -> V3 {
+        auto [it, fresh] = normal.try_emplace(std::uint32_t(f), V3(0, 0, 0));
+        if (!fresh) return it->second;
+        if (in_.creaseNormal) {
+            it->second = in_.creaseNormal(f);
+        } else {
+            const HalfedgeIndex h = S_.halfedge(f);
+            const V3 a = detail::pos(S_, S_.source(h)), b = detail::pos(S_, S_.target(h)),
+                     c = detail::pos(S_, S_.target(S_.next(h)));
+            if (detail::minAngle(a, b, c) >= kSliverDeg * kBandDeg) it->second = detail::unitNormal(a, b, c);
+        }
+        return it->second;
+    };
+    const bool filter = !stageOff("creasefilter");
+    std::vector<FaceIndex> outliers;
+    for (FaceIndex f : bandList_) {
+        const V3 n = creaseNormal(f);
+        if (!filter || !(n.squaredNorm() > 0)) continue;
+        int known = 0, apart = 0;
+        for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
+            if (!interiorEdge(h)) continue;
+            const V3 m = creaseNormal(S_.face(S_.opposite(h)));
+            if (!(m.squaredNorm() > 0)) continue;
+            ++known;
+            apart += n.dot(m) < creaseCos;
+        }
+        if (known >= 2 && apart == known) outliers.push_back(f);
+    }
+    for (FaceIndex f : outliers)
+        normal[std::uint32_t(f)] = V3(0, 0, 0);
+    std::unordered_map<std::uint64_t, double> cosine; // per crease edge: the cosine of its dihedral angle
+    for (FaceIndex f : bandList_)
+        for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
+            if (!interiorEdge(h)) continue;
+            const V3 n1 = creaseNormal(S_.face(h)), n2 = creaseNormal(S_.face(S_.opposite(h)));
+            if (n1.squaredNorm() > 0 && n2.squaredNorm() > 0 && n1.dot(n2) < creaseCos) {
+                addCrease(S_.source(h), S_.target(h));
+                cosine[bandKey(S_.source(h), S_.target(h))] = n1.dot(n2);
+            }
+        }
+    if (!filter) return;
+    const double strongCos = std::cos(2 * in_.creaseAngleDeg * kBandDeg);
+    std::vector<std::pair<VertexIndex, VertexIndex>> weak;
+    for (const auto& [k, c] : cosine) {
+        const VertexIndex a(std::uint32_t(k >> 32)), b(std::uint32_t(k & 0xffffffffu));
+        const int da = creaseDegree(a), db = creaseDegree(b);
+        const bool stub = (da == 1 && db != 2) || (db == 1 && da != 2);
+        if (stub && c > strongCos) weak.push_back({a, b});
+    }
+    std::sort(weak.begin(), weak.end());
+    for (const auto& [a, b] : weak)
+        removeCrease(a, b);
+}
+
 void BandRemesher::buildCreaseChains() {
     // Crease graph over S_'s vertices (at setup S_'s band is the draft, ref_ its copy).
     std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> adj;

@@ -19,25 +19,10 @@ void BandRemesher::setup() {
     std::sort(verts.begin(), verts.end());
     for (VertexIndex v : verts)
         at(fixed_, std::size_t(v), char(1)) = (!wholeStarInBand(v) || (in_.fixed && in_.fixed(v))) ? 1 : 0;
-    // Creases: band edges between band faces whose normals differ by more than the crease angle.
-    const double creaseCos = std::cos(in_.creaseAngleDeg * kBandDeg);
-    auto creaseNormal = [&](FaceIndex f) -> V3 {
-        if (in_.creaseNormal) return in_.creaseNormal(f);
-        const HalfedgeIndex h = S_.halfedge(f);
-        const V3 a = detail::pos(S_, S_.source(h)), b = detail::pos(S_, S_.target(h)),
-                 c = detail::pos(S_, S_.target(S_.next(h)));
-        return detail::minAngle(a, b, c) >= kSliverDeg * kBandDeg ? detail::unitNormal(a, b, c) : V3(0, 0, 0);
-    };
-    for (FaceIndex f : bandList_)
-        for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
-            if (!interiorEdge(h)) continue;
-            const V3 n1 = creaseNormal(S_.face(h)), n2 = creaseNormal(S_.face(S_.opposite(h)));
-            if (n1.squaredNorm() > 0 && n2.squaredNorm() > 0 && n1.dot(n2) < creaseCos)
-                addCrease(S_.source(h), S_.target(h));
-        }
+    findCreases();
     // Crease corners and ends stay (a vertex with other than two crease edges).
     for (const auto& [v, d] : creaseDeg_)
-        if (d != 2) at(fixed_, std::size_t(v), char(1)) = 1;
+        if (d != 0 && d != 2) at(fixed_, std::size_t(v), char(1)) = 1;
     buildCreaseChains();
     // The reference: a copy of the band (the draft surface), and each band vertex's face on it.
     std::unordered_map<std::uint32_t, VertexIndex> toRef;

@@ -40,8 +40,8 @@ constexpr double kSlideCreaseDeg = 10.0;
 constexpr double kSplitFloorDeg = 20.0;
 using V3 = Eigen::Vector3d;
 
-// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide turns parts of the band remesh off (to measure what each
-// brings).
+// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,creasefilter,collapseall (and lift, split, smooth) turns parts
+// of the band remesh off (to measure what each brings).
 inline bool stageOff(const char* name) {
     static const std::string off = [] {
         const char* e = std::getenv("FSS_STITCH_BAND_OFF");
@@ -371,6 +371,9 @@ private:
     // ---- creases as polylines of the draft (band_crease.cpp): each crease vertex's place on them, so that
     // splits and slides put crease vertices on the draft's crease line, not on a chord of it
     void buildCreaseChains();
+    // The band's creases at setup (band_crease.cpp): edges between faces whose normals differ by more than
+    // the crease angle, outlier faces and weak stubs left out.
+    void findCreases();
     // The point at parameter t between crease vertices a and b on their common crease polyline (into q);
     // chain -1 when they have none (q is left as it is).
     CreasePos creaseBetween(VertexIndex a, VertexIndex b, double t, V3& q) const;

@@ -138,23 +138,32 @@ bool BandRemesher::repairFlip(FaceIndex f) {
 }
 
 bool BandRemesher::repairCollapse(FaceIndex f) {
-    HalfedgeIndex shortest = Mesh::null_halfedge();
-    double len = std::numeric_limits<double>::infinity();
-    for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
-        const double l = (detail::pos(S_, S_.source(h)) - detail::pos(S_, S_.target(h))).norm();
-        if (l < len && interiorEdge(h)) {
-            len = l;
-            shortest = h;
+    // Each of the face's interior edges, either way (its shortest edge first: the first of equal scores
+    // wins): the collapse that gives the largest smallest angle around it, where that beats the face's. A
+    // cap's shortest edge often cannot go (a valence, a normal) while another of its edges can.
+    std::vector<std::pair<double, HalfedgeIndex>> edges;
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_))
+        if (interiorEdge(h))
+            edges.push_back({(detail::pos(S_, S_.source(h)) - detail::pos(S_, S_.target(h))).norm(), h});
+    if (edges.empty()) return false;
+    std::stable_sort(edges.begin(), edges.end(),
+                     [](const auto& x, const auto& y) { return x.first < y.first; });
+    const std::size_t tried = stageOff("collapseall") ? 1 : edges.size();
+    VertexIndex bestFrom, bestTo;
+    double best = faceMinAngle(f);
+    for (std::size_t i = 0; i < tried; ++i) {
+        const VertexIndex a = S_.source(edges[i].second), b = S_.target(edges[i].second);
+        for (const auto& [from, to] : {std::pair{a, b}, std::pair{b, a}}) {
+            double score = -1;
+            if (collapsible(from, to, score, 2.0) && score > best) {
+                best = score;
+                bestFrom = from;
+                bestTo = to;
+            }
         }
     }
-    if (shortest == Mesh::null_halfedge()) return false;
-    const VertexIndex a = S_.source(shortest), b = S_.target(shortest);
-    double sa = -1, sb = -1;
-    const bool okA = collapsible(a, b, sa, 2.0), okB = collapsible(b, a, sb, 2.0);
-    if (!okA && !okB) return false;
-    const VertexIndex from = (okA && (!okB || sa >= sb)) ? a : b, to = from == a ? b : a;
-    if (std::max(sa, sb) <= faceMinAngle(f)) return false;
-    collapse(from, to);
+    if (bestFrom == VertexIndex()) return false;
+    collapse(bestFrom, bestTo);
     return true;
 }
 
