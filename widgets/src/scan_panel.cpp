@@ -90,13 +90,14 @@ ScanPanel::ScanPanel(QWidget* parent) : QWidget(parent) {
         tr("Samples whose lattice triangle would have a smaller angle on the surface "
            "(seen at a slant) are left to another view; 0 = keep them"));
     form->addRow(tr("Min lattice angle"), minLatticeAngle_);
-    warp_ = new QCheckBox(tr("Warp lattice to the surface"), this);
+    // "Warp lattice | to the surface": split over the label and the field so that the panel does not widen.
+    warp_ = new QCheckBox(tr("to the surface"), this);
     warp_->setObjectName(QStringLiteral("warpToSurface"));
     warp_->setChecked(ScanOptions{}.warpToSurface);
     warp_->setToolTip(tr("Adaptive lattice only: bend the lattice per sample so that its triangles are "
                          "equilateral on the curved surface, not only on the plane at the view's main slant "
                          "(rounder triangles; off = the one lattice chosen for the view)"));
-    form->addRow(QString(), warp_);
+    form->addRow(tr("Warp lattice"), warp_);
     setLattice(ScanOptions{}.lattice);
     warp_->setEnabled(lattice() == Lattice::Adaptive);
     force_ = new QCheckBox(tr("Force replace"), this);
