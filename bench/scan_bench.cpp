@@ -30,9 +30,12 @@
 // without the warm-up that run's render_ms held the upload, about 1.9 s under load against 0.3–0.5 s.)
 #include "fss/camera.h"
 #include "fss/mask.h"
+#include "fss/metrics.h"
 #include "fss/parallel.h"
+#include "fss/render/gpu_mesh_renderer.h"
 #include "fss/render/rasterizer.h"
 #include "fss/scan.h"
+#include "fss/scan_pipeline.h"
 #include "fss/scan_workspace.h"
 #include "fss/shapes.h"
 #include "fss/triangulate.h"
@@ -124,7 +127,7 @@ Scene& sceneWith(int faces) {
     auto& s = cache[faces];
     if (!s) {
         s = std::make_unique<Scene>();
-        const int nu = faces >= 1000000 ? 1000 : 250;
+        const int nu = faces >= 1000000 ? 1000 : faces >= 100000 ? 250 : 100;
         s->mesh = fss::shapes::torus(nu, faces / (2 * nu), 1.0, 0.35);
         s->rasterizer.setMesh(s->mesh);
         s->current = s->mesh;
@@ -223,6 +226,43 @@ void BM_ScanStages(benchmark::State& state) {
     state.counters["floor_over_gpu"] = (floor / n) / ((render + read) / n);
 }
 
+// The whole regular scan (scanPatch, with a workspace as a session scans) on the default adaptive lattice,
+// warped to the surface (warp:1, ScanOptions::warpToSurface, the default since session file version 3) or
+// not (warp:0): what the warp costs (issue #20). The first scan is not measured (allocations, upload).
+// Counters: sample_ms (the lattice chosen, warped and sampled), scan_ms (render to patch), patch_faces and
+// mean_min_angle (the patch's mean smallest angle, degrees: what the warp buys).
+void BM_ScanWarp(benchmark::State& state) {
+    const int faces = int(state.range(0)), res = int(state.range(1));
+    Scene& scene = sceneWith(faces);
+    static std::map<int, std::unique_ptr<fss::render::GpuMeshRenderer>> renderers; // scanPatch's interface
+    auto& renderer = renderers[faces];
+    if (!renderer) {
+        renderer = std::make_unique<fss::render::GpuMeshRenderer>();
+        renderer->setMesh(scene.mesh);
+    }
+    fss::ScanParams params;
+    params.camera = fss::Camera::standardView(fss::StandardView::Iso, scene.box, res, res);
+    params.scan.lattice = fss::Lattice::Adaptive;
+    params.scan.warpToSurface = state.range(2) != 0;
+    fss::ScanWorkspace workspace;
+    fss::ScanResult result = fss::scanPatch(scene.mesh, *renderer, scene.mesh, *renderer, params, workspace);
+    double sample = 0, total = 0;
+    for (auto _ : state) {
+        workspace.recycle(std::move(result.grid));
+        workspace.recycle(std::move(result.patch));
+        result = fss::scanPatch(scene.mesh, *renderer, scene.mesh, *renderer, params, workspace);
+        sample += result.timings.sample * 1e3;
+        total += result.timings.total * 1e3;
+        benchmark::DoNotOptimize(result.patch.mesh.number_of_faces());
+    }
+    const double n = double(state.iterations());
+    state.counters["sample_ms"] = sample / n;
+    state.counters["scan_ms"] = total / n;
+    state.counters["patch_faces"] = double(result.patch.mesh.number_of_faces());
+    state.counters["mean_min_angle"] =
+        fss::computeMetrics(result.patch.mesh, {.selfIntersections = false}).meanMinAngleDeg;
+}
+
 } // namespace
 
 // FSS_SCAN_THREADS=N sets fss::setScanThreads(N) before the benchmarks run.
@@ -234,6 +274,12 @@ const bool threadsFromEnvironment = [] {
 BENCHMARK(BM_ScanStages)
     ->ArgsProduct({{100000, 1000000}, {256, 512, 1024}, {0, 1}})
     ->ArgNames({"faces", "res", "lattice"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+BENCHMARK(BM_ScanWarp)
+    ->ArgsProduct({{10000, 100000}, {256}, {0, 1}})
+    ->ArgNames({"faces", "res", "warp"})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

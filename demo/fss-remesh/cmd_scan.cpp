@@ -1,6 +1,6 @@
 // fss-remesh scan MESH -o OUT [--into CURRENT] [--view V | --camera ...] [--parallel] [--resolution W[xH]]
 // [--zoom F]
-//                  [--lasso "x,y;x,y;..."] [--erode N] [--dilate N] [--json] ...
+//                  [--lasso "x,y;x,y;..."] [--erode N] [--dilate N] [--lattice L] [--no-warp] [--json] ...
 //                  [--fishbone
 //                  "seed=X,Y[;dir=min|max][;h=PIXELS][;keyribs=X,Y|X,Y...][;backbone=X,Y|X,Y...][;sampling=K]"]
 #include "command_line.h"
@@ -251,6 +251,10 @@ ScanRun fishboneScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& 
     return run;
 }
 
+const char* latticeName(Lattice lattice) {
+    return lattice == Lattice::Square ? "square" : lattice == Lattice::Adaptive ? "adaptive" : "triangular";
+}
+
 ScanRun regularScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& current,
                     MeshRenderer& currentRenderer, const ScanParams& params, const std::string& meshPath,
                     const std::string& rendererUsed) {
@@ -260,6 +264,8 @@ ScanRun regularScan(const Mesh& reference, MeshRenderer& renderer, const Mesh& c
     ScanRun run;
     nlohmann::json& j = run.json;
     j["resolution"] = {params.camera.width, params.camera.height};
+    j["lattice"] = latticeName(params.scan.lattice);
+    j["warp_to_surface"] = params.scan.lattice == Lattice::Adaptive && params.scan.warpToSurface;
     j["camera"] = {{"eye", {params.camera.eye.x(), params.camera.eye.y(), params.camera.eye.z()}},
                    {"focal", {params.camera.focal.x(), params.camera.focal.y(), params.camera.focal.z()}},
                    {"up", {params.camera.up.x(), params.camera.up.y(), params.camera.up.z()}},
@@ -337,10 +343,6 @@ void requireRemeshingOf(const Mesh& current, const std::string& currentPath, con
     }
 }
 
-const char* latticeName(Lattice lattice) {
-    return lattice == Lattice::Square ? "square" : lattice == Lattice::Adaptive ? "adaptive" : "triangular";
-}
-
 // The lattice options' defaults are the core's (ScanParams{}: issue #20).
 struct ScanOptions {
     std::string meshPath, outPath, view = "iso", intoPath, rendererKind = "auto",
@@ -359,7 +361,7 @@ struct ScanOptions {
     const CLI::Option* intoOption = nullptr;
     const CLI::Option* scanIdOption = nullptr;
     OutputFileOptions file;
-    bool parallel = false, json = false, force = false;
+    bool parallel = false, json = false, force = false, noWarp = false;
 };
 
 int runScan(const ScanOptions& o) {
@@ -382,6 +384,15 @@ int runScan(const ScanOptions& o) {
     params.scan.minLatticeAngleDeg = o.minLatticeAngle;
     params.scan.spacingPixels = o.spacing;
     params.scan.spacingWorld = o.spacingWorld;
+    // The warp is a property of the adaptive lattice (ScanOptions::warpToSurface): turning it off elsewhere
+    // would do nothing, so it is refused rather than silently ignored.
+    if (o.noWarp && o.fishboneOption->count() > 0)
+        throw UsageError("The option --no-warp applies to a regular scan's adaptive lattice, not to a "
+                         "--fishbone grid.");
+    if (o.noWarp && params.scan.lattice != Lattice::Adaptive)
+        throw UsageError("The option --no-warp applies to the adaptive lattice only, not to --lattice " +
+                         o.lattice + ".");
+    params.scan.warpToSurface = !o.noWarp;
 
     checkOutputFileOptions(o.outPath, o.file);
     const Mesh reference = readInputMesh(meshPath);
@@ -523,14 +534,20 @@ Subcommand addScan(CLI::App& app) {
              "full resolution, finer direction fields at up to h^2 times the render cost). Points in "
              "normalised image coordinates as for --lasso. --max-edge-footprints is multiplied by h/K.")
             ->type_name("SPEC");
-    p->add_option(
-         "--lattice", o->lattice,
-         "Sample lattice of a regular scan: adaptive (default; a triangular lattice compressed and "
-         "turned per view so that the most of the visible surface gets round triangles despite its "
-         "slant), triangular (rows offset by half a spacing, equilateral triangles on the screen) or "
-         "square (one sample per pixel centre, the paper's pixel grid).")
+    p->add_option("--lattice", o->lattice,
+                  "Sample lattice of a regular scan: adaptive (default; a triangular lattice compressed and "
+                  "turned per view so that the most of the visible surface gets round triangles despite its "
+                  "slant, then warped to the surface unless --no-warp), triangular (rows offset by half a "
+                  "spacing, equilateral triangles on the screen) or "
+                  "square (one sample per pixel centre, the paper's pixel grid).")
         ->type_name("L")
         ->check(oneOf("--lattice", {"triangular", "square", "adaptive"}));
+    p->add_flag(
+        "--no-warp", o->noWarp,
+        "Do not warp the adaptive lattice to the surface: sample on the one affine lattice chosen for the "
+        "view (equilateral only on the plane at the view's dominant slant) instead of bending it per sample "
+        "so that its triangles are equilateral on the curved surface (default: warped). Only with the "
+        "adaptive lattice of a regular scan.");
     addDouble(*p, "--min-lattice-angle", o->minLatticeAngle, false, "DEG",
               "Leave to other views the surface where the lattice's triangles would have a smallest angle "
               "below DEG degrees (its slant), in [0, 60) (default 35; 0 = keep all).");

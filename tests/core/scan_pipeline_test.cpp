@@ -261,7 +261,7 @@ struct LatticeSetting {
     double minLatticeAngleDeg = 0;
     double minQuadAngleDeg = 20;
     int relaxIterations = 6;
-    bool warpToSurface = false;
+    bool warpToSurface = fss::ScanOptions{}.warpToSurface; // on (the default since issue #20)
 };
 
 LatticeFigures latticeScan(const fss::Mesh& ref, fss::MeshRenderer& renderer, fss::StandardView view, int res,
@@ -425,9 +425,10 @@ TEST(ScanPipeline, TriangularLatticeMakesRounderTrianglesThanThePixelGrid) {
     EXPECT_LE(tri.hausdorff, sq.hausdorff);
 }
 
-// The adaptive lattice with the lattice-angle mask at 35° (issue #20) on the view where the screen lattice
-// fails worst, fandisk from the iso view: the criterion of the issue (mean smallest angle ≥ 50°, ≤ 2 %
-// below 30°, interior valence 6) with at least half of the square lattice's patch area kept.
+// The adaptive lattice with the lattice-angle mask at 35° (issue #20), warped to the surface (the defaults)
+// on the view where the screen lattice fails worst, fandisk from the iso view: the criterion of the issue
+// (mean smallest angle ≥ 50°, ≤ 2 % below 30°, interior valence 6) with most of the square lattice's patch
+// area kept (the warp's gain: without it 54.8° on 0.63 of the area, with it 52.3° on 0.96).
 TEST(ScanPipeline, AdaptiveLatticeWithTheAngleMaskMakesRoundTrianglesOnFandiskIso) {
     const fss::Mesh ref = load("fandisk.off");
     fss::CpuMeshRenderer renderer;
@@ -440,15 +441,17 @@ TEST(ScanPipeline, AdaptiveLatticeWithTheAngleMaskMakesRoundTrianglesOnFandiskIs
     const fss::ScanResult square = fss::scanPatch(ref, renderer, ref, renderer, params);
     const fss::Metrics a = fss::computeMetrics(adaptive.patch.mesh, {.selfIntersections = false});
     const fss::Metrics s = fss::computeMetrics(square.patch.mesh, {.selfIntersections = false});
-    std::printf("fandisk iso 256²: adaptive + mask 35°: mean smallest angle %.1f°, %.1f %% < 30°, valence 6 "
-                "%.3f, area %.2f of the square lattice's; square: %.1f°, %.1f %%\n",
-                a.meanMinAngleDeg, 100 * a.fracMinAngleBelow30, a.fracValence6Interior, a.area / s.area,
-                s.meanMinAngleDeg, 100 * s.fracMinAngleBelow30);
+    std::printf(
+        "fandisk iso 256²: adaptive, warped, mask 35°: mean smallest angle %.1f°, %.1f %% < 30°, valence 6 "
+        "%.3f, area %.2f of the square lattice's; square: %.1f°, %.1f %%\n",
+        a.meanMinAngleDeg, 100 * a.fracMinAngleBelow30, a.fracValence6Interior, a.area / s.area,
+        s.meanMinAngleDeg, 100 * s.fracMinAngleBelow30);
     EXPECT_LT(adaptive.counts.wellShaped, adaptive.counts.frontFacing); // the mask dropped the slanted part
-    EXPECT_GE(a.meanMinAngleDeg, 50.0);                                 // measured 54.8°
+    EXPECT_GE(a.meanMinAngleDeg, 50.0);                                 // measured 52.3° (warped)
     EXPECT_LE(a.fracMinAngleBelow30, 0.02);                             // measured 0.0 %
     EXPECT_GE(a.fracValence6Interior, 0.98);
-    EXPECT_GE(a.area, 0.5 * s.area); // measured 0.63
+    // Measured 0.96 with the warp (0.63 without, when the bound was 0.5): raised to what the warp keeps.
+    EXPECT_GE(a.area, 0.85 * s.area);
 }
 
 // The lattice warped to the surface (ScanOptions::warpToSurface, issue #20) on a sphere seen from the
@@ -462,7 +465,8 @@ TEST(ScanPipeline, LatticeWarpedToTheSurfaceKeepsRoundTrianglesOnASphere) {
     renderer.setMesh(ref);
     fss::ScanParams params;
     params.camera = fss::Camera::standardView(fss::StandardView::PosZ, bbox(ref), 128, 128);
-    const fss::ScanResult affine = fss::scanPatch(ref, renderer, ref, renderer, params); // the defaults
+    params.scan.warpToSurface = false; // the plain affine lattice on purpose (the warp is the default)
+    const fss::ScanResult affine = fss::scanPatch(ref, renderer, ref, renderer, params);
     params.scan.warpToSurface = true;
     const fss::ScanResult warped = fss::scanPatch(ref, renderer, ref, renderer, params);
     const fss::Metrics a =
@@ -489,9 +493,9 @@ TEST(ScanPipeline, LatticeWarpedToTheSurfaceKeepsRoundTrianglesOnASphere) {
 // against the square pixel lattice of today's defaults (the figures of issue #20; the report lists which
 // meshes were tuned on). The setting from the environment: FSS_LATTICE = triangular | adaptive | square,
 // FSS_MIN_LATTICE_ANGLE (degrees, default 0), FSS_MIN_QUAD_ANGLE (default 20), FSS_RELAX (sweeps, default
-// 6), FSS_WARP=1 (ScanOptions::warpToSurface). Coverage: the patch's area over the square-lattice patch's
-// area from the same view ("cov"), and per mesh the share of the reference's area covered by the seven
-// patches together, for both settings.
+// 6), FSS_WARP (ScanOptions::warpToSurface, default 1 as the core's; 0 = the plain lattice). Coverage: the
+// patch's area over the square-lattice patch's area from the same view ("cov"), and per mesh the share of the
+// reference's area covered by the seven patches together, for both settings.
 TEST(ScanPipeline, LatticeTableOverCgalMeshesLong) {
     const char* env = std::getenv("FSS_LONG_TESTS");
     if (!env || std::string(env) != "1") GTEST_SKIP() << "set FSS_LONG_TESTS=1";
@@ -513,7 +517,7 @@ TEST(ScanPipeline, LatticeTableOverCgalMeshesLong) {
     setting.minLatticeAngleDeg = numberFromEnv("FSS_MIN_LATTICE_ANGLE", 0);
     setting.minQuadAngleDeg = numberFromEnv("FSS_MIN_QUAD_ANGLE", 20);
     setting.relaxIterations = int(numberFromEnv("FSS_RELAX", 6));
-    setting.warpToSurface = numberFromEnv("FSS_WARP", 0) != 0;
+    setting.warpToSurface = numberFromEnv("FSS_WARP", fss::ScanOptions{}.warpToSurface ? 1 : 0) != 0;
     const LatticeSetting square{.lattice = fss::Lattice::Square, .minQuadAngleDeg = 0, .relaxIterations = 0};
     const fss::StandardView views[] = {
         fss::StandardView::Iso,  fss::StandardView::PosX, fss::StandardView::NegX, fss::StandardView::PosY,

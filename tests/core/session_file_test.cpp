@@ -88,6 +88,7 @@ void expectSame(const fss::ScanStep& a, const fss::ScanStep& b) {
     EXPECT_TRUE(sameBits(a.params.scan.spacingPixels, b.params.scan.spacingPixels));
     EXPECT_TRUE(sameBits(a.params.scan.spacingWorld, b.params.scan.spacingWorld));
     EXPECT_TRUE(sameBits(a.params.scan.minLatticeAngleDeg, b.params.scan.minLatticeAngleDeg));
+    EXPECT_EQ(a.params.scan.warpToSurface, b.params.scan.warpToSurface);
     EXPECT_EQ(a.params.relaxIterations, b.params.relaxIterations);
     EXPECT_TRUE(sameBits(a.params.triangulate.minQuadAngleDeg, b.params.triangulate.minQuadAngleDeg));
     EXPECT_TRUE(sameBits(a.params.quality.margin, b.params.quality.margin));
@@ -178,6 +179,7 @@ fss::ScanStep regularStep() {
     s.params.scan.spacingPixels = 1.75;
     s.params.scan.spacingWorld = 0.125;
     s.params.scan.minLatticeAngleDeg = 37.5;
+    s.params.scan.warpToSurface = false; // not the default: the round trip keeps it
     s.params.relaxIterations = 3;
     s.params.triangulate.minQuadAngleDeg = 17.5;
     s.params.quality.margin = 0.0625;
@@ -398,8 +400,10 @@ TEST_F(BadSessionFile, GoodFileLoads) {
 
 TEST_F(BadSessionFile, WrongFormatOrVersion) {
     Json j = good_;
-    j["version"] = 3;
-    EXPECT_EQ(load(j), ": version is 3, but this FSS reads versions 1 to 2 only.");
+    // What an FSS reading versions 1 to 2 said of the version 3 files this one writes (warp_to_surface),
+    // here one version further.
+    j["version"] = 4;
+    EXPECT_EQ(load(j), ": version is 4, but this FSS reads versions 1 to 3 only.");
     j["version"] = "1";
     EXPECT_EQ(load(j), ": version must be a positive integer.");
     j = good_;
@@ -545,6 +549,39 @@ TEST_F(BadSessionFile, LatticeAndRelaxationAreOptionalAndOffWhenAbsent) {
     j = good_;
     j["events"][0]["step"]["relax_iterations"] = 101;
     EXPECT_EQ(load(j), ": events[0].step.relax_iterations must be in [0, 100], not 101.");
+}
+
+// Version 3 (issue #20): the lattice warped to the surface is on by default and always written; files
+// without the key (versions 1 and 2) were recorded without it and load so, whatever their version number.
+TEST_F(BadSessionFile, WarpToSurfaceIsAlwaysWrittenAndOffWhenAbsent) {
+    auto warpOf = [&](const Json& j) {
+        return fss::sessionFileFromJson(j.dump(2), "s.json", ".", {.verifyMesh = false})
+            .events.at(0)
+            .step.params.scan.warpToSurface;
+    };
+    EXPECT_TRUE(fss::ScanOptions{}.warpToSurface);
+    EXPECT_EQ(fss::kSessionFileVersion, 3);
+    EXPECT_EQ(good_["version"], 3);
+    ASSERT_EQ(good_["events"][0]["step"]["scan"]["warp_to_surface"], false); // sampleFile's step: off
+    EXPECT_FALSE(warpOf(good_));
+    EXPECT_EQ(good_["events"][1]["step"]["scan"]["warp_to_surface"], true); // the fishbone step: default
+    Json j = good_;
+    j["events"][0]["step"]["scan"]["warp_to_surface"] = true;
+    EXPECT_TRUE(warpOf(j));
+    for (int version : {1, 2, 3}) {
+        j["version"] = version;
+        j["events"][0]["step"]["scan"].erase("warp_to_surface");
+        EXPECT_FALSE(warpOf(j)) << "version " << version;
+    }
+    j = good_;
+    j["events"][0]["step"]["scan"]["warp_to_surface"] = 1;
+    EXPECT_EQ(load(j), ": events[0].step.scan.warp_to_surface must be true or false.");
+    // Written as set, and read back so.
+    fss::SessionFile f = sampleFile(mesh_);
+    f.events.at(0).step.params.scan.warpToSurface = true;
+    const Json on = Json::parse(fss::sessionFileToJson(f));
+    EXPECT_EQ(on["events"][0]["step"]["scan"]["warp_to_surface"], true);
+    EXPECT_TRUE(warpOf(on));
 }
 
 TEST_F(BadSessionFile, WrongTypesAndValues) {

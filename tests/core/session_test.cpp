@@ -299,8 +299,11 @@ TEST(Session, HistoryBytesFollowTheChangeNotTheMesh) {
     EXPECT_GT(small.meshFaces, 9000u);
     EXPECT_LT(small.meshFaces, 11000u);
     EXPECT_GT(large.meshFaces, 290000u);
-    EXPECT_EQ(small.patchFaces, large.patchFaces); // the same patch
-    EXPECT_GT(large.removed, 10 * small.removed);  // ... replacing many more faces of the finer mesh
+    // The same patch, up to the lattice's warp to the surface (on by default since issue #20): it reads each
+    // pixel's face plane, and the two spheres' facets differ; measured 21 036 against 21 038 faces (equal
+    // without the warp). The history figures below do not depend on those 2 faces.
+    EXPECT_NEAR(double(small.patchFaces), double(large.patchFaces), 0.001 * double(small.patchFaces));
+    EXPECT_GT(large.removed, 10 * small.removed); // ... replacing many more faces of the finer mesh
     EXPECT_LT(large.historyBytes, 1.5 * double(small.historyBytes));
     EXPECT_LT(small.historyBytes, 1.5 * double(large.historyBytes));
     EXPECT_LT(large.historyBytes, large.meshBytes / 5);

@@ -14,6 +14,7 @@
 #include <fss/widgets/vtk_view.h>
 
 #include <QApplication>
+#include <QCheckBox>
 #include <QElapsedTimer>
 #include <QFile>
 #include <QProcess>
@@ -182,6 +183,50 @@ private slots:
         QVERIFY2(a == b, "fss-remesh run does not reproduce the widget's mesh byte for byte");
     }
 
+    // Issue #20: the scan panel's "Warp lattice to the surface" switch — on by default, enabled only with
+    // the adaptive lattice — reaches the scan and is recorded in the session file (always written).
+    void warpSwitchReachesTheScanAndTheSession() {
+        auto w = shownWidget();
+        QVERIFY(w);
+        QVERIFY(w->openMesh(QString::fromStdString(fandisk_.string())));
+        fss::widgets::ScanPanel* panel = w->scanPanel();
+        auto* box = panel->findChild<QCheckBox*>("warpToSurface");
+        QVERIFY(box);
+        QVERIFY(box->isChecked());
+        QVERIFY(box->isEnabled());
+        QCOMPARE(panel->warpToSurface(), fss::ScanOptions{}.warpToSurface);
+        QSignalSpy changed(panel, &fss::widgets::ScanPanel::settingsChanged);
+        for (fss::Lattice other : {fss::Lattice::Square, fss::Lattice::Triangular}) {
+            panel->setLattice(other);
+            QVERIFY(!box->isEnabled());
+        }
+        panel->setLattice(fss::Lattice::Adaptive);
+        QVERIFY(box->isEnabled());
+        const int before = changed.count();
+        box->click(); // as the user does
+        QVERIFY(!panel->warpToSurface());
+        QCOMPARE(changed.count(), before + 1);
+        QVERIFY(!panel->scanParams(w->view()->camera()).scan.warpToSurface);
+
+        // Two scans of the same view, without and with the warp: different samples, both recorded.
+        QVERIFY2(scanAndAccept(*w, fss::StandardView::Iso, 128), qPrintable(w->statusText()));
+        const fss::Mesh plain = w->mesh();
+        w->undoStack()->undo();
+        panel->setWarpToSurface(true);
+        QVERIFY(scanAndAccept(*w, fss::StandardView::Iso, 128));
+        QVERIFY(!identical(w->mesh(), plain));
+        QVERIFY(!identical(w->mesh(), stages_[0]));
+        const std::filesystem::path file = dir_ / "warp.session.json";
+        QVERIFY(w->saveSession(QString::fromStdString(file.string())));
+        const fss::SessionFile saved = fss::loadSessionFile(file);
+        QCOMPARE(saved.events.size(), std::size_t(3)); // accept, undo, accept
+        QVERIFY(!saved.events[0].step.params.scan.warpToSurface);
+        QVERIFY(saved.events[2].step.params.scan.warpToSurface);
+        const std::string text = slurp(file);
+        QVERIFY(text.find("\"warp_to_surface\": false") != std::string::npos);
+        QVERIFY(text.find("\"warp_to_surface\": true") != std::string::npos);
+    }
+
     void aMeshFromMemoryIsSavedNextToTheSession() {
         auto w = shownWidget();
         QVERIFY(w);
@@ -230,7 +275,9 @@ private slots:
             return s;
         };
         const Case cases[] = {
-            {"version", replaced("\"version\": 1", "\"version\": 7"), "version"},
+            // (the file's own version, so that the replacement is made: "bad_version" alone names the field)
+            {"version",
+             replaced("\"version\": " + std::to_string(fss::kSessionFileVersion), "\"version\": 7"), "is 7"},
             {"width", replaced("\"width\": 160", "\"width\": -3"), "width"},
             {"sha", replaced("\"sha256\": \"", "\"sha256\": \"0"), "sha256"},
             {"json", good.substr(0, good.size() / 2), "json"},

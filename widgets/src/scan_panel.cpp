@@ -90,7 +90,16 @@ ScanPanel::ScanPanel(QWidget* parent) : QWidget(parent) {
         tr("Samples whose lattice triangle would have a smaller angle on the surface "
            "(seen at a slant) are left to another view; 0 = keep them"));
     form->addRow(tr("Min lattice angle"), minLatticeAngle_);
+    // "Warp lattice | to the surface": split over the label and the field so that the panel does not widen.
+    warp_ = new QCheckBox(tr("to the surface"), this);
+    warp_->setObjectName(QStringLiteral("warpToSurface"));
+    warp_->setChecked(ScanOptions{}.warpToSurface);
+    warp_->setToolTip(tr("Adaptive lattice only: bend the lattice per sample so that its triangles are "
+                         "equilateral on the curved surface, not only on the plane at the view's main slant "
+                         "(rounder triangles; off = the one lattice chosen for the view)"));
+    form->addRow(tr("Warp lattice"), warp_);
     setLattice(ScanOptions{}.lattice);
+    warp_->setEnabled(lattice() == Lattice::Adaptive);
     force_ = new QCheckBox(tr("Force replace"), this);
     force_->setToolTip(tr("Replace the mesh under the scan whatever its quality"));
     form->addRow(QString(), force_);
@@ -138,7 +147,11 @@ ScanPanel::ScanPanel(QWidget* parent) : QWidget(parent) {
     connect(maxAngle_, &QDoubleSpinBox::valueChanged, this, changed);
     connect(margin_, &QDoubleSpinBox::valueChanged, this, changed);
     connect(force_, &QCheckBox::toggled, this, changed);
-    connect(lattice_, &QComboBox::currentIndexChanged, this, changed);
+    connect(lattice_, &QComboBox::currentIndexChanged, this, [this, changed] {
+        warp_->setEnabled(lattice() == Lattice::Adaptive); // the warp bends the adaptive lattice only
+        changed();
+    });
+    connect(warp_, &QCheckBox::toggled, this, changed);
     connect(minLatticeAngle_, &QDoubleSpinBox::valueChanged, this, changed);
     connect(spacing_, &QDoubleSpinBox::valueChanged, this, changed);
     connect(fineField_, &QCheckBox::toggled, this, changed);
@@ -275,6 +288,12 @@ double ScanPanel::minLatticeAngleDeg() const {
 void ScanPanel::setMinLatticeAngleDeg(double degrees) {
     minLatticeAngle_->setValue(degrees);
 }
+bool ScanPanel::warpToSurface() const {
+    return warp_->isChecked();
+}
+void ScanPanel::setWarpToSurface(bool warp) {
+    warp_->setChecked(warp);
+}
 bool ScanPanel::forceReplace() const {
     return force_->isChecked();
 }
@@ -321,6 +340,7 @@ ScanParams ScanPanel::scanParams(const Camera& viewCamera) const {
     params.quality.forceReplace = forceReplace();
     params.scan.lattice = lattice();
     params.scan.minLatticeAngleDeg = minLatticeAngleDeg();
+    params.scan.warpToSurface = warpToSurface();
     return params;
 }
 

@@ -6,9 +6,9 @@
 /// Replaying the log on the same input with the same renderer reproduces the recording session's current
 /// mesh exactly (byte-identical when written).
 ///
-/// Format (version 1; every field is required unless marked optional, unknown fields are errors):
+/// Format (version 3; every field is required unless marked optional, unknown fields are errors):
 /// \code
-/// { "format": "fss-session", "version": 1,
+/// { "format": "fss-session", "version": 3,
 ///   "description": "...",                                   (optional)
 ///   "mesh": { "path": "../meshes/part.off", "sha256": "<64 hex digits>" },
 ///   "renderer": "cpu" | "gpu",
@@ -24,8 +24,9 @@
 ///         "relax_iterations": 6,                           (optional: written only when not 0, absent = 0)
 ///         "scan": { "scan_id": 0, "quality_angle_limit_deg": 85, "max_snap_footprints": 2,
 ///                   "lattice": "adaptive" | "triangular" | "square", "spacing_px": 1, "spacing_world": 0,
-///                   "min_lattice_angle_deg": 35 },  (the last four always written; each optional, absent =
-///                                                    "square", 1, 0, 0: files before issue #20)
+///                   "min_lattice_angle_deg": 35, "warp_to_surface": true },
+///                                    (the last five always written; each optional, absent = "square", 1, 0,
+///                                     0, false: files before issue #20; warp_to_surface since version 3)
 ///         "quality_mask": { "margin": 0.1, "force_replace": false, "search_rings": 2 },
 ///         "triangulate": { "max_edge_footprints": 3, "max_sampling_angle_deg": 80,
 ///                          "min_quad_angle_deg": 20 },  (optional: written only when not 0, absent = 0)
@@ -76,8 +77,11 @@ namespace fss {
 
 /// The session file format version this FSS writes; it reads versions 1 to this. Version 2 (issue 19): the
 /// stitch's seam band remesh is on by default ("remesh_seam" absent = on, written only when off); version 1
-/// files load and replay with it, so their results differ from the ones they were recorded with.
-inline constexpr int kSessionFileVersion = 2;
+/// files load and replay with it, so their results differ from the ones they were recorded with. Version 3
+/// (issue #20): "scan.warp_to_surface" (ScanOptions::warpToSurface, on by default) is always written;
+/// absent = off, so version 1 and 2 files replay as before. An FSS reading versions up to 2 refuses a
+/// version 3 file ("version is 3, but this FSS reads versions 1 to 2 only").
+inline constexpr int kSessionFileVersion = 3;
 
 /// A session file in memory.
 struct SessionFile {

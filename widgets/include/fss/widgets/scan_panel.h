@@ -2,9 +2,9 @@
 /// \file scan_panel.h
 /// ScanPanel: the settings of the next scan — the target edge length in world units or the resolution
 /// (whichever was set last is held as the view changes; the edge length the resolution gives is shown),
-/// the sample lattice and its slant mask, erosion / dilation radii, the triangulation and quality
-/// thresholds, force-replace, and the fishbone
-/// grid's spacing — and the scan camera they make from the view's camera.
+/// the sample lattice, its slant mask and its warp to the surface, erosion / dilation radii, the
+/// triangulation and quality thresholds, force-replace, and the fishbone grid's spacing — and the scan camera
+/// they make from the view's camera.
 
 #include "fss/camera.h"
 #include "fss/scan_pipeline.h"
@@ -76,6 +76,11 @@ public:
     /// core's (35).
     double minLatticeAngleDeg() const;
     void setMinLatticeAngleDeg(double degrees);
+    /// The adaptive lattice warped to the surface (ScanOptions::warpToSurface); default the core's (on). The
+    /// switch is enabled only while lattice() is Lattice::Adaptive; its state goes into scanParams() (and so
+    /// into the session) whatever the lattice, where the other lattices ignore it.
+    bool warpToSurface() const;
+    void setWarpToSurface(bool warp);
     /// Keep every sample regardless of the current mesh's quality (QualityMaskOptions::forceReplace).
     bool forceReplace() const;
     void setForceReplace(bool force);
@@ -132,6 +137,7 @@ private:
     QCheckBox* force_ = nullptr;
     QComboBox* lattice_ = nullptr;
     QDoubleSpinBox* minLatticeAngle_ = nullptr;
+    QCheckBox* warp_ = nullptr;
     QDoubleSpinBox* spacing_ = nullptr;
     QCheckBox* fineField_ = nullptr;
     QLabel* edgeLabel_ = nullptr;
