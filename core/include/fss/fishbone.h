@@ -73,6 +73,12 @@ struct FishboneOptions {
     /// reference (FishboneParams::creaseAngleDeg > 0; a rib running onto a neighbouring face of a CAD part).
     /// false here and in files written before it (true is not yet the default, issue 20).
     bool stopRibsAtCreases = false;
+    /// With stopRibsAtCreases: the crease the backbone follows stops none of its ribs — a crease segment
+    /// within 30° of the backbone's tangent and within 2h of the rib's backbone sample is not counted (on
+    /// CAD meshes the backbone wanders about a pixel around the crease's screen image, and ribs stopped
+    /// after one or two edges where their second edge crossed it back). false here and in files written
+    /// before it.
+    bool spareFollowedCrease = false;
     /// Loops of a traced backbone (issue 20): where the backbone comes back within h/2 of a point it passed
     /// at least 4h of arc length before, heading the same way, it is a closed curve: the loop through the
     /// seed is resampled at n = round(L/h) equal arcs (spacing L/n) and Backbone::closed is set, so that the
@@ -91,6 +97,14 @@ struct FishboneOptions {
     /// up to 1/cos θ times longer one way than the other, and their triangles slivers). Automatic mode only
     /// (key-ribs are blended with the paper's constant h). false here and in files written before it.
     bool isotropicRibs = false;
+    /// The fishbone scan drops both triangles of a grid quad where one of them has a 3D angle below this
+    /// (TriangulateOptions::minTriangleAngleDeg; it also bounds the quad's corners, each a triangle's angle
+    /// or the sum of two). Degrees in [0, 60); 0 = no bound (files written before it).
+    double minFaceAngleDeg = 0.0;
+    /// The fishbone scan drops every connected part of its patch with fewer faces than this
+    /// (TriangulateOptions::minComponentFaces): the fragments left between crease stops and dropped
+    /// quads. ≥ 0; 0 = none (files written before it).
+    int minComponentFaces = 0;
     /// The surface length of the screen segment a – b in pixel footprints (set by the fishbone scan for
     /// isotropicRibs; empty: no surface spacing). A rib's surface spacing is capped at 2.5 h of it (the
     /// triangulation drops edges longer than 3 h footprints). Must be safe to call from several threads. Not
@@ -98,9 +112,9 @@ struct FishboneOptions {
     std::function<double(const Eigen::Vector2d& a, const Eigen::Vector2d& b)> surfaceLength{};
 
     /// Checks the ranges: spacing finite and > 0, minRibGap in [0, 1), maxRibTurnDeg in (0, 180],
-    /// maxRibAspect 0 or in [1, 100], and both tracings (StreamlineOptions::validate, named
-    /// "FishboneOptions::backboneTracing.step" ...).
-    /// \throw InvalidOptionError naming the field.
+    /// maxRibAspect 0 or in [1, 100], minFaceAngleDeg in [0, 60), minComponentFaces ≥ 0, and both tracings
+    /// (StreamlineOptions::validate, named "FishboneOptions::backboneTracing.step" ...). \throw
+    /// InvalidOptionError naming the field.
     void validate() const;
 };
 
