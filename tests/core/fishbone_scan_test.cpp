@@ -1179,6 +1179,21 @@ TEST(FishboneScan, SliverTable) {
                     else
                         params.triangulate.minQuadAngleDeg = 20;
                     fb.tracing.minComponentFaces = set >= 6 ? 24 : 0;
+                    // FSS_SLIVER_DROP turns single rules off again (diagnosis): g minRibGap, t maxRibTurnDeg,
+                    // a maxRibAspect, r stopRibsAtCreases, b stopBackboneAtCreases, l closeLoops,
+                    // i isotropicRibs, s spareFollowedCrease.
+                    if (const char* d = std::getenv("FSS_SLIVER_DROP")) {
+                        const std::string drop = d;
+                        auto off = [&](char k) { return drop.find(k) != std::string::npos; };
+                        if (off('g')) fb.tracing.minRibGap = 0;
+                        if (off('t')) fb.tracing.maxRibTurnDeg = 180;
+                        if (off('a')) fb.tracing.maxRibAspect = 0;
+                        if (off('r')) fb.tracing.stopRibsAtCreases = false;
+                        if (off('b')) fb.tracing.stopBackboneAtCreases = false;
+                        if (off('l')) fb.tracing.closeLoops = false;
+                        if (off('i')) fb.tracing.isotropicRibs = false;
+                        if (off('s')) fb.tracing.spareFollowedCrease = false;
+                    }
                 }
                 fss::FishboneScanResult r;
                 try {
@@ -1239,12 +1254,14 @@ TEST(FishboneScan, SliverTable) {
                              pixelError = nearError(pixels.patch.mesh);
                 std::printf("%-26s %-7s %-6s %-7s | %5zu %6.1f %6.1f | %6.2f %6.2f %5.2f | pixel grid %5.2f "
                             "ratio %4.2f, backbone off the crease %.2f h | %s | %s | "
-                            "dropped: trim %zu creaseStop %zu sliverQuad %zu smallPart %zu\n",
+                            "grid %dx%d, %zu rib vertices, dropped: trim %zu creaseStop %zu sliverQuad %zu "
+                            "smallPart %zu\n",
                             c.name.c_str(), setName, lasso ? "lasso" : "-", c.tuned.c_str(), a.faces,
                             a.minDeg, 100 * a.below30, fishError, gridError, fishError / gridError,
                             pixelError, fishError / pixelError, offCrease, closedText(r).c_str(),
-                            sliverSources(r).c_str(), r.counts.trimmed, r.counts.creaseStopped,
-                            r.patch.report.sliverQuads, r.patch.report.smallParts);
+                            sliverSources(r).c_str(), r.fishbone.rows, r.fishbone.cols, r.counts.ribVertices,
+                            r.counts.trimmed, r.counts.creaseStopped, r.patch.report.sliverQuads,
+                            r.patch.report.smallParts);
                 if (const char* dir = std::getenv("FSS_SLIVER_PICTURES")) {
                     // The patch coloured by its faces' smallest angle (grey ≥ 30°, yellow < 30°, orange <
                     // 20°, red < 10°): the whole view left, three times closer around the seed right.
