@@ -524,6 +524,14 @@ TEST_F(BadSessionFile, FishboneSliverRulesAreOffWhenAbsentAndOnByDefault) {
     EXPECT_FALSE(off.isotropicRibs);
     EXPECT_EQ(off.minFaceAngleDeg, 0.0);
     EXPECT_EQ(off.minComponentFaces, 0);
+    // New scans: the loop closing, the face-angle bound and the small-part drop are on (SliverTable's
+    // figures, issue 20's report); the others stay off.
+    const fss::FishboneOptions fresh;
+    EXPECT_TRUE(fresh.closeLoops);
+    EXPECT_EQ(fresh.minFaceAngleDeg, 20.0);
+    EXPECT_EQ(fresh.minComponentFaces, 24);
+    EXPECT_FALSE(fresh.stopRibsAtCreases);
+    EXPECT_EQ(fresh.maxRibAspect, 0.0);
 }
 
 // Files written before the triangular lattice and the patch relaxation (issue #20) scanned on the pixel
