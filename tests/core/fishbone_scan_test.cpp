@@ -1118,8 +1118,8 @@ TEST(FishboneScan, SliverTable) {
 
     // The option sets (FSS_SLIVER_SETS="3,6" runs some of them; FSS_SLIVER_CASES="fandisk" only the cases
     // whose name contains it).
-    const std::array<const char*, 7> setNames{"paper",  "issue20", "+iso", "+aspect",
-                                              "+spare", "+face20", "+comp"};
+    const std::array<const char*, 8> setNames{"paper",  "issue20", "+iso",  "+aspect",
+                                              "+spare", "+face20", "+comp", "default"};
     std::vector<int> sets;
     if (const char* e = std::getenv("FSS_SLIVER_SETS")) {
         for (const char* q = e; *q; ++q)
@@ -1159,7 +1159,7 @@ TEST(FishboneScan, SliverTable) {
         const double h = 2, hWorld = h * c.camera.pixelFootprint(seedHit.point);
         for (const bool lasso : {false, true})
             for (const int set : sets) {
-                const char* setName = setNames[std::size_t(set)];
+                const char* setName = setNames.at(std::size_t(set));
                 fss::ScanParams params;
                 params.camera = c.camera;
                 const double half = 0.3 * c.camera.width;
