@@ -13,6 +13,7 @@
 #include "fss/mesh_io.h"
 #include "fss/raycast.h"
 #include "fss/scan_pipeline.h"
+#include "key_rib_move.h"
 #include "patch_picture.h"
 #include "test_data.h"
 
@@ -167,6 +168,29 @@ Eigen::AlignedBox3d bbox(const Mesh& m) {
     return box;
 }
 
+// The view: from the bisector of the two faces at the middle of \p chain (points \p line), 1.2 from its
+// centroid, 200² pixels (the quarter-circle crease spans the image as a curved arc; both faces are seen at
+// about 45°).
+fss::Camera bisectorView(const Mesh& m, const std::vector<fss::VertexIndex>& chain,
+                         const std::vector<Vector3d>& line) {
+    const std::size_t mid = chain.size() / 2;
+    const auto midEdge = m.halfedge(chain[mid], chain[mid + 1]);
+    const Vector3d n1 = faceNormal(m, m.face(midEdge)), n2 = faceNormal(m, m.face(m.opposite(midEdge)));
+    Vector3d centroid = Vector3d::Zero();
+    for (const auto& p : line)
+        centroid += p;
+    centroid /= double(line.size());
+    const Vector3d viewDir = (n1 + n2).normalized();
+    fss::Camera camera;
+    camera.focal = centroid;
+    camera.eye = centroid + 1.2 * viewDir;
+    camera.up = Vector3d(0, 0, 1);
+    camera.viewAngleDeg = 30;
+    camera.width = camera.height = 200;
+    camera.fitClippingRange(bbox(m));
+    return camera;
+}
+
 } // namespace
 
 TEST(FishboneFandisk, DrawnFishboneRemovesTheAliasingOfACurvedCrease) {
@@ -185,21 +209,9 @@ TEST(FishboneFandisk, DrawnFishboneRemovesTheAliasingOfACurvedCrease) {
     const Vector3d n1 = faceNormal(m, m.face(midEdge)), n2 = faceNormal(m, m.face(m.opposite(midEdge)));
     EXPECT_NEAR(std::acos(n1.dot(n2)) * 180 / std::numbers::pi, 90.0, 2.0);
 
-    // The view: from the bisector of the two faces at the middle of the crease, 1.2 from its centroid,
-    // 200² pixels (the crease spans the image as a curved arc; both faces are seen at about 45°).
-    Vector3d centroid = Vector3d::Zero();
-    for (const auto& p : line)
-        centroid += p;
-    centroid /= double(line.size());
-    const Vector3d viewDir = (n1 + n2).normalized();
-    fss::Camera camera;
-    camera.focal = centroid;
-    camera.eye = centroid + 1.2 * viewDir;
-    camera.up = Vector3d(0, 0, 1);
-    camera.viewAngleDeg = 30;
-    camera.width = camera.height = 200;
-    camera.fitClippingRange(bbox(m));
-    const double hWorld = camera.pixelFootprint(centroid); // h = 1 pixel, in world units at the crease
+    const fss::Camera camera = bisectorView(m, chain, line);
+    // h = 1 pixel, in world units at the crease (the camera's focal point is the crease's centroid).
+    const double hWorld = camera.pixelFootprint(camera.focal);
 
     // The user's strokes: a backbone through 9 points clicked on the crease, five straight key-ribs across
     // it, and the lasso: a band of ±15 pixels around the backbone (the same region for both scans).
@@ -413,4 +425,31 @@ TEST(FishboneFandisk, DrawnFishboneRemovesTheAliasingOfACurvedCrease) {
         for (int c = 0; c < 3; ++c)
             rgb[(std::size_t(y) * std::size_t(W) + std::size_t(view.width)) * 3 + std::size_t(c)] = 0;
     fss::test::writePng(fss::test::tmpPath("fishbone_vs_grid_fandisk.png").string(), W, view.height, rgb);
+}
+
+// Issue #20's "a key-rib moved by 1 px moves no sample by more than 2 px" on a CGAL mesh (the creased ring's
+// test is on an analytic shape): the traced fishbone on fandisk's quarter-circle crease (default options,
+// h = 2 px, seed at the crease's middle, bisector view), then two traced key-ribs at a quarter and three
+// quarters of its backbone, the second moved by 1 px in eight directions and across the midpoint of two
+// backbone samples. Measured: no move at all within a backbone sample's reach (the key-rib snaps to the
+// nearest sample, and its traced rib is the same), but 3.82 px across a midpoint, where the key-rib jumps to
+// the next sample and its traced rib there differs: issue #20's 2 px is NOT met on fandisk (0.61 px on the
+// creased ring). The bound asserts today's figure with a margin, so that it cannot get worse unnoticed.
+TEST(FishboneFandisk, KeyRibMovedByOnePixelFigures) {
+    const Mesh m = fss::readMesh(fss::test::meshPath("fandisk.off").string());
+    const std::vector<fss::VertexIndex> chain = fanTopCrease(m);
+    const std::vector<Vector3d> line = chainPoints(m, chain);
+    fss::ScanParams params;
+    params.camera = bisectorView(m, chain, line);
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(m);
+    fss::FishboneCache cache;
+    fss::FishboneParams fb;
+    fb.spacing = 2;
+    fb.seed = params.camera.project(line[line.size() / 2]).head<2>();
+    const fss::FishboneScanResult traced =
+        fss::scanFishbonePatch(m, renderer, m, renderer, params, fb, cache);
+    ASSERT_GT(traced.fishbone.rows, 20);
+    const double worst = fss::test::largestKeyRibMove("fandisk", m, renderer, params, fb, traced, cache, 200);
+    EXPECT_LE(worst, 4.5); // measured 3.82 px (issue #20 asks <= 2: not met, see above)
 }

@@ -116,6 +116,10 @@ void expectSame(const fss::ScanStep& a, const fss::ScanStep& b) {
         EXPECT_EQ(fa.tracing.closeLoops, fb.tracing.closeLoops);
         EXPECT_EQ(fa.tracing.stopBackboneAtCreases, fb.tracing.stopBackboneAtCreases);
         EXPECT_EQ(fa.tracing.isotropicRibs, fb.tracing.isotropicRibs);
+        EXPECT_TRUE(sameBits(fa.tracing.maxRibAspect, fb.tracing.maxRibAspect));
+        EXPECT_EQ(fa.tracing.spareFollowedCrease, fb.tracing.spareFollowedCrease);
+        EXPECT_TRUE(sameBits(fa.tracing.minFaceAngleDeg, fb.tracing.minFaceAngleDeg));
+        EXPECT_EQ(fa.tracing.minComponentFaces, fb.tracing.minComponentFaces);
         expectSame(fa.tracing.backboneTracing, fb.tracing.backboneTracing);
         expectSame(fa.tracing.ribTracing, fb.tracing.ribTracing);
         EXPECT_TRUE(sameBits(fa.minSeedAnisotropy, fb.minSeedAnisotropy));
@@ -222,6 +226,10 @@ fss::ScanStep fishboneStep() {
     fb.tracing.closeLoops = true;
     fb.tracing.stopBackboneAtCreases = true;
     fb.tracing.isotropicRibs = true;
+    fb.tracing.maxRibAspect = 1.75;
+    fb.tracing.spareFollowedCrease = true;
+    fb.tracing.minFaceAngleDeg = 22.5;
+    fb.tracing.minComponentFaces = 30;
     fb.tracing.backboneTracing.step = 0.3;
     fb.tracing.backboneTracing.minStep = 0.01;
     fb.tracing.backboneTracing.maxLength = 77.5;
@@ -481,7 +489,53 @@ TEST_F(BadSessionFile, FishboneLoopCreaseAndSurfaceSpacingKeysAreOptionalAndOffW
     EXPECT_FALSE(tracingOf(j).closeLoops);
     EXPECT_FALSE(tracingOf(j).stopBackboneAtCreases);
     EXPECT_FALSE(tracingOf(j).isotropicRibs);
-    EXPECT_FALSE(fss::FishboneParams{}.tracing.closeLoops);
+}
+
+// Files written before the sliver-free fishbone became the default (issue #20) traced with none of its rules:
+// without their keys they load with each rule off and replay as recorded, although new scans have them on.
+TEST_F(BadSessionFile, FishboneSliverRulesAreOffWhenAbsentAndOnByDefault) {
+    auto tracingOf = [&](const Json& j) {
+        const auto path = fss::test::tmpPath("slivers_" + name_ + ".session.json");
+        {
+            std::ofstream out(path, std::ios::binary | std::ios::trunc);
+            out << j.dump(2);
+        }
+        return fss::loadSessionFile(path).events.at(1).step.fishbone.value().tracing;
+    };
+    Json j = good_;
+    Json& t = j["events"][1]["step"]["fishbone"]["tracing"];
+    const std::vector<const char*> keys{
+        "min_rib_gap",           "max_rib_turn_deg",   "max_rib_aspect",           "stop_ribs_at_creases",
+        "spare_followed_crease", "close_loops",        "stop_backbone_at_creases", "isotropic_ribs",
+        "min_face_angle_deg",    "min_component_faces"};
+    for (const char* k : keys)
+        ASSERT_TRUE(t.contains(k)) << k;
+    const fss::FishboneOptions on = tracingOf(j);
+    EXPECT_EQ(on.maxRibAspect, 1.75);
+    EXPECT_TRUE(on.spareFollowedCrease);
+    EXPECT_EQ(on.minFaceAngleDeg, 22.5);
+    EXPECT_EQ(on.minComponentFaces, 30);
+    for (const char* k : keys)
+        t.erase(k);
+    const fss::FishboneOptions off = tracingOf(j);
+    EXPECT_EQ(off.minRibGap, 0.0);
+    EXPECT_EQ(off.maxRibTurnDeg, 180.0);
+    EXPECT_EQ(off.maxRibAspect, 0.0);
+    EXPECT_FALSE(off.stopRibsAtCreases);
+    EXPECT_FALSE(off.spareFollowedCrease);
+    EXPECT_FALSE(off.closeLoops);
+    EXPECT_FALSE(off.stopBackboneAtCreases);
+    EXPECT_FALSE(off.isotropicRibs);
+    EXPECT_EQ(off.minFaceAngleDeg, 0.0);
+    EXPECT_EQ(off.minComponentFaces, 0);
+    // New scans: the loop closing, the face-angle bound and the small-part drop are on (SliverTable's
+    // figures, issue 20's report); the others stay off.
+    const fss::FishboneOptions fresh;
+    EXPECT_TRUE(fresh.closeLoops);
+    EXPECT_EQ(fresh.minFaceAngleDeg, 20.0);
+    EXPECT_EQ(fresh.minComponentFaces, 24);
+    EXPECT_FALSE(fresh.stopRibsAtCreases);
+    EXPECT_EQ(fresh.maxRibAspect, 0.0);
 }
 
 // Files written before the triangular lattice and the patch relaxation (issue #20) scanned on the pixel

@@ -370,6 +370,49 @@ TEST(Triangulate, SliverQuadsAreDropped) {
     EXPECT_THROW(fss::triangulateGrid(g, {.minQuadAngleDeg = 90}), fss::InvalidOptionError);
 }
 
+// A quad with right corners but a thin triangle loses both triangles under minTriangleAngleDeg (issue #20),
+// not under minQuadAngleDeg: a full grid stretched along x by a = 3 on the plane and on the screen has
+// rectangles whose triangles have the smallest angle atan(1/3) = 18.43°.
+TEST(Triangulate, QuadsWithThinTrianglesAreDropped) {
+    constexpr double a = 3.0;
+    SampleGrid g = handMadeGrid(6, 40, [](int, int) { return true; });
+    for (int r = 0; r < g.rows; ++r)
+        for (int c = 0; c < g.cols; ++c) {
+            fss::Sample& s = g.at(r, c);
+            s.screen.x() = a * c + 0.5;
+            const Eigen::Vector3d onPlane = g.camera.unproject(s.screen.x(), s.screen.y(), 0.5);
+            s.point = {onPlane.x(), onPlane.y(), 0.0};
+        }
+    const double angle = std::atan2(1.0, a) / kDeg;
+    const std::size_t quads = 5 * 39;
+    for (double bound : {0.0, angle - 0.5, angle + 0.5}) {
+        SCOPED_TRACE(bound);
+        const Patch p = fss::triangulateGrid(g, {.maxEdgeFootprints = 10, .minTriangleAngleDeg = bound});
+        EXPECT_EQ(p.report.quads, quads);
+        EXPECT_EQ(p.report.sliverQuads, bound > angle ? 2 * quads : 0u);
+        EXPECT_EQ(p.mesh.number_of_faces(), bound > angle ? 0u : 2 * quads);
+    }
+    // The corner bound alone keeps them all (every corner is 90°).
+    EXPECT_EQ(
+        fss::triangulateGrid(g, {.maxEdgeFootprints = 10, .minQuadAngleDeg = 45}).mesh.number_of_faces(),
+        2 * quads);
+    EXPECT_THROW(fss::triangulateGrid(g, {.minTriangleAngleDeg = 60}), fss::InvalidOptionError);
+}
+
+// minComponentFaces drops the connected parts with fewer faces: a 6 × 15 grid without columns 10 and 11
+// has a part of 9 × 5 quads (90 triangles) and one of 2 × 5 quads (20 triangles).
+TEST(Triangulate, SmallPartsAreDropped) {
+    const SampleGrid g = handMadeGrid(6, 15, [](int, int c) { return c != 10 && c != 11; });
+    for (const int bound : {0, 20, 21, 91}) {
+        SCOPED_TRACE(bound);
+        const Patch p = fss::triangulateGrid(g, {.minComponentFaces = bound});
+        const std::size_t dropped = bound > 90 ? 110 : bound > 20 ? 20 : 0;
+        EXPECT_EQ(p.report.smallParts, dropped);
+        EXPECT_EQ(p.mesh.number_of_faces(), 110 - dropped);
+    }
+    EXPECT_THROW(fss::triangulateGrid(g, {.minComponentFaces = -1}), fss::InvalidOptionError);
+}
+
 TEST(Triangulate, IsoScanOfFandisk) {
     const RealScan s = scanMesh("fandisk.off");
     checkRealPatch(s, "fandisk");

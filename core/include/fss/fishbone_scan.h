@@ -161,6 +161,8 @@ struct FishboneTimings {
 struct FishboneCounts {
     int rows = 0, cols = 0;          ///< grid size (rows = ribs)
     std::size_t ribVertices = 0;     ///< present entries of the fishbone grid
+    std::size_t trimmed = 0;         ///< rib vertices removed by trimRibs (automatic mode)
+    std::size_t creaseStopped = 0;   ///< rib vertices removed by FishboneOptions::stopRibsAtCreases
     std::size_t directionPixels = 0; ///< direction field pixels computed (backbone's + ribs' fields)
     std::size_t covered = 0;         ///< rays that hit the reference
     std::size_t frontFacing = 0;     ///< of those, on front-facing faces

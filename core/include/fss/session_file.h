@@ -36,7 +36,13 @@
 ///             "key_ribs": [[x,y], ...], "drawn_key_ribs": [[[x,y], ...], ...],
 ///             "drawn_backbone": [[x,y], ...],
 ///             "tracing": { "spacing": 4, "extend_beyond_key_ribs": true,
-///                          "backbone": STREAMLINE, "ribs": STREAMLINE },
+///                          "backbone": STREAMLINE, "ribs": STREAMLINE,
+///                          the issue-20 rules, each optional, written only when not off, absent = off:
+///                          "min_rib_gap": 0.5, "max_rib_turn_deg": 60, "max_rib_aspect": 1.7,
+///                          "stop_ribs_at_creases": true, "spare_followed_crease": true,
+///                          "close_loops": true, "stop_backbone_at_creases": true,
+///                          "isotropic_ribs": true, "min_face_angle_deg": 20,
+///                          "min_component_faces": 24 },
 ///             "min_seed_anisotropy": 0.1,
 ///             "crease": { "angle_deg": 30, "snap_radius": 1.5 },  (optional; missing: these defaults)
 ///             "raycast": { "rings": 2, "verify_unoccluded": false },

@@ -12,7 +12,10 @@
 ///    screen positions) is not the grid's orientation, or it is degenerate (crossing fishbone ribs);
 ///  - is back-facing: its 3D normal or a corner's reference normal points away from the viewer;
 ///  - belongs to a quad with a 3D corner angle below `minQuadAngleDeg` (both triangles are dropped: a
-///    sliver of a fishbone grid whose ribs converge, issue #20).
+///    sliver of a fishbone grid whose ribs converge, issue #20), or with a triangle whose smallest 3D angle
+///    is below `minTriangleAngleDeg` (a long thin quad keeps right corners but splits into slivers).
+/// Then every connected set of kept triangles with fewer than `minComponentFaces` is dropped (the
+/// fragments a fishbone grid leaves between crease stops and dropped quads, issue #20).
 /// Vertices where the kept triangles meet in more than one fan (e.g. two quads touching only at a
 /// corner) are made manifold by removing the triangles of all but the largest fan (repeated until no
 /// such vertex is left). The result is a valid, edge-manifold, consistently oriented Surface_mesh whose
@@ -58,9 +61,16 @@ struct TriangulateOptions {
     /// Both triangles of a quad are dropped when one of the quad's four corner angles in 3D is smaller.
     /// Degrees, in [0, 90); 0 = no bound (session files written before it).
     double minQuadAngleDeg = 0.0;
+    /// Both triangles of a quad are dropped when one of them has a 3D angle smaller than this. Degrees, in
+    /// [0, 60); 0 = no bound (the regular scans; the fishbone scan sets FishboneOptions::minFaceAngleDeg).
+    double minTriangleAngleDeg = 0.0;
+    /// Connected parts of the patch (triangles sharing an edge, once the vertices are manifold) with fewer
+    /// faces are dropped. 0 = none (the regular scans; the fishbone scan sets
+    /// FishboneOptions::minComponentFaces).
+    int minComponentFaces = 0;
 
     /// Checks the ranges: maxEdgeFootprints finite and > 0, maxSamplingAngleDeg in (0, 90],
-    /// minQuadAngleDeg in [0, 90).
+    /// minQuadAngleDeg in [0, 90), minTriangleAngleDeg in [0, 60), minComponentFaces ≥ 0.
     /// \throw InvalidOptionError naming the field ("TriangulateOptions::maxEdgeFootprints must be a positive
     ///        finite number, not 0.").
     void validate() const;
@@ -71,12 +81,13 @@ struct TriangulateOptions {
 struct TriangulateReport {
     std::size_t quads = 0;                ///< grid quads with four valid samples (2 candidate triangles each)
     std::size_t flipped = 0;              ///< dropped: screen orientation against the grid's, or degenerate
-    std::size_t sliverQuads = 0;          ///< dropped: in a quad with a 3D angle below minQuadAngleDeg
+    std::size_t sliverQuads = 0;          ///< dropped: a quad or triangle angle below the bounds
     std::size_t backFacing = 0;           ///< dropped: 3D or reference normal facing away from the viewer
     std::size_t longEdges = 0;            ///< dropped: an edge longer than maxEdgeFootprints footprints
     std::size_t grazing = 0;              ///< dropped: sampling angle beyond maxSamplingAngleDeg
     std::size_t nonManifoldVertices = 0;  ///< vertices that had more than one fan of triangles
     std::size_t nonManifoldTriangles = 0; ///< triangles removed to make those vertices manifold
+    std::size_t smallParts = 0;           ///< dropped: in a part with fewer than minComponentFaces
     std::size_t faces = 0;                ///< faces of the patch
     std::size_t vertices = 0;             ///< vertices of the patch
 };

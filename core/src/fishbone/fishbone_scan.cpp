@@ -183,8 +183,17 @@ public:
     // A proper crossing of \p a – \p b with a crease segment that is not within acos(\p cosAlong) of its
     // direction (cosAlong = ∞: any crease segment).
     bool crossing(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double cosAlong) const {
-        if (!a.allFinite() || !b.allFinite()) return false;
         const Eigen::Vector2d d = b - a;
+        return crossingIf(a, b, [&](const CreaseSegment& s) {
+            const Eigen::Vector2d e = s.b - s.a;
+            return !(std::abs(d.dot(e)) >= cosAlong * d.norm() * e.norm());
+        });
+    }
+
+    // A proper crossing of \p a – \p b with a crease segment for which \p counts is true.
+    template <class Counts>
+    bool crossingIf(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Counts& counts) const {
+        if (!a.allFinite() || !b.allFinite()) return false;
         auto side = [](const Eigen::Vector2d& p, const Eigen::Vector2d& q, const Eigen::Vector2d& r) {
             const double v = (q - p).x() * (r - p).y() - (q - p).y() * (r - p).x();
             return v > 0 ? 1 : (v < 0 ? -1 : 0);
@@ -195,8 +204,7 @@ public:
             for (int x = x0; x <= x1; ++x)
                 for (std::size_t i : cells_[std::size_t(y) * std::size_t(cellsX_) + std::size_t(x)]) {
                     const CreaseSegment& s = segments_[i];
-                    const Eigen::Vector2d e = s.b - s.a;
-                    if (std::abs(d.dot(e)) >= cosAlong * d.norm() * e.norm()) continue;
+                    if (!counts(s)) continue;
                     if (side(a, b, s.a) * side(a, b, s.b) < 0 && side(s.a, s.b, a) * side(s.a, s.b, b) < 0)
                         return true;
                 }
@@ -237,20 +245,41 @@ public:
 
     /// Stops the half-ribs of \p grid where an edge after the first (which starts on the backbone, maybe
     /// on the crease it follows) crosses a crease: that edge's outer vertex and every one beyond become
-    /// absent. Returns the number of vertices removed.
-    std::size_t stopRibsAtCreases(FishboneGrid& grid) const {
+    /// absent. With \p spareFollowed, a crease segment that runs along the backbone at the rib's row (within
+    /// 30° of its tangent) and lies within 2h of its sample is the crease the backbone follows and stops no
+    /// rib of that row (on CAD meshes the backbone wanders up to a pixel or two about the crease's screen
+    /// image, and its ribs' second edges crossed it back: ribs of 1–2 edges). Returns the number of
+    /// vertices removed.
+    std::size_t stopRibsAtCreases(FishboneGrid& grid, bool spareFollowed) const {
         std::size_t removed = 0;
-        for (int r = 0; r < grid.rows; ++r)
+        const int bc = grid.backboneColumn;
+        const double cosAlong = std::cos(30.0 * std::numbers::pi / 180.0), near = 2.0 * grid.spacing;
+        for (int r = 0; r < grid.rows; ++r) {
+            // The backbone's screen tangent at row r (zero: not known, nothing is spared).
+            Eigen::Vector2d tangent = Eigen::Vector2d::Zero();
+            const int prev = grid.closed ? (r + grid.rows - 1) % grid.rows : std::max(r - 1, 0),
+                      next = grid.closed ? (r + 1) % grid.rows : std::min(r + 1, grid.rows - 1);
+            if (spareFollowed && grid.isPresent(prev, bc) && grid.isPresent(next, bc) && prev != next)
+                tangent = (grid.at(next, bc) - grid.at(prev, bc)).normalized();
+            const bool spare = tangent.allFinite() && !tangent.isZero() && grid.isPresent(r, bc);
+            auto counts = [&](const CreaseSegment& s) {
+                if (!spare) return true;
+                const Eigen::Vector2d e = s.b - s.a, o = grid.at(r, bc);
+                const double len2 = e.squaredNorm();
+                if (!(len2 > 0) || std::abs(e.dot(tangent)) < cosAlong * std::sqrt(len2)) return true;
+                const double t = std::clamp((o - s.a).dot(e) / len2, 0.0, 1.0);
+                return (s.a + t * e - o).norm() > near;
+            };
             for (const int side : {1, -1}) {
                 bool stopped = false;
-                for (int c = grid.backboneColumn + 2 * side; c >= 0 && c < grid.cols; c += side) {
+                for (int c = bc + 2 * side; c >= 0 && c < grid.cols; c += side) {
                     const std::size_t i = grid.index(r, c);
                     if (!grid.present[i]) {
                         stopped = true;
                         continue;
                     }
                     if (!stopped && grid.isPresent(r, c - side) &&
-                        crosses(grid.at(r, c - side), grid.at(r, c)))
+                        crossingIf(grid.at(r, c - side), grid.at(r, c), counts))
                         stopped = true;
                     if (stopped) {
                         grid.present[i] = 0;
@@ -258,6 +287,7 @@ public:
                     }
                 }
             }
+        }
         return removed;
     }
 
@@ -652,7 +682,7 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
         // The ribs are independent streamlines, traced on the scan threads (the grid is the same for any
         // thread count).
         result.fishbone = assembleFishboneGrid(backbone, traceAllRibs(ribField, backbone, options), h, W, H);
-        trimRibs(result.fishbone, backbone, options); // as automaticFishbone (fishbone.h)
+        result.counts.trimmed = trimRibs(result.fishbone, backbone, options); // as automaticFishbone
     } else {
         std::vector<KeyRib> keys;
         std::vector<std::uint8_t> used(backbone.samples.size(), 0);
@@ -679,7 +709,8 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
         }
         result.fishbone = keyRibFishbone(backbone, std::move(keys), options, W, H);
     }
-    if (options.stopRibsAtCreases && fb.creaseAngleDeg > 0) stops().stopRibsAtCreases(result.fishbone);
+    if (options.stopRibsAtCreases && fb.creaseAngleDeg > 0)
+        result.counts.creaseStopped = stops().stopRibsAtCreases(result.fishbone, options.spareFollowedCrease);
     result.timings.tracing = secondsSince(t);
     result.counts.directionPixels = backboneField.computedPixels() + ribField.computedPixels();
     result.counts.rows = result.fishbone.rows;
@@ -717,6 +748,10 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
     stages.morphology = {.radius = params.erodeRadius, .dilateRadius = params.dilateRadius};
     stages.triangulate = params.triangulate;
     stages.triangulate.maxEdgeFootprints *= std::max(1.0, h);
+    stages.triangulate.minTriangleAngleDeg =
+        std::max(stages.triangulate.minTriangleAngleDeg, options.minFaceAngleDeg);
+    stages.triangulate.minComponentFaces =
+        std::max(stages.triangulate.minComponentFaces, options.minComponentFaces);
     stages.atLasso = {0.7, "masks"};
     stages.atQuality = stages.atMorphology = {};
     stages.atTriangulate = {0.85, "triangulate"};

@@ -659,6 +659,12 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
                 // sampling image fandisk's auto run keeps 1 % less of its area and 1 % fewer valence-6
                 // vertices; these scans are few, so their render cost hardly counts).
                 fb.samplingFactor = 1;
+                // The paper's grid as before issue 20's defaults: auto's own figures were measured with it,
+                // and a drawn backbone along a crease chain has no loop to close; the sliver bound and the
+                // small-part drop of the fishbone scan are left to auto's own clean-up.
+                fb.tracing.closeLoops = false;
+                fb.tracing.minFaceAngleDeg = 0;
+                fb.tracing.minComponentFaces = 0;
                 step.camera = params.camera;
                 auto ts = Clock::now();
                 FishboneScanResult scan = scanFishbonePatch(reference, *referenceRenderer, current,

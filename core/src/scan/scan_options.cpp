@@ -33,6 +33,8 @@ void TriangulateOptions::validate() const {
     check.positive("maxEdgeFootprints", maxEdgeFootprints);
     check.inRange("maxSamplingAngleDeg", maxSamplingAngleDeg, 0, 90, true, false);
     check.inRange("minQuadAngleDeg", minQuadAngleDeg, 0, 90, false, true);
+    check.inRange("minTriangleAngleDeg", minTriangleAngleDeg, 0, 60, false, true);
+    check.intAtLeast("minComponentFaces", minComponentFaces, 0);
 }
 
 void ScanParams::validate() const {

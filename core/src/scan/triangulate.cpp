@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <string>
 
 namespace fss {
@@ -52,18 +53,33 @@ struct JudgeLimits {
     double maxAngle;    // radians
     double cosMaxAngle; // cos(maxAngle)
     double cosMinQuad;  // cos(minQuadAngleDeg); > 1 when there is no bound
+    double cosMinTriangle; // cos(minTriangleAngleDeg); > 1 when there is no bound
 };
 
-// A quad (corners in order around it) with a 3D corner angle below the bound (cos above cosMinQuad).
-bool sliverQuad(const SampleGrid& grid, std::array<std::uint32_t, 4> q, double cosMinQuad) {
-    if (!(cosMinQuad < 1)) return false;
-    for (std::size_t k = 0; k < 4; ++k) {
-        const Eigen::Vector3d& p = grid.samples[q[k]].point;
-        const Eigen::Vector3d u = grid.samples[q[(k + 1) % 4]].point - p,
-                              v = grid.samples[q[(k + 3) % 4]].point - p;
-        const double lu = u.norm(), lv = v.norm();
-        if (!(lu > 0 && lv > 0) || u.dot(v) > cosMinQuad * lu * lv) return true;
-    }
+// Whether the corner angle at \p p between the edges to \p a and \p b is below the bound whose cosine is
+// \p cosBound (a degenerate corner counts as below).
+bool cornerBelow(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                 double cosBound) {
+    const Eigen::Vector3d u = a - p, v = b - p;
+    const double lu = u.norm(), lv = v.norm();
+    return !(lu > 0 && lv > 0) || u.dot(v) > cosBound * lu * lv;
+}
+
+// A quad (corners in order around it, the first and third on the diagonal (r, c)–(r+1, c+1)) with a 3D corner
+// angle below the quad bound (cos above cosMinQuad), or with a triangle of the split whose 3D angle is
+// below the triangle bound (cos above cosMinTriangle).
+bool sliverQuad(const SampleGrid& grid, std::array<std::uint32_t, 4> q, double cosMinQuad,
+                double cosMinTriangle) {
+    auto at = [&](std::size_t k) -> const Eigen::Vector3d& { return grid.samples[q[k % 4]].point; };
+    if (cosMinQuad < 1)
+        for (std::size_t k = 0; k < 4; ++k)
+            if (cornerBelow(at(k), at(k + 1), at(k + 3), cosMinQuad)) return true;
+    if (cosMinTriangle < 1)
+        for (const std::size_t side : {1, 3}) // the triangles (q0, q1, q2) and (q0, q3, q2)
+            if (cornerBelow(at(0), at(side), at(2), cosMinTriangle) ||
+                cornerBelow(at(side), at(0), at(2), cosMinTriangle) ||
+                cornerBelow(at(2), at(0), at(side), cosMinTriangle))
+                return true;
     return false;
 }
 
@@ -246,6 +262,32 @@ std::size_t makeVerticesManifold(std::vector<Triangle>& triangles, int rows, int
     return pinched;
 }
 
+// Drops the triangles of every connected part with fewer than \p minFaces triangles, keeping the order of
+// the others; returns how many were dropped. Once every vertex has a single fan (makeVerticesManifold),
+// triangles sharing a vertex are connected through that fan, so the parts are the classes of the samples
+// joined by the triangles (union–find on sample indices).
+std::size_t dropSmallComponents(std::vector<Triangle>& triangles, std::size_t sampleCount, int minFaces) {
+    if (minFaces <= 1 || triangles.empty()) return 0;
+    std::vector<std::uint32_t> parent(sampleCount);
+    std::iota(parent.begin(), parent.end(), 0u);
+    auto root = [&](std::uint32_t x) {
+        while (parent[x] != x)
+            x = parent[x] = parent[parent[x]];
+        return x;
+    };
+    for (const Triangle& t : triangles)
+        for (std::size_t j = 1; j < 3; ++j) {
+            const std::uint32_t a = root(t[0]), b = root(t[j]);
+            if (a != b) parent[std::max(a, b)] = std::min(a, b);
+        }
+    std::vector<std::uint32_t> size(sampleCount, 0);
+    for (const Triangle& t : triangles)
+        ++size[root(t[0])];
+    const std::size_t before = triangles.size();
+    std::erase_if(triangles, [&](const Triangle& t) { return size[root(t[0])] < std::uint32_t(minFaces); });
+    return before - triangles.size();
+}
+
 // True when \p mesh has exactly the properties triangulateGrid gives a patch (so that, emptied and resized,
 // it is the same as a new mesh with them).
 bool hasPatchPropertiesOnly(const Mesh& mesh) {
@@ -274,7 +316,9 @@ std::vector<Triangle>& judgeQuadTriangles(const SampleGrid& grid, const Triangul
     const double maxAngle = options.maxSamplingAngleDeg * std::numbers::pi / 180.0;
     const JudgeLimits limits{
         options.maxEdgeFootprints, maxAngle, std::cos(maxAngle),
-        options.minQuadAngleDeg > 0 ? std::cos(options.minQuadAngleDeg * std::numbers::pi / 180.0) : 2.0};
+        options.minQuadAngleDeg > 0 ? std::cos(options.minQuadAngleDeg * std::numbers::pi / 180.0) : 2.0,
+        options.minTriangleAngleDeg > 0 ? std::cos(options.minTriangleAngleDeg * std::numbers::pi / 180.0)
+                                        : 2.0};
 
     // One pass over the quad rows, in blocks, one per thread (parallel.h), with the samples of a quad row
     // in cache: their own tests (sampleFlags, one byte per sample of the two rows at hand: every sample is
@@ -329,7 +373,8 @@ std::vector<Triangle>& judgeQuadTriangles(const SampleGrid& grid, const Triangul
                            i10 = std::uint32_t(grid.index(r + 1, c)),
                            i11 = std::uint32_t(grid.index(r + 1, c + 1));
                 ++out.quads;
-                const bool sliver = sliverQuad(grid, {i00, i01, i11, i10}, limits.cosMinQuad);
+                const bool sliver =
+                    sliverQuad(grid, {i00, i01, i11, i10}, limits.cosMinQuad, limits.cosMinTriangle);
                 const std::uint8_t lower = top[c] | bottom[c] | bottom[c + 1],
                                    upper = top[c] | bottom[c + 1] | top[c + 1];
                 for (const auto& [t, corners] :
@@ -571,6 +616,8 @@ Patch triangulateGrid(const SampleGrid& grid, const TriangulateOptions& options,
 
     report.nonManifoldVertices =
         makeVerticesManifold(triangles, grid.rows, grid.cols, mirrored, report.nonManifoldTriangles, w);
+
+    report.smallParts = dropSmallComponents(triangles, grid.samples.size(), options.minComponentFaces);
 
     buildPatchMesh(grid, triangles, w, patch);
     const Mesh& mesh = patch.mesh;

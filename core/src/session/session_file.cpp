@@ -120,6 +120,12 @@ struct Writer {
         if (p.tracing.isotropicRibs) t["isotropic_ribs"] = true;
         if (p.tracing.maxRibTurnDeg != 180)
             t["max_rib_turn_deg"] = number(p.tracing.maxRibTurnDeg, f + ".tracing.max_rib_turn_deg");
+        if (p.tracing.maxRibAspect != 0)
+            t["max_rib_aspect"] = number(p.tracing.maxRibAspect, f + ".tracing.max_rib_aspect");
+        if (p.tracing.spareFollowedCrease) t["spare_followed_crease"] = true;
+        if (p.tracing.minFaceAngleDeg != 0)
+            t["min_face_angle_deg"] = number(p.tracing.minFaceAngleDeg, f + ".tracing.min_face_angle_deg");
+        if (p.tracing.minComponentFaces != 0) t["min_component_faces"] = p.tracing.minComponentFaces;
         t["backbone"] = streamline(p.tracing.backboneTracing, f + ".tracing.backbone");
         t["ribs"] = streamline(p.tracing.ribTracing, f + ".tracing.ribs");
         j["tracing"] = std::move(t);
@@ -463,7 +469,8 @@ FishboneParams readFishbone(const Node& n) {
     p.drawnBackbone = n.at("drawn_backbone").points();
     const Node t = n.at("tracing");
     t.onlyKeys({"spacing", "extend_beyond_key_ribs", "backbone", "ribs", "min_rib_gap", "max_rib_turn_deg",
-                "stop_ribs_at_creases", "close_loops", "stop_backbone_at_creases", "isotropic_ribs"});
+                "stop_ribs_at_creases", "close_loops", "stop_backbone_at_creases", "isotropic_ribs",
+                "max_rib_aspect", "spare_followed_crease", "min_face_angle_deg", "min_component_faces"});
     p.tracing.spacing = t.at("spacing").number();
     p.tracing.extendBeyondKeyRibs = t.at("extend_beyond_key_ribs").boolean();
     p.tracing.minRibGap = t.has("min_rib_gap") ? t.at("min_rib_gap").number() : 0.0;
@@ -473,6 +480,10 @@ FishboneParams readFishbone(const Node& n) {
     p.tracing.stopBackboneAtCreases =
         t.has("stop_backbone_at_creases") && t.at("stop_backbone_at_creases").boolean();
     p.tracing.isotropicRibs = t.has("isotropic_ribs") && t.at("isotropic_ribs").boolean();
+    p.tracing.maxRibAspect = t.has("max_rib_aspect") ? t.at("max_rib_aspect").number() : 0.0;
+    p.tracing.spareFollowedCrease = t.has("spare_followed_crease") && t.at("spare_followed_crease").boolean();
+    p.tracing.minFaceAngleDeg = t.has("min_face_angle_deg") ? t.at("min_face_angle_deg").number() : 0.0;
+    p.tracing.minComponentFaces = t.has("min_component_faces") ? intField(t.at("min_component_faces")) : 0;
     p.tracing.backboneTracing = readStreamline(t.at("backbone"));
     p.tracing.ribTracing = readStreamline(t.at("ribs"));
     p.minSeedAnisotropy = n.at("min_seed_anisotropy").number();
