@@ -26,10 +26,12 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <map>
 #include <numbers>
 #include <sstream>
@@ -87,6 +89,9 @@ struct Row {
     int scans = 0;
     Irregular irregular; // FSS only
     std::string note;    // FSS only: why v2 fell back to v1
+    // FSS only: plan, scan, join, relax, crease (AutoResult; join, relax and crease are 0 for v1, whose
+    // stitches, relaxation and crease recovery are all in "join").
+    double stages[5] = {};
     bool have = false;
 };
 
@@ -163,6 +168,11 @@ void BM_FssAuto(benchmark::State& state, std::string name, int engine) {
         row.scans = res.scansStitched;
         row.irregular = irregularVertices(res.mesh, o.featureAngleDeg);
         row.note = res.engineNote;
+        const double rest = res.stitchSeconds - res.joinSeconds - res.relaxSeconds - res.creaseSeconds;
+        const double stages[5] = {res.planSeconds, res.scanSeconds,
+                                  res.joinSeconds + (res.joinSeconds > 0 ? 0 : rest), res.relaxSeconds,
+                                  res.creaseSeconds};
+        std::copy(std::begin(stages), std::end(stages), std::begin(row.stages));
         row.have = true;
         state.ResumeTiming();
     }
@@ -231,6 +241,18 @@ void printTable() {
                 row.note.empty() ? "" : "  ", row.note.c_str());
         }
     }
+    std::printf("\nFSS: seconds by stage (v1: stitches, relaxation and crease recovery all in join)\n");
+    std::printf("%-16s %-4s %7s %7s %7s %7s %7s %7s\n", "mesh", "who", "plan", "scan", "join", "relax",
+                "crease", "total");
+    for (const std::string& name : meshOrder)
+        for (int w = 0; w < 2; ++w) {
+            const Row& row = results()[name].fss[w];
+            if (!row.have) continue;
+            std::printf("%-16s %-4s", name.c_str(), w == 0 ? "v1" : "v2");
+            for (double s : row.stages)
+                std::printf(" %7.2f", s);
+            std::printf(" %7.2f\n", row.seconds);
+        }
     std::printf("\nFSS: irregular (valence != 6) / all vertices by where they are (first class that fits)\n");
     std::printf("%-16s %-4s %15s %15s %15s %15s\n", "mesh", "who", "input_faces", "feature_edge", "seam",
                 "patch_inside");

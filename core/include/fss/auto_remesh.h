@@ -256,6 +256,10 @@ struct AutoResult {
     double planSeconds = 0;   ///< of which: view planning and coverage bookkeeping
     double scanSeconds = 0;   ///< of which: rendering, masks, triangulation
     double stitchSeconds = 0; ///< of which: stitching and the seam relaxation
+    // Of stitchSeconds, with AutoEngine::V2 (0 with V1):
+    double joinSeconds = 0;   ///< the one-pass join (gap closing, hole filling, repair)
+    double relaxSeconds = 0;  ///< the sliver flips and the seam relaxation (both passes)
+    double creaseSeconds = 0; ///< the crease recovery
 };
 
 /// The edge length a regular triangulation with \p vertices vertices of a surface of area \p area has:

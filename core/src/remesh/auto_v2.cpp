@@ -352,6 +352,9 @@ bool repairJoin(Mesh& mesh, bool closed, int rounds, bool debug) {
             CGAL::Euler::remove_face(mesh.halfedge(f), mesh);
         for (VertexIndex v : mesh.vertices())
             if (mesh.is_isolated(v)) mesh.remove_vertex(v);
+        // Without this, the hole refinement's new vertices reuse removed ones and crashed on elephant (a
+        // corrupt free list in Surface_mesh::add_vertex); the face marks above are rebuilt every round.
+        mesh.collect_garbage();
         fillHoles(mesh);
     }
 }
@@ -545,13 +548,14 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
     repairJoin(current, closedInput, 4, debug);
     current.collect_garbage();
     if (debug) std::fprintf(stderr, "v2: join %.2f s\n", since(t));
-    result.stitchSeconds = since(t);
+    result.stitchSeconds = result.joinSeconds = since(t);
 
     // 4. Seam relaxation and crease recovery, once.
     progress.report(0.7, "relax");
     t = Clock::now();
     auto relax = [&] {
         if (options.seamRelaxRounds <= 0) return;
+        const auto t0 = Clock::now();
         SeamRelaxOptions ro;
         ro.rounds = options.seamRelaxRounds;
         ro.edgeLength = L;
@@ -564,12 +568,15 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         result.seamCollapses += rr.collapses;
         result.seamMoves += rr.moves;
         result.seamRelaxDiscarded = result.seamRelaxDiscarded || rr.reverted;
+        result.relaxSeconds += since(t0);
     };
     if (options.flipSliversBelowDeg > 0)
         result.sliverFlips = flipSliverFaces(current, options.flipSliversBelowDeg, 20.0, 8);
+    result.relaxSeconds = since(t);
     relax();
     if (debug) std::fprintf(stderr, "v2: relax %.2f s\n", since(t));
     if (options.creaseSnapRounds > 0) {
+        const auto t0 = Clock::now();
         CreaseSnapOptions co;
         co.edgeLength = L;
         co.creaseAngleDeg = options.featureAngleDeg;
@@ -581,6 +588,7 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         result.creaseFlips = cr.flips;
         result.creaseRemovals = cr.removals;
         result.creaseRepairs = cr.repairs;
+        result.creaseSeconds = since(t0);
         if (cr.snaps + cr.splits + cr.flips + cr.removals + cr.repairs > 0) relax();
         if (auto [onCrease, have] = current.property_map<VertexIndex, bool>(kOnCreaseProperty); have)
             current.remove_property_map(onCrease);

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -182,6 +183,19 @@ private:
     CreaseIndex creases_;
     std::vector<char> frozen_;   // vertices that never move: border vertices
     std::vector<char> onCrease_; // vertices this step put on a crease
+    /// The corners of a triangle, in order (exact: a cache key).
+    struct TriKey {
+        std::array<double, 9> x;
+        bool operator==(const TriKey& o) const { return x == o.x; }
+    };
+    struct TriKeyHash {
+        std::size_t operator()(const TriKey& k) const {
+            std::uint64_t h = 1469598103934665603ull;
+            for (double d : k.x)
+                h = (h ^ std::bit_cast<std::uint64_t>(d)) * 1099511628211ull;
+            return std::size_t(h);
+        }
+    };
 
     bool isInput(FaceIndex f) const {
         const auto [ids, have] = m_.property_map<FaceIndex, std::int32_t>(props::faceScanId);
@@ -222,7 +236,22 @@ private:
     struct Error {
         double max = 0, integral = 0;
     };
+    mutable std::unordered_map<TriKey, Error, TriKeyHash> errors_; // error() of the triangles measured
     Error error(const Tri& t) const {
+        // The same triangles are measured again and again (each face lies in the stars of its three vertices
+        // and next to three edges, over the sweeps and rounds): by their exact corners, once.
+        TriKey key;
+        for (int i = 0; i < 3; ++i) {
+            key.x[std::size_t(i)] = t.a[i];
+            key.x[std::size_t(3 + i)] = t.b[i];
+            key.x[std::size_t(6 + i)] = t.c[i];
+        }
+        if (const auto it = errors_.find(key); it != errors_.end()) return it->second;
+        const Error e = measureError(t);
+        errors_.emplace(key, e);
+        return e;
+    }
+    Error measureError(const Tri& t) const {
         static constexpr double w[7][3] = {{1.0 / 3, 1.0 / 3, 1.0 / 3},
                                            {0.5, 0.5, 0},
                                            {0, 0.5, 0.5},
