@@ -566,6 +566,37 @@ void closeUnrolledPatch(Patch& patch, SampleGrid& grid, int n, int p) {
     grid = std::move(cropped);
 }
 
+// Key-rib mode: every picked key-rib traced at its nearest backbone sample, every drawn one as drawn, blended
+// into one grid (keyRibFishbone). \p k is the sampling factor, only for the positions in error messages.
+FishboneGrid keyRibGrid(const DirectionField& ribField, const Backbone& backbone, const FishboneParams& fb,
+                        const FishboneOptions& options, int k, int W, int H) {
+    auto shown = [k](const Eigen::Vector2d& p) { return point(double(k) * p); };
+    const double h = options.spacing;
+    std::vector<KeyRib> keys;
+    std::vector<std::uint8_t> used(backbone.samples.size(), 0);
+    auto claim = [&](std::size_t row, const std::string& what) {
+        if (used[row])
+            throw InvalidInputError("Two key-ribs fall on the same backbone sample (" + what +
+                                    "); place them farther apart.");
+        used[row] = 1;
+    };
+    for (const Eigen::Vector2d& p : fb.keyRibs) {
+        const std::size_t row = backbone.nearestSample(p);
+        const double d = (backbone.samples[row] - p).norm();
+        if (d > 2 * h)
+            throw InvalidInputError("The key-rib point " + shown(p) + " lies " + fmt(k * d) +
+                                    " pixels from the backbone, farther than 2h = " + fmt(2 * k * h) + ".");
+        claim(row, shown(p));
+        keys.push_back(KeyRib{row, traceRib(ribField, backbone, row, options)});
+    }
+    for (const Polyline2& drawn : fb.drawnKeyRibs) {
+        KeyRib key = drawnKeyRib(backbone, drawn, options);
+        claim(key.row, "a drawn key-rib");
+        keys.push_back(std::move(key));
+    }
+    return keyRibFishbone(backbone, std::move(keys), options, W, H);
+}
+
 // The scan on its sampling image: \p params and \p fb are already scaled to it (and validated); \p k is
 // the sampling factor, only for the positions in error messages (which the user gave in scan pixels).
 FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& referenceRenderer,
@@ -684,30 +715,7 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
         result.fishbone = assembleFishboneGrid(backbone, traceAllRibs(ribField, backbone, options), h, W, H);
         result.counts.trimmed = trimRibs(result.fishbone, backbone, options); // as automaticFishbone
     } else {
-        std::vector<KeyRib> keys;
-        std::vector<std::uint8_t> used(backbone.samples.size(), 0);
-        auto claim = [&](std::size_t row, const std::string& what) {
-            if (used[row])
-                throw InvalidInputError("Two key-ribs fall on the same backbone sample (" + what +
-                                        "); place them farther apart.");
-            used[row] = 1;
-        };
-        for (const Eigen::Vector2d& p : fb.keyRibs) {
-            const std::size_t row = backbone.nearestSample(p);
-            const double d = (backbone.samples[row] - p).norm();
-            if (d > 2 * h)
-                throw InvalidInputError("The key-rib point " + shown(p) + " lies " + fmt(k * d) +
-                                        " pixels from the backbone, farther than 2h = " + fmt(2 * k * h) +
-                                        ".");
-            claim(row, shown(p));
-            keys.push_back(KeyRib{row, traceRib(ribField, backbone, row, options)});
-        }
-        for (const Polyline2& drawn : fb.drawnKeyRibs) {
-            KeyRib k = drawnKeyRib(backbone, drawn, options);
-            claim(k.row, "a drawn key-rib");
-            keys.push_back(std::move(k));
-        }
-        result.fishbone = keyRibFishbone(backbone, std::move(keys), options, W, H);
+        result.fishbone = keyRibGrid(ribField, backbone, fb, options, k, W, H);
     }
     if (options.stopRibsAtCreases && fb.creaseAngleDeg > 0)
         result.counts.creaseStopped = stops().stopRibsAtCreases(result.fishbone, options.spareFollowedCrease);

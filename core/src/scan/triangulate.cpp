@@ -50,9 +50,9 @@ enum class Verdict { Keep, Flipped, BackFacing, LongEdge, Grazing, SliverQuad };
 
 struct JudgeLimits {
     double maxEdgeFootprints;
-    double maxAngle;    // radians
-    double cosMaxAngle; // cos(maxAngle)
-    double cosMinQuad;  // cos(minQuadAngleDeg); > 1 when there is no bound
+    double maxAngle;       // radians
+    double cosMaxAngle;    // cos(maxAngle)
+    double cosMinQuad;     // cos(minQuadAngleDeg); > 1 when there is no bound
     double cosMinTriangle; // cos(minTriangleAngleDeg); > 1 when there is no bound
 };
 
