@@ -557,12 +557,13 @@ fss::Metrics checkV2(const fss::Mesh& reference, const fss::AutoResult& r) {
 
 // Bounds measured on these shapes (see the report of issue 23), with a margin.
 // Measured (CPU renderer): sphere 2603 vertices for 2562, valence-6 0.914, smallest angle 1.46°, mean
-// smallest angle 55.1°; torus 2949 for 3072, 0.845, 1.15°, 52.9°; fandisk 6445 for 6475, 0.895,
-// 0.05°, 52.9°, Hausdorff from it 0.0164 of the bbox diagonal (v1: 0.0024; the join still loses geometry).
+// smallest angle 55.1°; torus 2949 for 3072, 0.845, 1.15°, 52.9°; fandisk (session 15, after the repair
+// collects garbage before refilling holes) 6568 for 6475, 0.890, 5.78°, 52.86°, Hausdorff from it 0.0225 of
+// the bbox diagonal (v1: 0.0024; the join still loses geometry; CGAL's isotropic remeshing 0.0028, issue 23).
 constexpr double V2_SPHERE_MIN_ANGLE = 1.0, V2_SPHERE_MEAN_MIN_ANGLE = 53.0, V2_SPHERE_VALENCE6 = 0.89;
 constexpr double V2_TORUS_MIN_ANGLE = 0.8, V2_TORUS_MEAN_MIN_ANGLE = 51.0, V2_TORUS_VALENCE6 = 0.82;
-constexpr double V2_PART_MIN_ANGLE = 0, V2_PART_MEAN_MIN_ANGLE = 0, V2_PART_VALENCE6 = 0,
-                 V2_PART_HAUSDORFF_FROM = 1;
+constexpr double V2_PART_MIN_ANGLE = 4.0, V2_PART_MEAN_MIN_ANGLE = 52.0, V2_PART_VALENCE6 = 0.87,
+                 V2_PART_HAUSDORFF_FROM = 0.03;
 
 std::string meshBytes(const fss::Mesh& m) {
     std::string out;
