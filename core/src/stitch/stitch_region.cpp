@@ -355,15 +355,17 @@ bool ComponentStitcher::findRegion(Attempt& a) {
 bool ComponentStitcher::preTrim(Attempt& a) {
     double edge = 0;
     CGAL::Bbox_2 bounds;
+    reg_.tris.clear();
+    reg_.tris.reserve(reg_.faces.size());
     for (FaceIndex f : reg_.faces) {
-        const Triangle2 t = faceTriangle(f);
+        const Triangle2& t = reg_.tris.emplace_back(faceTriangle(f));
         edge += std::sqrt(dist2(t[0], t[1]));
         bounds += t.bbox();
     }
     edge /= double(reg_.faces.size());
     reg_.grid = BucketGrid(std::max(2.0 * comp_.h2, edge), reg_.faces.size(), bounds);
     for (std::size_t i = 0; i < reg_.faces.size(); ++i)
-        reg_.grid.insert(int(i), faceTriangle(reg_.faces[i]).bbox());
+        reg_.grid.insert(int(i), reg_.tris[i].bbox());
     std::vector<int> bad;
     for (int v : comp_.verts) {
         progress_.tick();
@@ -371,7 +373,7 @@ bool ComponentStitcher::preTrim(Attempt& a) {
         bool inside = false;
         reg_.grid.query(uv.bbox(), [&](int i) {
             if (inside) return;
-            const Triangle2 t = faceTriangle(reg_.faces[std::size_t(i)]);
+            const Triangle2& t = reg_.tris[std::size_t(i)];
             inside = inTriangle(uv, t[0], t[1], t[2]);
         });
         if (!inside) bad.push_back(v);
@@ -390,8 +392,7 @@ bool ComponentStitcher::insidePatch(const Point2& p) {
     return in;
 }
 
-bool ComponentStitcher::interiorsOverlap(FaceIndex f, FaceIndex g) {
-    const Triangle2 s = faceTriangle(f), t = faceTriangle(g);
+bool ComponentStitcher::interiorsOverlap(const Triangle2& s, const Triangle2& t) {
     for (const auto& [x, y] : {std::pair{&s, &t}, std::pair{&t, &s}})
         for (int k = 0; k < 3; ++k) {
             const Point2 &p = (*x)[k], &q = (*x)[(k + 1) % 3];
@@ -446,14 +447,15 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
     std::vector<FaceIndex> seam;
     std::vector<FaceIndex> stack;
     IndexSet isSeam, isInterior;
-    for (FaceIndex f : reg_.faces) {
+    for (std::size_t i = 0; i < reg_.faces.size(); ++i) {
         progress_.tick();
-        const Triangle2 t = faceTriangle(f);
+        const FaceIndex f = reg_.faces[i];
+        const Triangle2& t = reg_.tris[i];
         bool near = false;
-        segments.query(grown(t.bbox(), comp_.margin), [&](int i) {
+        segments.query(grown(t.bbox(), comp_.margin), [&](int k) {
             if (near) return;
-            const Segment2 e(P_.uv[std::size_t(comp_.pedges[std::size_t(i)].a)],
-                             P_.uv[std::size_t(comp_.pedges[std::size_t(i)].b)]);
+            const Segment2 e(P_.uv[std::size_t(comp_.pedges[std::size_t(k)].a)],
+                             P_.uv[std::size_t(comp_.pedges[std::size_t(k)].b)]);
             near = CGAL::do_intersect(t, e) || CGAL::squared_distance(t, e) <= reach2;
         });
         if (near) {
@@ -486,16 +488,16 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
             const std::size_t i = todo.back();
             todo.pop_back();
             progress_.tick();
-            reg_.grid.query(faceTriangle(reg_.faces[i]).bbox(), [&](int jj) {
+            reg_.grid.query(reg_.tris[i].bbox(), [&](int jj) {
                 const std::size_t j = std::size_t(jj);
                 if (j == i) return;
                 // Each pair in the order (lower, higher index), as a scan over all pairs would.
                 const std::size_t lo = std::min(i, j), hi = std::max(i, j);
-                if (!interiorsOverlap(reg_.faces[lo], reg_.faces[hi])) return;
+                if (!interiorsOverlap(reg_.tris[lo], reg_.tris[hi])) return;
                 folded[lo] = folded[hi] = 1;
                 clusters.unite(lo, hi);
                 // The one farther from the eye where they overlap is hidden there.
-                const Point2 q = overlapCentre(faceTriangle(reg_.faces[lo]), faceTriangle(reg_.faces[hi]));
+                const Point2 q = overlapCentre(reg_.tris[lo], reg_.tris[hi]);
                 hidden[depthAt(reg_.faces[lo], q) > depthAt(reg_.faces[hi], q) ? lo : hi] = 1;
                 if (!reached[j]) {
                     reached[j] = 1;
@@ -514,7 +516,7 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
             for (std::size_t i = 0; i < reg_.faces.size(); ++i) {
                 if (!folded[i] || !clusterAtSeam.count(find(int(i))) || (pass == 0 && !hidden[i])) continue;
                 const FaceIndex g = reg_.faces[i];
-                const Triangle2 t = faceTriangle(g);
+                const Triangle2& t = reg_.tris[i];
                 const double tolerance = gapTolerance(g);
                 comp_.grid.query(grown(t.bbox(), r), [&](int k) {
                     const auto& tri = P_.tri[std::size_t(faces_[std::size_t(k)])];
@@ -570,6 +572,7 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
     if (!bad.empty())
         return fail(a, "the mesh under it folds or has a hole in the scan's view", std::move(bad));
     reg_.faces = std::move(seam);
+    reg_.tris.clear(); // (it described the faces before)
     reg_.index.clear();
     for (std::size_t i = 0; i < reg_.faces.size(); ++i)
         reg_.index[std::uint32_t(reg_.faces[i])] = int(i);

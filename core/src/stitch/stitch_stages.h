@@ -60,6 +60,10 @@ struct Region {
     std::vector<FaceIndex> interior; // faces under the patch, removed whole
     IndexMap<int> index;
     BucketGrid grid;
+    // faceTriangle of every face of `faces`, in its order (preTrim to the end of splitRegion, where
+    // `faces` becomes the seam faces): the grid's queries test many faces per cell, each read once here
+    // instead of through three vertex-cache look-ups per test.
+    std::vector<Triangle2> tris;
 };
 
 // The local problem in the view (cut: local vertices, snapping, crossings; gap triangulation: the faces).
@@ -235,7 +239,7 @@ private:
     // Do the interiors of two (counter-clockwise) faces overlap in the view? Separating-axis test on
     // their edges with exact orientations: disjoint interiors iff one triangle lies on the closed outer
     // side of an edge of the other.
-    bool interiorsOverlap(FaceIndex f, FaceIndex g);
+    static bool interiorsOverlap(const Triangle2& s, const Triangle2& t);
     // A point inside the overlap of two counter-clockwise triangles (centre of s clipped by t).
     static Point2 overlapCentre(const Triangle2& s, const Triangle2& t);
     // Distance from the eye (along the view direction) of face f's plane at view position q.
