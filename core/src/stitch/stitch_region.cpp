@@ -138,14 +138,20 @@ void ComponentStitcher::addBad(std::vector<int>& bad, int i) {
 }
 
 auto ComponentStitcher::vproj(VertexIndex v) -> VProj {
-    auto [it, fresh] = search_.vcache.try_emplace(std::uint32_t(v));
-    if (fresh) it->ok = V_.project(toVec(M_.point(v)), it->uv, it->w);
-    return *it;
+    auto [it, fresh] = search_.vcache.slot(std::size_t(v), M_.num_vertices());
+    if (fresh) {
+        VProj p{}; // (value-initialised: a vertex behind the eye keeps uv = (0, 0), as in a map's new entry)
+        p.ok = V_.project(toVec(M_.point(v)), p.uv, p.w);
+        *it = {p.uv.x(), p.uv.y(), p.w, p.ok};
+        return p;
+    }
+    return {Point2(it->u, it->v), it->w, it->ok};
 }
 
 bool ComponentStitcher::acceptable(FaceIndex f) {
-    auto [it, fresh] = search_.accept.try_emplace(std::uint32_t(f), 0);
+    auto [it, fresh] = search_.accept.slot(std::size_t(f), M_.num_faces());
     if (!fresh) return *it != 0;
+    *it = 0;
     const HalfedgeIndex h = M_.halfedge(f);
     if (M_.next(M_.next(M_.next(h))) != h) return false;
     const VertexIndex a = M_.source(h), b = M_.target(h), c = M_.target(M_.next(h));

@@ -6,6 +6,8 @@
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 
+#include <memory>
+
 namespace fss::detail::stitching {
 
 // ---- What the stages hand on (in the order of ComponentStitcher::run).
@@ -45,10 +47,38 @@ struct VProj {
     double w = 0;
     bool ok = false;
 };
+// A cache by element index of the current mesh whose cost follows the elements asked for: the values'
+// array is allocated uninitialised (its pages are touched only where written) and a bitmap, one bit per
+// element, tells which are known. A direct look-up: the region stage asks for every face under the patch
+// and its vertices several times each (a hashed map cost a probe and a cache miss per question there).
+template <class T> class DenseCache {
+public:
+    // The slot of element i < size and whether it was unknown until now (then the caller fills it).
+    std::pair<T*, bool> slot(std::size_t i, std::size_t size) {
+        if (!values_) {
+            values_ = std::make_unique_for_overwrite<T[]>(size);
+            known_.assign(size / 64 + 1, 0);
+        }
+        std::uint64_t& word = known_[i / 64];
+        const std::uint64_t bit = std::uint64_t(1) << (i % 64);
+        const bool fresh = (word & bit) == 0;
+        word |= bit;
+        return {&values_[i], fresh};
+    }
+
+private:
+    std::unique_ptr<T[]> values_;
+    std::vector<std::uint64_t> known_;
+};
+// VProj's fields without initialisers (DenseCache leaves what it has not been asked for uninitialised).
+struct VProjSlot {
+    double u, v, w;
+    bool ok;
+};
 // The region stage's caches over the current mesh (stage-local).
 struct RegionSearch {
-    IndexMap<VProj> vcache;
-    IndexMap<char> accept; // bool (a char: vector<bool> has no addressable elements)
+    DenseCache<VProjSlot> vcache;
+    DenseCache<char> accept; // bool (a char: vector<bool> has no addressable elements)
     bool fallbackBuilt = false;
     std::vector<FaceIndex> fallback;
     BucketGrid fallbackGrid;
