@@ -339,10 +339,10 @@ bool ComponentStitcher::findRegion(Attempt& a) {
     }
     if (seeds.empty()) return fail(a, "no visible face of the mesh lies under it in the scan's view");
     // Grow over faces sharing a vertex, keeping the acceptable ones that meet the component in the view.
-    IndexSet visited;
+    DenseSet visited(M_.num_faces());
     std::vector<FaceIndex> stack;
     for (FaceIndex f : seeds)
-        if (visited.insert(std::uint32_t(f))) stack.push_back(f);
+        if (visited.insert(std::size_t(f))) stack.push_back(f);
     while (!stack.empty()) {
         const FaceIndex f = stack.back();
         stack.pop_back();
@@ -352,7 +352,7 @@ bool ComponentStitcher::findRegion(Attempt& a) {
         reg_.faces.push_back(f);
         for (VertexIndex v : faceVertices(f))
             for (FaceIndex g : CGAL::faces_around_target(M_.halfedge(v), M_))
-                if (g != Mesh::null_face() && visited.insert(std::uint32_t(g))) stack.push_back(g);
+                if (g != Mesh::null_face() && visited.insert(std::size_t(g))) stack.push_back(g);
     }
     if (reg_.faces.empty()) return fail(a, "no visible face of the mesh lies under it in the scan's view");
     return true;
@@ -452,7 +452,7 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
     const double reach2 = comp_.margin * comp_.margin; // the snapping distance
     std::vector<FaceIndex> seam;
     std::vector<FaceIndex> stack;
-    IndexSet isSeam, isInterior;
+    DenseSet isSeam(M_.num_faces()), isInterior(M_.num_faces());
     for (std::size_t i = 0; i < reg_.faces.size(); ++i) {
         progress_.tick();
         const FaceIndex f = reg_.faces[i];
@@ -466,9 +466,9 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
         });
         if (near) {
             seam.push_back(f);
-            isSeam.insert(std::uint32_t(f));
+            isSeam.insert(std::size_t(f));
         } else if (insidePatch(CGAL::centroid(t))) {
-            isInterior.insert(std::uint32_t(f));
+            isInterior.insert(std::size_t(f));
             stack.push_back(f);
         }
     }
@@ -486,7 +486,7 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
         std::vector<char> reached(reg_.faces.size(), 0);
         std::vector<std::size_t> todo;
         for (std::size_t i = 0; i < reg_.faces.size(); ++i)
-            if (isSeam.count(std::uint32_t(reg_.faces[i]))) {
+            if (isSeam.contains(std::size_t(reg_.faces[i]))) {
                 reached[i] = 1;
                 todo.push_back(i);
             }
@@ -513,7 +513,7 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
         }
         std::unordered_map<int, bool> clusterAtSeam;
         for (std::size_t i = 0; i < reg_.faces.size(); ++i)
-            if (folded[i] && isSeam.count(std::uint32_t(reg_.faces[i]))) clusterAtSeam[find(int(i))] = true;
+            if (folded[i] && isSeam.contains(std::size_t(reg_.faces[i]))) clusterAtSeam[find(int(i))] = true;
         // Cut the patch back around the hidden faces, where it lies on their sheet; if that frees
         // nothing, around the whole fold.
         // (Peeling: only the patch triangles within snapping distance; the next round sees what is left.)
@@ -551,7 +551,7 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
                 addNear(bad, vproj(M_.target(h)).uv); // the mesh's border under the patch
                 continue;
             }
-            if (isSeam.count(std::uint32_t(g)) || isInterior.count(std::uint32_t(g))) continue;
+            if (isSeam.contains(std::size_t(g)) || isInterior.contains(std::size_t(g))) continue;
             // Under the patch in the view, on its sheet (not a part of the mesh far behind or in front).
             bool under = true;
             const double tolerance = gapTolerance(g);
@@ -571,7 +571,7 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
                         vproj(M_.target(h)).uv); // a face reaching out without a seam: a fold, a hole
                 continue;
             }
-            isInterior.insert(std::uint32_t(g));
+            isInterior.insert(std::size_t(g));
             stack.push_back(g);
         }
     }

@@ -70,6 +70,24 @@ private:
     std::unique_ptr<T[]> values_;
     std::vector<std::uint64_t> known_;
 };
+// A set of element indices of the current mesh as a bitmap (one bit per element, zeroed once: an eighth of a
+// byte per element of the mesh, so cheap next to a hashed set's probe per question).
+class DenseSet {
+public:
+    explicit DenseSet(std::size_t size) : bits_(size / 64 + 1, 0) {}
+    // Inserts i; whether it was not there.
+    bool insert(std::size_t i) {
+        std::uint64_t& word = bits_[i / 64];
+        const std::uint64_t bit = std::uint64_t(1) << (i % 64);
+        const bool fresh = (word & bit) == 0;
+        word |= bit;
+        return fresh;
+    }
+    bool contains(std::size_t i) const { return (bits_[i / 64] >> (i % 64)) & 1u; }
+
+private:
+    std::vector<std::uint64_t> bits_;
+};
 // VProj's fields without initialisers (DenseCache leaves what it has not been asked for uninitialised).
 struct VProjSlot {
     double u, v, w;
