@@ -5,14 +5,16 @@
 // 10k. Also the scan time of the same patch (GPU render of the reference + sampling + masks +
 // triangulation; CPU ray casting when FSS::render is not built) and the ratio stitch / scan.
 //
-// BM_StitchWide/faces:N/spare:1  the same with a patch scanned in a 50° view (the widget's case, params()).
 // BM_Stitch/faces:N/spare:S   stitch time only: CPU time of the stitching thread (the machine is shared; wall
 // time
 //                     in the counter wall_ms); copying the mesh before each stitch is not timed.
 //                     Counters: patch_faces, faces_removed, faces_added, seam_edges.
+// BM_StitchWide/faces:N/spare:1  the same with a patch scanned in a 50° view (the widget's case, params()),
+//                     not in the table printed after the runs.
 // FSS_STITCH_REMESH=1 (0) turns the seam band remesh on (off), FSS_STITCH_CORE_BYPASS=0 the
 // core bypass off (DESIGN.md §6.1), FSS_STITCH_PROFILE=1 prints the stages' CPU time per stitch.
-// BM_Scan/faces:N     scanPatch of the same view and lasso on the sphere of N faces: time = CPU time of the
+// BM_Scan/faces:N     scanPatch of the same view and lasso on the sphere of N faces (FSS_BENCH_SCAN_WARP=0:
+//                     on the plain adaptive lattice, without the warp to the surface): time = CPU time of the
 //                     calling thread, wall_ms = wall time including the GL driver's own threads.
 // After the runs the program prints stitch(1M) / stitch(10k) and stitch / scan per size.
 #include "fss/camera.h"
@@ -63,9 +65,10 @@ fss::Mesh sphereWith(int faces) {
     return fss::shapes::uvSphere(1000, 501);
 }
 
-// wide: a 50° view instead of 25°, the same lasso in pixels, so the patch covers about 4.5 times the
-// sphere's area (faces removed at 1M: about 110k instead of 23k), as the widget's accept test does
-// (tests/widgets acceptLatency: the whole sphere in the view, a lasso of a third of its height).
+// wide: a 50° view instead of 25°, the same lasso in pixels, so the patch covers several times the sphere's
+// area (98k patch faces instead of 73k; faces removed at 1M: 175k instead of 23k), as the widget's accept
+// test does (tests/widgets acceptLatency: the whole sphere in the view, a lasso of a third of its height:
+// 250k faces removed at 1M).
 fss::ScanParams params(bool wide = false) {
     fss::ScanParams p;
     fss::Camera& c = p.camera;
@@ -188,7 +191,10 @@ void BM_StitchWide(benchmark::State& state) {
 void BM_Scan(benchmark::State& state) {
     const int faces = int(state.range(0));
     Scene& scene = sceneWith(faces);
-    const fss::ScanParams p = params();
+    fss::ScanParams p = params();
+    // FSS_BENCH_SCAN_WARP=0: the plain adaptive lattice (ScanOptions::warpToSurface off; the patch stitched
+    // above is the default scan's either way).
+    if (const char* e = std::getenv("FSS_BENCH_SCAN_WARP")) p.scan.warpToSurface = std::string(e) != "0";
     double total = 0;
     std::size_t patchFaces = 0;
     double wall = 0;
