@@ -9,9 +9,12 @@
 // time
 //                     in the counter wall_ms); copying the mesh before each stitch is not timed.
 //                     Counters: patch_faces, faces_removed, faces_added, seam_edges.
+// BM_StitchWide/faces:N/spare:1  the same with a patch scanned in a 50° view (the widget's case, params()),
+//                     not in the table printed after the runs.
 // FSS_STITCH_REMESH=1 (0) turns the seam band remesh on (off), FSS_STITCH_CORE_BYPASS=0 the
 // core bypass off (DESIGN.md §6.1), FSS_STITCH_PROFILE=1 prints the stages' CPU time per stitch.
-// BM_Scan/faces:N     scanPatch of the same view and lasso on the sphere of N faces: time = CPU time of the
+// BM_Scan/faces:N     scanPatch of the same view and lasso on the sphere of N faces (FSS_BENCH_SCAN_WARP=0:
+//                     on the plain adaptive lattice, without the warp to the surface): time = CPU time of the
 //                     calling thread, wall_ms = wall time including the GL driver's own threads.
 // After the runs the program prints stitch(1M) / stitch(10k) and stitch / scan per size.
 #include "fss/camera.h"
@@ -62,14 +65,18 @@ fss::Mesh sphereWith(int faces) {
     return fss::shapes::uvSphere(1000, 501);
 }
 
-fss::ScanParams params() {
+// wide: a 50° view instead of 25°, the same lasso in pixels, so the patch covers several times the sphere's
+// area (98k patch faces instead of 73k; faces removed at 1M: 175k instead of 23k), as the widget's accept
+// test does (tests/widgets acceptLatency: the whole sphere in the view, a lasso of a third of its height:
+// 250k faces removed at 1M).
+fss::ScanParams params(bool wide = false) {
     fss::ScanParams p;
     fss::Camera& c = p.camera;
     c.width = c.height = 256;
     c.focal = {0, 0, 0};
     c.eye = Eigen::Vector3d(1, 0.3, 0.2).normalized() * 3.0; // near the equator, away from the poles
     c.up = {0, 0, 1};
-    c.viewAngleDeg = 25;
+    c.viewAngleDeg = wide ? 50 : 25;
     c.fitClippingRange(Eigen::AlignedBox3d(Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1, 1, 1)));
     fss::Lasso lasso;
     for (int i = 0; i < 64; ++i) {
@@ -89,19 +96,21 @@ struct Scene {
 };
 
 // The patch: scanned once from the 1M-face sphere, stitched into every size.
-const fss::Patch& thePatch() {
-    static const fss::Patch patch = [] {
+const fss::Patch& thePatch(bool wide = false) {
+    static std::map<bool, fss::Patch> patches;
+    auto it = patches.find(wide);
+    if (it == patches.end()) {
         const fss::Mesh ref = sphereWith(1000000);
         auto r = makeRenderer();
         r->setMesh(ref);
-        return fss::scanPatch(ref, *r, ref, *r, params()).patch;
-    }();
-    return patch;
+        it = patches.emplace(wide, fss::scanPatch(ref, *r, ref, *r, params(wide)).patch).first;
+    }
+    return it->second;
 }
 
-Scene& sceneWith(int faces) {
-    static std::map<int, std::unique_ptr<Scene>> cache;
-    auto& s = cache[faces];
+Scene& sceneWith(int faces, bool wide = false) {
+    static std::map<std::pair<int, bool>, std::unique_ptr<Scene>> cache;
+    auto& s = cache[{faces, wide}];
     if (!s) {
         s = std::make_unique<Scene>();
         s->mesh = sphereWith(faces);
@@ -110,7 +119,7 @@ Scene& sceneWith(int faces) {
         s->mesh.add_property_map<fss::FaceIndex, std::int32_t>(fss::props::faceScanId, -1);
         s->renderer = makeRenderer();
         s->renderer->setMesh(s->mesh);
-        const fss::FrameBuffers fb = s->renderer->render(params().camera);
+        const fss::FrameBuffers fb = s->renderer->render(params(wide).camera);
         s->ids = fb.faceId;
         s->camera = fb.camera;
     }
@@ -133,10 +142,10 @@ double median(std::vector<double> v) {
     return v.empty() ? 0.0 : v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
-void BM_Stitch(benchmark::State& state) {
+void stitchBenchmark(benchmark::State& state, bool wide) {
     const int faces = int(state.range(0));
-    const fss::Patch& patch = thePatch();
-    Scene& scene = sceneWith(faces);
+    const fss::Patch& patch = thePatch(wide);
+    Scene& scene = sceneWith(faces, wide);
     fss::StitchReport report;
     double total = 0, wall = 0;
     for (auto _ : state) {
@@ -159,7 +168,7 @@ void BM_Stitch(benchmark::State& state) {
         total += cpu;
         benchmark::DoNotOptimize(current);
     }
-    if (state.range(1)) {
+    if (state.range(1) && !wide) {
         stitchMs[faces].push_back(1e3 * total / double(state.iterations()));
         stitchWallMs[faces].push_back(1e3 * wall / double(state.iterations()));
     }
@@ -170,10 +179,22 @@ void BM_Stitch(benchmark::State& state) {
     state.counters["seam_edges"] = double(report.seamEdges);
 }
 
+void BM_Stitch(benchmark::State& state) {
+    stitchBenchmark(state, false);
+}
+
+// The widget's case (a patch over many more faces of the mesh than BM_Stitch's): not in the table below.
+void BM_StitchWide(benchmark::State& state) {
+    stitchBenchmark(state, true);
+}
+
 void BM_Scan(benchmark::State& state) {
     const int faces = int(state.range(0));
     Scene& scene = sceneWith(faces);
-    const fss::ScanParams p = params();
+    fss::ScanParams p = params();
+    // FSS_BENCH_SCAN_WARP=0: the plain adaptive lattice (ScanOptions::warpToSurface off; the patch stitched
+    // above is the default scan's either way).
+    if (const char* e = std::getenv("FSS_BENCH_SCAN_WARP")) p.scan.warpToSurface = std::string(e) != "0";
     double total = 0;
     std::size_t patchFaces = 0;
     double wall = 0;
@@ -200,6 +221,11 @@ void BM_Scan(benchmark::State& state) {
 // arrays must grow during the stitch (the first stitch into a loaded mesh).
 BENCHMARK(BM_Stitch)
     ->ArgsProduct({{10000, 100000, 1000000}, {1, 0}})
+    ->ArgNames({"faces", "spare"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+BENCHMARK(BM_StitchWide)
+    ->ArgsProduct({{100000, 1000000}, {1}})
     ->ArgNames({"faces", "spare"})
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime();

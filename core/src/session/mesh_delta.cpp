@@ -311,6 +311,11 @@ void MeshJournal::record(const Mesh& mesh, std::span<const VertexIndex> vertices
         for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh))
             around.push_back(mesh.target(h));
     }
+    // Room for them at once (a stitch records up to the whole region under the patch in one call): no
+    // rehashing while they are inserted. `around` repeats shared vertices, so this is an upper bound.
+    vertices_.reserve(vertices_.size() + around.size());
+    halfedges_.reserve(halfedges_.size() + 2 * around.size());
+    faces_.reserve(faces_.size() + around.size());
     const Reader reader(mesh);
     for (VertexIndex v : around) {
         if (std::size_t(v) < vertexCount_ && !vertices_.count(std::uint32_t(v)))

@@ -671,8 +671,9 @@ public:
     }
 
 private:
+    // Per thread: a widget's trial stitch may run beside the accept's.
     static std::vector<std::pair<const char*, double>>& totals() {
-        static std::vector<std::pair<const char*, double>> t;
+        thread_local std::vector<std::pair<const char*, double>> t;
         return t;
     }
     // CPU time of the calling thread (the stitch is single-threaded; the machine may be shared).
@@ -682,7 +683,7 @@ private:
         return 1e3 * double(ts.tv_sec) + 1e-6 * double(ts.tv_nsec);
     }
     static double& last() {
-        static double t = 0;
+        thread_local double t = 0;
         return t;
     }
 };

@@ -138,14 +138,20 @@ void ComponentStitcher::addBad(std::vector<int>& bad, int i) {
 }
 
 auto ComponentStitcher::vproj(VertexIndex v) -> VProj {
-    auto [it, fresh] = search_.vcache.try_emplace(std::uint32_t(v));
-    if (fresh) it->ok = V_.project(toVec(M_.point(v)), it->uv, it->w);
-    return *it;
+    auto [it, fresh] = search_.vcache.slot(std::size_t(v), M_.num_vertices());
+    if (fresh) {
+        VProj p{}; // (value-initialised: a vertex behind the eye keeps uv = (0, 0), as in a map's new entry)
+        p.ok = V_.project(toVec(M_.point(v)), p.uv, p.w);
+        *it = {p.uv.x(), p.uv.y(), p.w, p.ok};
+        return p;
+    }
+    return {Point2(it->u, it->v), it->w, it->ok};
 }
 
 bool ComponentStitcher::acceptable(FaceIndex f) {
-    auto [it, fresh] = search_.accept.try_emplace(std::uint32_t(f), 0);
+    auto [it, fresh] = search_.accept.slot(std::size_t(f), M_.num_faces());
     if (!fresh) return *it != 0;
+    *it = 0;
     const HalfedgeIndex h = M_.halfedge(f);
     if (M_.next(M_.next(M_.next(h))) != h) return false;
     const VertexIndex a = M_.source(h), b = M_.target(h), c = M_.target(M_.next(h));
@@ -333,10 +339,10 @@ bool ComponentStitcher::findRegion(Attempt& a) {
     }
     if (seeds.empty()) return fail(a, "no visible face of the mesh lies under it in the scan's view");
     // Grow over faces sharing a vertex, keeping the acceptable ones that meet the component in the view.
-    IndexSet visited;
+    DenseSet visited(M_.num_faces());
     std::vector<FaceIndex> stack;
     for (FaceIndex f : seeds)
-        if (visited.insert(std::uint32_t(f))) stack.push_back(f);
+        if (visited.insert(std::size_t(f))) stack.push_back(f);
     while (!stack.empty()) {
         const FaceIndex f = stack.back();
         stack.pop_back();
@@ -346,7 +352,7 @@ bool ComponentStitcher::findRegion(Attempt& a) {
         reg_.faces.push_back(f);
         for (VertexIndex v : faceVertices(f))
             for (FaceIndex g : CGAL::faces_around_target(M_.halfedge(v), M_))
-                if (g != Mesh::null_face() && visited.insert(std::uint32_t(g))) stack.push_back(g);
+                if (g != Mesh::null_face() && visited.insert(std::size_t(g))) stack.push_back(g);
     }
     if (reg_.faces.empty()) return fail(a, "no visible face of the mesh lies under it in the scan's view");
     return true;
@@ -355,15 +361,17 @@ bool ComponentStitcher::findRegion(Attempt& a) {
 bool ComponentStitcher::preTrim(Attempt& a) {
     double edge = 0;
     CGAL::Bbox_2 bounds;
+    reg_.tris.clear();
+    reg_.tris.reserve(reg_.faces.size());
     for (FaceIndex f : reg_.faces) {
-        const Triangle2 t = faceTriangle(f);
+        const Triangle2& t = reg_.tris.emplace_back(faceTriangle(f));
         edge += std::sqrt(dist2(t[0], t[1]));
         bounds += t.bbox();
     }
     edge /= double(reg_.faces.size());
     reg_.grid = BucketGrid(std::max(2.0 * comp_.h2, edge), reg_.faces.size(), bounds);
     for (std::size_t i = 0; i < reg_.faces.size(); ++i)
-        reg_.grid.insert(int(i), faceTriangle(reg_.faces[i]).bbox());
+        reg_.grid.insert(int(i), reg_.tris[i].bbox());
     std::vector<int> bad;
     for (int v : comp_.verts) {
         progress_.tick();
@@ -371,7 +379,7 @@ bool ComponentStitcher::preTrim(Attempt& a) {
         bool inside = false;
         reg_.grid.query(uv.bbox(), [&](int i) {
             if (inside) return;
-            const Triangle2 t = faceTriangle(reg_.faces[std::size_t(i)]);
+            const Triangle2& t = reg_.tris[std::size_t(i)];
             inside = inTriangle(uv, t[0], t[1], t[2]);
         });
         if (!inside) bad.push_back(v);
@@ -390,8 +398,7 @@ bool ComponentStitcher::insidePatch(const Point2& p) {
     return in;
 }
 
-bool ComponentStitcher::interiorsOverlap(FaceIndex f, FaceIndex g) {
-    const Triangle2 s = faceTriangle(f), t = faceTriangle(g);
+bool ComponentStitcher::interiorsOverlap(const Triangle2& s, const Triangle2& t) {
     for (const auto& [x, y] : {std::pair{&s, &t}, std::pair{&t, &s}})
         for (int k = 0; k < 3; ++k) {
             const Point2 &p = (*x)[k], &q = (*x)[(k + 1) % 3];
@@ -445,22 +452,23 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
     const double reach2 = comp_.margin * comp_.margin; // the snapping distance
     std::vector<FaceIndex> seam;
     std::vector<FaceIndex> stack;
-    IndexSet isSeam, isInterior;
-    for (FaceIndex f : reg_.faces) {
+    DenseSet isSeam(M_.num_faces()), isInterior(M_.num_faces());
+    for (std::size_t i = 0; i < reg_.faces.size(); ++i) {
         progress_.tick();
-        const Triangle2 t = faceTriangle(f);
+        const FaceIndex f = reg_.faces[i];
+        const Triangle2& t = reg_.tris[i];
         bool near = false;
-        segments.query(grown(t.bbox(), comp_.margin), [&](int i) {
+        segments.query(grown(t.bbox(), comp_.margin), [&](int k) {
             if (near) return;
-            const Segment2 e(P_.uv[std::size_t(comp_.pedges[std::size_t(i)].a)],
-                             P_.uv[std::size_t(comp_.pedges[std::size_t(i)].b)]);
+            const Segment2 e(P_.uv[std::size_t(comp_.pedges[std::size_t(k)].a)],
+                             P_.uv[std::size_t(comp_.pedges[std::size_t(k)].b)]);
             near = CGAL::do_intersect(t, e) || CGAL::squared_distance(t, e) <= reach2;
         });
         if (near) {
             seam.push_back(f);
-            isSeam.insert(std::uint32_t(f));
+            isSeam.insert(std::size_t(f));
         } else if (insidePatch(CGAL::centroid(t))) {
-            isInterior.insert(std::uint32_t(f));
+            isInterior.insert(std::size_t(f));
             stack.push_back(f);
         }
     }
@@ -478,7 +486,7 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
         std::vector<char> reached(reg_.faces.size(), 0);
         std::vector<std::size_t> todo;
         for (std::size_t i = 0; i < reg_.faces.size(); ++i)
-            if (isSeam.count(std::uint32_t(reg_.faces[i]))) {
+            if (isSeam.contains(std::size_t(reg_.faces[i]))) {
                 reached[i] = 1;
                 todo.push_back(i);
             }
@@ -486,16 +494,16 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
             const std::size_t i = todo.back();
             todo.pop_back();
             progress_.tick();
-            reg_.grid.query(faceTriangle(reg_.faces[i]).bbox(), [&](int jj) {
+            reg_.grid.query(reg_.tris[i].bbox(), [&](int jj) {
                 const std::size_t j = std::size_t(jj);
                 if (j == i) return;
                 // Each pair in the order (lower, higher index), as a scan over all pairs would.
                 const std::size_t lo = std::min(i, j), hi = std::max(i, j);
-                if (!interiorsOverlap(reg_.faces[lo], reg_.faces[hi])) return;
+                if (!interiorsOverlap(reg_.tris[lo], reg_.tris[hi])) return;
                 folded[lo] = folded[hi] = 1;
                 clusters.unite(lo, hi);
                 // The one farther from the eye where they overlap is hidden there.
-                const Point2 q = overlapCentre(faceTriangle(reg_.faces[lo]), faceTriangle(reg_.faces[hi]));
+                const Point2 q = overlapCentre(reg_.tris[lo], reg_.tris[hi]);
                 hidden[depthAt(reg_.faces[lo], q) > depthAt(reg_.faces[hi], q) ? lo : hi] = 1;
                 if (!reached[j]) {
                     reached[j] = 1;
@@ -505,7 +513,7 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
         }
         std::unordered_map<int, bool> clusterAtSeam;
         for (std::size_t i = 0; i < reg_.faces.size(); ++i)
-            if (folded[i] && isSeam.count(std::uint32_t(reg_.faces[i]))) clusterAtSeam[find(int(i))] = true;
+            if (folded[i] && isSeam.contains(std::size_t(reg_.faces[i]))) clusterAtSeam[find(int(i))] = true;
         // Cut the patch back around the hidden faces, where it lies on their sheet; if that frees
         // nothing, around the whole fold.
         // (Peeling: only the patch triangles within snapping distance; the next round sees what is left.)
@@ -514,7 +522,7 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
             for (std::size_t i = 0; i < reg_.faces.size(); ++i) {
                 if (!folded[i] || !clusterAtSeam.count(find(int(i))) || (pass == 0 && !hidden[i])) continue;
                 const FaceIndex g = reg_.faces[i];
-                const Triangle2 t = faceTriangle(g);
+                const Triangle2& t = reg_.tris[i];
                 const double tolerance = gapTolerance(g);
                 comp_.grid.query(grown(t.bbox(), r), [&](int k) {
                     const auto& tri = P_.tri[std::size_t(faces_[std::size_t(k)])];
@@ -543,7 +551,7 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
                 addNear(bad, vproj(M_.target(h)).uv); // the mesh's border under the patch
                 continue;
             }
-            if (isSeam.count(std::uint32_t(g)) || isInterior.count(std::uint32_t(g))) continue;
+            if (isSeam.contains(std::size_t(g)) || isInterior.contains(std::size_t(g))) continue;
             // Under the patch in the view, on its sheet (not a part of the mesh far behind or in front).
             bool under = true;
             const double tolerance = gapTolerance(g);
@@ -563,13 +571,14 @@ bool ComponentStitcher::splitRegion(Attempt& a) {
                         vproj(M_.target(h)).uv); // a face reaching out without a seam: a fold, a hole
                 continue;
             }
-            isInterior.insert(std::uint32_t(g));
+            isInterior.insert(std::size_t(g));
             stack.push_back(g);
         }
     }
     if (!bad.empty())
         return fail(a, "the mesh under it folds or has a hole in the scan's view", std::move(bad));
     reg_.faces = std::move(seam);
+    reg_.tris.clear(); // (it described the faces before)
     reg_.index.clear();
     for (std::size_t i = 0; i < reg_.faces.size(); ++i)
         reg_.index[std::uint32_t(reg_.faces[i])] = int(i);

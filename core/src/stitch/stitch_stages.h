@@ -6,6 +6,8 @@
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 
+#include <memory>
+
 namespace fss::detail::stitching {
 
 // ---- What the stages hand on (in the order of ComponentStitcher::run).
@@ -45,10 +47,56 @@ struct VProj {
     double w = 0;
     bool ok = false;
 };
+// A cache by element index of the current mesh whose cost follows the elements asked for: the values'
+// array is allocated uninitialised (its pages are touched only where written) and a bitmap, one bit per
+// element, tells which are known. A direct look-up: the region stage asks for every face under the patch
+// and its vertices several times each (a hashed map cost a probe and a cache miss per question there).
+template <class T> class DenseCache {
+public:
+    // The slot of element i < size and whether it was unknown until now (then the caller fills it).
+    std::pair<T*, bool> slot(std::size_t i, std::size_t size) {
+        if (!values_) {
+            values_ = std::make_unique_for_overwrite<T[]>(size);
+            known_.assign(size / 64 + 1, 0);
+        }
+        std::uint64_t& word = known_[i / 64];
+        const std::uint64_t bit = std::uint64_t(1) << (i % 64);
+        const bool fresh = (word & bit) == 0;
+        word |= bit;
+        return {&values_[i], fresh};
+    }
+
+private:
+    std::unique_ptr<T[]> values_;
+    std::vector<std::uint64_t> known_;
+};
+// A set of element indices of the current mesh as a bitmap (one bit per element, zeroed once: an eighth of a
+// byte per element of the mesh, so cheap next to a hashed set's probe per question).
+class DenseSet {
+public:
+    explicit DenseSet(std::size_t size) : bits_(size / 64 + 1, 0) {}
+    // Inserts i; whether it was not there.
+    bool insert(std::size_t i) {
+        std::uint64_t& word = bits_[i / 64];
+        const std::uint64_t bit = std::uint64_t(1) << (i % 64);
+        const bool fresh = (word & bit) == 0;
+        word |= bit;
+        return fresh;
+    }
+    bool contains(std::size_t i) const { return (bits_[i / 64] >> (i % 64)) & 1u; }
+
+private:
+    std::vector<std::uint64_t> bits_;
+};
+// VProj's fields without initialisers (DenseCache leaves what it has not been asked for uninitialised).
+struct VProjSlot {
+    double u, v, w;
+    bool ok;
+};
 // The region stage's caches over the current mesh (stage-local).
 struct RegionSearch {
-    IndexMap<VProj> vcache;
-    IndexMap<char> accept; // bool (a char: vector<bool> has no addressable elements)
+    DenseCache<VProjSlot> vcache;
+    DenseCache<char> accept; // bool (a char: vector<bool> has no addressable elements)
     bool fallbackBuilt = false;
     std::vector<FaceIndex> fallback;
     BucketGrid fallbackGrid;
@@ -60,6 +108,10 @@ struct Region {
     std::vector<FaceIndex> interior; // faces under the patch, removed whole
     IndexMap<int> index;
     BucketGrid grid;
+    // faceTriangle of every face of `faces`, in its order (preTrim to the end of splitRegion, where
+    // `faces` becomes the seam faces): the grid's queries test many faces per cell, each read once here
+    // instead of through three vertex-cache look-ups per test.
+    std::vector<Triangle2> tris;
 };
 
 // The local problem in the view (cut: local vertices, snapping, crossings; gap triangulation: the faces).
@@ -235,7 +287,7 @@ private:
     // Do the interiors of two (counter-clockwise) faces overlap in the view? Separating-axis test on
     // their edges with exact orientations: disjoint interiors iff one triangle lies on the closed outer
     // side of an edge of the other.
-    bool interiorsOverlap(FaceIndex f, FaceIndex g);
+    static bool interiorsOverlap(const Triangle2& s, const Triangle2& t);
     // A point inside the overlap of two counter-clockwise triangles (centre of s clipped by t).
     static Point2 overlapCentre(const Triangle2& s, const Triangle2& t);
     // Distance from the eye (along the view direction) of face f's plane at view position q.
