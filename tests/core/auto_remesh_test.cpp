@@ -3,6 +3,8 @@
 // the vertex count it aims at, the distance to the input, the crease recovery (the cube's edges), the seam
 // relaxation (valence 6, invariants on random cases), the stitch's peeling trim (CGAL's elephant) and clear
 // errors for bad options.
+#include "remesh/auto_v2.h"
+
 #include "fss/auto_remesh.h"
 #include "fss/error.h"
 #include "fss/mesh_io.h"
@@ -17,12 +19,16 @@
 
 #include <gtest/gtest.h>
 
+#include <CGAL/boost/graph/Euler_operations.h>
+
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <limits>
 #include <numbers>
 #include <optional>
 #include <random>
+#include <string>
 
 namespace {
 
@@ -648,4 +654,74 @@ TEST(AutoRemeshV2, ElephantJoinIsClosedAndValidWithoutTheFallback) {
     EXPECT_NE(r.engineNote.find("not sampled"), std::string::npos) << r.engineNote;
     std::printf("v2 elephant: %zu vertices for %zu, %zu components, note: %s\n", m.vertices,
                 std::size_t(elephant.number_of_vertices()), std::size_t(m.components), r.engineNote.c_str());
+}
+
+namespace {
+
+// Two icospheres side by side in one mesh (two connected components, closed).
+fss::Mesh twoSpheres() {
+    fss::Mesh m = fss::shapes::icosphere(2, 1.0);
+    fss::Mesh other = fss::shapes::icosphere(2, 1.0);
+    for (fss::VertexIndex v : other.vertices()) {
+        const fss::Point3 p = other.point(v);
+        other.point(v) = fss::Point3(p.x() + 3.0, p.y(), p.z());
+    }
+    m += other;
+    return m;
+}
+
+// An icosphere with the faces at the given indices removed (each a hole: one boundary loop when no two of
+// them share a vertex).
+fss::Mesh sphereWithHoles(std::initializer_list<std::uint32_t> faces) {
+    fss::Mesh m = fss::shapes::icosphere(2, 1.0);
+    for (std::uint32_t f : faces)
+        CGAL::Euler::remove_face(m.halfedge(fss::FaceIndex(f)), m);
+    m.collect_garbage();
+    return m;
+}
+
+} // namespace
+
+// validateJoin (internal, remesh/auto_v2.h) counts connected components: a join that leaves a piece of the
+// surface apart is refused even when it is closed, manifold and has the right vertex count (session 15
+// measured two components on elephant and validate() let that pass).
+TEST(AutoRemeshV2, ValidationCountsConnectedComponents) {
+    const fss::Mesh one = fss::shapes::icosphere(2, 1.0);
+    const fss::Mesh two = twoSpheres();
+    ASSERT_EQ(one.number_of_vertices(), 162u);
+    ASSERT_EQ(two.number_of_vertices(), 324u);
+    EXPECT_EQ(fss::detail::validateJoin(
+                  one, {.closed = true, .components = 1, .boundaryLoops = 0, .vertices = 162}),
+              "");
+    EXPECT_EQ(fss::detail::validateJoin(
+                  two, {.closed = true, .components = 1, .boundaryLoops = 0, .vertices = 324}),
+              "the joined mesh has 2 connected components, the input 1");
+    EXPECT_EQ(fss::detail::validateJoin(
+                  two, {.closed = true, .components = 2, .boundaryLoops = 0, .vertices = 324}),
+              "");
+}
+
+// validateJoin counts boundary loops: an open join must end on the input's own borders (as many loops), and a
+// closed one must have none.
+TEST(AutoRemeshV2, ValidationCountsBoundaryLoops) {
+    const fss::Mesh oneHole = sphereWithHoles({0});
+    // Faces 0 and 300 of the level-2 icosphere share no vertex (asserted through the loop count below).
+    const fss::Mesh twoHoles = sphereWithHoles({0, 300});
+    const fss::MetricsOptions topologyOnly{.selfIntersections = false};
+    ASSERT_EQ(fss::computeMetrics(oneHole, topologyOnly).boundaryLoops, 1u);
+    ASSERT_EQ(fss::computeMetrics(twoHoles, topologyOnly).boundaryLoops, 2u);
+    EXPECT_EQ(fss::detail::validateJoin(
+                  oneHole, {.closed = true, .components = 1, .boundaryLoops = 0, .vertices = 162}),
+              "the joined mesh has 1 boundary loops, the input 0");
+    EXPECT_EQ(fss::detail::validateJoin(
+                  twoHoles, {.closed = false, .components = 1, .boundaryLoops = 1, .vertices = 162}),
+              "the joined mesh has 2 boundary loops, the input 1");
+    EXPECT_EQ(fss::detail::validateJoin(
+                  twoHoles, {.closed = false, .components = 1, .boundaryLoops = 2, .vertices = 162}),
+              "");
+    // The vertex count: 162 against a target of 200 is 19 % short.
+    EXPECT_NE(fss::detail::validateJoin(
+                  oneHole, {.closed = false, .components = 1, .boundaryLoops = 1, .vertices = 200})
+                  .find("parts of the surface were not sampled"),
+              std::string::npos);
 }

@@ -91,7 +91,7 @@ constexpr double kDensity = 0.97;
 /// The patch of region \p view: the triangular lattice at \p spacing world units, only the samples on the
 /// faces the view owns, triangulated.
 Patch regionPatch(const Mesh& reference, const FrameBuffers& buffers, const std::vector<int>& owner, int view,
-                  double spacing) {
+                  double spacing, std::string* debug = nullptr) {
     ScanOptions so;
     so.scanId = view;
     so.lattice = Lattice::Triangular;
@@ -99,16 +99,31 @@ Patch regionPatch(const Mesh& reference, const FrameBuffers& buffers, const std:
     so.minLatticeAngleDeg = 0; // the partition already gave each face its most frontal view
     ScanWorkspace workspace;
     SampleGrid grid = sampleLattice(buffers, reference, workspace, so);
-    for (Sample& s : grid.samples)
+    std::size_t hits = 0, admissible = 0, own = 0;
+    for (Sample& s : grid.samples) {
+        hits += s.hit;
+        admissible += s.admissible;
         if (s.admissible && (s.face == Sample::kNoFace || owner[s.face] != view))
             s.admissible = s.valid = false;
+        own += s.admissible;
+    }
     MaskStages stages;
     // The opening (radius 1) removes single samples and one-sample spikes, which the join cannot close
     // cleanly (measured on elephant: without it 1168 intersecting face pairs after the join, 79 with it).
-    stages.morphology = {.radius = 1, .dilateRadius = 1};
+    const int openR = std::getenv("FSS_AUTO_V2_OPEN") ? std::atoi(std::getenv("FSS_AUTO_V2_OPEN")) : 1;
+    stages.morphology = {.radius = openR, .dilateRadius = openR};
     stages.atQuality = stages.atMorphology = stages.atTriangulate = {};
     stages.nothingBetter = stages.nothingLeft = "The view owns no part of the surface.";
-    return maskAndTriangulate(grid, stages, workspace).patch;
+    MaskedPatch out = maskAndTriangulate(grid, stages, workspace);
+    if (debug)
+        *debug = "hits " + std::to_string(hits) + " admissible " + std::to_string(admissible) + " own " +
+                 std::to_string(own) + " morph " + std::to_string(out.counts.afterMorphology) + " verts " +
+                 std::to_string(out.patch.mesh.number_of_vertices()) + " long " +
+                 std::to_string(out.patch.report.longEdges) + " graz " +
+                 std::to_string(out.patch.report.grazing) + " back " +
+                 std::to_string(out.patch.report.backFacing) + " flip " +
+                 std::to_string(out.patch.report.flipped);
+    return std::move(out.patch);
 }
 
 /// Adds the faces of \p patch to \p out (scan id and quality kept).
@@ -394,21 +409,26 @@ std::vector<Unowned> unownedPieces(const Mesh& reference, const std::vector<int>
     return out;
 }
 
-/// Why \p mesh is not an acceptable result (empty when it is).
-std::string validate(const Mesh& mesh, bool mustBeClosed, double targetVertices, std::size_t boundaryLoops) {
+} // namespace v2
+} // namespace
+
+std::string validateJoin(const Mesh& mesh, const JoinTarget& target) {
     MetricsOptions mo;
     const Metrics m = computeMetrics(mesh, mo);
-    if (m.boundaryLoops != boundaryLoops)
-        return "the joined mesh has " + std::to_string(m.boundaryLoops) + " boundary loops, the input " +
-               std::to_string(boundaryLoops);
     if (mesh.number_of_faces() == 0) return "the joined mesh has no face";
+    if (m.boundaryLoops != target.boundaryLoops)
+        return "the joined mesh has " + std::to_string(m.boundaryLoops) + " boundary loops, the input " +
+               std::to_string(target.boundaryLoops);
+    if (m.components != target.components)
+        return "the joined mesh has " + std::to_string(m.components) + " connected components, the input " +
+               std::to_string(target.components);
     // Parts of the surface no region sampled are bridged by the hole filling: far fewer vertices than a
     // regular triangulation of the whole surface means parts of it were cut off.
-    if (std::abs(double(m.vertices) - targetVertices) > 0.1 * targetVertices)
+    if (std::abs(double(m.vertices) - target.vertices) > 0.1 * target.vertices)
         return "the joined mesh has " + std::to_string(m.vertices) + " vertices against the " +
-               std::to_string(std::llround(targetVertices)) +
+               std::to_string(std::llround(target.vertices)) +
                " of the target: parts of the surface were not sampled";
-    if (mustBeClosed && !m.closed)
+    if (target.closed && !m.closed)
         return "the joined mesh has " + std::to_string(m.boundaryEdges) + " boundary edges left";
     if (m.nonManifoldVertices > 0)
         return "the joined mesh has " + std::to_string(m.nonManifoldVertices) + " pinched vertices";
@@ -418,9 +438,6 @@ std::string validate(const Mesh& mesh, bool mustBeClosed, double targetVertices,
         return "the joined mesh intersects itself (" + std::to_string(*m.selfIntersections) + " face pairs)";
     return {};
 }
-
-} // namespace v2
-} // namespace
 
 AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const Progress& progress) {
     using namespace v2;
@@ -493,7 +510,7 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
             a * std::max(0.0, -faceNormal(reference, f).dot(buffers[std::size_t(o)].camera.viewDirection()));
     }
     std::vector<Patch> patches(nv);
-    std::vector<std::string> notes(nv);
+    std::vector<std::string> notes(nv), dbg(nv);
     progress.report(0.2, "scan");
     parallelItems(nv, 1, [&](std::size_t i) {
         if (regionArea[i] <= 0) {
@@ -502,12 +519,18 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         }
         const double c = std::clamp(cosArea[i] / regionArea[i], 0.5, 1.0);
         try {
-            patches[i] = regionPatch(reference, buffers[i], owner, int(i), kDensity * L * std::sqrt(c));
+            patches[i] =
+                regionPatch(reference, buffers[i], owner, int(i), kDensity * L * std::sqrt(c), &dbg[i]);
         } catch (const Error& e) {
             notes[i] = e.what();
         }
     });
     result.scanSeconds = since(t);
+    if (std::getenv("FSS_AUTO_V2_DEBUG"))
+        for (std::size_t i = 0; i < nv; ++i)
+            std::fprintf(stderr, "v2 region %zu: area %.4f expected %.0f verts, cos %.2f: %s\n", i,
+                         regionArea[i], regionArea[i] / (std::sqrt(3.0) / 2 * L * L),
+                         regionArea[i] > 0 ? cosArea[i] / regionArea[i] : 0.0, dbg[i].c_str());
 
     // 3. One join.
     progress.report(0.5, "join");
@@ -536,7 +559,8 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         return n;
     };
     const bool debug = std::getenv("FSS_AUTO_V2_DEBUG") != nullptr;
-    if (debug) std::fprintf(stderr, "v2: %zu views, %zu border edges before the join\n", nv, borderEdges());
+    if (debug) std::fprintf(stderr, "v2: %zu views, %zu border edges, %zu vertices before the join\n", nv, borderEdges(),
+                     std::size_t(current.number_of_vertices()));
     std::unique_ptr<RayCaster> caster;
     if (!closedInput) caster = std::make_unique<RayCaster>(reference);
     GapCloser(current, 2.5 * L, 80.0, 10.0, caster.get(), 0.25 * L).run();
@@ -547,7 +571,8 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
     if (debug) std::fprintf(stderr, "v2: %zu border edges after the hole filling\n", borderEdges());
     repairJoin(current, closedInput, 4, debug);
     current.collect_garbage();
-    if (debug) std::fprintf(stderr, "v2: join %.2f s\n", since(t));
+    if (debug)
+        std::fprintf(stderr, "v2: join %.2f s, %zu vertices\n", since(t), std::size_t(current.number_of_vertices()));
     result.stitchSeconds = result.joinSeconds = since(t);
 
     // 4. Seam relaxation and crease recovery, once.
@@ -574,7 +599,8 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         result.sliverFlips = flipSliverFaces(current, options.flipSliversBelowDeg, 20.0, 8);
     result.relaxSeconds = since(t);
     relax();
-    if (debug) std::fprintf(stderr, "v2: relax %.2f s\n", since(t));
+    if (debug)
+        std::fprintf(stderr, "v2: relax %.2f s, %zu vertices\n", since(t), std::size_t(current.number_of_vertices()));
     if (options.creaseSnapRounds > 0) {
         const auto t0 = Clock::now();
         CreaseSnapOptions co;
@@ -594,16 +620,20 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
             current.remove_property_map(onCrease);
     }
     result.stitchSeconds += since(t);
-    if (debug) std::fprintf(stderr, "v2: relax + creases %.2f s\n", since(t));
+    if (debug)
+        std::fprintf(stderr, "v2: relax + creases %.2f s, %zu vertices\n", since(t),
+                     std::size_t(current.number_of_vertices()));
 
     // 5. Validation; v1 when it fails.
     progress.report(0.95, "validate");
     t = Clock::now();
     MetricsOptions referenceTopology;
     referenceTopology.selfIntersections = false;
-    const std::size_t referenceLoops = computeMetrics(reference, referenceTopology).boundaryLoops;
-    const std::string why =
-        validate(current, closedInput, result.area / (std::sqrt(3.0) / 2.0 * L * L), referenceLoops);
+    const Metrics referenceMetrics = computeMetrics(reference, referenceTopology);
+    const std::string why = validateJoin(current, {.closed = closedInput,
+                                                   .components = referenceMetrics.components,
+                                                   .boundaryLoops = referenceMetrics.boundaryLoops,
+                                                   .vertices = result.area / (std::sqrt(3.0) / 2.0 * L * L)});
     if (debug) std::fprintf(stderr, "v2: validation %.2f s\n", since(t));
     if (!why.empty() && !options.fallbackToV1) {
         result.engineNote = "auto v2 failed (" + why + ").";
