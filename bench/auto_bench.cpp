@@ -13,6 +13,7 @@
 //   FSS_AUTO_BENCH_MESHES=fandisk,bunny00 ./build/bin/bench_auto
 //   FSS_AUTO_BENCH_ENGINES=v2 ./build/bin/bench_auto   # one engine only
 //   FSS_AUTO_BENCH_FISHBONE=1 ./build/bin/bench_auto   # with --fishbone auto
+//   FSS_AUTO_BENCH_FALLBACK=0 ./build/bin/bench_auto   # v2 without the fallback to v1 (its own mesh)
 //
 // CGAL's isotropic remeshing is a heavy translation unit: it lives here only, never in core.
 #include "fss/auto_remesh.h"
@@ -146,6 +147,8 @@ fss::AutoOptions autoOptions() {
     if (gpuAvailable()) o.renderer = [] { return std::make_unique<fss::render::GpuMeshRenderer>(); };
     const char* fb = std::getenv("FSS_AUTO_BENCH_FISHBONE");
     o.fishbone = fb && std::string(fb) == "1";
+    const char* fallback = std::getenv("FSS_AUTO_BENCH_FALLBACK");
+    o.fallbackToV1 = !(fallback && std::string(fallback) == "0");
     return o;
 }
 
@@ -219,11 +222,12 @@ std::string opt(const std::optional<double>& v) {
 void printTable() {
     std::printf(
         "\nauto (FSS v1, v2) vs CGAL isotropic_remeshing (5 iterations, sharp edges >= 60 deg protected), "
-        "same target edge length; renderer: %s, fishbone: %s\n",
-        gpuAvailable() ? "gpu" : "cpu", autoOptions().fishbone ? "auto" : "off");
-    std::printf("%-16s %-4s %8s %7s %7s %6s %6s %4s %4s %4s %4s %6s %6s %6s %9s %9s\n", "mesh", "who", "L",
-                "verts", "time_s", "t/cgal", "cover", "clsd", "pnch", "SI", "dgn", "val6", "minang", "meanmn",
-                "H_to_rel", "H_from_rel");
+        "same target edge length; renderer: %s, fishbone: %s, v2 falls back to v1: %s\n",
+        gpuAvailable() ? "gpu" : "cpu", autoOptions().fishbone ? "auto" : "off",
+        autoOptions().fallbackToV1 ? "yes" : "no");
+    std::printf("%-16s %-4s %8s %7s %7s %6s %6s %4s %4s %4s %4s %4s %4s %6s %6s %6s %9s %9s\n", "mesh", "who",
+                "L", "verts", "time_s", "t/cgal", "cover", "clsd", "cmp", "loop", "pnch", "SI", "dgn", "val6",
+                "minang", "meanmn", "H_to_rel", "H_from_rel");
     for (const std::string& name : meshOrder) {
         const MeshResults& r = results()[name];
         const char* who[3] = {"v1", "v2", "cgal"};
@@ -231,14 +235,14 @@ void printTable() {
             const Row& row = w < 2 ? r.fss[w] : r.cgal;
             if (!row.have) continue;
             const fss::Metrics& m = row.metrics;
-            std::printf(
-                "%-16s %-4s %8.5f %7zu %7.2f %6.2f %6.4f %4s %4zu %4zu %4zu %6.4f %6.2f %6.2f %9s %9s%s%s\n",
-                name.c_str(), who[w], r.edgeLength, m.vertices, row.seconds,
-                r.cgal.have ? row.seconds / r.cgal.seconds : 0.0, w < 2 ? row.coverage : 1.0,
-                m.closed ? "yes" : "no", m.nonManifoldVertices, m.selfIntersections.value_or(0),
-                m.degenerateFaces, m.fracValence6Interior, m.minAngleDeg, m.meanMinAngleDeg,
-                opt(m.hausdorffToRefRel).c_str(), opt(m.hausdorffFromRefRel).c_str(),
-                row.note.empty() ? "" : "  ", row.note.c_str());
+            std::printf("%-16s %-4s %8.5f %7zu %7.2f %6.2f %6.4f %4s %4zu %4zu %4zu %4zu %4zu %6.4f %6.2f "
+                        "%6.2f %9s %9s%s%s\n",
+                        name.c_str(), who[w], r.edgeLength, m.vertices, row.seconds,
+                        r.cgal.have ? row.seconds / r.cgal.seconds : 0.0, w < 2 ? row.coverage : 1.0,
+                        m.closed ? "yes" : "no", m.components, m.boundaryLoops, m.nonManifoldVertices,
+                        m.selfIntersections.value_or(0), m.degenerateFaces, m.fracValence6Interior,
+                        m.minAngleDeg, m.meanMinAngleDeg, opt(m.hausdorffToRefRel).c_str(),
+                        opt(m.hausdorffFromRefRel).c_str(), row.note.empty() ? "" : "  ", row.note.c_str());
         }
     }
     std::printf("\nFSS: seconds by stage (v1: stitches, relaxation and crease recovery all in join)\n");

@@ -3,6 +3,8 @@
 // the vertex count it aims at, the distance to the input, the crease recovery (the cube's edges), the seam
 // relaxation (valence 6, invariants on random cases), the stitch's peeling trim (CGAL's elephant) and clear
 // errors for bad options.
+#include "remesh/auto_v2.h"
+
 #include "fss/auto_remesh.h"
 #include "fss/error.h"
 #include "fss/mesh_io.h"
@@ -17,12 +19,16 @@
 
 #include <gtest/gtest.h>
 
+#include <CGAL/boost/graph/Euler_operations.h>
+
 #include <cmath>
 #include <cstdio>
+#include <initializer_list>
 #include <limits>
 #include <numbers>
 #include <optional>
 #include <random>
+#include <string>
 
 namespace {
 
@@ -533,8 +539,9 @@ TEST(AutoRemesh, ElephantKeepsMoreOfItsPatchesWhenTheStitchPeels) {
 namespace {
 
 // auto v2 (issue 23) on \p reference at its own vertex count: the checks every v2 result must pass, measured
-// independently of autoRemesh's own validation; returns the metrics for the shape-specific bounds.
-fss::Metrics checkV2(const fss::Mesh& reference, const fss::AutoResult& r) {
+// independently of autoRemesh's own validation; returns the metrics for the shape-specific bounds. Coverage
+// at least \p minCoverage (issue 23's target, 0.99, unless a shape's bound says why not).
+fss::Metrics checkV2(const fss::Mesh& reference, const fss::AutoResult& r, double minCoverage = 0.99) {
     EXPECT_EQ(r.engineUsed, fss::AutoEngine::V2) << r.engineNote;
     EXPECT_TRUE(r.engineNote.empty()) << r.engineNote;
     fss::MetricsOptions mo;
@@ -545,7 +552,8 @@ fss::Metrics checkV2(const fss::Mesh& reference, const fss::AutoResult& r) {
     // The vertex count of a regular triangulation of the reference's area at the edge length used.
     const double target = double(reference.number_of_vertices());
     EXPECT_NEAR(double(m.vertices), target, 0.05 * target);
-    EXPECT_GE(r.coverage, 0.99);
+    EXPECT_GE(r.coverage, minCoverage);
+    EXPECT_NEAR(r.coverage, scannedAreaFraction(r.mesh), 0.02);
     std::printf(
         "v2: %zu vertices (target %zu), coverage %.4f, valence-6 %.4f, smallest angle %.2f, mean smallest "
         "angle %.2f, Hausdorff to %.3g from %.3g (of the diagonal; L %.4g), %.2f s\n",
@@ -559,11 +567,13 @@ fss::Metrics checkV2(const fss::Mesh& reference, const fss::AutoResult& r) {
 // Measured (CPU renderer): sphere 2603 vertices for 2562, valence-6 0.914, smallest angle 1.46°, mean
 // smallest angle 55.1°; torus 2949 for 3072, 0.845, 1.15°, 52.9°; fandisk (session 15, after the repair
 // collects garbage before refilling holes) 6568 for 6475, 0.890, 5.78°, 52.86°, Hausdorff from it 0.0225 of
-// the bbox diagonal (v1: 0.0024; the join still loses geometry; CGAL's isotropic remeshing 0.0028, issue 23).
+// the bbox diagonal; session 16 (new join faces within L/4 of the reference, one pass) 6605, 0.892, 5.78°,
+// 53.04°, 0.0119 (v1: 0.0024; CGAL's isotropic remeshing 0.0028, issue 23).
 constexpr double V2_SPHERE_MIN_ANGLE = 1.0, V2_SPHERE_MEAN_MIN_ANGLE = 53.0, V2_SPHERE_VALENCE6 = 0.89;
-constexpr double V2_TORUS_MIN_ANGLE = 0.8, V2_TORUS_MEAN_MIN_ANGLE = 51.0, V2_TORUS_VALENCE6 = 0.82;
+constexpr double V2_TORUS_MIN_ANGLE = 0.8, V2_TORUS_MEAN_MIN_ANGLE = 51.0, V2_TORUS_VALENCE6 = 0.82,
+                 V2_TORUS_COVERAGE = 0.985;
 constexpr double V2_PART_MIN_ANGLE = 4.0, V2_PART_MEAN_MIN_ANGLE = 52.0, V2_PART_VALENCE6 = 0.87,
-                 V2_PART_HAUSDORFF_FROM = 0.03;
+                 V2_PART_HAUSDORFF_FROM = 0.02;
 
 std::string meshBytes(const fss::Mesh& m) {
     std::string out;
@@ -606,7 +616,10 @@ TEST(AutoRemeshV2, TorusIsClosedAndManifold) {
     fss::AutoOptions o;
     o.engine = fss::AutoEngine::V2;
     const fss::AutoResult r = fss::autoRemesh(torus, o);
-    const fss::Metrics m = checkV2(torus, r);
+    // Coverage: since session 16 the faces of the torus no patch reaches (centroid farther than L from every
+    // patch vertex, on the inner side of the ring) count as not covered; measured 0.9896 (was reported as
+    // 0.99+ when coverage was the area of the regions whose patch was made).
+    const fss::Metrics m = checkV2(torus, r, V2_TORUS_COVERAGE);
     EXPECT_GE(m.minAngleDeg, V2_TORUS_MIN_ANGLE);
     EXPECT_GE(m.meanMinAngleDeg, V2_TORUS_MEAN_MIN_ANGLE);
     EXPECT_GE(m.fracValence6Interior, V2_TORUS_VALENCE6);
@@ -627,25 +640,105 @@ TEST(AutoRemeshV2, FandiskIsClosedAndManifold) {
     EXPECT_LT(*m.hausdorffFromRefRel, V2_PART_HAUSDORFF_FROM);
 }
 
-// auto v2 on CGAL's elephant without the fallback to v1: the repair of the join removes faces and refills the
-// holes, which crashed (a corrupt vertex free list in the hole refinement) before the repair collected the
-// garbage. The joined mesh is closed, manifold, free of degenerate faces and self-intersections; it still
-// fails validation on its vertex count (parts of the surface are not sampled, issue 23), which the note says,
-// and it has two components (measured; validate() does not count components yet), so it is not checked with
-// expectClosedValidMesh.
-TEST(AutoRemeshV2, ElephantJoinIsClosedAndValidWithoutTheFallback) {
+// auto v2 on CGAL's elephant without the fallback to v1 (tuned on it, session 16): the parts no region
+// samples (thin pieces of the regions that the opening removes, 31 % of the area) stay as input faces and are
+// joined like the other regions, so the result passes validation: closed, one component as the input,
+// manifold, no degenerate face or self-intersection, the vertex count within 10 % of the target (session 15:
+// 1853 of 2775 and two components, v1 ran instead). Measured: 2985 vertices, coverage 0.690, Hausdorff from
+// it 0.042 of the diagonal (CGAL's isotropic remeshing: 0.010).
+TEST(AutoRemeshV2, ElephantJoinKeepsTheUnsampledPartsAndPassesValidation) {
     const fss::Mesh elephant = fss::readMesh(fss::test::meshPath("elephant.off"));
     fss::AutoOptions o;
     o.engine = fss::AutoEngine::V2;
     o.fallbackToV1 = false;
     const fss::AutoResult r = fss::autoRemesh(elephant, o);
     EXPECT_EQ(r.engineUsed, fss::AutoEngine::V2);
-    const fss::Metrics m = fss::computeMetrics(r.mesh, {});
-    EXPECT_TRUE(m.closed);
-    EXPECT_EQ(m.nonManifoldVertices, 0u);
+    EXPECT_TRUE(r.engineNote.empty()) << r.engineNote;
+    fss::MetricsOptions mo;
+    mo.reference = &elephant;
+    const fss::Metrics m = fss::computeMetrics(r.mesh, mo);
+    fss::test::expectClosedValidMesh(m);
+    EXPECT_EQ(m.components, 1u);
     EXPECT_EQ(m.degenerateFaces, 0u);
-    EXPECT_EQ(m.selfIntersections, std::optional<std::size_t>(0));
-    EXPECT_NE(r.engineNote.find("not sampled"), std::string::npos) << r.engineNote;
-    std::printf("v2 elephant: %zu vertices for %zu, %zu components, note: %s\n", m.vertices,
-                std::size_t(elephant.number_of_vertices()), std::size_t(m.components), r.engineNote.c_str());
+    const double target = double(elephant.number_of_vertices());
+    EXPECT_NEAR(double(m.vertices), target, 0.1 * target);
+    // The coverage the report gives is the share of the result's area on scanned faces, recounted here.
+    EXPECT_NEAR(r.coverage, scannedAreaFraction(r.mesh), 0.02);
+    EXPECT_GT(r.coverage, 0.6);
+    EXPECT_GT(r.inputFacesLeft, 0u);
+    ASSERT_TRUE(m.hausdorffFromRefRel);
+    EXPECT_LT(*m.hausdorffFromRefRel, 0.06);
+    std::printf("v2 elephant: %zu vertices for %zu, coverage %.4f, Hausdorff from %.4g, note: %s\n",
+                m.vertices, std::size_t(elephant.number_of_vertices()), r.coverage,
+                m.hausdorffFromRefRel.value_or(-1), r.engineNote.c_str());
+}
+
+namespace {
+
+// Two icospheres side by side in one mesh (two connected components, closed).
+fss::Mesh twoSpheres() {
+    fss::Mesh m = fss::shapes::icosphere(2, 1.0);
+    fss::Mesh other = fss::shapes::icosphere(2, 1.0);
+    for (fss::VertexIndex v : other.vertices()) {
+        const fss::Point3 p = other.point(v);
+        other.point(v) = fss::Point3(p.x() + 3.0, p.y(), p.z());
+    }
+    m += other;
+    return m;
+}
+
+// An icosphere with the faces at the given indices removed (each a hole: one boundary loop when no two of
+// them share a vertex).
+fss::Mesh sphereWithHoles(std::initializer_list<std::uint32_t> faces) {
+    fss::Mesh m = fss::shapes::icosphere(2, 1.0);
+    for (std::uint32_t f : faces)
+        CGAL::Euler::remove_face(m.halfedge(fss::FaceIndex(f)), m);
+    m.collect_garbage();
+    return m;
+}
+
+} // namespace
+
+// validateJoin (internal, remesh/auto_v2.h) counts connected components: a join that leaves a piece of the
+// surface apart is refused even when it is closed, manifold and has the right vertex count (session 15
+// measured two components on elephant and validate() let that pass).
+TEST(AutoRemeshV2, ValidationCountsConnectedComponents) {
+    const fss::Mesh one = fss::shapes::icosphere(2, 1.0);
+    const fss::Mesh two = twoSpheres();
+    ASSERT_EQ(one.number_of_vertices(), 162u);
+    ASSERT_EQ(two.number_of_vertices(), 324u);
+    EXPECT_EQ(fss::detail::validateJoin(
+                  one, {.closed = true, .components = 1, .boundaryLoops = 0, .vertices = 162}),
+              "");
+    EXPECT_EQ(fss::detail::validateJoin(
+                  two, {.closed = true, .components = 1, .boundaryLoops = 0, .vertices = 324}),
+              "the joined mesh has 2 connected components, the input 1");
+    EXPECT_EQ(fss::detail::validateJoin(
+                  two, {.closed = true, .components = 2, .boundaryLoops = 0, .vertices = 324}),
+              "");
+}
+
+// validateJoin counts boundary loops: an open join must end on the input's own borders (as many loops), and a
+// closed one must have none.
+TEST(AutoRemeshV2, ValidationCountsBoundaryLoops) {
+    const fss::Mesh oneHole = sphereWithHoles({0});
+    // Faces 0 and 300 of the level-2 icosphere share no vertex (asserted through the loop count below).
+    const fss::Mesh twoHoles = sphereWithHoles({0, 300});
+    const fss::MetricsOptions topologyOnly{.selfIntersections = false};
+    ASSERT_EQ(fss::computeMetrics(oneHole, topologyOnly).boundaryLoops, 1u);
+    ASSERT_EQ(fss::computeMetrics(twoHoles, topologyOnly).boundaryLoops, 2u);
+    EXPECT_EQ(fss::detail::validateJoin(
+                  oneHole, {.closed = true, .components = 1, .boundaryLoops = 0, .vertices = 162}),
+              "the joined mesh has 1 boundary loops, the input 0");
+    EXPECT_EQ(fss::detail::validateJoin(
+                  twoHoles, {.closed = false, .components = 1, .boundaryLoops = 1, .vertices = 162}),
+              "the joined mesh has 2 boundary loops, the input 1");
+    EXPECT_EQ(fss::detail::validateJoin(
+                  twoHoles, {.closed = false, .components = 1, .boundaryLoops = 2, .vertices = 162}),
+              "");
+    // The vertex count: 162 against a target of 200 is 19 % short.
+    EXPECT_NE(fss::detail::validateJoin(
+                  oneHole, {.closed = false, .components = 1, .boundaryLoops = 1, .vertices = 200})
+                  .find("parts of the surface were not sampled"),
+              std::string::npos);
 }

@@ -10,17 +10,19 @@
 //     (no margin), triangulated on the lattice. The regions are independent: they are sampled in parallel
 //     (parallelItems) from buffers rendered beforehand on one thread, and merged in view order, so the
 //     result is the same for any thread count.
-//  3. One join: the patches are put into one mesh and the gaps between them (about one lattice spacing
-//     wide, along the partition borders) are closed by an advancing front over the patches' boundary
-//     edges, a zipper in the manner of Turk & Levoy's zippering of range images: each boundary edge takes
-//     as third corner the boundary vertex in front of it that sees it under the largest angle (the Delaunay
-//     choice), best triangles first; Surface_mesh::add_face refuses whatever would make the mesh
-//     non-manifold. A second pass with a longer reach closes what is left (junctions of three regions).
+//  3. One join: the patches are put into one mesh, with the faces of the reference no patch reaches (centroid
+//     farther than L from every patch vertex: thin pieces the opening removed, regions whose patch failed,
+//     faces no view sees) as a region of their own, left from the input (scan id -1; the coverage says how
+//     much). The gaps between them (about one lattice spacing wide, along the partition borders) are closed
+//     by an advancing front over the boundary edges, a zipper in the manner of Turk & Levoy's zippering of
+//     range images: each boundary edge takes as third corner the boundary vertex in front of it that sees it
+//     under the largest angle (the Delaunay choice), best triangles first, only faces whose centroid lies
+//     within L/4 of the reference; Surface_mesh::add_face refuses whatever would make the mesh non-manifold.
+//     On a closed reference CGAL's hole filling closes what is left (junctions of three regions).
 //  4. Seam relaxation and crease recovery once, as v1 ends (seam_relax.h, crease_snap.h).
-//  5. Validation: closed when the reference is, no pinched vertex, no degenerate face, no self-intersection
-//     (computeMetrics), as many boundary loops as the reference, and a vertex count within 10 % of the
-//     target (else parts went unsampled). On an open reference the join adds no face whose centroid is
-//     farther than L/4 from the reference, so that the reference's own boundaries stay open.
+//  5. Validation (validateJoin): as many boundary loops and connected components as the reference, a vertex
+//     count within 10 % of the target (else parts went unsampled), closed when the reference is, no pinched
+//     vertex, no degenerate face, no self-intersection.
 // FSS_AUTO_V2_DEBUG=1 in the environment prints the stages' figures to stderr. A result that fails is dropped
 // and v1 runs instead (AutoResult::engineNote). The advancing front is our own: CGAL's hole filling works on
 // one boundary cycle at a time, and the gaps between patches are one multiply-connected region bounded by
@@ -45,6 +47,7 @@
 #include <CGAL/boost/graph/Euler_operations.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -91,7 +94,7 @@ constexpr double kDensity = 0.97;
 /// The patch of region \p view: the triangular lattice at \p spacing world units, only the samples on the
 /// faces the view owns, triangulated.
 Patch regionPatch(const Mesh& reference, const FrameBuffers& buffers, const std::vector<int>& owner, int view,
-                  double spacing) {
+                  double spacing, std::string* debug = nullptr) {
     ScanOptions so;
     so.scanId = view;
     so.lattice = Lattice::Triangular;
@@ -99,16 +102,30 @@ Patch regionPatch(const Mesh& reference, const FrameBuffers& buffers, const std:
     so.minLatticeAngleDeg = 0; // the partition already gave each face its most frontal view
     ScanWorkspace workspace;
     SampleGrid grid = sampleLattice(buffers, reference, workspace, so);
-    for (Sample& s : grid.samples)
+    std::size_t hits = 0, admissible = 0, own = 0;
+    for (Sample& s : grid.samples) {
+        hits += s.hit;
+        admissible += s.admissible;
         if (s.admissible && (s.face == Sample::kNoFace || owner[s.face] != view))
             s.admissible = s.valid = false;
+        own += s.admissible;
+    }
     MaskStages stages;
     // The opening (radius 1) removes single samples and one-sample spikes, which the join cannot close
     // cleanly (measured on elephant: without it 1168 intersecting face pairs after the join, 79 with it).
     stages.morphology = {.radius = 1, .dilateRadius = 1};
     stages.atQuality = stages.atMorphology = stages.atTriangulate = {};
     stages.nothingBetter = stages.nothingLeft = "The view owns no part of the surface.";
-    return maskAndTriangulate(grid, stages, workspace).patch;
+    MaskedPatch out = maskAndTriangulate(grid, stages, workspace);
+    if (debug)
+        *debug = "hits " + std::to_string(hits) + " admissible " + std::to_string(admissible) + " own " +
+                 std::to_string(own) + " morph " + std::to_string(out.counts.afterMorphology) + " verts " +
+                 std::to_string(out.patch.mesh.number_of_vertices()) + " long " +
+                 std::to_string(out.patch.report.longEdges) + " graz " +
+                 std::to_string(out.patch.report.grazing) + " back " +
+                 std::to_string(out.patch.report.backFacing) + " flip " +
+                 std::to_string(out.patch.report.flipped);
+    return std::move(out.patch);
 }
 
 /// Adds the faces of \p patch to \p out (scan id and quality kept).
@@ -127,6 +144,61 @@ void appendPatch(Mesh& out, const Mesh& patch) {
         if (g == Mesh::null_face()) continue;
         outIds[g] = haveIds ? ids[f] : -1;
         outQuality[g] = haveQuality ? quality[f] : 0.f;
+    }
+}
+
+/// Flags the faces of \p reference whose centroid lies farther than \p reach from every vertex of \p patches:
+/// the parts of the surface no region sampled (thin pieces the opening removed, regions whose patch failed,
+/// faces no view sees).
+std::vector<char> unsampledFaces(const Mesh& reference, const std::vector<Patch>& patches, double reach) {
+    const auto key = [reach](const Eigen::Vector3d& p) {
+        const Eigen::Vector3i c((p / reach).array().floor().cast<int>());
+        return (std::int64_t(c.x() & 0x1FFFFF) << 42) | (std::int64_t(c.y() & 0x1FFFFF) << 21) |
+               std::int64_t(c.z() & 0x1FFFFF);
+    };
+    std::unordered_map<std::int64_t, std::vector<Eigen::Vector3d>> cells;
+    for (const Patch& patch : patches)
+        for (VertexIndex v : patch.mesh.vertices())
+            cells[key(at(patch.mesh, v))].push_back(at(patch.mesh, v));
+    std::vector<char> out(reference.number_of_faces() + reference.number_of_removed_faces(), 0);
+    for (FaceIndex f : reference.faces()) {
+        Eigen::Vector3d c(0, 0, 0);
+        for (VertexIndex v : CGAL::vertices_around_face(reference.halfedge(f), reference))
+            c += at(reference, v) / 3.0;
+        bool near = false;
+        for (int dx = -1; dx <= 1 && !near; ++dx)
+            for (int dy = -1; dy <= 1 && !near; ++dy)
+                for (int dz = -1; dz <= 1 && !near; ++dz) {
+                    const auto it = cells.find(key(c + reach * Eigen::Vector3d(dx, dy, dz)));
+                    if (it == cells.end()) continue;
+                    for (const Eigen::Vector3d& p : it->second)
+                        if ((p - c).squaredNorm() <= reach * reach) {
+                            near = true;
+                            break;
+                        }
+                }
+        out[f.idx()] = !near;
+    }
+    return out;
+}
+
+/// Adds the faces of \p reference flagged in \p keep to \p out as faces left from the input (scan id -1).
+void appendInputFaces(Mesh& out, const Mesh& reference, const std::vector<char>& keep) {
+    auto outIds = out.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1).first;
+    auto outQuality = out.add_property_map<FaceIndex, float>(props::faceQuality, 0.f).first;
+    std::vector<VertexIndex> map(reference.number_of_vertices() + reference.number_of_removed_vertices());
+    for (FaceIndex f : reference.faces()) {
+        if (!keep[f.idx()]) continue;
+        std::array<VertexIndex, 3> corners;
+        int i = 0;
+        for (VertexIndex v : CGAL::vertices_around_face(reference.halfedge(f), reference)) {
+            if (map[v.idx()] == VertexIndex()) map[v.idx()] = out.add_vertex(reference.point(v));
+            corners[std::size_t(i++)] = map[v.idx()];
+        }
+        const FaceIndex g = out.add_face(corners[0], corners[1], corners[2]);
+        if (g == Mesh::null_face()) continue;
+        outIds[g] = -1;
+        outQuality[g] = 0.f;
     }
 }
 
@@ -359,6 +431,48 @@ bool repairJoin(Mesh& mesh, bool closed, int rounds, bool debug) {
     }
 }
 
+/// How joinRegions closes the gaps between the regions.
+enum class JoinStyle {
+    /// The faces of the reference no patch reaches are added as a region left from the input; one pass of
+    /// the gap closing, every new face within L/4 of the reference (no face bridges the two sides of a thin
+    /// part); on a closed reference CGAL's hole filling closes what is left.
+    InputRegions,
+    /// Session 15's join: two passes of the gap closing (the second with a reach of 6 L), faces kept near
+    /// the reference only on an open one; the hole filling bridges the parts no patch reaches.
+    TwoPasses,
+};
+
+/// Closes the gaps between the patches already in \p mesh (file comment, step 3) and repairs the result
+/// (repairJoin). \p unsampled: the reference's faces to add as input faces (JoinStyle::InputRegions).
+void joinRegions(Mesh& mesh, const Mesh& reference, const std::vector<char>* unsampled,
+                 const RayCaster& caster, JoinStyle style, double L, bool closed, bool debug) {
+    const auto borderEdges = [&] {
+        std::size_t n = 0;
+        for (HalfedgeIndex h : mesh.halfedges())
+            n += mesh.is_border(h);
+        return n;
+    };
+    if (style == JoinStyle::InputRegions) {
+        if (unsampled) appendInputFaces(mesh, reference, *unsampled);
+        if (debug)
+            std::fprintf(stderr, "v2: %zu border edges, %zu vertices with the input regions\n", borderEdges(),
+                         std::size_t(mesh.number_of_vertices()));
+        // Measured on elephant: a second pass with a reach of 6 L (TwoPasses) made most of the intersections
+        // the repair then removes (103 intersecting face pairs after the first pass, 589 after the second).
+        GapCloser(mesh, 2.5 * L, 80.0, 10.0, &caster, 0.25 * L).run();
+    } else {
+        const RayCaster* onSurface = closed ? nullptr : &caster;
+        GapCloser(mesh, 2.5 * L, 80.0, 10.0, onSurface, 0.25 * L).run();
+        if (debug) std::fprintf(stderr, "v2: %zu border edges after pass 1\n", borderEdges());
+        GapCloser(mesh, 6.0 * L, 85.0, 0.5, onSurface, 0.25 * L).run();
+    }
+    if (debug) std::fprintf(stderr, "v2: %zu border edges after the gap closing\n", borderEdges());
+    if (closed) fillHoles(mesh);
+    if (debug) std::fprintf(stderr, "v2: %zu border edges after the hole filling\n", borderEdges());
+    repairJoin(mesh, closed, 4, debug);
+    mesh.collect_garbage();
+}
+
 /// Faces of \p reference no view owns, in connected pieces (through edges), largest area first.
 struct Unowned {
     std::vector<FaceIndex> faces;
@@ -394,21 +508,26 @@ std::vector<Unowned> unownedPieces(const Mesh& reference, const std::vector<int>
     return out;
 }
 
-/// Why \p mesh is not an acceptable result (empty when it is).
-std::string validate(const Mesh& mesh, bool mustBeClosed, double targetVertices, std::size_t boundaryLoops) {
+} // namespace v2
+} // namespace
+
+std::string validateJoin(const Mesh& mesh, const JoinTarget& target) {
     MetricsOptions mo;
     const Metrics m = computeMetrics(mesh, mo);
-    if (m.boundaryLoops != boundaryLoops)
-        return "the joined mesh has " + std::to_string(m.boundaryLoops) + " boundary loops, the input " +
-               std::to_string(boundaryLoops);
     if (mesh.number_of_faces() == 0) return "the joined mesh has no face";
+    if (m.boundaryLoops != target.boundaryLoops)
+        return "the joined mesh has " + std::to_string(m.boundaryLoops) + " boundary loops, the input " +
+               std::to_string(target.boundaryLoops);
+    if (m.components != target.components)
+        return "the joined mesh has " + std::to_string(m.components) + " connected components, the input " +
+               std::to_string(target.components);
     // Parts of the surface no region sampled are bridged by the hole filling: far fewer vertices than a
     // regular triangulation of the whole surface means parts of it were cut off.
-    if (std::abs(double(m.vertices) - targetVertices) > 0.1 * targetVertices)
+    if (std::abs(double(m.vertices) - target.vertices) > 0.1 * target.vertices)
         return "the joined mesh has " + std::to_string(m.vertices) + " vertices against the " +
-               std::to_string(std::llround(targetVertices)) +
+               std::to_string(std::llround(target.vertices)) +
                " of the target: parts of the surface were not sampled";
-    if (mustBeClosed && !m.closed)
+    if (target.closed && !m.closed)
         return "the joined mesh has " + std::to_string(m.boundaryEdges) + " boundary edges left";
     if (m.nonManifoldVertices > 0)
         return "the joined mesh has " + std::to_string(m.nonManifoldVertices) + " pinched vertices";
@@ -418,9 +537,6 @@ std::string validate(const Mesh& mesh, bool mustBeClosed, double targetVertices,
         return "the joined mesh intersects itself (" + std::to_string(*m.selfIntersections) + " face pairs)";
     return {};
 }
-
-} // namespace v2
-} // namespace
 
 AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const Progress& progress) {
     using namespace v2;
@@ -493,7 +609,7 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
             a * std::max(0.0, -faceNormal(reference, f).dot(buffers[std::size_t(o)].camera.viewDirection()));
     }
     std::vector<Patch> patches(nv);
-    std::vector<std::string> notes(nv);
+    std::vector<std::string> notes(nv), dbg(nv);
     progress.report(0.2, "scan");
     parallelItems(nv, 1, [&](std::size_t i) {
         if (regionArea[i] <= 0) {
@@ -502,18 +618,23 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         }
         const double c = std::clamp(cosArea[i] / regionArea[i], 0.5, 1.0);
         try {
-            patches[i] = regionPatch(reference, buffers[i], owner, int(i), kDensity * L * std::sqrt(c));
+            patches[i] =
+                regionPatch(reference, buffers[i], owner, int(i), kDensity * L * std::sqrt(c), &dbg[i]);
         } catch (const Error& e) {
             notes[i] = e.what();
         }
     });
     result.scanSeconds = since(t);
+    if (std::getenv("FSS_AUTO_V2_DEBUG"))
+        for (std::size_t i = 0; i < nv; ++i)
+            std::fprintf(stderr, "v2 region %zu: area %.4f expected %.0f verts, cos %.2f: %s\n", i,
+                         regionArea[i], regionArea[i] / (std::sqrt(3.0) / 2 * L * L),
+                         regionArea[i] > 0 ? cosArea[i] / regionArea[i] : 0.0, dbg[i].c_str());
 
     // 3. One join.
     progress.report(0.5, "join");
     t = Clock::now();
     Mesh current;
-    std::vector<char> patchMade(nv, 0);
     for (std::size_t i = 0; i < nv; ++i) {
         AutoStep step;
         step.kind = AutoStep::Kind::Initial;
@@ -523,31 +644,44 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         step.facesAdded = step.patchFaces;
         step.stitched = step.patchFaces > 0;
         step.note = notes[i];
-        if (step.stitched) appendPatch(current, patches[i].mesh), patchMade[i] = 1;
+        if (step.stitched) appendPatch(current, patches[i].mesh);
         (step.stitched ? result.scansStitched : result.scansSkipped)++;
         result.steps.push_back(std::move(step));
     }
-    patches.clear();
     if (current.number_of_faces() == 0) throw InvalidInputError("No view of auto v2 sees the surface.");
-    const auto borderEdges = [&] {
-        std::size_t n = 0;
-        for (HalfedgeIndex h : current.halfedges())
-            n += current.is_border(h);
-        return n;
-    };
     const bool debug = std::getenv("FSS_AUTO_V2_DEBUG") != nullptr;
-    if (debug) std::fprintf(stderr, "v2: %zu views, %zu border edges before the join\n", nv, borderEdges());
-    std::unique_ptr<RayCaster> caster;
-    if (!closedInput) caster = std::make_unique<RayCaster>(reference);
-    GapCloser(current, 2.5 * L, 80.0, 10.0, caster.get(), 0.25 * L).run();
-    if (debug) std::fprintf(stderr, "v2: %zu border edges after pass 1\n", borderEdges());
-    GapCloser(current, 6.0 * L, 85.0, 0.5, caster.get(), 0.25 * L).run();
-    if (debug) std::fprintf(stderr, "v2: %zu border edges after pass 2\n", borderEdges());
-    if (closedInput) fillHoles(current);
-    if (debug) std::fprintf(stderr, "v2: %zu border edges after the hole filling\n", borderEdges());
-    repairJoin(current, closedInput, 4, debug);
-    current.collect_garbage();
-    if (debug) std::fprintf(stderr, "v2: join %.2f s\n", since(t));
+    // Two ways to join; the first whose result passes validateJoin is kept (else the first): the faces no
+    // region sampled kept as a region of their own, joined in one pass (JoinStyle::InputRegions), then
+    // session 15's join (JoinStyle::TwoPasses), which bridges those parts with the hole filling.
+    const std::vector<char> unsampled = unsampledFaces(reference, patches, L);
+    patches.clear();
+    const RayCaster caster(reference);
+    MetricsOptions referenceTopology;
+    referenceTopology.selfIntersections = false;
+    const Metrics referenceMetrics = computeMetrics(reference, referenceTopology);
+    const JoinTarget target{.closed = closedInput,
+                            .components = referenceMetrics.components,
+                            .boundaryLoops = referenceMetrics.boundaryLoops,
+                            .vertices = result.area / (std::sqrt(3.0) / 2.0 * L * L)};
+    {
+        Mesh joined = current;
+        joinRegions(joined, reference, &unsampled, caster, JoinStyle::InputRegions, L, closedInput, debug);
+        std::string why = validateJoin(joined, target);
+        if (debug)
+            std::fprintf(stderr, "v2: join with input regions: %s\n", why.empty() ? "valid" : why.c_str());
+        if (why.empty()) {
+            current = std::move(joined);
+        } else {
+            joinRegions(current, reference, nullptr, caster, JoinStyle::TwoPasses, L, closedInput, debug);
+            const std::string other = validateJoin(current, target);
+            if (debug)
+                std::fprintf(stderr, "v2: join in two passes: %s\n", other.empty() ? "valid" : other.c_str());
+            if (!other.empty()) current = std::move(joined);
+        }
+    }
+    if (debug)
+        std::fprintf(stderr, "v2: join %.2f s, %zu vertices\n", since(t),
+                     std::size_t(current.number_of_vertices()));
     result.stitchSeconds = result.joinSeconds = since(t);
 
     // 4. Seam relaxation and crease recovery, once.
@@ -574,7 +708,9 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         result.sliverFlips = flipSliverFaces(current, options.flipSliversBelowDeg, 20.0, 8);
     result.relaxSeconds = since(t);
     relax();
-    if (debug) std::fprintf(stderr, "v2: relax %.2f s\n", since(t));
+    if (debug)
+        std::fprintf(stderr, "v2: relax %.2f s, %zu vertices\n", since(t),
+                     std::size_t(current.number_of_vertices()));
     if (options.creaseSnapRounds > 0) {
         const auto t0 = Clock::now();
         CreaseSnapOptions co;
@@ -594,16 +730,14 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
             current.remove_property_map(onCrease);
     }
     result.stitchSeconds += since(t);
-    if (debug) std::fprintf(stderr, "v2: relax + creases %.2f s\n", since(t));
+    if (debug)
+        std::fprintf(stderr, "v2: relax + creases %.2f s, %zu vertices\n", since(t),
+                     std::size_t(current.number_of_vertices()));
 
     // 5. Validation; v1 when it fails.
     progress.report(0.95, "validate");
     t = Clock::now();
-    MetricsOptions referenceTopology;
-    referenceTopology.selfIntersections = false;
-    const std::size_t referenceLoops = computeMetrics(reference, referenceTopology).boundaryLoops;
-    const std::string why =
-        validate(current, closedInput, result.area / (std::sqrt(3.0) / 2.0 * L * L), referenceLoops);
+    const std::string why = validateJoin(current, target);
     if (debug) std::fprintf(stderr, "v2: validation %.2f s\n", since(t));
     if (!why.empty() && !options.fallbackToV1) {
         result.engineNote = "auto v2 failed (" + why + ").";
@@ -617,11 +751,25 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
     }
     // Coverage: the share of the reference's area in regions whose patch was made (sampled by a view); the
     // rest is bridged by the join (no face is left from the input in v2).
-    double covered = 0;
-    for (FaceIndex f : reference.faces())
-        if (owner[f.idx()] >= 0 && patchMade[std::size_t(owner[f.idx()])]) covered += faceArea(reference, f);
-    result.coverage = covered / result.area;
-    result.inputAreaLeft = result.area - covered;
+    {
+        const auto [ids, haveIds] = current.property_map<FaceIndex, std::int32_t>(props::faceScanId);
+        double scanned = 0, total = 0;
+        for (FaceIndex f : current.faces()) {
+            const double a = faceArea(current, f);
+            total += a;
+            if (haveIds && ids[f] >= 0)
+                scanned += a;
+            else
+                ++result.inputFacesLeft;
+        }
+        // The faces no patch reached are either left from the input (JoinStyle::InputRegions) or bridged by
+        // the hole filling (TwoPasses, whose new faces take a neighbour's scan id): not sampled either way.
+        double unsampledArea = 0;
+        for (FaceIndex f : reference.faces())
+            if (unsampled[f.idx()]) unsampledArea += faceArea(reference, f);
+        result.coverage = std::min(total > 0 ? scanned / total : 0.0, 1.0 - unsampledArea / result.area);
+        result.inputAreaLeft = total - scanned;
+    }
     for (AutoStep& s : result.steps)
         s.coverageAfter = result.coverage;
     progress.report(1.0, "done");

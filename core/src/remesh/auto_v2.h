@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include <string>
 #include <vector>
 
 namespace fss::detail {
@@ -30,6 +31,20 @@ std::vector<Eigen::Vector3d> planViews(const Mesh& reference, double servedAngle
 /// Flips edges between nearly coplanar faces where that raises the smaller smallest angle of faces whose
 /// smallest angle is below \p belowDeg (auto_remesh.cpp, flipSlivers). Returns the flips.
 std::size_t flipSliverFaces(Mesh& mesh, double belowDeg, double maxDihedralDeg, int rounds);
+
+/// What the joined mesh of auto v2 must match (the reference's topology and the target's vertex count).
+struct JoinTarget {
+    bool closed = true;            ///< no boundary edge (the reference is closed)
+    std::size_t components = 1;    ///< connected components (faces connected by edges), the reference's
+    std::size_t boundaryLoops = 0; ///< boundary loops, the reference's
+    double vertices = 0;           ///< the target's vertex count; the mesh must be within 10 % of it
+};
+
+/// Why \p mesh is not an acceptable result of auto v2 (an empty string when it is): a boundary loop or
+/// connected component count other than \p target's, a vertex count more than 10 % off (parts of the
+/// surface not sampled), open when it must be closed, a pinched vertex, a degenerate face, a
+/// self-intersection. The first failure found is named, in that order.
+std::string validateJoin(const Mesh& mesh, const JoinTarget& target);
 
 /// autoRemesh with AutoEngine::V2 (auto_v2.cpp). Throws what autoRemesh throws; returns a result whose
 /// engineUsed is V1 (and engineNote the reason) when the V2 mesh failed validation and \p fallback ran.
