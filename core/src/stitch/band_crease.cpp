@@ -7,12 +7,25 @@
 
 namespace fss::stitch::band {
 
+bool BandRemesher::isCap(FaceIndex f) const {
+    for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
+        const V3 p = detail::pos(S_, S_.target(h));
+        if (detail::angleBetween(detail::pos(S_, S_.source(h)) - p,
+                                 detail::pos(S_, S_.target(S_.next(h))) - p) > 120.0 * kBandDeg)
+            return true;
+    }
+    return false;
+}
+
 void BandRemesher::findCreases() {
     // Band edges between band faces whose normals differ by more than the crease angle, with two filters
     // against false creases (finely cut curved surfaces, where one tilted face or a short stub of a crease
     // would pin vertices that the band needs to move, DESIGN.md §6.2):
     //  - a face whose normal differs by more than the crease angle from every band neighbour with a known
-    //    normal (at least two) is an outlier, not a feature: its normal counts as unknown;
+    //    normal (at least two), or (a cap below the split floor: an angle above 120 deg) from at least two
+    //    of them while they agree with each other (pairwise within the crease angle: one smooth surface
+    //    around a tilted cap, a fold the cut left: its two tilted edges would make a crease turning back on
+    //    itself that pins the cap's apex), is an outlier, not a feature: its normal counts as unknown;
     //  - a crease edge that hangs off a crease (one end on no other crease edge, the other on two or more)
     //    or stands alone is dropped unless its dihedral angle is at least twice the crease angle.
     const double creaseCos = std::cos(in_.creaseAngleDeg * kBandDeg);
@@ -36,14 +49,20 @@ void BandRemesher::findCreases() {
         const V3 n = creaseNormal(f);
         if (!filter || !(n.squaredNorm() > 0)) continue;
         int known = 0, apart = 0;
+        std::array<V3, 3> around;
         for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(f), S_)) {
             if (!interiorEdge(h)) continue;
             const V3 m = creaseNormal(S_.face(S_.opposite(h)));
             if (!(m.squaredNorm() > 0)) continue;
-            ++known;
+            around[std::size_t(known++)] = m;
             apart += n.dot(m) < creaseCos;
         }
-        if (known >= 2 && apart == known) outliers.push_back(f);
+        bool agree = true;
+        for (int i = 0; i < known; ++i)
+            for (int j = i + 1; j < known; ++j)
+                agree = agree && around[std::size_t(i)].dot(around[std::size_t(j)]) >= creaseCos;
+        const bool tilted = apart >= 2 && agree && faceMinAngle(f) < kSplitFloorDeg * kBandDeg && isCap(f);
+        if (known >= 2 && (apart == known || tilted)) outliers.push_back(f);
     }
     for (FaceIndex f : outliers)
         normal[std::uint32_t(f)] = V3(0, 0, 0);

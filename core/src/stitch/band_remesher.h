@@ -374,6 +374,8 @@ private:
     // The band's creases at setup (band_crease.cpp): edges between faces whose normals differ by more than
     // the crease angle, outlier faces and weak stubs left out.
     void findCreases();
+    // Whether a face has an angle above 120 deg.
+    bool isCap(FaceIndex f) const;
     // The point at parameter t between crease vertices a and b on their common crease polyline (into q);
     // chain -1 when they have none (q is left as it is).
     CreasePos creaseBetween(VertexIndex a, VertexIndex b, double t, V3& q) const;

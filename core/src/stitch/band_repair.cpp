@@ -55,6 +55,21 @@ void BandRemesher::countBelow20() {
     const double floor = 20.0 * kBandDeg;
     const char* e = std::getenv("FSS_STITCH_BAND_DIAG");
     const bool verbose = e && std::string(e) == "2";
+    if (verbose) {
+        // Band vertices of valence 9 or more (issue 4's seam criterion allows 4..8): held or free, and
+        // whether the local mesh knows their whole star (a vertex on its border has an unknown valence).
+        std::unordered_set<std::uint32_t> seen;
+        for (std::size_t i = 0; i < band_.size(); ++i) {
+            const FaceIndex f(static_cast<std::uint32_t>(i));
+            if (!band_[i] || S_.is_removed(f)) continue;
+            for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(f), S_))
+                if (S_.degree(v) >= 9 && seen.insert(std::uint32_t(v)).second)
+                    std::fprintf(stderr, "  vertex %u valence %zu%s%s%s crease %d\n", std::uint32_t(v),
+                                 std::size_t(S_.degree(v)), isFixed(v) ? " fixed" : "",
+                                 wholeStarInBand(v) ? "" : " rim", S_.is_border(v) ? " local-border" : "",
+                                 creaseDegree(v));
+        }
+    }
     for (FaceIndex f : S_.faces()) {
         const bool band = inBand(f), unseen = in_.unseen && in_.unseen(f);
         if (!band && !unseen && !growable(f)) continue;
