@@ -42,11 +42,15 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <ctime>
 #include <map>
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include <sys/resource.h>
 
@@ -230,7 +234,10 @@ void BM_ScanStages(benchmark::State& state) {
 // warped to the surface (warp:1, ScanOptions::warpToSurface, the default since session file version 3) or
 // not (warp:0): what the warp costs (issue #20). The first scan is not measured (allocations, upload).
 // Counters: sample_ms (the lattice chosen, warped and sampled), scan_ms (render to patch), patch_faces and
-// mean_min_angle (the patch's mean smallest angle, degrees: what the warp buys).
+// mean_min_angle (the patch's mean smallest angle, degrees: what the warp buys). The scan times of every
+// run are kept for the table of warped / plain that main prints at the end (issue #20's target: ≤ 2).
+std::map<std::pair<int, int>, std::vector<double>> warpScanMs; // (faces, warp) -> scan_ms of each run
+
 void BM_ScanWarp(benchmark::State& state) {
     const int faces = int(state.range(0)), res = int(state.range(1));
     Scene& scene = sceneWith(faces);
@@ -258,6 +265,7 @@ void BM_ScanWarp(benchmark::State& state) {
     const double n = double(state.iterations());
     state.counters["sample_ms"] = sample / n;
     state.counters["scan_ms"] = total / n;
+    warpScanMs[{faces, int(state.range(2))}].push_back(total / n);
     state.counters["patch_faces"] = double(result.patch.mesh.number_of_faces());
     state.counters["mean_min_angle"] =
         fss::computeMetrics(result.patch.mesh, {.selfIntersections = false}).meanMinAngleDeg;
@@ -283,4 +291,27 @@ BENCHMARK(BM_ScanWarp)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    // The warped scan against the plain adaptive one (BM_ScanWarp), medians over the repetitions.
+    auto median = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+    };
+    bool header = false;
+    for (const auto& [key, runs] : warpScanMs) {
+        const auto plain = warpScanMs.find({key.first, 0});
+        if (key.second == 0 || plain == warpScanMs.end()) continue;
+        if (!header)
+            std::printf("\n%9s %14s %15s %13s %5s\n", "faces", "plain scan ms", "warped scan ms",
+                        "warped/plain", "runs");
+        header = true;
+        const double p = median(plain->second), w = median(runs);
+        std::printf("%9d %14.1f %15.1f %13.2f %5zu\n", key.first, p, w, w / p, runs.size());
+    }
+    if (header) std::printf("target: warped/plain <= 2 at every size (issue #20)\n");
+    return 0;
+}

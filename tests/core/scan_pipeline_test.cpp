@@ -480,7 +480,7 @@ TEST(ScanPipeline, LatticeWarpedToTheSurfaceKeepsRoundTrianglesOnASphere) {
         w.area, w.meanMinAngleDeg, 100 * w.fracMinAngleBelow30, w.fracValence6Interior, *w.hausdorffToRefRel);
     // The visible hemisphere has area 2π; a cap up to the slant θ has 2π(1 − cos θ). Measured: area 2.31 ->
     // 3.99 (the cap to 55° -> to 76°), mean smallest angle 50.4° -> 53.9°, 0 % below 30°, Hausdorff 1.56e-4
-    // -> 1.00e-4.
+    // -> 1.00e-4; with session 16's faster fit area 3.86, 54.8°, 0 %, Hausdorff 1.14e-4 (the bounds hold).
     EXPECT_GE(w.area, 1.5 * a.area);
     EXPECT_GE(w.area, 2 * std::numbers::pi * (1 - std::cos(65 * std::numbers::pi / 180)));
     EXPECT_GE(w.meanMinAngleDeg, 50.0);
