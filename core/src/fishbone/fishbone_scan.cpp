@@ -5,6 +5,7 @@
 #include "fss/mask_triangulate.h"
 
 #include "base/parallel_rows.h"
+#include "fishbone/crease_backbone.h"
 #include "fishbone/fishbone_options.h"
 #include "mesh/features.h"
 
@@ -566,6 +567,22 @@ void closeUnrolledPatch(Patch& patch, SampleGrid& grid, int n, int p) {
     grid = std::move(cropped);
 }
 
+// The backbone along the crease near the seed (FishboneOptions::creaseBackbone; crease_backbone.h), if any.
+std::optional<Backbone> creaseBackbone(const Mesh& reference, const FishboneParams& fb,
+                                       const FishboneOptions& options, const FrameBuffers& buffers,
+                                       FishboneCache& cache) {
+    if (!options.creaseBackbone || !(fb.creaseAngleDeg > 0) || !fb.seed) return std::nullopt;
+    detail::CreaseBackboneInput in;
+    in.mesh = &reference;
+    in.creaseEdges = &cache.creaseEdges(reference, fb.creaseAngleDeg);
+    in.caster = &cache.rayCaster(reference);
+    in.camera = buffers.camera;
+    in.spacing = options.spacing;
+    in.snapDistance = 3.0;
+    in.maxLength = options.backboneTracing.maxLength;
+    return detail::creaseBackbone(in, *fb.seed);
+}
+
 // Key-rib mode: every picked key-rib traced at its nearest backbone sample, every drawn one as drawn, blended
 // into one grid (keyRibFishbone). \p k is the sampling factor, only for the positions in error messages.
 FishboneGrid keyRibGrid(const DirectionField& ribField, const Backbone& backbone, const FishboneParams& fb,
@@ -574,20 +591,32 @@ FishboneGrid keyRibGrid(const DirectionField& ribField, const Backbone& backbone
     const double h = options.spacing;
     std::vector<KeyRib> keys;
     std::vector<std::uint8_t> used(backbone.samples.size(), 0);
+    auto twoOnOne = [](const std::string& what) {
+        return InvalidInputError("Two key-ribs fall on the same backbone sample (" + what +
+                                 "); place them farther apart.");
+    };
     auto claim = [&](std::size_t row, const std::string& what) {
-        if (used[row])
-            throw InvalidInputError("Two key-ribs fall on the same backbone sample (" + what +
-                                    "); place them farther apart.");
+        if (used[row]) throw twoOnOne(what);
         used[row] = 1;
     };
+    std::vector<double> positions; // of the continuous key-ribs (FishboneOptions::continuousKeyRibs)
     for (const Eigen::Vector2d& p : fb.keyRibs) {
+        const BackbonePoint at = backbone.nearestPoint(p);
         const std::size_t row = backbone.nearestSample(p);
-        const double d = (backbone.samples[row] - p).norm();
+        const double d = options.continuousKeyRibs ? at.distance : (backbone.samples[row] - p).norm();
         if (d > 2 * h)
             throw InvalidInputError("The key-rib point " + shown(p) + " lies " + fmt(k * d) +
                                     " pixels from the backbone, farther than 2h = " + fmt(2 * k * h) + ".");
-        claim(row, shown(p));
-        keys.push_back(KeyRib{row, traceRib(ribField, backbone, row, options)});
+        if (!options.continuousKeyRibs) {
+            claim(row, shown(p));
+            keys.push_back(KeyRib{row, traceRib(ribField, backbone, row, options)});
+            continue;
+        }
+        for (double q : positions)
+            if (std::abs(q - at.position) < 0.5) throw twoOnOne("less than h/2 apart along it, " + shown(p));
+        used[row] = 1;
+        positions.push_back(at.position);
+        keys.push_back(tracedKeyRib(ribField, backbone, p, options));
     }
     for (const Polyline2& drawn : fb.drawnKeyRibs) {
         KeyRib key = drawnKeyRib(backbone, drawn, options);
@@ -689,6 +718,9 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
     Backbone backbone;
     if (drawnBackbone) {
         backbone = fss::drawnBackbone(fb.drawnBackbone, options);
+    } else if (std::optional<Backbone> onCrease = creaseBackbone(reference, fb, options, buffers, cache)) {
+        backbone = std::move(*onCrease);
+        if (options.stopBackboneAtCreases && fb.creaseAngleDeg > 0) stops().cutBackbone(backbone);
     } else {
         const std::optional<DirectionSample> at = backboneField.sample(*fb.seed, Eigen::Vector2d(1, 0));
         if (!at || at->anisotropy < fb.minSeedAnisotropy)
