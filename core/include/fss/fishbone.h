@@ -92,7 +92,9 @@ struct FishboneOptions {
     /// backbone along that crease's polyline, resampled every h footprints in 3D and stopped at its corners
     /// and branches, where it is hidden or leaves the image (a closed crease seen whole gives a closed
     /// backbone), instead of tracing the principal direction (which follows the noisy curvature of coarse
-    /// CAD tessellations, 3–36 h off the crease). The ribs are traced from it as from any backbone. On by
+    /// CAD tessellations, 3–36 h off the crease). Its automatic ribs leave it perpendicular to the crease and
+    /// walk straight on over the surface, stop at the next crease and are trimmed where their quads get
+    /// thinner than 1:1.5 or neighbours closer than h/2; key-ribs are traced as on any backbone. On by
     /// default; false in files written before it.
     bool creaseBackbone = true;
     /// Key-ribs that move continuously (issue 20): the fishbone scan traces a picked key-rib from the point

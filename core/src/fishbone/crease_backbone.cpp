@@ -3,6 +3,7 @@
 #include "mesh/features.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -95,7 +96,7 @@ std::vector<double> walk(const CreaseBackboneInput& in, const Chain& chain, doub
 
 } // namespace
 
-std::optional<Backbone> creaseBackbone(const CreaseBackboneInput& in, const Eigen::Vector2d& seed) {
+std::optional<CreaseBackbone> creaseBackbone(const CreaseBackboneInput& in, const Eigen::Vector2d& seed) {
     if (!in.mesh || !in.creaseEdges || !in.caster || in.creaseEdges->empty() || !(in.spacing > 0))
         return std::nullopt;
     const Camera& cam = in.camera;
@@ -127,8 +128,12 @@ std::optional<Backbone> creaseBackbone(const CreaseBackboneInput& in, const Eige
         const SurfacePoint hit = in.caster->intersect(cam.ray(s.x(), s.y()));
         if (!hit || (hit.point - start).norm() > cam.pixelFootprint(start)) return std::nullopt;
     }
-    auto screen = [&](double s) { return Eigen::Vector2d(cam.project(chain.at(s)).head<2>()); };
-    Backbone b;
+    CreaseBackbone out;
+    Backbone& b = out.backbone;
+    auto add = [&](double s) {
+        out.points.push_back(chain.at(s));
+        b.samples.emplace_back(cam.project(out.points.back()).head<2>());
+    };
     const double L = chain.length();
     const double inf = std::numeric_limits<double>::infinity();
     std::vector<double> forward = walk(in, chain, s0, 1, chain.closed() ? L : inf);
@@ -138,22 +143,91 @@ std::optional<Backbone> creaseBackbone(const CreaseBackboneInput& in, const Eige
         if (covered + step >= L - 0.5 * step) { // all the way round: a closed backbone of equal arcs
             const std::size_t n = std::max<std::size_t>(3, std::size_t(std::lround(L / step)));
             for (std::size_t k = 0; k < n; ++k)
-                b.samples.push_back(screen(s0 + L * double(k) / double(n)));
+                add(s0 + L * double(k) / double(n));
             b.closed = true;
-            return b;
+            return out;
         }
     }
     const double used = forward.empty() ? 0.0 : forward.back() - s0;
     const std::vector<double> backward = walk(
         in, chain, s0, -1, chain.closed() ? L - used - 0.5 * in.spacing * cam.pixelFootprint(start) : inf);
     for (std::size_t k = backward.size(); k-- > 0;)
-        b.samples.push_back(screen(backward[k]));
+        add(backward[k]);
     b.seedIndex = backward.size();
-    b.samples.push_back(screen(s0));
+    add(s0);
     for (double s : forward)
-        b.samples.push_back(screen(s));
+        add(s);
     if (b.samples.size() < 2) return std::nullopt;
-    return b;
+    return out;
+}
+
+namespace {
+
+// The unit normal of face \p f.
+Eigen::Vector3d unitNormal(const Mesh& m, FaceIndex f) {
+    std::array<Eigen::Vector3d, 3> v;
+    int k = 0;
+    for (VertexIndex x : m.vertices_around_face(m.halfedge(f)))
+        v[std::size_t(k++)] = Eigen::Vector3d(m.point(x).x(), m.point(x).y(), m.point(x).z());
+    return (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+}
+
+} // namespace
+
+std::vector<Rib> creaseRibs(const CreaseBackboneInput& in, const CreaseBackbone& crease) {
+    const Camera& cam = in.camera;
+    const Backbone& b = crease.backbone;
+    const std::vector<Eigen::Vector3d>& q = crease.points;
+    const std::size_t n = q.size();
+    auto screen = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d(cam.project(p).head<2>()); };
+    // The visible surface under screen point s (front-facing), if any.
+    auto surfaceAt = [&](const Eigen::Vector2d& s) -> SurfacePoint {
+        if (!s.allFinite() || s.x() < 0 || s.y() < 0 || s.x() > cam.width || s.y() > cam.height) return {};
+        const Ray ray = cam.ray(s.x(), s.y());
+        SurfacePoint hit = in.caster->intersect(ray);
+        if (hit && !(unitNormal(*in.mesh, hit.face).dot(ray.direction) < 0)) hit = {};
+        return hit;
+    };
+    std::vector<Rib> ribs(n);
+    for (std::size_t r = 0; r < n; ++r) {
+        const Eigen::Vector2d p0 = b.samples[r], normal = b.normal(r);
+        ribs[r] = Rib{{p0}, {p0}};
+        const std::size_t prev = b.closed ? (r + n - 1) % n : (r == 0 ? 0 : r - 1);
+        const std::size_t next = b.closed ? (r + 1) % n : std::min(r + 1, n - 1);
+        const Eigen::Vector3d tangent = (q[next] - q[prev]).normalized();
+        const double step = in.spacing * cam.pixelFootprint(q[r]);
+        if (!tangent.allFinite() || !(step > 0)) continue;
+        for (const int side : {1, -1}) {
+            SurfacePoint at = surfaceAt(p0 + 0.5 * in.spacing * side * normal);
+            if (!at) continue;
+            // Perpendicular to the crease in the face beside it, towards this side on the screen.
+            Eigen::Vector3d n3 = unitNormal(*in.mesh, at.face), u = n3.cross(tangent).normalized();
+            if ((screen(q[r] + step * u) - p0).dot(side * normal) < 0) u = -u;
+            Polyline2& half = side > 0 ? ribs[r].positive : ribs[r].negative;
+            Eigen::Vector3d from = q[r];
+            double length = 0;
+            for (;;) {
+                // One step straight on, onto the surface under it: straight on a planar face, the surface's
+                // straightest line on a curved one. It ends off the surface, at a depth jump (the surface
+                // point farther than half a step from the step's end) and where its screen edges shrink.
+                const Eigen::Vector3d to = from + step * u;
+                if (!(cam.viewDepth(to) > 0)) break;
+                const Eigen::Vector2d s = screen(to);
+                const double edge = (s - half.back()).norm();
+                if (edge < 0.3 * in.spacing || length + edge > in.ribMaxLength) break;
+                const SurfacePoint hit = surfaceAt(s);
+                if (!hit || (hit.point - to).norm() > 0.5 * step) break;
+                length += edge;
+                half.push_back(s);
+                n3 = unitNormal(*in.mesh, hit.face);
+                const Eigen::Vector3d along = (hit.point - from) - (hit.point - from).dot(n3) * n3;
+                if (!(along.norm() > 0)) break;
+                u = along.normalized();
+                from = hit.point;
+            }
+        }
+    }
+    return ribs;
 }
 
 } // namespace fss::detail

@@ -567,11 +567,10 @@ void closeUnrolledPatch(Patch& patch, SampleGrid& grid, int n, int p) {
     grid = std::move(cropped);
 }
 
-// The backbone along the crease near the seed (FishboneOptions::creaseBackbone; crease_backbone.h), if any.
-std::optional<Backbone> creaseBackbone(const Mesh& reference, const FishboneParams& fb,
-                                       const FishboneOptions& options, const FrameBuffers& buffers,
-                                       FishboneCache& cache) {
-    if (!options.creaseBackbone || !(fb.creaseAngleDeg > 0) || !fb.seed) return std::nullopt;
+// What the crease backbone and its ribs need (FishboneOptions::creaseBackbone; crease_backbone.h).
+detail::CreaseBackboneInput creaseInput(const Mesh& reference, const FishboneParams& fb,
+                                        const FishboneOptions& options, const FrameBuffers& buffers,
+                                        FishboneCache& cache) {
     detail::CreaseBackboneInput in;
     in.mesh = &reference;
     in.creaseEdges = &cache.creaseEdges(reference, fb.creaseAngleDeg);
@@ -580,7 +579,8 @@ std::optional<Backbone> creaseBackbone(const Mesh& reference, const FishbonePara
     in.spacing = options.spacing;
     in.snapDistance = 3.0;
     in.maxLength = options.backboneTracing.maxLength;
-    return detail::creaseBackbone(in, *fb.seed);
+    in.ribMaxLength = options.ribTracing.maxLength;
+    return in;
 }
 
 // Key-rib mode: every picked key-rib traced at its nearest backbone sample, every drawn one as drawn, blended
@@ -716,10 +716,13 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
     auto visible = [&]() -> const CreaseIndex& { return index(creaseIndex, nullptr); };
     auto stops = [&]() -> const CreaseIndex& { return index(stopIndex, &caster); };
     Backbone backbone;
+    std::optional<detail::CreaseBackbone> onCrease; // the backbone along a crease (creaseBackbone)
+    if (!drawnBackbone && options.creaseBackbone && fb.creaseAngleDeg > 0)
+        onCrease = detail::creaseBackbone(creaseInput(reference, fb, options, buffers, cache), *fb.seed);
     if (drawnBackbone) {
         backbone = fss::drawnBackbone(fb.drawnBackbone, options);
-    } else if (std::optional<Backbone> onCrease = creaseBackbone(reference, fb, options, buffers, cache)) {
-        backbone = std::move(*onCrease);
+    } else if (onCrease) {
+        backbone = onCrease->backbone;
         if (options.stopBackboneAtCreases && fb.creaseAngleDeg > 0) stops().cutBackbone(backbone);
     } else {
         const std::optional<DirectionSample> at = backboneField.sample(*fb.seed, Eigen::Vector2d(1, 0));
@@ -741,16 +744,33 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
         throw InvalidInputError("The fishbone backbone has fewer than two samples; pick a point on a longer "
                                 "feature or reduce h.");
     if (options.isotropicRibs) options.surfaceLength = surfaceMetric(buffers, caster, fb.raycast);
+    bool straight = false;
     if (!keyRibMode) {
         // The ribs are independent streamlines, traced on the scan threads (the grid is the same for any
         // thread count).
-        result.fishbone = assembleFishboneGrid(backbone, traceAllRibs(ribField, backbone, options), h, W, H);
-        result.counts.trimmed = trimRibs(result.fishbone, backbone, options); // as automaticFishbone
+        // On a crease (and not cut by stopBackboneAtCreases): straight ribs perpendicular to it in 3D.
+        straight = onCrease && onCrease->backbone.samples.size() == backbone.samples.size();
+        result.fishbone = assembleFishboneGrid(
+            backbone,
+            straight ? detail::creaseRibs(creaseInput(reference, fb, options, buffers, cache), *onCrease)
+                     : traceAllRibs(ribField, backbone, options),
+            h, W, H);
+        // Straight ribs converge on a crease's concave side and fan out on its convex side: they are always
+        // trimmed where their quads get thinner than 1:1.5 (whose triangles keep 33.7°) or where neighbours
+        // come closer than h/2 (the options' own bounds when tighter).
+        FishboneOptions trim = options;
+        if (straight) {
+            trim.minRibGap = std::max(trim.minRibGap, 0.5);
+            trim.maxRibAspect = trim.maxRibAspect >= 1 ? std::min(trim.maxRibAspect, 1.5) : 1.5;
+        }
+        result.counts.trimmed = trimRibs(result.fishbone, backbone, trim); // as automaticFishbone
     } else {
         result.fishbone = keyRibGrid(ribField, backbone, fb, options, k, W, H);
     }
-    if (options.stopRibsAtCreases && fb.creaseAngleDeg > 0)
-        result.counts.creaseStopped = stops().stopRibsAtCreases(result.fishbone, options.spareFollowedCrease);
+    // The straight ribs of a crease backbone always stop at the next crease (sparing the one they leave).
+    if ((options.stopRibsAtCreases || straight) && fb.creaseAngleDeg > 0)
+        result.counts.creaseStopped =
+            stops().stopRibsAtCreases(result.fishbone, options.spareFollowedCrease || straight);
     result.timings.tracing = secondsSince(t);
     result.counts.directionPixels = backboneField.computedPixels() + ribField.computedPixels();
     result.counts.rows = result.fishbone.rows;
