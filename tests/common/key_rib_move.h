@@ -44,9 +44,9 @@ inline double largestKeyRibMove(const char* what, const Mesh& mesh, MeshRenderer
     const FishboneGrid& g0 = traced.fishbone;
     const int bc = g0.backboneColumn, r2 = 3 * g0.rows / 4;
     fb.keyRibs = {g0.at(g0.rows / 4, bc), g0.at(r2, bc)};
-    // Each key-rib starts at the backbone sample nearest its point: the second point 1 px before the
-    // midpoint of two samples, then moved by 1 px along the backbone across that midpoint (the worst case),
-    // and 1 px in eight directions from the sample itself.
+    // The second point 1 px before the midpoint of two backbone samples, then moved by 1 px along the
+    // backbone across that midpoint (the worst case where key-ribs start at the nearest sample,
+    // FishboneOptions::continuousKeyRibs off), and 1 px in eight directions from the sample itself.
     const Eigen::Vector2d along = (g0.at(r2 + 1, bc) - g0.at(r2, bc)).normalized();
     const Eigen::Vector2d beforeMid = 0.5 * (g0.at(r2, bc) + g0.at(r2 + 1, bc)) - 0.5 * along;
     double worst = 0;

@@ -294,6 +294,43 @@ TEST(Fishbone, KeyRibGridBlendsBetweenKeyRibs) {
     EXPECT_THROW(fss::keyRibFishbone(b, {KeyRib{40, {}}}, o), fss::InvalidInputError);
 }
 
+// Key-ribs between backbone samples (KeyRib::position, FishboneOptions::continuousKeyRibs): the row of sample
+// r between key-ribs at positions a < b is their blend with t = (r − a)/(b − a), and a key-rib moved along
+// the backbone by a quarter of h moves the grid by a fraction of that (no row jumps to another key-rib).
+TEST(Fishbone, KeyRibsBetweenSamplesBlendByTheirPositions) {
+    const double h = 2.0, R = 25.0, beta = 2 * std::asin(h / (2 * R));
+    const Backbone b = straightBackbone({100, 10}, {0, 1}, h, 40);
+    const Eigen::Vector2d n = b.normal(0);
+    FishboneOptions o;
+    o.spacing = h;
+    auto grid = [&](double pa, double pb) {
+        auto at = [&](double pos) { return Eigen::Vector2d(b.samples[0] + pos * h * Eigen::Vector2d(0, 1)); };
+        KeyRib a{std::size_t(std::lround(pa)),
+                 Rib{arcRib(at(pa), n, h, 0.0, 10), arcRib(at(pa), -n, h, 0.0, 10)}, pa};
+        KeyRib c{std::size_t(std::lround(pb)),
+                 Rib{arcRib(at(pb), n, h, beta, 10), arcRib(at(pb), -n, h, -beta, 10)}, pb};
+        return fss::keyRibFishbone(b, {c, a}, o);
+    };
+    const FishboneGrid g = grid(5.3, 24.6);
+    ASSERT_EQ(g.rows, 40);
+    for (int r = 0; r < 40; ++r) {
+        const double t = std::clamp((r - 5.3) / (24.6 - 5.3), 0.0, 1.0);
+        const Polyline2 expect = arcRib(b.samples[std::size_t(r)], n, h, t * beta, 10);
+        for (int c = 0; c <= 10; ++c)
+            ASSERT_LT((g.at(r, g.backboneColumn + c) - expect[std::size_t(c)]).norm(), 1e-9) << r << " " << c;
+    }
+    // Moved by h/4 along the backbone: every vertex moves by less than 0.1 h (about 0.09 px by the formula:
+    // row 24's t changes by 0.0124, its tenth vertex by 45·h·0.0124·β).
+    const FishboneGrid moved = grid(5.3, 24.85);
+    double most = 0;
+    for (std::size_t i = 0; i < g.screen.size(); ++i)
+        if (g.present[i] && moved.present[i]) most = std::max(most, (g.screen[i] - moved.screen[i]).norm());
+    EXPECT_LT(most, 0.1 * h);
+    EXPECT_GT(most, 0.0);
+    // A key-rib beyond the backbone's last sample is refused.
+    EXPECT_THROW(grid(5.3, 39.5), fss::InvalidInputError);
+}
+
 TEST(Fishbone, AutomaticGridOnSyntheticFields) {
     // Backbone field vertical, rib field horizontal (random signs): a square grid of spacing h.
     const int W = 120, H = 100;

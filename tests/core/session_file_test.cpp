@@ -120,6 +120,8 @@ void expectSame(const fss::ScanStep& a, const fss::ScanStep& b) {
         EXPECT_EQ(fa.tracing.spareFollowedCrease, fb.tracing.spareFollowedCrease);
         EXPECT_TRUE(sameBits(fa.tracing.minFaceAngleDeg, fb.tracing.minFaceAngleDeg));
         EXPECT_EQ(fa.tracing.minComponentFaces, fb.tracing.minComponentFaces);
+        EXPECT_EQ(fa.tracing.creaseBackbone, fb.tracing.creaseBackbone);
+        EXPECT_EQ(fa.tracing.continuousKeyRibs, fb.tracing.continuousKeyRibs);
         expectSame(fa.tracing.backboneTracing, fb.tracing.backboneTracing);
         expectSame(fa.tracing.ribTracing, fb.tracing.ribTracing);
         EXPECT_TRUE(sameBits(fa.minSeedAnisotropy, fb.minSeedAnisotropy));
@@ -505,9 +507,9 @@ TEST_F(BadSessionFile, FishboneSliverRulesAreOffWhenAbsentAndOnByDefault) {
     Json j = good_;
     Json& t = j["events"][1]["step"]["fishbone"]["tracing"];
     const std::vector<const char*> keys{
-        "min_rib_gap",           "max_rib_turn_deg",   "max_rib_aspect",           "stop_ribs_at_creases",
-        "spare_followed_crease", "close_loops",        "stop_backbone_at_creases", "isotropic_ribs",
-        "min_face_angle_deg",    "min_component_faces"};
+        "min_rib_gap",           "max_rib_turn_deg",    "max_rib_aspect",           "stop_ribs_at_creases",
+        "spare_followed_crease", "close_loops",         "stop_backbone_at_creases", "isotropic_ribs",
+        "min_face_angle_deg",    "min_component_faces", "crease_backbone",          "continuous_key_ribs"};
     for (const char* k : keys)
         ASSERT_TRUE(t.contains(k)) << k;
     const fss::FishboneOptions on = tracingOf(j);
@@ -515,6 +517,8 @@ TEST_F(BadSessionFile, FishboneSliverRulesAreOffWhenAbsentAndOnByDefault) {
     EXPECT_TRUE(on.spareFollowedCrease);
     EXPECT_EQ(on.minFaceAngleDeg, 22.5);
     EXPECT_EQ(on.minComponentFaces, 30);
+    EXPECT_TRUE(on.creaseBackbone);
+    EXPECT_TRUE(on.continuousKeyRibs);
     for (const char* k : keys)
         t.erase(k);
     const fss::FishboneOptions off = tracingOf(j);
@@ -528,12 +532,16 @@ TEST_F(BadSessionFile, FishboneSliverRulesAreOffWhenAbsentAndOnByDefault) {
     EXPECT_FALSE(off.isotropicRibs);
     EXPECT_EQ(off.minFaceAngleDeg, 0.0);
     EXPECT_EQ(off.minComponentFaces, 0);
+    EXPECT_FALSE(off.creaseBackbone);
+    EXPECT_FALSE(off.continuousKeyRibs);
     // New scans: the loop closing, the face-angle bound and the small-part drop are on (SliverTable's
     // figures, issue 20's report); the others stay off.
     const fss::FishboneOptions fresh;
     EXPECT_TRUE(fresh.closeLoops);
     EXPECT_EQ(fresh.minFaceAngleDeg, 20.0);
     EXPECT_EQ(fresh.minComponentFaces, 24);
+    EXPECT_TRUE(fresh.creaseBackbone);    // session 16: backbones on creases
+    EXPECT_TRUE(fresh.continuousKeyRibs); // and key-ribs between samples
     EXPECT_FALSE(fresh.stopRibsAtCreases);
     EXPECT_EQ(fresh.maxRibAspect, 0.0);
 }

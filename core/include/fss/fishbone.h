@@ -87,6 +87,22 @@ struct FishboneOptions {
     /// other way) stops before it. On by default (issue 20: the lens torus top view closes with no seam
     /// gap, 26.8 → 24.9 % of faces below 30° with the face bound below); false in files written before it.
     bool closeLoops = true;
+    /// Backbones on creases (issue 20): when the seed's surface point lies within 3h (pixel footprints) of a
+    /// sharp crease of the reference (FishboneParams::creaseAngleDeg > 0), the fishbone scan runs the
+    /// backbone along that crease's polyline, resampled every h footprints in 3D and stopped at its corners
+    /// and branches, where it is hidden or leaves the image (a closed crease seen whole gives a closed
+    /// backbone), instead of tracing the principal direction (which follows the noisy curvature of coarse
+    /// CAD tessellations, 3–36 h off the crease). Its automatic ribs leave it perpendicular to the crease and
+    /// walk straight on over the surface, stop at the next crease and are trimmed where their quads get
+    /// thinner than 1:1.5 or neighbours closer than h/2; key-ribs are traced as on any backbone. On by
+    /// default; false in files written before it.
+    bool creaseBackbone = true;
+    /// Key-ribs that move continuously (issue 20): the fishbone scan traces a picked key-rib from the point
+    /// of the backbone nearest to it (Backbone::nearestPoint, tracedKeyRib), not from the nearest backbone
+    /// sample, and blends the rows between key-ribs by their continuous positions (KeyRib::position), so
+    /// that moving a key-rib by a pixel moves the grid by about as much instead of jumping a row. On by
+    /// default; false in files written before it (ribs at the nearest sample).
+    bool continuousKeyRibs = true;
     /// The fishbone scan stops a traced backbone, outwards from its seed, before its first edge that
     /// crosses a visible crease of the reference at more than 30° (FishboneParams::creaseAngleDeg > 0; a
     /// crease it runs along does not stop it). A closed backbone so cut is open. false here and in files
@@ -121,6 +137,14 @@ struct FishboneOptions {
     void validate() const;
 };
 
+/// The point of a backbone's polyline nearest to a screen point (Backbone::nearestPoint).
+struct BackbonePoint {
+    double position = 0;           ///< samples: segment index + fraction along it
+    Eigen::Vector2d point{0, 0};   ///< on the polyline
+    Eigen::Vector2d tangent{1, 0}; ///< unit; the samples' tangents interpolated linearly
+    double distance = 0;           ///< from the query point
+};
+
 /// The backbone: samples every h along a streamline or a drawn spline.
 struct Backbone {
     Polyline2 samples;         ///< consecutive samples at distance h
@@ -135,6 +159,9 @@ struct Backbone {
     Eigen::Vector2d normal(std::size_t r) const;
     /// Index of the sample nearest to \p p (to place a key-rib at a picked point). \pre !samples.empty().
     std::size_t nearestSample(const Eigen::Vector2d& p) const;
+    /// The point of the polyline through the samples (open, also when closed) nearest to \p p, with its
+    /// continuous position and tangent (a continuous key-rib's start). \pre samples.size() ≥ 2.
+    BackbonePoint nearestPoint(const Eigen::Vector2d& p) const;
 };
 
 /// A rib through one backbone sample: both halves start at that sample (index 0) and continue every h.
@@ -147,6 +174,12 @@ struct Rib {
 struct KeyRib {
     std::size_t row = 0;
     Rib rib;
+    /// Where along the backbone the key-rib starts, in samples (sample r at r, the middle of samples r and
+    /// r + 1 at r + ½; tracedKeyRib): blended rows take t from it, so that the grid changes continuously
+    /// with the key-rib's position. Negative (the default): at sample `row`.
+    double position = -1;
+    /// `position` when it is set, else `row`.
+    double at() const { return position >= 0 ? position : double(row); }
 };
 
 /// One half of a rib in the paper's representation [E0, {αᵢ}] (see the file comment for the convention).
@@ -268,11 +301,20 @@ FishboneGrid assembleFishboneGrid(const Backbone& backbone, const std::vector<Ri
 FishboneGrid automaticFishbone(const DirectionField& backboneField, const DirectionField& ribField,
                                const Eigen::Vector2d& seed, const FishboneOptions& options = {});
 
+/// A key-rib traced from the point of \p backbone nearest to \p p (Backbone::nearestPoint) along the
+/// backbone's interpolated normal there, on \p ribField; its position is that point's, its row the
+/// nearest sample. \throw InvalidInputError as traceRib.
+KeyRib tracedKeyRib(const DirectionField& ribField, const Backbone& backbone, const Eigen::Vector2d& p,
+                    const FishboneOptions& options);
+
 /// Key-rib mode (DESIGN.md §1, key-ribs and blended ribs): ribs only at the given key-ribs, blended
 /// ribs between neighbouring key-ribs, copies of the nearest key-rib beyond the first and last
-/// (options.extendBeyondKeyRibs) or no rows there. Of several key-ribs at one row the last given wins.
+/// (options.extendBeyondKeyRibs) or no rows there. Of several key-ribs at one position the last given wins.
+/// The row of backbone sample r between key-ribs at positions a < b (KeyRib::at) is their blend with
+/// t = (r − a)/(b − a); a key-rib exactly at a sample is that row as it is.
 /// Entries outside the image [0, width] × [0, height] are absent (width or height ≤ 0: no test).
-/// \pre at least one key-rib; every key row < backbone.samples.size(); backbone ≥ 2 samples.
+/// \pre at least one key-rib; every key row and position ≤ backbone.samples.size() − 1; backbone ≥ 2
+/// samples.
 /// \throw InvalidInputError otherwise.
 FishboneGrid keyRibFishbone(const Backbone& backbone, std::vector<KeyRib> keyRibs,
                             const FishboneOptions& options = {}, int width = 0, int height = 0);

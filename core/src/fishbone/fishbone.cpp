@@ -102,6 +102,18 @@ std::size_t Backbone::nearestSample(const Eigen::Vector2d& p) const {
     return best;
 }
 
+BackbonePoint Backbone::nearestPoint(const Eigen::Vector2d& p) const {
+    requireBackbone(*this);
+    const Closest c = closestOnPolyline(samples, p);
+    BackbonePoint b;
+    b.position = double(c.segment) + c.t;
+    b.point = samples[c.segment] + c.t * (samples[c.segment + 1] - samples[c.segment]);
+    const Eigen::Vector2d t = (1 - c.t) * tangent(c.segment) + c.t * tangent(c.segment + 1);
+    b.tangent = t.norm() > 0 ? Eigen::Vector2d(t.normalized()) : tangent(c.segment);
+    b.distance = c.distance;
+    return b;
+}
+
 std::size_t FishboneGrid::presentCount() const {
     std::size_t n = 0;
     for (auto p : present)
@@ -445,6 +457,21 @@ Rib traceRib(const DirectionField& ribField, const Backbone& backbone, std::size
     return traceRibs(ribField, backbone, row, 1, options).front();
 }
 
+KeyRib tracedKeyRib(const DirectionField& ribField, const Backbone& backbone, const Eigen::Vector2d& p,
+                    const FishboneOptions& options) {
+    requireSpacing(options.spacing);
+    const BackbonePoint at = backbone.nearestPoint(p);
+    // A three-sample backbone whose middle sample is the start, with the interpolated tangent there.
+    Backbone local;
+    const Eigen::Vector2d d = 0.5 * options.spacing * at.tangent;
+    local.samples = {at.point - d, at.point, at.point + d};
+    KeyRib key;
+    key.rib = traceRib(ribField, local, 1, options);
+    key.position = at.position;
+    key.row = std::min(std::size_t(std::lround(at.position)), backbone.samples.size() - 1);
+    return key;
+}
+
 KeyRib drawnKeyRib(const Backbone& backbone, const Polyline2& points, const FishboneOptions& options) {
     requireSpacing(options.spacing);
     requireBackbone(backbone);
@@ -597,24 +624,25 @@ FishboneGrid keyRibFishbone(const Backbone& backbone, std::vector<KeyRib> keyRib
     requireBackbone(backbone);
     if (keyRibs.empty()) throw InvalidInputError("The key-rib mode needs at least one key-rib.");
     for (const KeyRib& k : keyRibs)
-        if (k.row >= backbone.samples.size())
-            throw InvalidInputError("A key-rib sits at backbone sample " + std::to_string(k.row) +
+        if (k.row >= backbone.samples.size() || !(k.at() <= double(backbone.samples.size() - 1)))
+            throw InvalidInputError("A key-rib sits at backbone sample " + std::to_string(k.at()) +
                                     ", but the backbone has only " + std::to_string(backbone.samples.size()) +
                                     " samples.");
-    // Sorted by row; of several key-ribs on one row the last given wins.
+    // Sorted by position; of several key-ribs at one position the last given wins.
     std::stable_sort(keyRibs.begin(), keyRibs.end(),
-                     [](const KeyRib& a, const KeyRib& b) { return a.row < b.row; });
+                     [](const KeyRib& a, const KeyRib& b) { return a.at() < b.at(); });
     std::vector<KeyRib> keys;
     for (KeyRib& k : keyRibs) {
-        if (!keys.empty() && keys.back().row == k.row)
+        if (!keys.empty() && keys.back().at() == k.at())
             keys.back() = std::move(k);
         else
             keys.push_back(std::move(k));
     }
 
     const double h = options.spacing;
-    const std::size_t first = options.extendBeyondKeyRibs ? 0 : keys.front().row;
-    const std::size_t last = options.extendBeyondKeyRibs ? backbone.samples.size() - 1 : keys.back().row;
+    const std::size_t first = options.extendBeyondKeyRibs ? 0 : std::size_t(std::ceil(keys.front().at()));
+    const std::size_t last =
+        options.extendBeyondKeyRibs ? backbone.samples.size() - 1 : std::size_t(std::floor(keys.back().at()));
     Backbone part; // open: key-ribs are blended along the backbone, not across a closed backbone's seam
     part.samples.assign(backbone.samples.begin() + std::ptrdiff_t(first),
                         backbone.samples.begin() + std::ptrdiff_t(last) + 1);
@@ -624,10 +652,10 @@ FishboneGrid keyRibFishbone(const Backbone& backbone, std::vector<KeyRib> keyRib
     ribs.reserve(part.samples.size());
     std::size_t next = 0; // first key with row ≥ r
     for (std::size_t r = first; r <= last; ++r) {
-        while (next < keys.size() && keys[next].row < r)
+        while (next < keys.size() && keys[next].at() < double(r))
             ++next;
         const Eigen::Vector2d& p0 = backbone.samples[r];
-        if (next < keys.size() && keys[next].row == r) {
+        if (next < keys.size() && keys[next].at() == double(r)) {
             ribs.push_back(keys[next].rib);
         } else if (next == 0) {
             ribs.push_back(blendRibs(keys.front().rib, keys.front().rib, p0, 0.0, h));
@@ -636,7 +664,7 @@ FishboneGrid keyRibFishbone(const Backbone& backbone, std::vector<KeyRib> keyRib
         } else {
             const KeyRib& a = keys[next - 1];
             const KeyRib& b = keys[next];
-            const double t = double(r - a.row) / double(b.row - a.row);
+            const double t = (double(r) - a.at()) / (b.at() - a.at());
             ribs.push_back(blendRibs(a.rib, b.rib, p0, t, h));
         }
     }

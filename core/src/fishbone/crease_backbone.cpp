@@ -1,0 +1,233 @@
+#include "fishbone/crease_backbone.h"
+
+#include "mesh/features.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <numbers>
+
+namespace fss::detail {
+namespace {
+
+// A crease chain as an arc-length parametrised 3D polyline (closed: its first and last points coincide).
+class Chain {
+public:
+    explicit Chain(std::vector<Eigen::Vector3d> points) : p_(std::move(points)), arc_(p_.size(), 0.0) {
+        for (std::size_t i = 1; i < p_.size(); ++i)
+            arc_[i] = arc_[i - 1] + (p_[i] - p_[i - 1]).norm();
+        closed_ = p_.size() > 3 && (p_.front() - p_.back()).norm() <= 1e-12 * (1.0 + arc_.back());
+    }
+    double length() const { return arc_.back(); }
+    bool closed() const { return closed_; }
+    /// The point at arc length \p s (a closed chain wraps around; an open one is clamped).
+    Eigen::Vector3d at(double s) const {
+        const double L = length();
+        if (closed_ && L > 0) s -= L * std::floor(s / L);
+        s = std::clamp(s, 0.0, L);
+        const std::size_t i = std::min<std::size_t>(
+            std::size_t(std::upper_bound(arc_.begin(), arc_.end(), s) - arc_.begin()), p_.size() - 1);
+        const std::size_t a = i == 0 ? 0 : i - 1;
+        const double len = arc_[i] - arc_[a];
+        return len > 0 ? Eigen::Vector3d(p_[a] + (s - arc_[a]) / len * (p_[i] - p_[a])) : p_[a];
+    }
+    /// The arc length of the point of the chain nearest to \p q, and its distance.
+    std::pair<double, double> nearest(const Eigen::Vector3d& q) const {
+        double best = std::numeric_limits<double>::infinity(), where = 0;
+        for (std::size_t i = 0; i + 1 < p_.size(); ++i) {
+            const Eigen::Vector3d d = p_[i + 1] - p_[i];
+            const double len2 = d.squaredNorm();
+            const double t = len2 > 0 ? std::clamp((q - p_[i]).dot(d) / len2, 0.0, 1.0) : 0.0;
+            const double dist = (p_[i] + t * d - q).norm();
+            if (dist < best) {
+                best = dist;
+                where = arc_[i] + t * std::sqrt(len2);
+            }
+        }
+        return {where, best};
+    }
+
+private:
+    std::vector<Eigen::Vector3d> p_;
+    std::vector<double> arc_;
+    bool closed_ = false;
+};
+
+// The walk along a chain from arc length s0 one way (dir = ±1), every h footprints, until one of
+// creaseBackbone's stops or until \p budget of arc length is used. Returns the arc lengths of the samples
+// after s0.
+std::vector<double> walk(const CreaseBackboneInput& in, const Chain& chain, double s0, int dir,
+                         double budget) {
+    const Camera& cam = in.camera;
+    const double cosCorner = std::cos(45.0 * std::numbers::pi / 180.0);
+    auto screen = [&](const Eigen::Vector3d& q) { return Eigen::Vector2d(cam.project(q).head<2>()); };
+    auto visible = [&](const Eigen::Vector3d& q) {
+        if (!(cam.viewDepth(q) > 0)) return false;
+        const Eigen::Vector2d s = screen(q);
+        if (!s.allFinite() || s.x() < 0 || s.y() < 0 || s.x() > cam.width || s.y() > cam.height) return false;
+        const SurfacePoint hit = in.caster->intersect(cam.ray(s.x(), s.y()));
+        return hit && (hit.point - q).norm() <= cam.pixelFootprint(q);
+    };
+    std::vector<double> out;
+    double s = s0, used = 0, screenLength = 0;
+    Eigen::Vector3d previous = Eigen::Vector3d::Zero();
+    for (;;) {
+        const Eigen::Vector3d q = chain.at(s);
+        const double step = in.spacing * cam.pixelFootprint(q);
+        if (!(step > 0) || used + step > budget) break;
+        const double next = s + dir * step;
+        if (!chain.closed() && (next < 0 || next > chain.length())) break;
+        const Eigen::Vector3d qn = chain.at(next), edge = qn - q;
+        if (!previous.isZero() && edge.dot(previous) < cosCorner * edge.norm() * previous.norm()) break;
+        const double onScreen = (screen(qn) - screen(q)).norm();
+        // A crease seen end-on: its samples crowd on the screen and the backbone's tangent is undefined.
+        if (onScreen < 0.3 * in.spacing || !visible(qn)) break;
+        screenLength += onScreen;
+        if (screenLength > in.maxLength && !chain.closed()) break; // a closed chain is bounded by itself
+        out.push_back(next);
+        s = next;
+        used += step;
+        previous = edge;
+    }
+    return out;
+}
+
+} // namespace
+
+std::optional<CreaseBackbone> creaseBackbone(const CreaseBackboneInput& in, const Eigen::Vector2d& seed) {
+    if (!in.mesh || !in.creaseEdges || !in.caster || in.creaseEdges->empty() || !(in.spacing > 0))
+        return std::nullopt;
+    const Camera& cam = in.camera;
+    const SurfacePoint seedHit = in.caster->intersect(cam.ray(seed.x(), seed.y()));
+    if (!seedHit) return std::nullopt;
+    const Mesh& mesh = *in.mesh;
+    std::vector<char> sharp(mesh.number_of_edges() + mesh.number_of_removed_edges(), 0);
+    for (EdgeIndex e : *in.creaseEdges)
+        sharp[e.idx()] = 1;
+    // Chains between corners and branches only (no split where the faces' bisector turns: a closed ridge
+    // turns it all the way round).
+    std::optional<Chain> best;
+    double bestDistance = in.snapDistance * in.spacing * cam.pixelFootprint(seedHit.point), s0 = 0;
+    for (CreaseChain& c : creaseChains(mesh, sharp, 180.0)) {
+        if (c.points.size() < 2) continue;
+        Chain chain(std::move(c.points));
+        const auto [where, distance] = chain.nearest(seedHit.point);
+        if (distance <= bestDistance) {
+            bestDistance = distance;
+            s0 = where;
+            best = std::move(chain);
+        }
+    }
+    if (!best) return std::nullopt;
+    const Chain& chain = *best;
+    const Eigen::Vector3d start = chain.at(s0);
+    {
+        const Eigen::Vector3d s = cam.project(start);
+        const SurfacePoint hit = in.caster->intersect(cam.ray(s.x(), s.y()));
+        if (!hit || (hit.point - start).norm() > cam.pixelFootprint(start)) return std::nullopt;
+    }
+    CreaseBackbone out;
+    Backbone& b = out.backbone;
+    auto add = [&](double s) {
+        out.points.push_back(chain.at(s));
+        b.samples.emplace_back(cam.project(out.points.back()).head<2>());
+    };
+    const double L = chain.length();
+    const double inf = std::numeric_limits<double>::infinity();
+    std::vector<double> forward = walk(in, chain, s0, 1, chain.closed() ? L : inf);
+    if (chain.closed() && !forward.empty()) {
+        const double covered = forward.back() - s0;
+        const double step = covered / double(forward.size());
+        if (covered + step >= L - 0.5 * step) { // all the way round: a closed backbone of equal arcs
+            const std::size_t n = std::max<std::size_t>(3, std::size_t(std::lround(L / step)));
+            for (std::size_t k = 0; k < n; ++k)
+                add(s0 + L * double(k) / double(n));
+            b.closed = true;
+            return out;
+        }
+    }
+    const double used = forward.empty() ? 0.0 : forward.back() - s0;
+    const std::vector<double> backward = walk(
+        in, chain, s0, -1, chain.closed() ? L - used - 0.5 * in.spacing * cam.pixelFootprint(start) : inf);
+    for (std::size_t k = backward.size(); k-- > 0;)
+        add(backward[k]);
+    b.seedIndex = backward.size();
+    add(s0);
+    for (double s : forward)
+        add(s);
+    if (b.samples.size() < 2) return std::nullopt;
+    return out;
+}
+
+namespace {
+
+// The unit normal of face \p f.
+Eigen::Vector3d unitNormal(const Mesh& m, FaceIndex f) {
+    std::array<Eigen::Vector3d, 3> v;
+    int k = 0;
+    for (VertexIndex x : m.vertices_around_face(m.halfedge(f)))
+        v[std::size_t(k++)] = Eigen::Vector3d(m.point(x).x(), m.point(x).y(), m.point(x).z());
+    return (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+}
+
+} // namespace
+
+std::vector<Rib> creaseRibs(const CreaseBackboneInput& in, const CreaseBackbone& crease) {
+    const Camera& cam = in.camera;
+    const Backbone& b = crease.backbone;
+    const std::vector<Eigen::Vector3d>& q = crease.points;
+    const std::size_t n = q.size();
+    auto screen = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d(cam.project(p).head<2>()); };
+    // The visible surface under screen point s (front-facing), if any.
+    auto surfaceAt = [&](const Eigen::Vector2d& s) -> SurfacePoint {
+        if (!s.allFinite() || s.x() < 0 || s.y() < 0 || s.x() > cam.width || s.y() > cam.height) return {};
+        const Ray ray = cam.ray(s.x(), s.y());
+        SurfacePoint hit = in.caster->intersect(ray);
+        if (hit && !(unitNormal(*in.mesh, hit.face).dot(ray.direction) < 0)) hit = {};
+        return hit;
+    };
+    std::vector<Rib> ribs(n);
+    for (std::size_t r = 0; r < n; ++r) {
+        const Eigen::Vector2d p0 = b.samples[r], normal = b.normal(r);
+        ribs[r] = Rib{{p0}, {p0}};
+        const std::size_t prev = b.closed ? (r + n - 1) % n : (r == 0 ? 0 : r - 1);
+        const std::size_t next = b.closed ? (r + 1) % n : std::min(r + 1, n - 1);
+        const Eigen::Vector3d tangent = (q[next] - q[prev]).normalized();
+        const double step = in.spacing * cam.pixelFootprint(q[r]);
+        if (!tangent.allFinite() || !(step > 0)) continue;
+        for (const int side : {1, -1}) {
+            SurfacePoint at = surfaceAt(p0 + 0.5 * in.spacing * side * normal);
+            if (!at) continue;
+            // Perpendicular to the crease in the face beside it, towards this side on the screen.
+            Eigen::Vector3d n3 = unitNormal(*in.mesh, at.face), u = n3.cross(tangent).normalized();
+            if ((screen(q[r] + step * u) - p0).dot(side * normal) < 0) u = -u;
+            Polyline2& half = side > 0 ? ribs[r].positive : ribs[r].negative;
+            Eigen::Vector3d from = q[r];
+            double length = 0;
+            for (;;) {
+                // One step straight on, onto the surface under it: straight on a planar face, the surface's
+                // straightest line on a curved one. It ends off the surface, at a depth jump (the surface
+                // point farther than half a step from the step's end) and where its screen edges shrink.
+                const Eigen::Vector3d to = from + step * u;
+                if (!(cam.viewDepth(to) > 0)) break;
+                const Eigen::Vector2d s = screen(to);
+                const double edge = (s - half.back()).norm();
+                if (edge < 0.3 * in.spacing || length + edge > in.ribMaxLength) break;
+                const SurfacePoint hit = surfaceAt(s);
+                if (!hit || (hit.point - to).norm() > 0.5 * step) break;
+                length += edge;
+                half.push_back(s);
+                n3 = unitNormal(*in.mesh, hit.face);
+                const Eigen::Vector3d along = (hit.point - from) - (hit.point - from).dot(n3) * n3;
+                if (!(along.norm() > 0)) break;
+                u = along.normalized();
+                from = hit.point;
+            }
+        }
+    }
+    return ribs;
+}
+
+} // namespace fss::detail
