@@ -44,6 +44,7 @@ inline double largestKeyRibMove(const char* what, const Mesh& mesh, MeshRenderer
     const FishboneGrid& g0 = traced.fishbone;
     const int bc = g0.backboneColumn, r2 = 3 * g0.rows / 4;
     fb.keyRibs = {g0.at(g0.rows / 4, bc), g0.at(r2, bc)};
+    fb.tracing.continuousKeyRibs = true; // the 2 px criterion holds with continuous key-ribs only
     // The second point 1 px before the midpoint of two backbone samples, then moved by 1 px along the
     // backbone across that midpoint (the worst case where key-ribs start at the nearest sample,
     // FishboneOptions::continuousKeyRibs off), and 1 px in eight directions from the sample itself.

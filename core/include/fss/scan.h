@@ -198,8 +198,9 @@ LatticeBasis chooseAdaptiveLattice(const FrameBuffers& referenceBuffers, const M
 /// equilateral with side spacing × the pixel footprint on the plane of the face under the pixel (the
 /// linearised map of latticeAngleOnPlane), turned to be closest to the affine basis; the positions are
 /// the weighted least-squares fit of the grid's edges (a, b, a + b in (row, column)) to those local
-/// bases (Poisson: 2 direct rounds on every 8th row and column, bases re-read, then 50 CG steps on every 4th).
-/// Uncovered pixels keep the affine basis with a small weight. Deterministic, the same for any thread count.
+/// bases (Poisson: 2 direct rounds on every 8th row and column, bases re-read, then 50 CG steps on every
+/// 4th). Uncovered pixels keep the affine basis with a small weight. Deterministic, the same for any thread
+/// count.
 std::vector<Eigen::Vector2d> warpLatticeToSurface(const FrameBuffers& referenceBuffers, const Mesh& reference,
                                                   double spacing, const LatticeBasis& basis,
                                                   const Eigen::Vector2d& origin, int rows, int cols);

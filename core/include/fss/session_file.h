@@ -86,8 +86,12 @@ namespace fss {
 /// files load and replay with it, so their results differ from the ones they were recorded with. Version 3
 /// (issue #20): "scan.warp_to_surface" (ScanOptions::warpToSurface, on by default) is always written;
 /// absent = off, so version 1 and 2 files replay as before. An FSS reading versions up to 2 refuses a
-/// version 3 file ("version is 3, but this FSS reads versions 1 to 2 only").
-inline constexpr int kSessionFileVersion = 3;
+/// version 3 file ("version is 3, but this FSS reads versions 1 to 2 only"). Version 4 (issue #20, session
+/// 16): fishbone steps carry "tracing.crease_backbone" and "tracing.continuous_key_ribs" (on by default,
+/// written only when on, absent = off, so older files replay their fishbone scans as recorded); the warp's
+/// solver and the seam band's outlier-cap rule changed, so version 1 to 3 files replay to different bytes
+/// than before.
+inline constexpr int kSessionFileVersion = 4;
 
 /// A session file in memory.
 struct SessionFile {

@@ -462,8 +462,7 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
 
     progress.report(0.4, "tracing");
     t = Clock::now();
-    // The visible creases, made once when needed: for the crease following of the backbone, and (with the ray
-    // test of visibleCreases) for the stops of issue 20.
+    // The visible creases, made once when needed: for the backbone's crease following and issue 20's stops.
     std::optional<CreaseIndex> creaseIndex, stopIndex;
     auto index = [&](std::optional<CreaseIndex>& i, const RayCaster* rays) -> const CreaseIndex& {
         if (!i) {
