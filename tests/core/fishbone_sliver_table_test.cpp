@@ -45,27 +45,8 @@ std::vector<std::vector<Vector3d>> creaseChains(const Mesh& m, fss::FishboneCach
     }
     std::vector<char> used(m.number_of_edges(), 0);
     std::vector<std::vector<Vector3d>> chains;
-    for (auto v : m.vertices()) {
-        const auto& hs = out[v.idx()];
-        if (hs.empty() || hs.size() == 2) continue;
-        for (auto h : hs) {
-            if (used[m.edge(h).idx()]) continue;
-            std::vector<Vector3d> chain{pt(m, m.source(h))};
-            for (;;) {
-                used[m.edge(h).idx()] = 1;
-                chain.push_back(pt(m, m.target(h)));
-                const auto& next = out[m.target(h).idx()];
-                if (next.size() != 2) break;
-                h = m.edge(next[0]) == m.edge(h) ? next[1] : next[0];
-                if (used[m.edge(h).idx()]) break;
-            }
-            chains.push_back(std::move(chain));
-        }
-    }
-    // Closed loops (every vertex with two sharp edges): from any unused sharp edge round to it.
-    for (auto e : sharp) {
-        if (used[e.idx()]) continue;
-        auto h = m.halfedge(e);
+    // Along sharp edges from h through vertices with two of them, to a chain end or back to an edge walked.
+    auto walk = [&](fss::HalfedgeIndex h) {
         std::vector<Vector3d> chain{pt(m, m.source(h))};
         for (;;) {
             used[m.edge(h).idx()] = 1;
@@ -75,7 +56,20 @@ std::vector<std::vector<Vector3d>> creaseChains(const Mesh& m, fss::FishboneCach
             h = m.edge(next[0]) == m.edge(h) ? next[1] : next[0];
             if (used[m.edge(h).idx()]) break;
         }
-        chains.push_back(std::move(chain));
+        return chain;
+    };
+    for (auto v : m.vertices()) {
+        const auto& hs = out[v.idx()];
+        if (hs.empty() || hs.size() == 2) continue;
+        for (auto h : hs) {
+            if (used[m.edge(h).idx()]) continue;
+            chains.push_back(walk(h));
+        }
+    }
+    // Closed loops (every vertex with two sharp edges): from any unused sharp edge round to it.
+    for (auto e : sharp) {
+        if (used[e.idx()]) continue;
+        chains.push_back(walk(m.halfedge(e)));
     }
     return chains;
 }
