@@ -23,6 +23,8 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 using fss::Mesh;
@@ -271,6 +273,39 @@ TEST(Metrics, ValenceAndMinAngleAreComputeMetricsFigures) {
     }
     EXPECT_EQ(fss::valenceAndMinAngle(pinched).minAngleDeg, 0.0);                      // the collinear face
     EXPECT_EQ(fss::valenceAndMinAngle(meshes[0]).fracValence6Interior, 630.0 / 642.0); // 12 of valence 5
+}
+
+// valenceAndMinAngle reports every kFiguresProgressFaces faces of its angle loop and stops when its progress
+// asks: a stop at the second report in the loop leaves it after exactly kFiguresProgressFaces faces; a
+// progress that never stops changes no figure.
+TEST(Metrics, ValenceAndMinAngleStopsWhenAsked) {
+    const Mesh torus = fss::shapes::torus(200, 100, 1.0, 0.4); // 40000 faces: 10 reports in the angle loop
+    const double faces = double(torus.number_of_faces());
+    std::vector<std::pair<std::string, double>> seen;
+    const fss::Progress all([&](double f, std::string_view stage) {
+        seen.emplace_back(std::string(stage), f);
+        return true;
+    });
+    const fss::ValenceAndMinAngle whole = fss::valenceAndMinAngle(torus, all);
+    const fss::ValenceAndMinAngle plain = fss::valenceAndMinAngle(torus);
+    EXPECT_EQ(whole.fracValence6Interior, plain.fracValence6Interior);
+    EXPECT_EQ(whole.minAngleDeg, plain.minAngleDeg);
+    ASSERT_EQ(seen.size(), 2u + 10u); // "valence", 10 in the loop (0, 4096, … 36864), the final 1
+    EXPECT_EQ(seen.front().first, "valence");
+    for (std::size_t k = 0; k < 10; ++k)
+        EXPECT_EQ(seen[1 + k].second, double(k * fss::kFiguresProgressFaces) / faces) << k;
+    EXPECT_EQ(seen.back().second, 1.0);
+
+    std::size_t loopReports = 0;
+    double stoppedAt = -1;
+    const fss::Progress stop([&](double f, std::string_view stage) {
+        if (stage != "smallest angle") return true;
+        stoppedAt = f;
+        return ++loopReports < 2;
+    });
+    EXPECT_THROW(fss::valenceAndMinAngle(torus, stop), fss::CancelledError);
+    EXPECT_EQ(loopReports, 2u);
+    EXPECT_EQ(stoppedAt * faces, double(fss::kFiguresProgressFaces));
 }
 
 TEST(Metrics, PinchedVertexIsNonManifold) {

@@ -8,7 +8,9 @@
 #include <fss/camera.h>
 #include <fss/mask.h>
 #include <fss/mesh_io.h>
+#include <fss/metrics.h>
 #include <fss/shapes.h>
+#include <fss/widgets/figures_measurer.h>
 #include <fss/widgets/fishbone_tool.h>
 #include <fss/widgets/lasso_tool.h>
 #include <fss/widgets/quality_panel.h>
@@ -52,6 +54,8 @@
 #include <memory>
 #include <numbers>
 #include <set>
+#include <stop_token>
+#include <thread>
 #include <utility>
 
 namespace PMP = CGAL::Polygon_mesh_processing;
@@ -977,6 +981,47 @@ private slots:
         QVERIFY(w->trialMesh() || trialDone.wait(120000));
         QVERIFY(w->trialMesh());
         QCOMPARE(w->trialReport()->facesAdded > 0, true);
+    }
+
+    // The trials' whole-mesh measure stops when a newer one is requested (a user who scans again on a large
+    // mesh no longer waits for the abandoned trial's measure): a measure of 1M faces on a worker thread,
+    // then another request on this thread. Counted in faces, not timed: the first one measured fewer than
+    // all of its faces and gave no figures; the second one's figures are valenceAndMinAngle's.
+    void figuresMeasureIsStoppedByANewerRequest() {
+        const fss::Mesh big = fss::shapes::torus(1000, 500, 1.0, 0.4);
+        const fss::Mesh small = fss::shapes::icosphere(3);
+        QCOMPARE(std::size_t(big.number_of_faces()), std::size_t(1000000));
+        fss::widgets::FiguresMeasurer measurer;
+        fss::widgets::FiguresResult first;
+        std::thread worker([&] { first = measurer.measure(big); });
+        while (measurer.requests() == 0)
+            std::this_thread::yield(); // the first request has begun (it may not have measured a face yet)
+        const fss::widgets::FiguresResult second = measurer.measure(small);
+        worker.join();
+        QVERIFY(!first.figures);
+        QVERIFY(first.facesMeasured < big.number_of_faces());
+        QCOMPARE(first.facesMeasured % fss::kFiguresProgressFaces, std::size_t(0)); // stopped at a check
+        QVERIFY(second.figures);
+        QCOMPARE(second.facesMeasured, std::size_t(small.number_of_faces()));
+        const fss::ValenceAndMinAngle expected = fss::valenceAndMinAngle(small);
+        QCOMPARE(second.figures->valence6, expected.fracValence6Interior);
+        QCOMPARE(second.figures->minAngle, expected.minAngleDeg);
+        qInfo("the first measure ended after %zu of %zu faces", first.facesMeasured,
+              std::size_t(big.number_of_faces()));
+        // A request whose own token is stopped ends at once and leaves a running one alone; stop() ends
+        // the running one.
+        std::stop_source cancelled;
+        cancelled.request_stop();
+        QCOMPARE(measurer.measure(big, cancelled.get_token()).facesMeasured, std::size_t(0));
+        QCOMPARE(measurer.requests(), std::size_t(2));
+        fss::widgets::FiguresResult third;
+        std::thread again([&] { third = measurer.measure(big); });
+        while (measurer.requests() == 2)
+            std::this_thread::yield();
+        measurer.stop();
+        again.join();
+        QVERIFY(!third.figures);
+        QVERIFY(third.facesMeasured < big.number_of_faces());
     }
 
     // The widget's accept latency with the trial's result (figures) and without (accept at once: the trial is

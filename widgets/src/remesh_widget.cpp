@@ -8,6 +8,7 @@
 #include "fss/render/fem_io.h"
 #include "fss/replay.h"
 #include "fss/session_file.h"
+#include "fss/widgets/figures_measurer.h"
 #include "fss/widgets/fishbone_tool.h"
 #include "fss/widgets/lasso_tool.h"
 #include "fss/widgets/quality_panel.h"
@@ -44,6 +45,7 @@
 #include <functional>
 #include <mutex>
 #include <optional>
+#include <stop_token>
 #include <string>
 
 namespace fss::widgets {
@@ -52,7 +54,7 @@ namespace {
 
 // State shared between the GUI thread and one worker job.
 struct Job {
-    std::atomic<bool> cancel{false};
+    std::stop_source stop; // Cancel
     std::atomic<double> fraction{0.0};
     std::mutex mutex;
     std::string stage;
@@ -113,15 +115,10 @@ double meanEdgeLength(const Mesh& mesh) {
 }
 
 // Whole-mesh figures shown before → after an accept (computeMetrics' figures, without its other measures:
-// twice per accept, so they cost a fraction of its time).
-struct MeshFigures {
-    double valence6 = 0; // fraction of interior vertices with valence 6
-    double minAngle = 0; // smallest corner angle, degrees
-};
-
-MeshFigures figuresOf(const Mesh& mesh) {
-    const ValenceAndMinAngle m = valenceAndMinAngle(mesh);
-    return {m.fracValence6Interior, m.minAngleDeg};
+// twice per accept, so they cost a fraction of its time): \p result's, or CancelledError when it was stopped.
+MeshFigures figuresOf(const FiguresResult& result) {
+    if (!result.figures) throw CancelledError();
+    return *result.figures;
 }
 
 // One trial stitch (see the file comment of remesh_widget.h), shared by the GUI and the trial's thread. The
@@ -130,7 +127,8 @@ MeshFigures figuresOf(const Mesh& mesh) {
 struct Trial {
     const Session* session = nullptr; // the preview it is for: session and scan id
     std::int32_t scanId = 0;
-    std::atomic<bool> cancel{false};
+    std::stop_source stop;                     // Cancel, a newer preview, an accept
+    std::shared_ptr<FiguresMeasurer> measurer; // the widget's: its whole-mesh measures stop when asked
     std::atomic<double> fraction{0.0};
     Mesh mesh; // the current mesh, stitched in place
     Mesh patch;
@@ -150,15 +148,15 @@ struct Trial {
         const auto start = std::chrono::steady_clock::now();
         const Progress progress([this](double f, std::string_view) {
             fraction = f;
-            return !cancel.load();
+            return !stop.stop_requested();
         });
         try {
-            before = figuresOf(mesh);
+            before = figuresOf(measurer->measure(mesh, stop.get_token()));
             progress.report(0.0, "stitch");
             report = stitchPatch(mesh, patch, camera, options, faceIds, progress, &stitched);
             if (mesh.has_garbage()) mesh.collect_garbage();
             progress.report(0.95, "figures");
-            after = figuresOf(mesh);
+            after = figuresOf(measurer->measure(mesh, stop.get_token()));
         } catch (const CancelledError&) {
             cancelled = true;
         } catch (const std::exception& e) {
@@ -279,6 +277,8 @@ struct RemeshWidget::Impl {
     // abandoned one: the next trial starts when it has ended).
     std::shared_ptr<Trial> trial;
     QThread* trialThread = nullptr;
+    // Measures the trials' whole-mesh figures (a newer trial's measure stops an older one's).
+    std::shared_ptr<FiguresMeasurer> figures = std::make_shared<FiguresMeasurer>();
 };
 
 RemeshWidget::RemeshWidget(QWidget* parent) : QWidget(parent), d_(std::make_unique<Impl>()) {
@@ -522,8 +522,8 @@ void RemeshWidget::createToolBar() {
 
 RemeshWidget::~RemeshWidget() {
     d_->view->removeEventFilter(this); // the view outlives d_
-    if (d_->job) d_->job->cancel = true;
-    if (d_->trial) d_->trial->cancel = true;
+    if (d_->job) d_->job->stop.request_stop();
+    if (d_->trial) d_->trial->stop.request_stop();
     if (d_->thread) {
         d_->thread->wait();
         delete d_->thread; // its finished() handler will not run any more
@@ -698,7 +698,7 @@ void RemeshWidget::replayNext() {
     // Undo and redo here; a scan on the GUI thread (it needs the view's GL context), its stitch and the
     // reference's curvature on the worker thread.
     while (!replay->done()) {
-        if (d_->job->cancel.load()) return failReplay({});
+        if (d_->job->stop.stop_requested()) return failReplay({});
         const std::size_t i = replay->nextEvent();
         d_->job->base = double(i) / double(replay->eventCount());
         d_->job->span = 1.0 / double(replay->eventCount());
@@ -960,10 +960,12 @@ void RemeshWidget::accept() {
     stopTrial();
     setBusy(true, tr("Stitching the scan into the mesh"));
     startWork(
-        [s, report, figures, reuse](const Progress& progress) {
-            if (!reuse) figures->first = figuresOf(s->current());
+        [s, report, figures, reuse, stop = d_->job->stop.get_token()](const Progress& progress) {
+            // Cancel stops the measure before the stitch; the one after it runs to its end (the accept is
+            // committed by then).
+            if (!reuse) figures->first = figuresOf(FiguresMeasurer::measureAlone(s->current(), stop));
             *report = s->accept(progress);
-            if (!reuse) figures->second = figuresOf(s->current());
+            if (!reuse) figures->second = figuresOf(FiguresMeasurer::measureAlone(s->current()));
         },
         [this, report, name, figures] {
             const std::shared_ptr<Job> job = d_->job;
@@ -1000,7 +1002,7 @@ void RemeshWidget::startWork(std::function<void(const Progress&)> work, std::fun
                 job->stage = std::string(stage);
             }
             // Never cancel on the final report: the work is committed by then.
-            return f >= 1.0 || !job->cancel.load();
+            return f >= 1.0 || !job->stop.stop_requested();
         });
         try {
             work(progress);
@@ -1032,9 +1034,9 @@ void RemeshWidget::reject() {
 
 void RemeshWidget::cancel() {
     if (isBusy()) {
-        if (d_->job) d_->job->cancel = true;
+        if (d_->job) d_->job->stop.request_stop();
     } else if (d_->trial && d_->trialThread && !d_->trial->finished) {
-        d_->trial->cancel = true;
+        d_->trial->stop.request_stop();
     } else {
         return;
     }
@@ -1130,7 +1132,7 @@ void RemeshWidget::updateTrial() {
 }
 
 void RemeshWidget::stopTrial() {
-    if (d_->trial) d_->trial->cancel = true;
+    if (d_->trial) d_->trial->stop.request_stop();
     d_->trial.reset();
 }
 
@@ -1139,6 +1141,7 @@ void RemeshWidget::startTrial() {
     auto t = std::make_shared<Trial>();
     t->session = d_->session.get();
     t->scanId = p.step.params.scan.scanId;
+    t->measurer = d_->figures;
     // The inputs of Session::accept, copied: the thread never touches the session.
     t->mesh = d_->mesh;
     t->patch = p.patch.mesh;

@@ -111,12 +111,17 @@ Metrics computeMetrics(const Mesh& mesh, const MetricsOptions& options = {}, con
 /// of valence 6 and the smallest corner angle, exactly computeMetrics' fracValence6Interior and minAngleDeg
 /// (the same doubles), without its other measures and mostly without atan2 (a corner clearly wider than the
 /// smallest so far is skipped by a sign test): a fraction of computeMetrics' time on large meshes.
-/// \pre every face of \p mesh is a triangle. \throw InvalidInputError when a face is not a triangle.
+/// Reports progress through \p progress before the valences (0, stage "valence") and then every
+/// kFiguresProgressFaces faces of the angle loop (fraction = faces measured / faces, stage "smallest
+/// angle"; 1 at the end), so a caller on another thread can stop it (RemeshWidget's trials).
+/// \pre every face of \p mesh is a triangle. \throw InvalidInputError when a face is not a triangle;
+///      CancelledError through \p progress.
 struct ValenceAndMinAngle {
     double fracValence6Interior = 0; ///< as Metrics::fracValence6Interior
     double minAngleDeg = 0;          ///< as Metrics::minAngleDeg (0 for a mesh without faces)
 };
-ValenceAndMinAngle valenceAndMinAngle(const Mesh& mesh);
+inline constexpr std::size_t kFiguresProgressFaces = 4096;
+ValenceAndMinAngle valenceAndMinAngle(const Mesh& mesh, const Progress& progress = {});
 
 /// The metrics as one JSON object with the snake_case keys documented above, in declaration order, with
 /// null for unmeasured values (no trailing newline). \p indent < 0 gives a single line.

@@ -493,10 +493,11 @@ Metrics computeMetrics(const Mesh& mesh, const MetricsOptions& options, const Pr
     return out;
 }
 
-ValenceAndMinAngle valenceAndMinAngle(const Mesh& mesh) {
+ValenceAndMinAngle valenceAndMinAngle(const Mesh& mesh, const Progress& progress) {
     const DenseMesh dense(mesh);
     const Mesh& m = dense.get();
     requireTriangles(m, "mesh");
+    progress.report(0.0, "valence");
     Metrics counts;
     countInteriorValences(m, counts);
     ValenceAndMinAngle out;
@@ -519,13 +520,18 @@ ValenceAndMinAngle valenceAndMinAngle(const Mesh& mesh) {
         cosBest = std::cos(best);
         sinBest = std::sin(best);
     };
+    const double faces = double(m.number_of_faces());
+    std::size_t done = 0;
     for (FaceIndex f : m.faces()) {
+        if (done % kFiguresProgressFaces == 0) progress.report(double(done) / faces, "smallest angle");
+        ++done;
         const auto [a, b, c] = corners(m, f);
         const Vector3 ab = b - a, bc = c - b, ca = a - c;
         corner(ab, -ca);
         corner(bc, -ab);
         corner(ca, -bc);
     }
+    progress.report(1.0, "smallest angle");
     out.minAngleDeg = best * kRadToDeg;
     return out;
 }
