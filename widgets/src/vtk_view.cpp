@@ -1,394 +1,20 @@
-#include "fss/widgets/vtk_view.h"
-
-#include "fss/error.h"
-#include "fss/render/colour_maps.h"
-#include "fss/render/gpu_mesh_renderer.h"
-
-// GL constants come from Qt's qopengl.h (through QOpenGLWidget); vtk_glew.h cannot be combined with it
-// and is not needed: every GL call goes through VTK (vtkOpenGLState, the render window).
-#include <vtkActor.h>
-#include <vtkAxesActor.h>
-#include <vtkCamera.h>
-#include <vtkCellArray.h>
-#include <vtkCellData.h>
-#include <vtkCommand.h>
-#include <vtkGenericOpenGLRenderWindow.h>
-#include <vtkGenericRenderWindowInteractor.h>
-#include <vtkInteractorStyleTrackballCamera.h>
-#include <vtkLookupTable.h>
-#include <vtkNew.h>
-#include <vtkObjectFactory.h>
-#include <vtkOpenGLShaderCache.h>
-#include <vtkOpenGLState.h>
-#include <vtkOrientationMarkerWidget.h>
-#include <vtkPoints.h>
-#include <vtkPolyData.h>
-#include <vtkPolyDataMapper.h>
-#include <vtkProperty.h>
-#include <vtkRenderer.h>
-#include <vtkScalarBarActor.h>
-#include <vtkSmartPointer.h>
-#include <vtkTextProperty.h>
-#include <vtkUnsignedCharArray.h>
-#include <vtkVariant.h>
-
-#include <QKeyEvent>
-#include <QMouseEvent>
-#include <QOpenGLContext>
-#include <QPainter>
-#include <QPainterPath>
-#include <QPointer>
-#include <QSurfaceFormat>
-#include <QWheelEvent>
-#include <QtDebug>
-
-#include <algorithm>
-#include <array>
-#include <cmath>
-#include <cstdint>
-#include <functional>
-#include <limits>
-#include <string>
-#include <vector>
+// VtkView: construction, the OpenGL hand-over to VTK, the camera and the input events (vtk_view_impl.h holds
+// what VtkView's files share).
+#include "vtk_view_impl.h"
 
 namespace fss::widgets {
-namespace {
 
-// A vtkCommand calling a std::function: observers that capture the view.
-class FunctionCommand : public vtkCommand {
-public:
-    static FunctionCommand* New() { return new FunctionCommand; }
-    std::function<void(unsigned long event, void* callData)> callback;
-    void Execute(vtkObject*, unsigned long event, void* callData) override {
-        if (callback) callback(event, callData);
-    }
-};
-
-// VTK's trackball camera without its keyboard shortcuts: 'e'/'q' would call exit(), 'w'/'s' switch the
-// representation (and lose the edges), 'f'/'p' fly to and pick (timers and pickers the view does not
-// drive), '3' stereo. Only 'r' (reset the camera onto the mesh) is kept.
-class NavigationStyle : public vtkInteractorStyleTrackballCamera {
-public:
-    static NavigationStyle* New();
-    vtkTypeMacro(NavigationStyle, vtkInteractorStyleTrackballCamera);
-    void OnChar() override {
-        const char key = this->Interactor ? this->Interactor->GetKeyCode() : 0;
-        if (key == 'r' || key == 'R') vtkInteractorStyleTrackballCamera::OnChar();
-    }
-};
+namespace detail {
 vtkStandardNewMacro(NavigationStyle);
+} // namespace detail
 
-double cornerAngleDeg(const Point3& at, const Point3& a, const Point3& b) {
-    const Vector3 u = a - at, v = b - at;
-    const double lu = std::sqrt(u.squared_length()), lv = std::sqrt(v.squared_length());
-    if (lu == 0 || lv == 0) return 0;
-    return std::acos(std::clamp((u * v) / (lu * lv), -1.0, 1.0)) * 180.0 / M_PI;
-}
+namespace {
 
 Eigen::Vector3d toEigen(const double* p) {
     return {p[0], p[1], p[2]};
 }
 
-// The live vertices and faces of \p mesh as VTK points and polygons (dense VTK ids, faces in the order of
-// mesh.faces(), so VTK cell i is the i-th live face). Extends \p bounds by every point when given.
-vtkSmartPointer<vtkPolyData> toPolyData(const Mesh& mesh, Eigen::AlignedBox3d* bounds = nullptr) {
-    vtkNew<vtkPoints> points;
-    points->SetDataTypeToDouble();
-    points->Allocate(vtkIdType(mesh.number_of_vertices()));
-    std::vector<vtkIdType> pointId(mesh.num_vertices(), -1); // num_vertices counts removed ones too
-    for (VertexIndex v : mesh.vertices()) {
-        const Point3& p = mesh.point(v);
-        pointId[std::size_t(v)] = points->InsertNextPoint(p.x(), p.y(), p.z());
-        if (bounds) bounds->extend(Eigen::Vector3d(p.x(), p.y(), p.z()));
-    }
-    vtkNew<vtkCellArray> polys;
-    polys->AllocateEstimate(vtkIdType(mesh.number_of_faces()), 3);
-    std::vector<vtkIdType> ids;
-    for (FaceIndex f : mesh.faces()) {
-        ids.clear();
-        for (VertexIndex v : mesh.vertices_around_face(mesh.halfedge(f)))
-            ids.push_back(pointId[std::size_t(v)]);
-        polys->InsertNextCell(vtkIdType(ids.size()), ids.data());
-    }
-    auto polyData = vtkSmartPointer<vtkPolyData>::New();
-    polyData->SetPoints(points);
-    polyData->SetPolys(polys);
-    return polyData;
-}
-
-// What a VtkView shares with the MeshRenderers it created: its GL context while VTK lives in it, and the
-// renderers to tell when that context goes away. Owned jointly, so a renderer may outlive the view.
-class ViewMeshRenderer;
-struct GlLink {
-    QOpenGLContext* context = nullptr; // the widget's context while VTK is initialised in it
-    QSurface* surface = nullptr;       // the surface the widget makes that context current with
-    std::vector<ViewMeshRenderer*> renderers;
-};
-
-// render::GlContext on a VtkView's QOpenGLContext. makeCurrent() uses QOpenGLContext::makeCurrent (never
-// QOpenGLWidget::makeCurrent, which would rebind the widget's framebuffer) and doneCurrent() makes the
-// previously current context current again (another view's, typically), or releases the context.
-class ViewGlContext final : public render::GlContext {
-public:
-    explicit ViewGlContext(std::shared_ptr<GlLink> link) : link_(std::move(link)) {}
-
-    void makeCurrent() override {
-        QOpenGLContext* context = link_->context;
-        if (!context)
-            throw Error("The 3D view has no OpenGL context: scans from the view need the widget shown "
-                        "(and not destroyed).");
-        QOpenGLContext* current = QOpenGLContext::currentContext();
-        if (current == context) return;
-        previous_ = current;
-        previousSurface_ = current ? current->surface() : nullptr;
-        if (!context->makeCurrent(link_->surface))
-            throw Error("The 3D view's OpenGL context could not be made current.");
-    }
-    bool isCurrent() const override {
-        return link_->context && QOpenGLContext::currentContext() == link_->context;
-    }
-    void doneCurrent() override {
-        QOpenGLContext* previous = previous_;
-        QSurface* previousSurface = previousSurface_;
-        previous_ = nullptr;
-        previousSurface_ = nullptr;
-        if (previous && previousSurface && previous->makeCurrent(previousSurface)) return;
-        if (link_->context && QOpenGLContext::currentContext() == link_->context)
-            link_->context->doneCurrent();
-    }
-
-private:
-    std::shared_ptr<GlLink> link_;
-    QPointer<QOpenGLContext> previous_;
-    QSurface* previousSurface_ = nullptr;
-};
-
-// The MeshRenderer of VtkView::createMeshRenderer: a GpuMeshRenderer in the view's context. Its GL
-// resources belong to one QOpenGLContext: when the view drops that context (re-parenting, destruction) it
-// calls releaseGl() with the context current, and the next render() builds a new GpuMeshRenderer in the
-// view's new context from the mesh of setMesh() (which MeshRenderer's contract keeps alive).
-class ViewMeshRenderer final : public MeshRenderer {
-public:
-    explicit ViewMeshRenderer(std::shared_ptr<GlLink> link) : link_(std::move(link)), context_(link_) {
-        link_->renderers.push_back(this);
-    }
-    ~ViewMeshRenderer() override {
-        auto& list = link_->renderers;
-        list.erase(std::remove(list.begin(), list.end(), this), list.end());
-        // GpuMeshRenderer frees its GL resources making the view's context current when it still exists.
-        gpu_.reset();
-    }
-    ViewMeshRenderer(const ViewMeshRenderer&) = delete;
-    ViewMeshRenderer& operator=(const ViewMeshRenderer&) = delete;
-
-    void setMesh(const Mesh& mesh) override {
-        if (mesh.number_of_faces() == 0) throw InvalidInputError("Cannot render a mesh without faces.");
-        if (!gpu_) gpu_ = std::make_unique<render::GpuMeshRenderer>(context_);
-        gpu_->setMesh(mesh); // copies and checks the mesh; touches GL only when GL was initialised
-        mesh_ = &mesh;
-    }
-
-    FrameBuffers render(const Camera& camera) override {
-        if (!mesh_) throw InvalidInputError("Cannot render a scan before a mesh was given (setMesh).");
-        if (!link_->context)
-            throw Error("The 3D view has no OpenGL context: scans from the view need the widget shown "
-                        "(and not destroyed).");
-        if (!gpu_) {
-            auto gpu = std::make_unique<render::GpuMeshRenderer>(context_);
-            gpu->setMesh(*mesh_);
-            gpu_ = std::move(gpu);
-        }
-        return gpu_->render(camera);
-    }
-
-    // Frees the GL resources in the view's context, which the caller has made current.
-    void releaseGl() { gpu_.reset(); }
-
-private:
-    std::shared_ptr<GlLink> link_;
-    ViewGlContext context_;
-    const Mesh* mesh_ = nullptr;
-    std::unique_ptr<render::GpuMeshRenderer> gpu_;
-};
-
 } // namespace
-
-QColor scanIdColor(int scanId) {
-    const render::Rgb c = render::scanIdColor(scanId);
-    return QColor(c[0], c[1], c[2]);
-}
-
-std::optional<ColorMap> parseColorMap(std::string_view name) {
-    if (name == "none") return ColorMap::None;
-    if (name == "angle" || name == "min-angle") return ColorMap::MinAngle;
-    if (name == "valence") return ColorMap::Valence;
-    if (name == "scan-id") return ColorMap::ScanId;
-    return std::nullopt;
-}
-
-QString colorMapName(ColorMap map) {
-    switch (map) {
-    case ColorMap::None:
-        return QStringLiteral("none");
-    case ColorMap::MinAngle:
-        return QStringLiteral("angle");
-    case ColorMap::Valence:
-        return QStringLiteral("valence");
-    case ColorMap::ScanId:
-        return QStringLiteral("scan-id");
-    }
-    return {};
-}
-
-struct VtkView::Impl {
-    vtkNew<vtkGenericOpenGLRenderWindow> window;
-    vtkNew<vtkRenderer> renderer;
-    vtkNew<vtkGenericRenderWindowInteractor> interactor;
-    vtkNew<NavigationStyle> style;
-    vtkNew<vtkPolyData> polyData;
-    vtkNew<vtkPolyDataMapper> mapper;
-    vtkNew<vtkActor> actor;
-    std::vector<unsigned long> windowObservers;
-    unsigned long renderObserver = 0;
-
-    // The translucent reference (ghost) and the pending patch (preview).
-    vtkNew<vtkPolyDataMapper> ghostMapper;
-    vtkNew<vtkActor> ghostActor;
-    bool ghostVisible = true;
-    vtkNew<vtkPolyDataMapper> previewMapper;
-    vtkNew<vtkActor> previewActor;
-    std::vector<OverlayPath> overlay;
-
-    // The widget's GL context (while VTK is initialised in it), shared with createMeshRenderer()'s.
-    std::shared_ptr<GlLink> gl = std::make_shared<GlLink>();
-    QMetaObject::Connection contextDestroyed;
-    bool initialized = false;
-    bool inPaint = false;
-
-    // Per-face measures of the shown mesh (kept so that switching the colour map needs no mesh).
-    std::vector<double> faceMinAngle;
-    std::vector<int> faceValenceDeviation;
-    std::vector<std::int32_t> faceScanId; // −1 for input faces
-    Eigen::AlignedBox3d bounds;
-    ColorMap colorMap = ColorMap::None;
-    StandardView initialView = StandardView::Iso;
-    UpAxis upAxis = UpAxis::Z;
-    vtkMTimeType cameraTime = 0;
-
-    // The colour legend and the axis triad.
-    vtkNew<vtkScalarBarActor> legend;
-    vtkNew<vtkLookupTable> legendTable;
-    bool legendEnabled = true;
-    vtkNew<vtkAxesActor> axes;
-    vtkNew<vtkOrientationMarkerWidget> axesWidget;
-
-    // The legend of the active colour map: the render layer's colours (colour_maps.h) in a lookup table.
-    void updateLegend() {
-        const bool show = legendEnabled && colorMap != ColorMap::None && polyData->GetNumberOfCells() > 0;
-        legend->SetVisibility(show);
-        if (!show) return;
-        vtkLookupTable* t = legendTable;
-        t->ResetAnnotations();
-        auto set = [t](vtkIdType i, const render::Rgb& c) {
-            t->SetTableValue(i, c[0] / 255.0, c[1] / 255.0, c[2] / 255.0, 1.0);
-        };
-        if (colorMap == ColorMap::MinAngle) {
-            t->IndexedLookupOff();
-            t->SetNumberOfTableValues(61);
-            for (int a = 0; a <= 60; ++a)
-                set(a, render::minAngleColor(a));
-            t->SetTableRange(0, 60);
-            legend->SetTitle("Min angle (deg)");
-            legend->SetNumberOfLabels(5);
-        } else {
-            // Categories: one swatch per annotation, in the table's order.
-            std::vector<std::pair<int, std::string>> entries;
-            if (colorMap == ColorMap::Valence) {
-                entries = {{0, "0 (regular)"}, {1, "1"}, {2, "2"}, {3, ">= 3"}, {-1, "boundary"}};
-                legend->SetTitle("|valence - 6|");
-            } else {
-                std::vector<std::int32_t> ids = faceScanId;
-                std::sort(ids.begin(), ids.end());
-                ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-                for (std::int32_t id : ids) {
-                    if (int(entries.size()) == kMaxLegendScans) break;
-                    entries.emplace_back(id, id < 0 ? std::string("input") : "scan " + std::to_string(id));
-                }
-                legend->SetTitle("Made by");
-            }
-            t->IndexedLookupOn();
-            t->SetNumberOfTableValues(vtkIdType(entries.size()));
-            for (std::size_t i = 0; i < entries.size(); ++i) {
-                const int v = entries[i].first;
-                set(vtkIdType(i),
-                    colorMap == ColorMap::Valence ? render::valenceColor(v) : render::scanIdColor(v));
-                t->SetAnnotation(vtkVariant(v), entries[i].second);
-            }
-        }
-        t->Build();
-        legend->SetLookupTable(t);
-        legend->Modified();
-    }
-
-    void applyColorMap() {
-        vtkProperty* property = actor->GetProperty();
-        updateLegend();
-        if (colorMap == ColorMap::None || polyData->GetNumberOfCells() == 0) {
-            polyData->GetCellData()->SetScalars(nullptr);
-            mapper->ScalarVisibilityOff();
-            property->SetSpecularColor(kSurface[0], kSurface[1], kSurface[2]);
-            return;
-        }
-        // The face colours replace ambient and diffuse colour; a white highlight keeps them true (a tan
-        // one would tint the neutral grey of input faces in the scan-id map).
-        property->SetSpecularColor(1.0, 1.0, 1.0);
-        vtkNew<vtkUnsignedCharArray> colors;
-        colors->SetName("face colour");
-        colors->SetNumberOfComponents(3);
-        const auto n = static_cast<vtkIdType>(faceMinAngle.size());
-        colors->SetNumberOfTuples(n);
-        for (vtkIdType f = 0; f < n; ++f) {
-            const std::size_t i = std::size_t(f);
-            // The render layer's colour maps (colour_maps.h), the snapshots' colours.
-            render::Rgb c;
-            switch (colorMap) {
-            case ColorMap::MinAngle:
-                c = render::minAngleColor(faceMinAngle[i]);
-                break;
-            case ColorMap::Valence:
-                c = render::valenceColor(faceValenceDeviation[i]);
-                break;
-            default:
-                c = render::scanIdColor(faceScanId[i]);
-            }
-            for (int k = 0; k < 3; ++k)
-                colors->SetTypedComponent(f, k, c[std::size_t(k)]);
-        }
-        polyData->GetCellData()->SetScalars(colors);
-        mapper->ScalarVisibilityOn();
-        mapper->SetScalarModeToUseCellData();
-        mapper->SetColorModeToDirectScalars();
-    }
-
-    // Frees every GL resource held in the widget's context (VTK's and those of the MeshRenderers made
-    // by createMeshRenderer) while it still exists; afterwards nothing refers to it.
-    void releaseGraphics(VtkView* view) {
-        if (!gl->context) return;
-        view->makeCurrent();
-        // Copy: a renderer's release must not invalidate the iteration.
-        const std::vector<ViewMeshRenderer*> renderers = gl->renderers;
-        for (ViewMeshRenderer* r : renderers)
-            r->releaseGl();
-        if (initialized) {
-            window->Finalize();
-            window->SetReadyForRendering(false);
-        }
-        view->doneCurrent();
-        initialized = false;
-        gl->context = nullptr;
-        gl->surface = nullptr;
-    }
-};
 
 QSurfaceFormat VtkView::surfaceFormat() {
     QSurfaceFormat format;
@@ -424,19 +50,19 @@ VtkView::VtkView(QWidget* parent) : QOpenGLWidget(parent), impl_(std::make_uniqu
     d.window->AddRenderer(d.renderer);
 
     auto observe = [&](unsigned long event, std::function<void(void*)> f) {
-        vtkNew<FunctionCommand> command;
+        vtkNew<detail::FunctionCommand> command;
         command->callback = [f = std::move(f)](unsigned long, void* callData) { f(callData); };
         d.windowObservers.push_back(d.window->AddObserver(event, command));
     };
     // Trap (PLATFORM-NOTES): QOpenGLContext::makeCurrent, not QOpenGLWidget::makeCurrent — the latter
     // rebinds Qt's framebuffer while VTK sets up its own and the image comes out garbage.
     observe(vtkCommand::WindowMakeCurrentEvent, [this](void*) {
-        const GlLink& gl = *impl_->gl;
+        const detail::GlLink& gl = *impl_->gl;
         if (gl.context && gl.surface && QOpenGLContext::currentContext() != gl.context)
             gl.context->makeCurrent(gl.surface);
     });
     observe(vtkCommand::WindowIsCurrentEvent, [this](void* callData) {
-        const GlLink& gl = *impl_->gl;
+        const detail::GlLink& gl = *impl_->gl;
         *static_cast<bool*>(callData) = gl.context && QOpenGLContext::currentContext() == gl.context;
     });
     // A render started outside paintGL (by code holding the render window) must reach the screen.
@@ -448,7 +74,7 @@ VtkView::VtkView(QWidget* parent) : QOpenGLWidget(parent), impl_(std::make_uniqu
     d.interactor->SetInteractorStyle(d.style);
     d.interactor->EnableRenderOff(); // the interactor asks for renders through RenderEvent → update()
     {
-        vtkNew<FunctionCommand> command;
+        vtkNew<detail::FunctionCommand> command;
         command->callback = [this](unsigned long, void*) {
             update();
             // Navigation changed the camera (the style asks for a render after every step).
@@ -647,99 +273,6 @@ void VtkView::paintOverlay() {
     }
 }
 
-void VtkView::setMesh(const Mesh& mesh) {
-    auto& d = *impl_;
-    d.bounds.setEmpty();
-    vtkSmartPointer<vtkPolyData> fresh = toPolyData(mesh, &d.bounds);
-
-    // Per-face measures for the colour maps, in the order of mesh.faces() (= VTK cell order).
-    d.faceMinAngle.clear();
-    d.faceValenceDeviation.clear();
-    d.faceScanId.clear();
-    d.faceMinAngle.reserve(mesh.number_of_faces());
-    d.faceValenceDeviation.reserve(mesh.number_of_faces());
-    d.faceScanId.reserve(mesh.number_of_faces());
-    std::vector<int> deviation(mesh.num_vertices(), -1); // |valence − 6| of interior vertices, else −1
-    for (VertexIndex v : mesh.vertices())
-        if (!mesh.is_border(v) && !mesh.is_isolated(v))
-            deviation[std::size_t(v)] = std::abs(int(mesh.degree(v)) - 6);
-    const auto scanIds = mesh.property_map<FaceIndex, std::int32_t>(props::faceScanId);
-    std::vector<Point3> corners;
-    for (FaceIndex f : mesh.faces()) {
-        corners.clear();
-        int worst = -1;
-        for (VertexIndex v : mesh.vertices_around_face(mesh.halfedge(f))) {
-            corners.push_back(mesh.point(v));
-            worst = std::max(worst, deviation[std::size_t(v)]);
-        }
-        double minAngle = 180;
-        const std::size_t n = corners.size();
-        for (std::size_t i = 0; i < n; ++i)
-            minAngle = std::min(minAngle,
-                                cornerAngleDeg(corners[i], corners[(i + n - 1) % n], corners[(i + 1) % n]));
-        d.faceMinAngle.push_back(minAngle);
-        d.faceValenceDeviation.push_back(worst);
-        d.faceScanId.push_back(scanIds.second ? scanIds.first[f] : -1);
-    }
-    d.polyData->ShallowCopy(fresh);
-    d.applyColorMap();
-    d.polyData->Modified();
-    d.actor->SetVisibility(d.polyData->GetNumberOfCells() > 0);
-    setStandardView(d.initialView);
-}
-
-void VtkView::clearMesh() {
-    setMesh(Mesh{});
-}
-
-bool VtkView::hasMesh() const {
-    return impl_->polyData->GetNumberOfCells() > 0;
-}
-
-void VtkView::setColorMap(ColorMap map) {
-    impl_->colorMap = map;
-    impl_->applyColorMap();
-    impl_->polyData->Modified();
-    update();
-}
-
-ColorMap VtkView::colorMap() const {
-    return impl_->colorMap;
-}
-
-void VtkView::setLegendVisible(bool visible) {
-    impl_->legendEnabled = visible;
-    impl_->updateLegend();
-    update();
-}
-
-bool VtkView::legendVisible() const {
-    return impl_->legendEnabled;
-}
-
-bool VtkView::legendShown() const {
-    return impl_->legend->GetVisibility() != 0;
-}
-
-void VtkView::setEdgesVisible(bool visible) {
-    impl_->actor->GetProperty()->SetEdgeVisibility(visible);
-    update();
-}
-
-bool VtkView::edgesVisible() const {
-    return impl_->actor->GetProperty()->GetEdgeVisibility() != 0;
-}
-
-void VtkView::setAxesVisible(bool visible) {
-    impl_->axesWidget->SetEnabled(visible);
-    if (visible) impl_->axesWidget->InteractiveOff();
-    update();
-}
-
-bool VtkView::axesVisible() const {
-    return impl_->axesWidget->GetEnabled() != 0;
-}
-
 void VtkView::setUpAxis(UpAxis axis) {
     impl_->upAxis = axis;
 }
@@ -822,94 +355,8 @@ QPointF VtkView::toImagePixels(QPointF widgetPoint) const {
     return widgetPoint * devicePixelRatioF();
 }
 
-void VtkView::setOverlay(std::vector<OverlayPath> paths) {
-    impl_->overlay = std::move(paths);
-    update();
-}
-
-void VtkView::clearOverlay() {
-    setOverlay({});
-}
-
-const std::vector<OverlayPath>& VtkView::overlay() const {
-    return impl_->overlay;
-}
-
-void VtkView::setGhostMesh(const Mesh& reference) {
-    auto& d = *impl_;
-    if (reference.number_of_faces() == 0) {
-        clearGhostMesh();
-        return;
-    }
-    d.ghostMapper->SetInputData(toPolyData(reference));
-    d.ghostActor->SetVisibility(d.ghostVisible);
-    update();
-}
-
-void VtkView::clearGhostMesh() {
-    auto& d = *impl_;
-    d.ghostMapper->SetInputData(nullptr);
-    d.ghostActor->VisibilityOff();
-    update();
-}
-
-void VtkView::setGhostVisible(bool visible) {
-    auto& d = *impl_;
-    d.ghostVisible = visible;
-    d.ghostActor->SetVisibility(visible && d.ghostMapper->GetInput() != nullptr);
-    update();
-}
-
-bool VtkView::ghostVisible() const {
-    return impl_->ghostActor->GetVisibility() != 0;
-}
-
-void VtkView::setPreviewMesh(const Mesh& patch) {
-    setPreviewMesh(patch, {});
-}
-
-void VtkView::setPreviewMesh(const Mesh& patch, const std::vector<std::uint8_t>& stitched) {
-    auto& d = *impl_;
-    if (patch.number_of_faces() == 0) {
-        clearPreviewMesh();
-        return;
-    }
-    if (!stitched.empty() && stitched.size() != patch.num_faces())
-        throw InvalidInputError("The preview's stitched-face flags do not match its faces.");
-    vtkSmartPointer<vtkPolyData> data = toPolyData(patch);
-    if (!stitched.empty()) {
-        // Direct cell colours: VTK cell i is the i-th live face (toPolyData).
-        vtkNew<vtkUnsignedCharArray> colours;
-        colours->SetNumberOfComponents(3);
-        colours->SetNumberOfTuples(vtkIdType(patch.number_of_faces()));
-        vtkIdType cell = 0;
-        for (FaceIndex f : patch.faces()) {
-            const double* c = stitched[std::size_t(f)] ? kPreview : kPreviewTrimmed;
-            for (int k = 0; k < 3; ++k)
-                colours->SetValue(3 * cell + k, static_cast<unsigned char>(std::lround(255 * c[k])));
-            ++cell;
-        }
-        data->GetCellData()->SetScalars(colours);
-    }
-    d.previewMapper->SetScalarVisibility(stitched.empty() ? 0 : 1);
-    d.previewMapper->SetInputData(data);
-    d.previewActor->VisibilityOn();
-    update();
-}
-
-void VtkView::clearPreviewMesh() {
-    auto& d = *impl_;
-    d.previewMapper->SetInputData(nullptr);
-    d.previewActor->VisibilityOff();
-    update();
-}
-
-bool VtkView::hasPreviewMesh() const {
-    return impl_->previewActor->GetVisibility() != 0;
-}
-
 std::unique_ptr<MeshRenderer> VtkView::createMeshRenderer() {
-    return std::make_unique<ViewMeshRenderer>(impl_->gl);
+    return std::make_unique<detail::ViewMeshRenderer>(impl_->gl);
 }
 
 // ---- events: forwarded to VTK's interactor in device pixels, y flipped (VTK's origin is bottom-left) ----
