@@ -6,6 +6,7 @@
 #include "mesh/triangle_geometry.h"
 
 #include <CGAL/boost/graph/iterator.h>
+#include <boost/container/small_vector.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -47,7 +48,9 @@ std::optional<CreaseLine> creaseUnder(const Mesh& ref, FaceIndex f, const Eigen:
 // The smallest angle of the faces around \p v, and whether each is acceptable after a move (normal turned
 // by less than the bound from \p before, not degenerate, facing the camera).
 struct Ring {
-    std::vector<Eigen::Vector3d> normals; // by incident face, in circulation order
+    // By incident face, in circulation order (inline up to 12: two rings per vertex and sweep, no
+    // allocation).
+    boost::container::small_vector<Eigen::Vector3d, 12> normals;
     double minAngle = 0;
     bool ok = true;
 };

@@ -569,13 +569,14 @@ private:
         std::vector<VertexIndex> verts;
         std::vector<FaceIndex> hints;
         std::vector<double> sizes;
-        std::unordered_set<std::uint32_t> seen;
+        std::vector<char> seen(S_.num_vertices(), 0); // (a bitmap: the vertices are sorted below)
         for (std::size_t f = 0; f < band_.size(); ++f) {
             const FaceIndex g(static_cast<std::uint32_t>(f));
             if (!band_[f] || S_.is_removed(g)) continue;
             for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_)) {
                 // Crease vertices stay: the crease keeps its exact line (splits put new vertices on it).
-                if (isFixed(v) || creaseDegree(v) > 0 || !seen.insert(std::uint32_t(v)).second) continue;
+                if (isFixed(v) || creaseDegree(v) > 0 || std::exchange(seen[std::size_t(v)], char(1)))
+                    continue;
                 const FaceIndex hf = at(hint_, std::size_t(v), Mesh::null_face());
                 if (hf == Mesh::null_face() || !wholeStarInBand(v)) continue;
                 verts.push_back(v);

@@ -27,31 +27,44 @@ bool ComponentStitcher::fail(Attempt& a, std::string reason, std::vector<int> ba
 std::string describeComponent(const PatchData& P, const std::vector<int>& faces, double collapseEdgeRatio,
                               ComponentShape& c, ComponentProgress* progress) {
     c = ComponentShape{};
-    std::vector<std::uint64_t> directed;
-    directed.reserve(3 * faces.size());
-    for (int f : faces) {
-        if (progress) progress->tick();
-        const auto& t = P.tri[std::size_t(f)];
-        for (int k = 0; k < 3; ++k) {
-            directed.push_back(
-                dirKey(std::uint32_t(t[std::size_t(k)]), std::uint32_t(t[std::size_t((k + 1) % 3)])));
-            c.verts.push_back(t[std::size_t(k)]);
+    // The component's directed edges grouped by source vertex (a counting sort over the patch's vertices,
+    // linear in the component where a sort of all edge keys and a binary search per edge cost n log n): an
+    // edge is on the boundary when its reverse is not among them. The vertices come out sorted.
+    const std::size_t nv = P.pos.size();
+    std::vector<std::uint32_t> first(nv + 1, 0); // out-edges of v: to[first[v] .. first[v + 1])
+    for (int f : faces)
+        for (int v : P.tri[std::size_t(f)])
+            ++first[std::size_t(v) + 1]; // each corner is the source of one directed edge of its face
+    for (std::size_t v = 0; v < nv; ++v) {
+        if (first[v + 1] > 0) c.verts.push_back(int(v));
+        first[v + 1] += first[v];
+    }
+    std::vector<int> to(first[nv]);
+    {
+        std::vector<std::uint32_t> fill(first.begin(), first.end() - 1);
+        for (int f : faces) {
+            if (progress) progress->tick();
+            const auto& t = P.tri[std::size_t(f)];
+            for (int k = 0; k < 3; ++k)
+                to[fill[std::size_t(t[std::size_t(k)])]++] = t[std::size_t((k + 1) % 3)];
         }
     }
-    std::sort(directed.begin(), directed.end());
-    std::sort(c.verts.begin(), c.verts.end());
-    c.verts.erase(std::unique(c.verts.begin(), c.verts.end()), c.verts.end());
+    auto hasEdge = [&](int p, int q) {
+        return std::find(to.begin() + first[std::size_t(p)], to.begin() + first[std::size_t(p) + 1], q) !=
+               to.begin() + first[std::size_t(p) + 1];
+    };
+    std::vector<char> onBoundary(nv, 0);
     std::vector<double> len2, len3;
     for (int f : faces) {
         const auto& t = P.tri[std::size_t(f)];
         for (int k = 0; k < 3; ++k) {
             const int p = t[std::size_t(k)], q = t[std::size_t((k + 1) % 3)];
-            const bool border = !std::binary_search(directed.begin(), directed.end(),
-                                                    dirKey(std::uint32_t(q), std::uint32_t(p)));
+            const bool border = !hasEdge(q, p);
             if (border) {
                 c.pedgeIndex[dirKey(std::uint32_t(p), std::uint32_t(q))] = int(c.pedges.size());
                 c.pedges.push_back({p, q, t[std::size_t((k + 2) % 3)], {}, {}});
                 c.boundary.insert(p);
+                onBoundary[std::size_t(p)] = 1;
             }
             if (border || p < q) {
                 len2.push_back(std::sqrt(dist2(P.uv[std::size_t(p)], P.uv[std::size_t(q)])));
@@ -62,7 +75,7 @@ std::string describeComponent(const PatchData& P, const std::vector<int>& faces,
     if (c.pedges.empty()) return "it has no boundary in the scan's view (it would cover the whole view)";
     for (int f : faces)
         for (int v : P.tri[std::size_t(f)])
-            if (c.boundary.count(v)) c.vertexFaces[v].push_back(f);
+            if (onBoundary[std::size_t(v)]) c.vertexFaces[v].push_back(f);
     auto median = [](std::vector<double> v) {
         std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
         return v[v.size() / 2];

@@ -4,8 +4,23 @@
 
 namespace fss::detail::stitching {
 
+namespace {
+// FSS_STITCH_V1_OFF=collapse,refine,collapse+flip,smooth,needles,valence,search skips those passes of the
+// seam optimisation where the band remesh follows (to measure what each changes after it; the retry without
+// the band runs them all).
+bool v1Off(const char* name) {
+    static const std::string off = [] {
+        const char* e = std::getenv("FSS_STITCH_V1_OFF");
+        return e ? std::string(",") + e + "," : std::string();
+    }();
+    return off.find(std::string(",") + name + ",") != std::string::npos;
+}
+} // namespace
+
 void ComponentStitcher::optimise(Local& loc, Plan& plan) {
     Mesh& S = loc.star.S;
+    const bool bandFollows = remesh_ && !refill_;
+    auto skip = [&](const char* name) { return bandFollows && v1Off(name); };
     const double maxTurn = O_.maxNormalChangeDeg * kDeg;
     const double shortEdge = O_.collapseEdgeRatio * comp_.h3;
     auto isNewFace = [&](FaceIndex f) { return f != Mesh::null_face() && !loc.star.kept[f]; };
@@ -84,22 +99,24 @@ void ComponentStitcher::optimise(Local& loc, Plan& plan) {
         }
     };
     StageClock::lap("optimise:other");
-    collapsePass();
+    if (!skip("collapse")) collapsePass();
     StageClock::lap("optimise:collapse");
     // -- refinement outside the patch: split long edges of the pieces around the seam (the new vertices
     // lie on the old surface: in a face's plane or on a mesh edge), graded from the patch's edge length
     // at the seam outwards, then flip within the faces' planes.
-    for (int round = 0; round < 4 && O_.seamGrading > 0; ++round) {
+    for (int round = 0; round < 4 && O_.seamGrading > 0 && !skip("refine"); ++round) {
         if (refineOutside(loc) == 0) break;
         flipPass(loc, plan);
     }
     StageClock::lap("optimise:refine");
-    collapsePass();
-    flipPass(loc, plan);
+    if (!skip("collapse+flip")) {
+        collapsePass();
+        flipPass(loc, plan);
+    }
     StageClock::lap("optimise:collapse+flip");
     // -- smoothing: the vertices added outside the patch move within their face's plane towards the
     // centre of their neighbours where that raises the smallest angle around them.
-    for (int pass = 0; pass < 3; ++pass) {
+    for (int pass = 0; pass < 3 && !skip("smooth"); ++pass) {
         if (smoothOutside(loc) == 0) break;
         flipPass(loc, plan);
     }
@@ -107,7 +124,7 @@ void ComponentStitcher::optimise(Local& loc, Plan& plan) {
     // -- needles: a face near the seam with a small angle loses its shortest edge when collapsing it
     // (either way, with every check of tryCollapse: no fold, no flip in the view, pieces outside stay
     // in their planes) raises the smallest angle around; then flip again.
-    for (int pass = 0; pass < 3; ++pass) {
+    for (int pass = 0; pass < 3 && !skip("needles"); ++pass) {
         const auto near = seamNeighbourhood(loc);
         Candidates cands;
         for (const auto& [ang, f] : thinFaces(loc, near)) {
@@ -128,11 +145,11 @@ void ComponentStitcher::optimise(Local& loc, Plan& plan) {
         flipPass(loc, plan);
     }
     StageClock::lap("optimise:needles");
-    valencePass(loc, plan);
+    if (!skip("valence")) valencePass(loc, plan);
     StageClock::lap("optimise:valence");
     // -- last smoothing: the free vertices near the seam whose smallest angle around is still small
     // search for a better place (smoothOutside with search; no flips after it, so the valences stay).
-    for (int pass = 0; pass < 2; ++pass)
+    for (int pass = 0; pass < 2 && !skip("search"); ++pass)
         if (smoothOutside(loc, true) == 0) break;
     StageClock::lap("optimise:search");
 }
