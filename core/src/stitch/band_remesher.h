@@ -40,8 +40,8 @@ constexpr double kSlideCreaseDeg = 10.0;
 constexpr double kSplitFloorDeg = 20.0;
 using V3 = Eigen::Vector3d;
 
-// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,creasefilter,collapseall,short (and lift, split, smooth) turns parts
-// of the band remesh off (to measure what each brings).
+// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,creasefilter,collapseall,short (and lift, split, smooth) turns
+// parts of the band remesh off (to measure what each brings).
 inline bool stageOff(const char* name) {
     static const std::string off = [] {
         const char* e = std::getenv("FSS_STITCH_BAND_OFF");
