@@ -40,8 +40,8 @@ constexpr double kSlideCreaseDeg = 10.0;
 constexpr double kSplitFloorDeg = 20.0;
 using V3 = Eigen::Vector3d;
 
-// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,creasefilter,collapseall (and lift, split, smooth) turns parts
-// of the band remesh off (to measure what each brings).
+// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,creasefilter,collapseall,short (and lift, split, smooth) turns
+// parts of the band remesh off (to measure what each brings).
 inline bool stageOff(const char* name) {
     static const std::string off = [] {
         const char* e = std::getenv("FSS_STITCH_BAND_OFF");
@@ -94,7 +94,8 @@ public:
             flipPass();
         }
         for (int it = 0; it < 3 && !stageOff("repair"); ++it) {
-            const bool changed = repairPass();
+            const bool merged = !stageOff("short") && shortEdgePass();
+            const bool changed = repairPass() || merged;
             if (!stageOff("slide")) slidePass();
             improvePass();
             flipPass();
@@ -450,7 +451,8 @@ private:
         score = newMin;
         return true;
     }
-    void collapse(VertexIndex from, VertexIndex to) {
+    // Returns the surviving vertex (at `to`'s place, with its data; the descriptor may be `from`'s).
+    VertexIndex collapse(VertexIndex from, VertexIndex to) {
         const HalfedgeIndex h = S_.halfedge(from, to);
         const FaceIndex f1 = S_.face(h), f2 = S_.face(S_.opposite(h));
         const V3 keep = detail::pos(S_, to);
@@ -489,7 +491,13 @@ private:
         for (VertexIndex w : creaseEnds)
             addCrease(kept, w);
         ++report_.collapses;
+        return kept;
     }
+    // ---- short edges (band_cluster.cpp): a band edge much shorter than the local size (a crease edge a
+    // draft's sliver left, DESIGN.md §6.2) goes with the cluster of short edges around it, judged on the
+    // faces after the whole cluster is merged into one of its vertices. True when something changed.
+    bool shortEdgePass();
+    bool collapseCluster(VertexIndex a);
 
     // ---- flips towards valence 6 and larger angles
     void flipPass() {

@@ -1,0 +1,95 @@
+// The seam band's short crease edges (issue 19, core/src/stitch/band_cluster.cpp): a draft's sliver leaves
+// two or three vertices within a few percent of the local size at a held crease vertex; the band must not
+// leave such an edge (a later band, whose rim it is, cannot remove it: the main job's 10.83 deg).
+#include "stitch/band_remesh.h"
+#include "stitch/seam_quality.h"
+
+#include "fss/shapes.h"
+#include "mesh/local_ops.h"
+
+#include <CGAL/boost/graph/iterator.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+namespace {
+
+Eigen::Vector3d at(const fss::Mesh& m, fss::VertexIndex v) {
+    return {m.point(v).x(), m.point(v).y(), m.point(v).z()};
+}
+
+fss::VertexIndex vertexAt(const fss::Mesh& m, double x, double y) {
+    for (fss::VertexIndex v : m.vertices())
+        if (std::abs(m.point(v).x() - x) < 1e-12 && std::abs(m.point(v).y() - y) < 1e-12) return v;
+    return fss::Mesh::null_vertex();
+}
+
+// A roof (z = -0.6 |x - 6|, a crease along x = 6) on a 12 x 12 grid of unit edges. At the held crease vertex
+// c = (6, 6) (a crease end or the band's rim in a stitch) the crease edge towards (6, 7) is split 4 % from c
+// (a vertex s) and the edge towards (5, 6) too (a free vertex u): the kind of cluster the 1st band of the
+// main job left at its 2.89 deg face. What holds: the mesh stays valid, c stays, every vertex stays on the
+// roof, no edge crosses the ridge, the smallest angle does not drop. NOT fixed yet (measured 1.15 -> 12.21
+// deg with and without band_cluster.cpp; a 0.04 crease edge stays at c): the slivers around c and s have no
+// reliable normal, so the crease is cut there and s becomes a crease end, which is held like a corner; the
+// cluster merge moves no crease end. The bound on `before` keeps the case a sliver cluster.
+TEST(BandCrease, ShortEdgesAtAHeldCreaseVertexKeepTheCrease) {
+    fss::Mesh m = fss::shapes::grid(12, 12, 1.0);
+    auto roof = [](double x) { return -0.6 * std::abs(x - 6); };
+    for (fss::VertexIndex v : m.vertices()) {
+        const auto p = m.point(v);
+        m.point(v) = fss::Point3(p.x(), p.y(), roof(p.x()));
+    }
+    const fss::VertexIndex c = vertexAt(m, 6, 6), up = vertexAt(m, 6, 7), left = vertexAt(m, 5, 6);
+    ASSERT_NE(c, fss::Mesh::null_vertex());
+    const fss::HalfedgeIndex hs = m.halfedge(c, up);
+    ASSERT_NE(hs, fss::Mesh::null_halfedge());
+    ASSERT_NE(m.halfedge(c, left), fss::Mesh::null_halfedge());
+    fss::detail::splitEdge(m, hs, fss::Point3(6, 6.04, 0));
+    fss::detail::splitEdge(m, m.halfedge(c, left), fss::Point3(5.96, 6, roof(5.96)));
+    std::vector<fss::FaceIndex> band;
+    for (fss::FaceIndex f : m.faces()) {
+        double x = 0, y = 0;
+        for (auto v : CGAL::vertices_around_face(m.halfedge(f), m)) {
+            x += m.point(v).x() / 3;
+            y += m.point(v).y() / 3;
+        }
+        if (x > 3.5 && x < 9.5 && y > 2.5 && y < 9.5) band.push_back(f);
+    }
+    fss::Camera camera;
+    camera.eye = {6, 6, 25};
+    camera.focal = {6, 6, 0};
+    camera.width = camera.height = 256;
+    fss::stitch::BandRemeshInput in;
+    in.mesh = &m;
+    in.band = band;
+    in.camera = &camera;
+    in.edgeLength = 1.0;
+    in.fixed = [&](fss::VertexIndex v) { return v == c; };
+    const auto r = fss::stitch::remeshBand(in);
+    ASSERT_TRUE(m.is_valid(false));
+    double shortest = 1e9, after = 180;
+    for (fss::FaceIndex f : r.faces) {
+        const auto h = m.halfedge(f);
+        const Eigen::Vector3d a = at(m, m.source(h)), b = at(m, m.target(h)), d = at(m, m.target(m.next(h)));
+        shortest = std::min({shortest, (a - b).norm(), (b - d).norm(), (d - a).norm()});
+        after = std::min(after, fss::stitch::smallestAngleDeg(a, b, d));
+    }
+    std::printf(
+        "held crease vertex with short edges: smallest angle %.2f -> %.2f deg, shortest band edge %.3f; "
+        "%zu collapses, %zu repairs\n",
+        r.minAngleBeforeDeg, after, shortest, r.collapses, r.repairs);
+    EXPECT_FALSE(m.is_removed(c));
+    EXPECT_EQ(at(m, c), Eigen::Vector3d(6, 6, 0)); // held
+    EXPECT_LT(r.minAngleBeforeDeg, 5.0);
+    EXPECT_GE(after, r.minAngleBeforeDeg);
+    for (fss::VertexIndex v : m.vertices())
+        EXPECT_NEAR(m.point(v).z(), roof(m.point(v).x()), 1e-9);
+    for (fss::EdgeIndex e : m.edges()) {
+        const double a = m.point(m.vertex(e, 0)).x() - 6, b = m.point(m.vertex(e, 1)).x() - 6;
+        EXPECT_FALSE((a < -1e-9 && b > 1e-9) || (a > 1e-9 && b < -1e-9)) << "an edge crosses the ridge";
+    }
+}
+
+} // namespace
