@@ -300,10 +300,11 @@ LatticeFigures latticeScan(const fss::Mesh& ref, fss::MeshRenderer& renderer, fs
             double d = 0; // at the points of a 6-fold subdivision of the face (28 points)
             for (int i = 0; i <= 6; ++i)
                 for (int j = 0; i + j <= 6; ++j)
-                    d = std::max(d, caster.closestPoint((double(i) * p[0] + double(j) * p[1] +
-                                                         double(6 - i - j) * p[2]) /
-                                                        6.0)
-                                        .distance);
+                    d = std::max(
+                        d, caster
+                               .closestPoint(
+                                   (double(i) * p[0] + double(j) * p[1] + double(6 - i - j) * p[2]) / 6.0)
+                               .distance);
             if (d <= worst) continue;
             worst = d;
             const fss::Sample& s0 = r.grid.at(gi[vs[0]].row, gi[vs[0]].col);
@@ -332,15 +333,16 @@ LatticeFigures latticeScan(const fss::Mesh& ref, fss::MeshRenderer& renderer, fs
                         }
                 }
             char buf[300];
-            std::snprintf(buf, sizeof buf,
-                          "worst face %.2e of diag at screen (%.0f, %.0f) lattice (%d, %d): longest edge %.2f "
-                          "footprints (mean edge within 3: %.2f), %d steps from the patch border, sampling "
-                          "angle %.0f deg, faces %u %u %u",
-                          d / bbox(ref).diagonal().norm(), s0.screen.x(), s0.screen.y(), r0, c0,
-                          longest / double(s0.footprint), aroundCount ? around / aroundCount : 0.0, toBorder,
-                          double(s0.samplingAngle) * 180 / std::numbers::pi, unsigned(s0.face),
-                          unsigned(r.grid.at(gi[vs[1]].row, gi[vs[1]].col).face),
-                          unsigned(r.grid.at(gi[vs[2]].row, gi[vs[2]].col).face));
+            std::snprintf(
+                buf, sizeof buf,
+                "worst face %.2e of diag at screen (%.0f, %.0f) lattice (%d, %d): longest edge %.2f "
+                "footprints (mean edge within 3: %.2f), %d steps from the patch border, sampling "
+                "angle %.0f deg, faces %u %u %u",
+                d / bbox(ref).diagonal().norm(), s0.screen.x(), s0.screen.y(), r0, c0,
+                longest / double(s0.footprint), aroundCount ? around / aroundCount : 0.0, toBorder,
+                double(s0.samplingAngle) * 180 / std::numbers::pi, unsigned(s0.face),
+                unsigned(r.grid.at(gi[vs[1]].row, gi[vs[1]].col).face),
+                unsigned(r.grid.at(gi[vs[2]].row, gi[vs[2]].col).face));
             where = buf;
         }
         out.worst = where;
