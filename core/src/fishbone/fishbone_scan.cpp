@@ -344,6 +344,30 @@ void castColumnUnhinted(SampleGrid& grid, int column, const Mesh& reference, con
     }
 }
 
+// The backbone traced along the principal direction through the seed (through the visible \p creases'
+// attraction), cut at creases when asked (\p stops); \p k only for the positions in error messages.
+Backbone seedBackbone(const DirectionField& backboneField, const FishboneParams& fb,
+                      const FishboneOptions& options, const CreaseIndex& creases,
+                      const std::function<const CreaseIndex&()>& stops, int k) {
+    const std::optional<DirectionSample> at = backboneField.sample(*fb.seed, Eigen::Vector2d(1, 0));
+    if (!at || at->anisotropy < fb.minSeedAnisotropy)
+        throw InvalidInputError("The fishbone seed " + point(double(k) * *fb.seed) +
+                                " lies on a flat or isotropic region where no principal direction is "
+                                "defined; pick a point on a curved feature.");
+    FishboneOptions backboneOptions = options;
+    if (!creases.empty())
+        backboneOptions.backboneTracing.attractor = [&](const Eigen::Vector2d& q,
+                                                        const Eigen::Vector2d& heading) {
+            return creases.nearestAlong(q, heading);
+        };
+    Backbone traced = traceBackbone(backboneField, *fb.seed, backboneOptions);
+    if (options.stopBackboneAtCreases && fb.creaseAngleDeg > 0) stops().cutBackbone(traced);
+    if (traced.samples.size() < 2)
+        throw InvalidInputError("The fishbone backbone has fewer than two samples; pick a point on a longer "
+                                "feature or reduce h.");
+    return traced;
+}
+
 // What the crease backbone and its ribs need (FishboneOptions::creaseBackbone; crease_backbone.h).
 detail::CreaseBackboneInput creaseInput(const Mesh& reference, const FishboneParams& fb,
                                         const FishboneOptions& options, const FrameBuffers& buffers,
@@ -495,28 +519,7 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
     std::optional<detail::CreaseBackbone> onCrease; // the backbone along a crease (creaseBackbone)
     if (!drawnBackbone && options.creaseBackbone && fb.creaseAngleDeg > 0)
         onCrease = detail::creaseBackbone(creaseInput(reference, fb, options, buffers, cache), *fb.seed);
-    // The backbone traced along the principal direction through the seed (through the visible creases'
-    // attraction), cut at creases when asked.
-    auto traceSeedBackbone = [&]() {
-        const std::optional<DirectionSample> at = backboneField.sample(*fb.seed, Eigen::Vector2d(1, 0));
-        if (!at || at->anisotropy < fb.minSeedAnisotropy)
-            throw InvalidInputError("The fishbone seed " + shown(*fb.seed) +
-                                    " lies on a flat or isotropic region where no principal direction is "
-                                    "defined; pick a point on a curved feature.");
-        const CreaseIndex& creases = visible();
-        FishboneOptions backboneOptions = options;
-        if (!creases.empty())
-            backboneOptions.backboneTracing.attractor = [&](const Eigen::Vector2d& q,
-                                                            const Eigen::Vector2d& heading) {
-                return creases.nearestAlong(q, heading);
-            };
-        Backbone traced = traceBackbone(backboneField, *fb.seed, backboneOptions);
-        if (options.stopBackboneAtCreases && fb.creaseAngleDeg > 0) stops().cutBackbone(traced);
-        if (traced.samples.size() < 2)
-            throw InvalidInputError("The fishbone backbone has fewer than two samples; pick a point on a "
-                                    "longer feature or reduce h.");
-        return traced;
-    };
+    auto traceSeedBackbone = [&] { return seedBackbone(backboneField, fb, options, visible(), stops, k); };
     if (drawnBackbone) {
         backbone = fss::drawnBackbone(fb.drawnBackbone, options);
     } else if (onCrease) {
@@ -579,7 +582,8 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
     result.grid =
         rayCastFishbone(closedGrid ? unrollClosedGrid(result.fishbone, pad) : result.fishbone, buffers,
                         reference, caster, params.scan, fb.raycast, &result.counts.onHintFace);
-    if (straight) castColumnUnhinted(result.grid, result.fishbone.backboneColumn, reference, caster, params.scan);
+    if (straight)
+        castColumnUnhinted(result.grid, result.fishbone.backboneColumn, reference, caster, params.scan);
     // Sampling quality as on the scan image (its pixel footprint, 1/k of the sampling image's), so that the
     // quality mask ranks a fishbone patch the same whatever k is. The footprints stay the sampling camera's
     // (the triangulation's edge limits are in them).
