@@ -29,11 +29,12 @@ struct CreaseBackboneInput {
 /// it lies within snapDistance·h footprints of it: the chain (sharp edges between vertices where creases end
 /// or branch; mesh/features.h creaseChains) resampled in 3D from the seed's nearest point on it both ways,
 /// every h pixel footprints (at each sample's own depth), projected to the screen. Each way stops before the
-/// chain's end, before a sample that is hidden (its ray hits the reference farther than a footprint from it)
-/// or outside the image, before a turn of more than 45° between consecutive 3D edges (a corner), and after
-/// maxLength on the screen. A closed chain seen whole gives a closed backbone (equal 3D arcs, the seed's
-/// point first). std::nullopt when no chain is near enough, or fewer than two samples remain.
-/// A backbone on a crease with the 3D points of its samples.
+/// chain's end, before a sample that is hidden or outside the image (seen: the
+/// viewing ray through its projection, or 0.01 px beside it across a crease on the silhouette, first hits
+/// the reference within 0.05 footprints of it; the backbone sample is that screen position), before a turn of
+/// more than 45° between consecutive 3D edges (a corner), and after maxLength on the screen. A closed chain
+/// seen whole gives a closed backbone (equal 3D arcs, the seed's point first). std::nullopt when no chain is
+/// near enough, or fewer than two samples remain. A backbone on a crease with the 3D points of its samples.
 struct CreaseBackbone {
     Backbone backbone;
     std::vector<Eigen::Vector3d> points; ///< on the crease, one per sample
