@@ -64,6 +64,16 @@ void joinRegions(Mesh& mesh, const Mesh& reference, const std::vector<char>* uns
                  const RayCaster& caster, JoinStyle style, double L, bool closed, bool debug,
                  int repairRounds);
 
+/// Repairs what the join left wrong: the faces that intersect another, are degenerate, touch a pinched vertex
+/// or (\p closed) an unclosed boundary are removed with a ring of faces around them and the holes filled
+/// again, up to \p rounds times. Returns true when none is left.
+bool repairJoin(Mesh& mesh, bool closed, int rounds, bool debug);
+
+/// Removes the smallest connected pieces of \p mesh of at most \p maxFaces faces while it has more than
+/// \p components pieces (an input face no patch reached, closed on itself by the hole filling); returns how
+/// many were removed.
+std::size_t dropSmallPieces(Mesh& mesh, std::size_t components, std::size_t maxFaces);
+
 /// Flags in \p inputFaces the faces of \p reference whose centroid lies within \p reach of a face the join
 /// \p joined left wrong (as joinRegions' repair finds them); returns how many were flagged.
 std::size_t widenInputRegions(const Mesh& reference, const Mesh& joined, bool closed, double reach,
