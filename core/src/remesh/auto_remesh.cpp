@@ -4,6 +4,7 @@
 #include "mesh/local_ops.h"
 #include "remesh/auto_v2.h"
 #include "remesh/crease_snap.h"
+#include "remesh/join_regions.h"
 #include "remesh/seam_relax.h"
 
 #include "fss/error.h"
@@ -750,25 +751,15 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
             Eigen::Vector3d normalSum{0, 0, 0};
         };
         std::vector<Region> regions;
-        std::vector<char> seen(current.number_of_faces() + current.number_of_removed_faces(), 0);
-        for (FaceIndex f : current.faces()) {
-            if (ids[f] >= 0 || seen[f.idx()]) continue;
+        for (std::vector<FaceIndex>& faces :
+             detail::faceComponents(current, [&](FaceIndex f) { return ids[f] < 0; })) {
             Region r;
-            std::vector<FaceIndex> stack{f};
-            seen[f.idx()] = 1;
-            while (!stack.empty()) {
-                const FaceIndex g = stack.back();
-                stack.pop_back();
-                r.faces.push_back(g);
+            for (FaceIndex g : faces) {
                 const FaceGeometry fg = faceGeometry(current, g);
                 r.area += fg.area;
                 r.normalSum += fg.area * fg.normal;
-                for (HalfedgeIndex h : CGAL::halfedges_around_face(current.halfedge(g), current)) {
-                    const FaceIndex o = current.face(current.opposite(h));
-                    if (o != Mesh::null_face() && ids[o] < 0 && !seen[o.idx()])
-                        seen[o.idx()] = 1, stack.push_back(o);
-                }
             }
+            r.faces = std::move(faces);
             regions.push_back(std::move(r));
         }
         std::sort(regions.begin(), regions.end(),

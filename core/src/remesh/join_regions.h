@@ -1,0 +1,86 @@
+#pragma once
+// Internal (not installed): the one-pass join of auto v2 (auto_v2.cpp, step 3) and the flood fill over faces
+// that auto v1's follow-up views and auto v2's extra views share.
+#include "fss/mesh.h"
+#include "fss/raycast.h"
+#include "fss/scan.h"
+
+#include <CGAL/boost/graph/iterator.h>
+
+#include <vector>
+
+namespace fss::detail {
+
+/// The connected pieces (through edges) of the faces of \p mesh for which \p member(f) is true, in the order
+/// of mesh.faces() of their first face; each piece's faces in the order a depth-first fill reaches them.
+template <class Member>
+std::vector<std::vector<FaceIndex>> faceComponents(const Mesh& mesh, Member&& member) {
+    std::vector<std::vector<FaceIndex>> out;
+    std::vector<char> seen(mesh.number_of_faces() + mesh.number_of_removed_faces(), 0);
+    for (FaceIndex f : mesh.faces()) {
+        if (seen[f.idx()] || !member(f)) continue;
+        std::vector<FaceIndex> piece;
+        std::vector<FaceIndex> stack{f};
+        seen[f.idx()] = 1;
+        while (!stack.empty()) {
+            const FaceIndex g = stack.back();
+            stack.pop_back();
+            piece.push_back(g);
+            for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(g), mesh)) {
+                const FaceIndex o = mesh.face(mesh.opposite(h));
+                if (o != Mesh::null_face() && !seen[o.idx()] && member(o))
+                    seen[o.idx()] = 1, stack.push_back(o);
+            }
+        }
+        out.push_back(std::move(piece));
+    }
+    return out;
+}
+
+/// Adds the faces of \p patch to \p out (scan id and quality kept).
+void appendPatch(Mesh& out, const Mesh& patch);
+
+/// Flags the faces of \p reference whose centroid lies farther than \p reach from every vertex of \p patches:
+/// the parts of the surface no region sampled (thin pieces the opening removed, regions whose patch failed,
+/// faces no view sees).
+std::vector<char> unsampledFaces(const Mesh& reference, const std::vector<Patch>& patches, double reach);
+
+/// How joinRegions closes the gaps between the regions.
+enum class JoinStyle {
+    /// The faces of the reference no patch reaches are added as a region left from the input; one pass of
+    /// the gap closing, every new face within L/4 of the reference (no face bridges the two sides of a thin
+    /// part); on a closed reference CGAL's hole filling closes what is left.
+    InputRegions,
+    /// Session 15's join: two passes of the gap closing (the second with a reach of 6 L), faces kept near
+    /// the reference only on an open one; the hole filling bridges the parts no patch reaches.
+    TwoPasses,
+};
+
+/// Closes the gaps between the patches already in \p mesh (auto_v2.cpp, step 3) and repairs the result: the
+/// faces that intersect another, are degenerate, touch a pinched vertex or (\p closed) an unclosed boundary
+/// are removed with a ring around them and the holes filled again, up to \p repairRounds times.
+/// \p unsampled: the reference's faces to add as input faces (JoinStyle::InputRegions).
+void joinRegions(Mesh& mesh, const Mesh& reference, const std::vector<char>* unsampled,
+                 const RayCaster& caster, JoinStyle style, double L, bool closed, bool debug,
+                 int repairRounds);
+
+/// Repairs what the join left wrong: the faces that intersect another, are degenerate, touch a pinched vertex
+/// or (\p closed) an unclosed boundary are removed with a ring of faces around them and the holes filled
+/// again, up to \p rounds times. Returns true when none is left.
+bool repairJoin(Mesh& mesh, bool closed, int rounds, bool debug);
+
+/// Removes the smallest connected pieces of \p mesh of at most \p maxFaces faces while it has more than
+/// \p components pieces (an input face no patch reached, closed on itself by the hole filling); returns how
+/// many were removed.
+std::size_t dropSmallPieces(Mesh& mesh, std::size_t components, std::size_t maxFaces);
+
+/// Flags in \p inputFaces the faces of \p reference whose centroid lies within \p reach of a face the join
+/// \p joined left wrong (as joinRegions' repair finds them); returns how many were flagged.
+std::size_t widenInputRegions(const Mesh& reference, const Mesh& joined, bool closed, double reach,
+                              std::vector<char>& inputFaces);
+
+/// Removes from \p mesh the faces with a vertex within \p reach of the centroid of a face of \p reference
+/// flagged in \p faces (so that those faces are as far from the patches as unsampledFaces' are).
+void removePatchFacesNear(Mesh& mesh, const Mesh& reference, const std::vector<char>& faces, double reach);
+
+} // namespace fss::detail
