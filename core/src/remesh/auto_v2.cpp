@@ -59,24 +59,6 @@ double since(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-Eigen::Vector3d at(const Mesh& m, VertexIndex v) {
-    const Point3& p = m.point(v);
-    return {p.x(), p.y(), p.z()};
-}
-
-Eigen::Vector3d faceNormal(const Mesh& m, FaceIndex f) {
-    const HalfedgeIndex h = m.halfedge(f);
-    const Eigen::Vector3d a = at(m, m.source(h)), b = at(m, m.target(h)), c = at(m, m.target(m.next(h)));
-    const Eigen::Vector3d n = (b - a).cross(c - a);
-    return n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
-}
-
-double faceArea(const Mesh& m, FaceIndex f) {
-    const HalfedgeIndex h = m.halfedge(f);
-    const Eigen::Vector3d a = at(m, m.source(h)), b = at(m, m.target(h)), c = at(m, m.target(m.next(h)));
-    return 0.5 * (b - a).cross(c - a).norm();
-}
-
 /// The lattice spacing is this fraction of the spacing that gives a regular triangulation's vertex density:
 /// the join adds no vertex and the seam relaxation collapses a few (measured: fandisk, bunny00 4-6 % short
 /// of the target at 1).

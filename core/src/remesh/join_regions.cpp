@@ -30,24 +30,6 @@
 namespace fss::detail {
 namespace {
 
-Eigen::Vector3d at(const Mesh& m, VertexIndex v) {
-    const Point3& p = m.point(v);
-    return {p.x(), p.y(), p.z()};
-}
-
-Eigen::Vector3d faceNormal(const Mesh& m, FaceIndex f) {
-    const HalfedgeIndex h = m.halfedge(f);
-    const Eigen::Vector3d a = at(m, m.source(h)), b = at(m, m.target(h)), c = at(m, m.target(m.next(h)));
-    const Eigen::Vector3d n = (b - a).cross(c - a);
-    return n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
-}
-
-double faceArea(const Mesh& m, FaceIndex f) {
-    const HalfedgeIndex h = m.halfedge(f);
-    const Eigen::Vector3d a = at(m, m.source(h)), b = at(m, m.target(h)), c = at(m, m.target(m.next(h)));
-    return 0.5 * (b - a).cross(c - a).norm();
-}
-
 /// Adds the faces of \p reference flagged in \p keep to \p out as faces left from the input (scan id -1).
 void appendInputFaces(Mesh& out, const Mesh& reference, const std::vector<char>& keep) {
     auto outIds = out.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1).first;

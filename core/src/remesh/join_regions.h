@@ -11,6 +11,27 @@
 
 namespace fss::detail {
 
+/// A vertex's position as an Eigen vector (auto v2 and its join).
+inline Eigen::Vector3d at(const Mesh& m, VertexIndex v) {
+    const Point3& p = m.point(v);
+    return {p.x(), p.y(), p.z()};
+}
+
+/// The unit normal of face \p f (zero for a degenerate face).
+inline Eigen::Vector3d faceNormal(const Mesh& m, FaceIndex f) {
+    const HalfedgeIndex h = m.halfedge(f);
+    const Eigen::Vector3d a = at(m, m.source(h)), b = at(m, m.target(h)), c = at(m, m.target(m.next(h)));
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    return n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
+}
+
+/// The area of face \p f.
+inline double faceArea(const Mesh& m, FaceIndex f) {
+    const HalfedgeIndex h = m.halfedge(f);
+    const Eigen::Vector3d a = at(m, m.source(h)), b = at(m, m.target(h)), c = at(m, m.target(m.next(h)));
+    return 0.5 * (b - a).cross(c - a).norm();
+}
+
 /// The connected pieces (through edges) of the faces of \p mesh for which \p member(f) is true, in the order
 /// of mesh.faces() of their first face; each piece's faces in the order a depth-first fill reaches them.
 template <class Member>
