@@ -1,9 +1,13 @@
 # Keeps FSS's sources readable (issue 18, docs/DESIGN.md §9): no function body over 200 lines and no core
-# source file over 900 lines, outside core/src/remesh/ (its own issue restructures it); the stitch stages'
-# files under core/src/stitch/ (issue 19, DESIGN.md §6) and the widgets' files (split by topic in session 17:
-# remesh_widget*.cpp, vtk_view*.cpp) are held to 800 lines. Run as a script:
+# source file over 900 lines; the stitch stages' files under core/src/stitch/ (issue 19, DESIGN.md §6), the
+# widgets' files (split by topic in session 17: remesh_widget*.cpp, vtk_view*.cpp) and the remeshing files
+# under core/src/remesh/ (auto_remesh.cpp split in session 18: auto_views.cpp) are held to 800 lines.
+# core/src/remesh/ is still exempt from the function rule (issue 23 restructures autoRemesh, 348 lines, and
+# autoRemeshV2, 270) and crease_snap.cpp from the file rule (split by topic in session 18, branch
+# autotime18; drop REMESH_EXEMPT when it lands). Run as a script:
 #   cmake -DROOT=<source tree> [-DMAX_FUNCTION_LINES=200] [-DMAX_CORE_FILE_LINES=900]
-#         [-DMAX_STITCH_FILE_LINES=800] [-DMAX_WIDGETS_FILE_LINES=800] -P cmake/SizeCheck.cmake
+#         [-DMAX_STITCH_FILE_LINES=800] [-DMAX_WIDGETS_FILE_LINES=800] [-DMAX_REMESH_FILE_LINES=800]
+#         -P cmake/SizeCheck.cmake
 # Functions are found the way .clang-format lays them out (namespaces not indented): a definition starts
 # at column 0 and ends at a line that is exactly "}" at column 0; members defined inside a class body are
 # counted with their class only when the class itself is a definition at column 0 (i.e. not at all).
@@ -23,9 +27,13 @@ endif()
 if(NOT MAX_WIDGETS_FILE_LINES)
   set(MAX_WIDGETS_FILE_LINES 800)
 endif()
+if(NOT MAX_REMESH_FILE_LINES)
+  set(MAX_REMESH_FILE_LINES 800)
+endif()
+set(REMESH_EXEMPT "core/src/remesh/crease_snap.cpp")
 include("${CMAKE_CURRENT_LIST_DIR}/FSSReadLines.cmake")
 
-fss_cpp_sources(sources ROOT "${ROOT}" DIRS core widgets plugins demo examples EXCLUDE "core/src/remesh/")
+fss_cpp_sources(sources ROOT "${ROOT}" DIRS core widgets plugins demo examples)
 list(LENGTH sources count)
 
 set(problems "")
@@ -39,6 +47,11 @@ foreach(file IN LISTS sources)
     if(total GREATER MAX_STITCH_FILE_LINES)
       list(APPEND problems "${rel}: ${total} lines (a stitch file has at most ${MAX_STITCH_FILE_LINES})")
     endif()
+  elseif(rel MATCHES "^core/src/remesh/")
+    if(total GREATER MAX_REMESH_FILE_LINES AND NOT rel IN_LIST REMESH_EXEMPT)
+      list(APPEND problems "${rel}: ${total} lines (a remesh file has at most ${MAX_REMESH_FILE_LINES})")
+    endif()
+    continue() # exempt from the function rule (see above)
   elseif(rel MATCHES "^widgets/")
     if(total GREATER MAX_WIDGETS_FILE_LINES)
       list(APPEND problems "${rel}: ${total} lines (a widgets file has at most ${MAX_WIDGETS_FILE_LINES})")
