@@ -1,8 +1,9 @@
 # Keeps FSS's sources readable (issue 18, docs/DESIGN.md §9): no function body over 200 lines and no core
 # source file over 900 lines; the stitch stages' files under core/src/stitch/ (issue 19, DESIGN.md §6), the
-# remesh files under core/src/remesh/ (crease recovery split by topic in session 18) and the widgets' files
-# (split by topic in session 17: remesh_widget*.cpp, vtk_view*.cpp) are held to 800 lines. Still left out:
-# auto_remesh.cpp and auto_v2.cpp (issue 23 splits them: their drivers are functions of 270-350 lines).
+# remesh files under core/src/remesh/ (crease recovery and auto_remesh.cpp split by topic in session 18) and the
+# widgets' files (split by topic in session 17: remesh_widget*.cpp, vtk_view*.cpp) are held to 800 lines.
+# auto_remesh.cpp and auto_v2.cpp are still exempt from the function rule (issue 23 restructures their drivers,
+# autoRemesh 348 lines and autoRemeshV2 270).
 # Run as a script:
 #   cmake -DROOT=<source tree> [-DMAX_FUNCTION_LINES=200] [-DMAX_CORE_FILE_LINES=900]
 #         [-DMAX_STITCH_FILE_LINES=800] [-DMAX_WIDGETS_FILE_LINES=800] -P cmake/SizeCheck.cmake
@@ -27,8 +28,7 @@ if(NOT MAX_WIDGETS_FILE_LINES)
 endif()
 include("${CMAKE_CURRENT_LIST_DIR}/FSSReadLines.cmake")
 
-fss_cpp_sources(sources ROOT "${ROOT}" DIRS core widgets plugins demo examples
-                 EXCLUDE "core/src/remesh/auto_(remesh|v2)\\.cpp")
+fss_cpp_sources(sources ROOT "${ROOT}" DIRS core widgets plugins demo examples)
 list(LENGTH sources count)
 
 set(problems "")
@@ -49,6 +49,9 @@ foreach(file IN LISTS sources)
     endif()
   elseif(rel MATCHES "^core/" AND total GREATER MAX_CORE_FILE_LINES)
     list(APPEND problems "${rel}: ${total} lines (a core file has at most ${MAX_CORE_FILE_LINES})")
+  endif()
+  if(rel MATCHES "^core/src/remesh/auto_(remesh|v2)\\.cpp$")
+    continue() # exempt from the function rule (see above)
   endif()
   set(n 0)
   set(start 0)
