@@ -454,3 +454,37 @@ TEST(FishboneFandisk, KeyRibMovedByOnePixelFigures) {
     const double worst = fss::test::largestKeyRibMove("fandisk", m, renderer, params, fb, traced, cache, 200);
     EXPECT_LE(worst, 2.0); // issue #20's bound; measured 1.93 px
 }
+
+// The CLI's drawn case (tests/cli/fishbone_scan_test.cpp, `fss-remesh scan fandisk.off --renderer cpu
+// --fishbone "backbone=0.3,0.5|0.4,0.55|0.5,0.6;h=3;keyribs=0.32,0.51|0.48,0.59"`: iso view, 256²): its first
+// key-rib point lies at the border of a flat face whose vertices have no principal direction, so the rib
+// field is undefined there and at the nearest backbone sample. With continuous key-ribs (the default since
+// session 18) that key-rib came back with both halves empty and the blend left 62 grid vertices that the
+// sliver rules dropped ("Nothing is left to triangulate"); with key-ribs at the nearest sample it was empty
+// too (96 faces, from the other key-rib alone). Now its half towards the defined region starts straight
+// (tracedKeyRib): measured 174 faces, 179 samples.
+TEST(FishboneFandisk, DrawnBackboneWithKeyRibOnAFlatFace) {
+    const Mesh m = fss::readMesh(fss::test::meshPath("fandisk.off").string());
+    fss::CpuMeshRenderer renderer;
+    renderer.setMesh(m);
+    fss::ScanParams params;
+    params.camera = fss::Camera::standardView(fss::StandardView::Iso, fss::boundingBox(m), 256, 256);
+    fss::FishboneParams fb;
+    fb.spacing = 3;
+    for (const Vector2d& p : {Vector2d(0.3, 0.5), Vector2d(0.4, 0.55), Vector2d(0.5, 0.6)})
+        fb.drawnBackbone.push_back(256 * p);
+    fb.keyRibs = {256 * Vector2d(0.32, 0.51), 256 * Vector2d(0.48, 0.59)};
+    ASSERT_TRUE(fb.tracing.continuousKeyRibs); // the default
+    fss::FishboneCache cache;
+    const fss::FishboneScanResult r = fss::scanFishbonePatch(m, renderer, m, renderer, params, fb, cache);
+    fb.tracing.continuousKeyRibs = false;
+    const fss::FishboneScanResult nearest =
+        fss::scanFishbonePatch(m, renderer, m, renderer, params, fb, cache);
+    const std::size_t faces = r.patch.mesh.number_of_faces(), before = nearest.patch.mesh.number_of_faces();
+    std::printf("drawn backbone, key-rib on a flat face: %zu faces, %zu samples (key-ribs at the nearest "
+                "sample: %zu faces)\n",
+                faces, r.counts.covered, before);
+    // The first key-rib's half adds rows of samples on its side: more than the other key-rib alone gives.
+    EXPECT_GT(faces, before + before / 2);
+    EXPECT_GT(r.counts.covered, nearest.counts.covered);
+}

@@ -420,7 +420,38 @@ TEST(FishboneScan, SliverTable) {
                 for (int row = 0; row < r.fishbone.rows; ++row)
                     if (r.fishbone.isPresent(row, r.fishbone.backboneColumn))
                         backbone.push_back(r.fishbone.at(row, r.fishbone.backboneColumn));
-                auto nearError = [&](const Mesh& m) {
+                // The screen pixels the fishbone patch covers (its faces rasterised): "common" restricts the
+                // regular grid's faces to them, so that both errors are taken over the same part of the
+                // crease (a one-sided fishbone patch against the two-sided regular one, issue 20 session 18).
+                const fss::Camera& cam = c.camera;
+                std::vector<char> fishCovered(std::size_t(cam.width) * std::size_t(cam.height), 0);
+                for (auto f : r.patch.mesh.faces()) {
+                    std::array<Vector2d, 3> q;
+                    int k = 0;
+                    for (auto v : CGAL::vertices_around_face(r.patch.mesh.halfedge(f), r.patch.mesh))
+                        q[std::size_t(k++)] = cam.project(pt(r.patch.mesh, v)).head<2>();
+                    const Vector2d lo = q[0].cwiseMin(q[1]).cwiseMin(q[2]),
+                                   hi = q[0].cwiseMax(q[1]).cwiseMax(q[2]);
+                    const double area =
+                        (q[1] - q[0]).x() * (q[2] - q[0]).y() - (q[1] - q[0]).y() * (q[2] - q[0]).x();
+                    if (area == 0) continue;
+                    for (int y = std::max(0, int(lo.y())); y <= std::min(cam.height - 1, int(hi.y())); ++y)
+                        for (int x = std::max(0, int(lo.x())); x <= std::min(cam.width - 1, int(hi.x()));
+                             ++x) {
+                            const Vector2d pc(x + 0.5, y + 0.5);
+                            bool inside = true;
+                            for (int e = 0; e < 3; ++e) {
+                                const Vector2d a = q[std::size_t(e)], b = q[std::size_t((e + 1) % 3)];
+                                inside =
+                                    inside &&
+                                    ((b - a).x() * (pc - a).y() - (b - a).y() * (pc - a).x()) * area >= 0;
+                            }
+                            if (inside)
+                                fishCovered[std::size_t(y) * std::size_t(cam.width) + std::size_t(x)] = 1;
+                        }
+                }
+                std::size_t nearCount = 0;
+                auto nearError = [&](const Mesh& m, bool common = false) {
                     double sum = 0;
                     std::size_t n = 0;
                     for (auto f : m.faces()) {
@@ -433,16 +464,32 @@ TEST(FishboneScan, SliverTable) {
                         for (const Vector2d& b : backbone)
                             near = near || (b - s).norm() <= 3 * h;
                         if (!near) continue;
+                        if (common) {
+                            const int x = int(s.x()), y = int(s.y());
+                            if (x < 0 || y < 0 || x >= cam.width || y >= cam.height ||
+                                !fishCovered[std::size_t(y) * std::size_t(cam.width) + std::size_t(x)])
+                                continue;
+                        }
                         const Vector3d ref = faceNormal(*c.mesh, caster.closestPoint(centroid).face);
                         sum += std::acos(std::clamp(faceNormal(m, f).dot(ref), -1.0, 1.0)) * 180 /
                                std::numbers::pi;
                         ++n;
                     }
+                    nearCount = n;
                     return n ? sum / double(n) : std::numeric_limits<double>::quiet_NaN();
                 };
                 const AngleFigures a = angleFigures(r.patch.mesh);
-                const double fishError = nearError(r.patch.mesh), gridError = nearError(regular.patch.mesh),
-                             pixelError = nearError(pixels.patch.mesh);
+                const double fishError = nearError(r.patch.mesh);
+                const std::size_t fishNear = nearCount;
+                const double gridError = nearError(regular.patch.mesh);
+                const std::size_t gridNear = nearCount;
+                const double commonError = nearError(regular.patch.mesh, true);
+                const std::size_t commonNear = nearCount;
+                const double pixelError = nearError(pixels.patch.mesh);
+                std::printf("%-26s %-7s %-6s near-crease faces: fishbone %zu (%.2f°), regular %zu (%.2f°), "
+                            "regular where the fishbone is %zu (%.2f°, ratio %.2f)\n",
+                            c.name.c_str(), setName, lasso ? "lasso" : "-", fishNear, fishError, gridNear,
+                            gridError, commonNear, commonError, fishError / commonError);
                 std::printf("%-26s %-7s %-6s %-7s | %5zu %6.1f %6.1f | %6.2f %6.2f %5.2f | pixel grid %5.2f "
                             "ratio %4.2f, backbone off the crease %.2f h | %s | %s | "
                             "grid %dx%d, %zu rib vertices, dropped: trim %zu creaseStop %zu sliverQuad %zu "

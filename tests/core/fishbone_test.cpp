@@ -331,6 +331,43 @@ TEST(Fishbone, KeyRibsBetweenSamplesBlendByTheirPositions) {
     EXPECT_THROW(grid(5.3, 39.5), fss::InvalidInputError);
 }
 
+// A traced key-rib whose point lies where the rib field is undefined (fandisk's flat faces: no principal
+// direction, tests/cli/fishbone_scan_test.cpp's drawn case): the half towards a defined region within 8h
+// runs straight to it and is traced on from there; the half into the undefined region stays empty. The
+// field: horizontal for x ≥ 20 only; the backbone vertical at x = 17.5, the key-rib's point at y = 20.3
+// (between samples). Before session 18 both halves came back empty.
+TEST(Fishbone, TracedKeyRibStartsStraightWhereTheFieldIsUndefined) {
+    const int W = 60, H = 40;
+    fss::DirectionField across(W, H);
+    for (int y = 0; y < H; ++y)
+        for (int x = 20; x < W; ++x)
+            across.setPixel(x, y, {1, 0}, 1.0);
+    const double h = 2.0;
+    const Backbone b = straightBackbone({17.5, 4}, {0, 1}, h, 16);
+    FishboneOptions o;
+    o.spacing = h;
+    const KeyRib k = fss::tracedKeyRib(across, b, {18.0, 20.3}, o);
+    EXPECT_NEAR(k.position, 8.15, 1e-9);
+    EXPECT_EQ(k.row, 8u);
+    const bool positiveRight = b.normal(8).x() > 0;
+    const Polyline2& right = positiveRight ? k.rib.positive : k.rib.negative;
+    const Polyline2& left = positiveRight ? k.rib.negative : k.rib.positive;
+    EXPECT_EQ(left.size(), 1u); // into the undefined region: nothing to trace
+    // To the image's right border (42.5 px from the start) at spacing h: 22 vertices, all on y = 20.3.
+    ASSERT_EQ(right.size(), 22u);
+    for (std::size_t i = 0; i < right.size(); ++i) {
+        EXPECT_NEAR(right[i].x(), 17.5 + h * double(i), 1e-6) << i;
+        EXPECT_NEAR(right[i].y(), 20.3, 1e-6) << i;
+    }
+    // Defined only beyond 8h (x ≥ 34): no straight start that long.
+    fss::DirectionField far(W, H);
+    for (int y = 0; y < H; ++y)
+        for (int x = 34; x < W; ++x)
+            far.setPixel(x, y, {1, 0}, 1.0);
+    const KeyRib none = fss::tracedKeyRib(far, b, {18.0, 20.3}, o);
+    EXPECT_EQ(none.rib.positive.size() + none.rib.negative.size(), 2u);
+}
+
 TEST(Fishbone, AutomaticGridOnSyntheticFields) {
     // Backbone field vertical, rib field horizontal (random signs): a square grid of spacing h.
     const int W = 120, H = 100;

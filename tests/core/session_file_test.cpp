@@ -230,7 +230,6 @@ fss::ScanStep fishboneStep() {
     fb.tracing.isotropicRibs = true;
     fb.tracing.maxRibAspect = 1.75;
     fb.tracing.spareFollowedCrease = true;
-    fb.tracing.continuousKeyRibs = true; // off by default: set, so that its key is written and read back
     fb.tracing.minFaceAngleDeg = 22.5;
     fb.tracing.minComponentFaces = 30;
     fb.tracing.backboneTracing.step = 0.3;
@@ -541,8 +540,8 @@ TEST_F(BadSessionFile, FishboneSliverRulesAreOffWhenAbsentAndOnByDefault) {
     EXPECT_TRUE(fresh.closeLoops);
     EXPECT_EQ(fresh.minFaceAngleDeg, 20.0);
     EXPECT_EQ(fresh.minComponentFaces, 24);
-    EXPECT_TRUE(fresh.creaseBackbone);     // session 16: backbones on creases
-    EXPECT_FALSE(fresh.continuousKeyRibs); // key-ribs between samples: off until the CLI's drawn case works
+    EXPECT_TRUE(fresh.creaseBackbone);    // session 16: backbones on creases
+    EXPECT_TRUE(fresh.continuousKeyRibs); // session 18: key-ribs between samples
     EXPECT_FALSE(fresh.stopRibsAtCreases);
     EXPECT_EQ(fresh.maxRibAspect, 0.0);
 }

@@ -101,10 +101,11 @@ struct FishboneOptions {
     /// of the backbone nearest to it (Backbone::nearestPoint, tracedKeyRib), not from the nearest backbone
     /// sample, and blends the rows between key-ribs by their continuous positions (KeyRib::position), so
     /// that moving a key-rib by a pixel moves the grid by about as much instead of jumping a row (fandisk:
-    /// 1.93 px for a 1 px move, 3.82 px without). Off by default for now: with a drawn backbone and two
-    /// picked key-ribs on fandisk (tests/cli/fishbone_scan_test.cpp) it leaves nothing to triangulate, not
-    /// traced yet; off also in files written before it (ribs at the nearest sample).
-    bool continuousKeyRibs = false;
+    /// 1.93 px for a 1 px move, 3.82 px without). On by default (session 18: the drawn case of
+    /// tests/cli/fishbone_scan_test.cpp, whose first key-rib starts where the rib field is undefined, now
+    /// gets a half from tracedKeyRib's straight start); off in files written before it (ribs at the nearest
+    /// sample, as recorded).
+    bool continuousKeyRibs = true;
     /// The fishbone scan stops a traced backbone, outwards from its seed, before its first edge that
     /// crosses a visible crease of the reference at more than 30° (FishboneParams::creaseAngleDeg > 0; a
     /// crease it runs along does not stop it). A closed backbone so cut is open. false here and in files
@@ -305,7 +306,9 @@ FishboneGrid automaticFishbone(const DirectionField& backboneField, const Direct
 
 /// A key-rib traced from the point of \p backbone nearest to \p p (Backbone::nearestPoint) along the
 /// backbone's interpolated normal there, on \p ribField; its position is that point's, its row the
-/// nearest sample. \throw InvalidInputError as traceRib.
+/// nearest sample. A half whose start lies where \p ribField is undefined runs straight along the normal
+/// to the first point within 8h where it is defined and is traced from there (else it stays empty).
+/// \throw InvalidInputError as traceRib.
 KeyRib tracedKeyRib(const DirectionField& ribField, const Backbone& backbone, const Eigen::Vector2d& p,
                     const FishboneOptions& options);
 

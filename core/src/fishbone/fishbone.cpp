@@ -467,8 +467,31 @@ KeyRib tracedKeyRib(const DirectionField& ribField, const Backbone& backbone, co
     local.samples = {at.point - d, at.point, at.point + d};
     KeyRib key;
     key.rib = traceRib(ribField, local, 1, options);
-    key.position = at.position;
     key.row = std::min(std::size_t(std::lround(at.position)), backbone.samples.size() - 1);
+    // A half that cannot start where the rib field is undefined (a pixel whose interpolated principal
+    // direction vanishes: beside fandisk's flat faces, whose vertices have no curvature direction) runs
+    // straight along the backbone's normal to the first point where the field is defined, at most 8h away,
+    // and is traced from there. The nearest backbone sample, where a key-rib started before, usually lies
+    // in the same region: tests/cli/fishbone_scan_test.cpp's drawn case had both halves empty either way
+    // and the grid left nothing to triangulate with continuous key-ribs; its negative half runs 4.7 h.
+    const Eigen::Vector2d n = local.normal(1);
+    for (const bool positive : {true, false}) {
+        Polyline2& half = positive ? key.rib.positive : key.rib.negative;
+        if (half.size() >= 2) continue;
+        const Eigen::Vector2d side = positive ? n : Eigen::Vector2d(-n);
+        const double step = options.ribTracing.step;
+        for (double s = step; s <= 8 * options.spacing; s += step) {
+            const Eigen::Vector2d q = at.point + s * side;
+            if (!ribHalfTraceable(ribField, q, side, options)) continue;
+            Polyline2 dense{at.point};
+            const std::vector<StreamlineHalf> traced =
+                traceHalvesInLockstep(ribField, {{q, side}}, options.ribTracing);
+            dense.insert(dense.end(), traced.front().points.begin(), traced.front().points.end());
+            half = resampleAtSpacing(dense, options.spacing);
+            break;
+        }
+    }
+    key.position = at.position;
     return key;
 }
 
