@@ -40,7 +40,16 @@ constexpr double kSlideCreaseDeg = 10.0;
 constexpr double kSplitFloorDeg = 20.0;
 using V3 = Eigen::Vector3d;
 
-// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,creasefilter,collapseall,short (and lift, split, smooth) turns
+// FSS_STITCH_BAND_DIAG=2: the band prints each face below 20 deg and what its repairs tried.
+inline bool bandDiagnosticsVerbose() {
+    static const bool on = [] {
+        const char* e = std::getenv("FSS_STITCH_BAND_DIAG");
+        return e && std::string(e) == "2";
+    }();
+    return on;
+}
+
+// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,creasefilter,collapseall,short,star,bridge (and lift, split, smooth) turns
 // parts of the band remesh off (to measure what each brings).
 inline bool stageOff(const char* name) {
     static const std::string off = [] {
@@ -353,6 +362,27 @@ private:
     bool repairFlip(FaceIndex f);
     bool repairCollapse(FaceIndex f);
     bool repairCap(FaceIndex f);
+    // ---- the compound repair of a face no single operation improves (band_star.cpp): a small disk of band
+    // faces around it triangulated anew in the view (the gap's quality CDT), new vertices on the draft's
+    // smooth surface, kept only where the disk's smallest angle rises and every band rule holds.
+    struct StarDisk {
+        std::vector<FaceIndex> faces;   // sorted
+        std::vector<VertexIndex> loop;  // its border, counter-clockwise in the view
+        std::vector<VertexIndex> inner; // its interior vertices (free: they go)
+    };
+    struct StarPlan {
+        StarDisk disk;
+        std::vector<V3> points;               // new vertices (GapTriangulation points past the loop's)
+        std::vector<FaceIndex> hints;         // their faces on the draft
+        std::vector<double> sizes;            // their local sizes
+        std::vector<std::array<int, 3>> triangles; // loop indices, then n + new vertex index
+        std::vector<FaceIndex> parents;       // per triangle: the old face under its centroid
+        double minAngle = -1;                 // radians
+    };
+    bool repairStar(FaceIndex f);
+    bool starDisk(const std::vector<FaceIndex>& faces, StarDisk& disk);
+    bool planStar(const StarDisk& disk, StarPlan& best);
+    bool applyStar(const StarPlan& plan);
 
     // ---- the smooth surface through the draft (band_crease.cpp): a point of a draft face lifted by Phong
     // tessellation (Boubekeur & Alexa 2008, shape factor 1/2: exact to second order on a sphere) with the
@@ -375,6 +405,8 @@ private:
     // The band's creases at setup (band_crease.cpp): edges between faces whose normals differ by more than
     // the crease angle, outlier faces and weak stubs left out.
     void findCreases();
+    // Crease ends facing each other across a sliver (no reliable normal) joined into one crease.
+    void bridgeCreases(const std::unordered_map<std::uint32_t, V3>& normal);
     // Whether a face has an angle above 120 deg.
     bool isCap(FaceIndex f) const;
     // The point at parameter t between crease vertices a and b on their common crease polyline (into q);
