@@ -119,7 +119,8 @@ void BandRemesher::bridgeCreases(const std::unordered_map<std::uint32_t, V3>& no
         double bestTurn = kStraightCreaseDeg * kBandDeg;
         for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(a), S_)) {
             const VertexIndex b = S_.source(h);
-            if (std::uint32_t(b) <= ai || creaseDegree(b) != 1 || isCrease(a, b) || !interiorEdge(h)) continue;
+            if (std::uint32_t(b) <= ai || creaseDegree(b) != 1 || isCrease(a, b) || !interiorEdge(h))
+                continue;
             if (!unknownNormal(S_.face(h)) && !unknownNormal(S_.face(S_.opposite(h)))) continue;
             const VertexIndex y = along(b);
             if (y == Mesh::null_vertex() || y == x) continue;

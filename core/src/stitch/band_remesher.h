@@ -2,6 +2,7 @@
 // The state and operations of one seam band remesh (band_remesh.h): internal to band_remesh.cpp and
 // band_repair.cpp (the repair of faces still bad at the end, the band's growth and the diagnostics).
 #include "stitch/band_remesh.h"
+#include "stitch/gap_triangulation.h"
 
 #include "fss/raycast.h"
 
@@ -49,8 +50,8 @@ inline bool bandDiagnosticsVerbose() {
     return on;
 }
 
-// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,creasefilter,collapseall,short,star,bridge (and lift, split, smooth) turns
-// parts of the band remesh off (to measure what each brings).
+// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,creasefilter,collapseall,short,star,bridge (and lift, split,
+// smooth) turns parts of the band remesh off (to measure what each brings).
 inline bool stageOff(const char* name) {
     static const std::string off = [] {
         const char* e = std::getenv("FSS_STITCH_BAND_OFF");
@@ -372,14 +373,29 @@ private:
     };
     struct StarPlan {
         StarDisk disk;
-        std::vector<V3> points;               // new vertices (GapTriangulation points past the loop's)
-        std::vector<FaceIndex> hints;         // their faces on the draft
-        std::vector<double> sizes;            // their local sizes
+        std::vector<V3> points;                    // new vertices (GapTriangulation points past the loop's)
+        std::vector<FaceIndex> hints;              // their faces on the draft
+        std::vector<double> sizes;                 // their local sizes
         std::vector<std::array<int, 3>> triangles; // loop indices, then n + new vertex index
-        std::vector<FaceIndex> parents;       // per triangle: the old face under its centroid
-        double minAngle = -1;                 // radians
+        std::vector<FaceIndex> parents;            // per triangle: the old face under its centroid
+        double minAngle = -1;                      // radians
+    };
+    // The disk seen in the view: the CDT's input (loop constraints, crease chords), each vertex's place, the
+    // disk's edges, mean normal, smallest angle and local size in pixels.
+    struct StarView {
+        const StarDisk* disk = nullptr;
+        GapBoundary gap;
+        std::unordered_map<std::uint32_t, Eigen::Vector2d> uvOf;
+        std::vector<Eigen::Vector2d> innerUv;
+        std::unordered_set<std::uint64_t> diskEdges;
+        V3 starNormal{0, 0, 0};
+        double oldMin = 0, sizePx = 0;
     };
     bool repairStar(FaceIndex f);
+    bool viewStar(const StarDisk& disk, StarView& sv);
+    FaceIndex starFaceAt(const StarView& sv, const Eigen::Vector2d& p, std::array<double, 3>& w) const;
+    // Empty when the triangulation t of the disk passes every rule (then in plan), else why not.
+    std::string judgeStar(const StarView& sv, const GapTriangulation& t, StarPlan& plan);
     bool starDisk(const std::vector<FaceIndex>& faces, StarDisk& disk);
     bool planStar(const StarDisk& disk, StarPlan& best);
     bool applyStar(const StarPlan& plan);

@@ -9,6 +9,7 @@
 #include "stitch/gap_triangulation.h"
 
 #include <map>
+#include <string>
 
 namespace fss::stitch::band {
 
@@ -152,6 +153,40 @@ bool BandRemesher::repairStar(FaceIndex f) {
 }
 
 bool BandRemesher::planStar(const StarDisk& disk, StarPlan& best) {
+    StarView sv;
+    if (!viewStar(disk, sv)) return false;
+    // Variants: the loop alone; with the old interior points; refined for quality with the local size.
+    struct Variant {
+        bool innerPoints;
+        double angle;
+    };
+    const double aim = in_.minAngleDeg * kBandDeg;
+    for (const Variant& var : {Variant{false, 0}, Variant{true, 0}, Variant{false, 25}, Variant{true, 25}}) {
+        GapBoundary b = sv.gap;
+        if (var.innerPoints && sv.innerUv.empty()) continue;
+        if (var.innerPoints) b.points.insert(b.points.end(), sv.innerUv.begin(), sv.innerUv.end());
+        GapOptions o;
+        o.minAngleDeg = var.angle;
+        o.lloydIterations = 0;
+        o.maxSteinerPerBoundaryPoint = 1.0;
+        const double sizePx = sv.sizePx;
+        if (var.angle > 0) o.size = [sizePx](const V2&) { return 1.5 * sizePx; };
+        const GapTriangulation t = triangulateGap(b, o);
+        StarPlan plan;
+        const std::string why = t.ok && !t.triangles.empty() ? judgeStar(sv, t, plan) : t.reason;
+        if (bandDiagnosticsVerbose() && !why.empty())
+            std::fprintf(stderr, "    variant %d/%.0f: %s\n", int(var.innerPoints), var.angle, why.c_str());
+        if (!why.empty()) continue;
+        if (plan.minAngle > best.minAngle) best = std::move(plan);
+        if (best.minAngle >= aim) break;
+    }
+    return !best.triangles.empty();
+}
+
+bool BandRemesher::viewStar(const StarDisk& disk, StarView& sv) {
+    sv.disk = &disk;
+    GapBoundary& gap = sv.gap;
+    std::unordered_map<std::uint32_t, V2>& uvOf = sv.uvOf;
     // The disk in the view (screen x, -screen y: front-facing triangles counter-clockwise).
     const Eigen::Matrix4d vp = in_.camera->viewProjectionMatrix();
     auto project = [&](const V3& p, V2& uv) {
@@ -162,8 +197,8 @@ bool BandRemesher::planStar(const StarDisk& disk, StarPlan& best) {
         return uv.allFinite();
     };
     std::unordered_map<std::uint32_t, int> index; // loop and interior vertices -> GapBoundary point
-    GapBoundary gap;
-    double len3 = 0, len2 = 0, oldMin = std::numbers::pi;
+    double len3 = 0, len2 = 0;
+    sv.oldMin = std::numbers::pi;
     for (VertexIndex v : disk.loop) {
         V2 uv;
         if (!project(detail::pos(S_, v), uv)) return false;
@@ -183,26 +218,25 @@ bool BandRemesher::planStar(const StarDisk& disk, StarPlan& best) {
     if (!(area > 0) || !(len3 > 0)) return false;
     const double pxPerUnit = len2 / len3;
     // The old faces in the view (to place new points on the draft and to find each new face's reference).
-    std::unordered_map<std::uint32_t, V2> uvOf;
     for (std::size_t i = 0; i < disk.loop.size(); ++i)
         uvOf[std::uint32_t(disk.loop[i])] = gap.points[i];
-    std::vector<V2> innerUv;
     for (VertexIndex v : disk.inner) {
         V2 uv;
         if (!project(detail::pos(S_, v), uv)) return false;
         uvOf[std::uint32_t(v)] = uv;
-        innerUv.push_back(uv);
+        sv.innerUv.push_back(uv);
     }
     // Crease chords inside the disk (both ends on the loop) stay as constraints; so must existing edges
     // between loop vertices outside the disk not be made twice.
-    std::unordered_set<std::uint64_t> diskEdges, chords;
-    V3 starNormal(0, 0, 0);
+    std::unordered_set<std::uint64_t> chords;
+    V3& starNormal = sv.starNormal;
+    starNormal = V3(0, 0, 0);
     for (FaceIndex g : disk.faces) {
-        oldMin = std::min(oldMin, faceMinAngle(g));
+        sv.oldMin = std::min(sv.oldMin, faceMinAngle(g));
         starNormal += areaVector(g);
         for (HalfedgeIndex h : CGAL::halfedges_around_face(S_.halfedge(g), S_)) {
             const VertexIndex a = S_.source(h), b = S_.target(h);
-            diskEdges.insert(bandKey(a, b));
+            sv.diskEdges.insert(bandKey(a, b));
             if (isCrease(a, b) && chords.insert(bandKey(a, b)).second) {
                 const int ia = index.at(std::uint32_t(a)), ib = index.at(std::uint32_t(b));
                 if (std::abs(ia - ib) != 1 && std::abs(ia - ib) != n - 1) gap.constraints.push_back({ia, ib});
@@ -210,188 +244,156 @@ bool BandRemesher::planStar(const StarDisk& disk, StarPlan& best) {
         }
     }
     starNormal.normalize();
-    auto oldFaceAt = [&](const V2& p, std::array<double, 3>& w) -> FaceIndex {
-        FaceIndex bestFace = Mesh::null_face();
-        double bestMin = -std::numeric_limits<double>::infinity();
-        for (FaceIndex g : disk.faces) {
-            std::array<V2, 3> t;
-            int k = 0;
-            for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_))
-                t[std::size_t(k++)] = uvOf.at(std::uint32_t(v));
-            std::array<double, 3> b;
-            if (!barycentric2(t[0], t[1], t[2], p, b)) continue;
-            const double m = std::min({b[0], b[1], b[2]});
-            if (m > bestMin) {
-                bestMin = m;
-                bestFace = g;
-                w = b;
-            }
-        }
-        return bestFace;
-    };
     double sizeSum = 0;
     for (VertexIndex v : disk.loop)
         sizeSum += sizeOf(v);
-    const double sizePx = sizeSum / double(disk.loop.size()) * pxPerUnit;
+    sv.sizePx = sizeSum / double(disk.loop.size()) * pxPerUnit;
+    return true;
+}
 
-    // Variants: the loop alone; with the old interior points; refined for quality with the local size.
-    struct Variant {
-        bool innerPoints;
-        double angle;
-    };
-    const double aim = in_.minAngleDeg * kBandDeg;
-    for (const Variant& var : {Variant{false, 0}, Variant{true, 0}, Variant{false, 25}, Variant{true, 25}}) {
-        GapBoundary b = gap;
-        if (var.innerPoints) b.points.insert(b.points.end(), innerUv.begin(), innerUv.end());
-        if (var.innerPoints && innerUv.empty()) continue;
-        GapOptions o;
-        o.minAngleDeg = var.angle;
-        o.lloydIterations = 0;
-        o.maxSteinerPerBoundaryPoint = 1.0;
-        if (var.angle > 0) o.size = [&](const V2&) { return 1.5 * sizePx; };
-        const GapTriangulation t = triangulateGap(b, o);
-        auto why = [&](const char* reason) {
-            if (bandDiagnosticsVerbose())
-                std::fprintf(stderr, "    variant %d/%.0f: %s\n", int(var.innerPoints), var.angle, reason);
-        };
-        if (!t.ok || t.triangles.empty()) {
-            why(t.reason.c_str());
-            continue;
+FaceIndex BandRemesher::starFaceAt(const StarView& sv, const V2& p, std::array<double, 3>& w) const {
+    // The old face under p in the view: the one p is most inside of.
+    FaceIndex bestFace = Mesh::null_face();
+    double bestMin = -std::numeric_limits<double>::infinity();
+    for (FaceIndex g : sv.disk->faces) {
+        std::array<V2, 3> t;
+        int k = 0;
+        for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_))
+            t[std::size_t(k++)] = sv.uvOf.at(std::uint32_t(v));
+        std::array<double, 3> b;
+        if (!barycentric2(t[0], t[1], t[2], p, b)) continue;
+        const double m = std::min({b[0], b[1], b[2]});
+        if (m > bestMin) {
+            bestMin = m;
+            bestFace = g;
+            w = b;
         }
-        StarPlan plan;
-        plan.disk = disk;
-        // New points (interior points given and Steiner points) placed on the draft's smooth surface.
-        bool placed = true;
-        for (std::size_t i = std::size_t(n); i < t.points.size() && placed; ++i) {
-            std::array<double, 3> w{};
-            const FaceIndex g = oldFaceAt(t.points[i], w);
-            if (g == Mesh::null_face()) {
-                placed = false;
-                break;
-            }
-            V3 q(0, 0, 0);
-            double size = 0;
-            FaceIndex hint = Mesh::null_face();
-            int k = 0;
-            for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_)) {
-                q += w[std::size_t(k)] * detail::pos(S_, v);
-                size += w[std::size_t(k++)] * sizeOf(v);
-                const FaceIndex hv = at(hint_, std::size_t(v), Mesh::null_face());
-                if (hint == Mesh::null_face()) hint = hv;
-            }
-            if (hint == Mesh::null_face()) {
-                placed = false;
-                break;
-            }
-            const SurfacePoint sp = near2_(q, hint);
-            if (!sp) {
-                placed = false;
-                break;
-            }
-            plan.points.push_back(smoothPoint(sp.face, sp.point));
-            plan.hints.push_back(sp.face);
-            plan.sizes.push_back(size);
-        }
-        if (!placed) {
-            why("a point off the draft");
-            continue;
-        }
-        auto posOf = [&](int i) {
-            return i < n ? detail::pos(S_, disk.loop[std::size_t(i)]) : plan.points[std::size_t(i - n)];
-        };
-        auto hintOf = [&](int i) {
-            return i < n ? at(hint_, std::size_t(disk.loop[std::size_t(i)]), Mesh::null_face())
-                         : plan.hints[std::size_t(i - n)];
-        };
-        // Faces: facing, within the normal bound of the old face under them, near the draft.
-        bool ok = true;
-        double newMin = std::numbers::pi;
-        std::map<std::pair<int, int>, int> edgeUse;
-        std::vector<int> degree(t.points.size(), 0);
-        for (const auto& tri : t.triangles) {
-            const V3 a = posOf(tri[0]), bb = posOf(tri[1]), c = posOf(tri[2]);
-            const V2 centre = (t.points[std::size_t(tri[0])] + t.points[std::size_t(tri[1])] +
-                               t.points[std::size_t(tri[2])]) /
-                              3.0;
-            std::array<double, 3> w{};
-            const FaceIndex under = oldFaceAt(centre, w);
-            if (under == Mesh::null_face() || !acceptableFace(a, bb, c, referenceNormal(under, starNormal))) {
-                if (bandDiagnosticsVerbose() && under != Mesh::null_face()) {
-                    const V3 nr = referenceNormal(under, starNormal);
-                    std::fprintf(stderr, "    variant %d/%.0f: a face turned (facing %d, %.1f deg from %u)\n",
-                                 int(var.innerPoints), var.angle, int(facing(a, bb, c)),
-                                 detail::angleBetween(detail::unitNormal(a, bb, c), nr) / kBandDeg,
-                                 std::uint32_t(under));
-                }
-                ok = false;
-                break;
-            }
-            newMin = std::min(newMin, detail::minAngle(a, bb, c));
-            plan.parents.push_back(under);
-            for (int e = 0; e < 3; ++e) {
-                const int x = tri[std::size_t(e)], y = tri[std::size_t((e + 1) % 3)];
-                if (++edgeUse[{std::min(x, y), std::max(x, y)}] == 1) {
-                    ++degree[std::size_t(x)];
-                    ++degree[std::size_t(y)];
-                }
-            }
-        }
-        if (ok && !(newMin > oldMin + 0.5 * kBandDeg)) {
-            if (bandDiagnosticsVerbose())
-                std::fprintf(stderr, "    variant %d/%.0f: %.2f -> %.2f deg\n", int(var.innerPoints),
-                             var.angle, oldMin / kBandDeg, newMin / kBandDeg);
-            continue;
-        }
-        if (!ok) continue;
-        // Interior edges: near the draft; between two loop vertices only where no such edge exists outside.
-        for (const auto& [e, uses] : edgeUse) {
-            const auto [x, y] = e;
-            const bool loopEdge = x < n && y < n && (y - x == 1 || (x == 0 && y == n - 1));
-            if (loopEdge) continue;
-            if (uses != 2) {
-                ok = false;
-                break;
-            }
-            if (x < n && y < n) {
-                const VertexIndex a = disk.loop[std::size_t(x)], b2 = disk.loop[std::size_t(y)];
-                if (S_.halfedge(a, b2) != Mesh::null_halfedge() && !diskEdges.count(bandKey(a, b2))) {
-                    ok = false;
-                    break;
-                }
-            }
-            const V3 pa = posOf(x), pb = posOf(y);
-            const SurfacePoint sp = near2_(0.5 * (pa + pb), hintOf(x));
-            if (sp && sp.distance > 0.1 * (pa - pb).norm()) {
-                ok = false;
-                break;
-            }
-        }
-        if (!ok) {
-            why("an edge off the draft or made twice");
-            continue;
-        }
-        // Valences: the loop's vertices lose the old interior edges and gain the new ones; new vertices 4..8.
-        for (int i = 0; i < n && ok; ++i) {
-            const VertexIndex v = disk.loop[std::size_t(i)];
-            // Its old interior edges: the disk's edges at it other than its two loop edges.
-            int oldInner = -2;
-            for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(v), S_))
-                oldInner += int(diskEdges.count(bandKey(v, w)));
-            ok = valenceOk(v, (degree[std::size_t(i)] - 2) - oldInner);
-        }
-        for (std::size_t i = std::size_t(n); i < degree.size() && ok; ++i)
-            ok = degree[i] >= 4 && degree[i] <= 8;
-        if (!ok) {
-            why("a valence");
-            continue;
-        }
-        // Aim: at least the aim where it can, else the most.
-        plan.minAngle = newMin;
-        plan.triangles = t.triangles;
-        if (plan.minAngle > best.minAngle) best = std::move(plan);
-        if (best.minAngle >= aim) break;
     }
-    return !best.triangles.empty();
+    return bestFace;
+}
+
+std::string BandRemesher::judgeStar(const StarView& sv, const GapTriangulation& t, StarPlan& plan) {
+    const StarDisk& disk = *sv.disk;
+    const int n = int(disk.loop.size());
+    const V3& starNormal = sv.starNormal;
+    auto oldFaceAt = [&](const V2& p, std::array<double, 3>& w) { return starFaceAt(sv, p, w); };
+    plan.disk = disk;
+    // New points (interior points given and Steiner points) placed on the draft's smooth surface.
+    bool placed = true;
+    for (std::size_t i = std::size_t(n); i < t.points.size() && placed; ++i) {
+        std::array<double, 3> w{};
+        const FaceIndex g = oldFaceAt(t.points[i], w);
+        if (g == Mesh::null_face()) {
+            placed = false;
+            break;
+        }
+        V3 q(0, 0, 0);
+        double size = 0;
+        FaceIndex hint = Mesh::null_face();
+        int k = 0;
+        for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_)) {
+            q += w[std::size_t(k)] * detail::pos(S_, v);
+            size += w[std::size_t(k++)] * sizeOf(v);
+            const FaceIndex hv = at(hint_, std::size_t(v), Mesh::null_face());
+            if (hint == Mesh::null_face()) hint = hv;
+        }
+        if (hint == Mesh::null_face()) {
+            placed = false;
+            break;
+        }
+        const SurfacePoint sp = near2_(q, hint);
+        if (!sp) {
+            placed = false;
+            break;
+        }
+        plan.points.push_back(smoothPoint(sp.face, sp.point));
+        plan.hints.push_back(sp.face);
+        plan.sizes.push_back(size);
+    }
+    if (!placed) return "a point off the draft";
+    auto posOf = [&](int i) {
+        return i < n ? detail::pos(S_, disk.loop[std::size_t(i)]) : plan.points[std::size_t(i - n)];
+    };
+    auto hintOf = [&](int i) {
+        return i < n ? at(hint_, std::size_t(disk.loop[std::size_t(i)]), Mesh::null_face())
+                     : plan.hints[std::size_t(i - n)];
+    };
+    // Faces: facing, within the normal bound of the old face under them, near the draft.
+    bool ok = true;
+    double newMin = std::numbers::pi;
+    std::map<std::pair<int, int>, int> edgeUse;
+    std::vector<int> degree(t.points.size(), 0);
+    for (const auto& tri : t.triangles) {
+        const V3 a = posOf(tri[0]), bb = posOf(tri[1]), c = posOf(tri[2]);
+        const V2 centre =
+            (t.points[std::size_t(tri[0])] + t.points[std::size_t(tri[1])] + t.points[std::size_t(tri[2])]) /
+            3.0;
+        std::array<double, 3> w{};
+        const FaceIndex under = oldFaceAt(centre, w);
+        if (under == Mesh::null_face() || !acceptableFace(a, bb, c, referenceNormal(under, starNormal))) {
+            if (under == Mesh::null_face()) return "a face off the disk";
+            char why[96];
+            std::snprintf(
+                why, sizeof why, "a face turned (facing %d, %.1f deg from face %u)", int(facing(a, bb, c)),
+                detail::angleBetween(detail::unitNormal(a, bb, c), referenceNormal(under, starNormal)) /
+                    kBandDeg,
+                std::uint32_t(under));
+            return why;
+        }
+        newMin = std::min(newMin, detail::minAngle(a, bb, c));
+        plan.parents.push_back(under);
+        for (int e = 0; e < 3; ++e) {
+            const int x = tri[std::size_t(e)], y = tri[std::size_t((e + 1) % 3)];
+            if (++edgeUse[{std::min(x, y), std::max(x, y)}] == 1) {
+                ++degree[std::size_t(x)];
+                ++degree[std::size_t(y)];
+            }
+        }
+    }
+    if (!(newMin > sv.oldMin + 0.5 * kBandDeg)) {
+        char why[64];
+        std::snprintf(why, sizeof why, "%.2f -> %.2f deg", sv.oldMin / kBandDeg, newMin / kBandDeg);
+        return why;
+    }
+    // Interior edges: near the draft; between two loop vertices only where no such edge exists outside.
+    for (const auto& [e, uses] : edgeUse) {
+        const auto [x, y] = e;
+        const bool loopEdge = x < n && y < n && (y - x == 1 || (x == 0 && y == n - 1));
+        if (loopEdge) continue;
+        if (uses != 2) {
+            ok = false;
+            break;
+        }
+        if (x < n && y < n) {
+            const VertexIndex a = disk.loop[std::size_t(x)], b2 = disk.loop[std::size_t(y)];
+            if (S_.halfedge(a, b2) != Mesh::null_halfedge() && !sv.diskEdges.count(bandKey(a, b2))) {
+                ok = false;
+                break;
+            }
+        }
+        const V3 pa = posOf(x), pb = posOf(y);
+        const SurfacePoint sp = near2_(0.5 * (pa + pb), hintOf(x));
+        if (sp && sp.distance > 0.1 * (pa - pb).norm()) {
+            ok = false;
+            break;
+        }
+    }
+    if (!ok) return "an edge off the draft or made twice";
+    // Valences: the loop's vertices lose the old interior edges and gain the new ones; new vertices 4..8.
+    for (int i = 0; i < n && ok; ++i) {
+        const VertexIndex v = disk.loop[std::size_t(i)];
+        // Its old interior edges: the disk's edges at it other than its two loop edges.
+        int oldInner = -2;
+        for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(v), S_))
+            oldInner += int(sv.diskEdges.count(bandKey(v, w)));
+        ok = valenceOk(v, (degree[std::size_t(i)] - 2) - oldInner);
+    }
+    for (std::size_t i = std::size_t(n); i < degree.size() && ok; ++i)
+        ok = degree[i] >= 4 && degree[i] <= 8;
+    if (!ok) return "a valence";
+    plan.minAngle = newMin;
+    plan.triangles = t.triangles;
+    return {};
 }
 
 bool BandRemesher::applyStar(const StarPlan& plan) {
