@@ -1,7 +1,10 @@
 # Keeps FSS's sources readable (issue 18, docs/DESIGN.md §9): no function body over 200 lines and no core
-# source file over 900 lines, outside core/src/remesh/ (its own issue restructures it); the stitch stages'
-# files under core/src/stitch/ (issue 19, DESIGN.md §6) and the widgets' files (split by topic in session 17:
-# remesh_widget*.cpp, vtk_view*.cpp) are held to 800 lines. Run as a script:
+# source file over 900 lines; the stitch stages' files under core/src/stitch/ (issue 19, DESIGN.md §6), the
+# remesh files under core/src/remesh/ (crease recovery and auto_remesh.cpp split by topic in session 18) and the
+# widgets' files (split by topic in session 17: remesh_widget*.cpp, vtk_view*.cpp) are held to 800 lines.
+# auto_remesh.cpp and auto_v2.cpp are still exempt from the function rule (issue 23 restructures their drivers,
+# autoRemesh 348 lines and autoRemeshV2 270).
+# Run as a script:
 #   cmake -DROOT=<source tree> [-DMAX_FUNCTION_LINES=200] [-DMAX_CORE_FILE_LINES=900]
 #         [-DMAX_STITCH_FILE_LINES=800] [-DMAX_WIDGETS_FILE_LINES=800] -P cmake/SizeCheck.cmake
 # Functions are found the way .clang-format lays them out (namespaces not indented): a definition starts
@@ -25,7 +28,7 @@ if(NOT MAX_WIDGETS_FILE_LINES)
 endif()
 include("${CMAKE_CURRENT_LIST_DIR}/FSSReadLines.cmake")
 
-fss_cpp_sources(sources ROOT "${ROOT}" DIRS core widgets plugins demo examples EXCLUDE "core/src/remesh/")
+fss_cpp_sources(sources ROOT "${ROOT}" DIRS core widgets plugins demo examples)
 list(LENGTH sources count)
 
 set(problems "")
@@ -35,9 +38,10 @@ foreach(file IN LISTS sources)
   file(RELATIVE_PATH rel "${ROOT}" "${file}")
   fss_read_lines("${file}" lines)
   list(LENGTH lines total)
-  if(rel MATCHES "^core/src/stitch/")
+  if(rel MATCHES "^core/src/(stitch|remesh)/")
     if(total GREATER MAX_STITCH_FILE_LINES)
-      list(APPEND problems "${rel}: ${total} lines (a stitch file has at most ${MAX_STITCH_FILE_LINES})")
+      string(REGEX REPLACE "^core/src/([a-z]+)/.*" "\\1" module "${rel}")
+      list(APPEND problems "${rel}: ${total} lines (a ${module} file has at most ${MAX_STITCH_FILE_LINES})")
     endif()
   elseif(rel MATCHES "^widgets/")
     if(total GREATER MAX_WIDGETS_FILE_LINES)
@@ -45,6 +49,9 @@ foreach(file IN LISTS sources)
     endif()
   elseif(rel MATCHES "^core/" AND total GREATER MAX_CORE_FILE_LINES)
     list(APPEND problems "${rel}: ${total} lines (a core file has at most ${MAX_CORE_FILE_LINES})")
+  endif()
+  if(rel MATCHES "^core/src/remesh/auto_(remesh|v2)\\.cpp$")
+    continue() # exempt from the function rule (see above)
   endif()
   set(n 0)
   set(start 0)

@@ -19,8 +19,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -256,12 +258,14 @@ struct LatticeFigures {
     std::string worst; // FSS_WORST: where the patch is farthest from the reference
 };
 
+// The lattice options of a scan; by default those of ScanParams{}, which are the command line's and the scan
+// panel's (fss-remesh scan: adaptive lattice, mask 35°, warped, no quad-angle bound, no relaxation).
 struct LatticeSetting {
-    fss::Lattice lattice = fss::Lattice::Triangular;
-    double minLatticeAngleDeg = 0;
-    double minQuadAngleDeg = 20;
-    int relaxIterations = 6;
-    bool warpToSurface = fss::ScanOptions{}.warpToSurface; // on (the default since issue #20)
+    fss::Lattice lattice = fss::ScanOptions{}.lattice;
+    double minLatticeAngleDeg = fss::ScanOptions{}.minLatticeAngleDeg;
+    double minQuadAngleDeg = fss::TriangulateOptions{}.minQuadAngleDeg;
+    int relaxIterations = fss::ScanParams{}.relaxIterations;
+    bool warpToSurface = fss::ScanOptions{}.warpToSurface;
 };
 
 LatticeFigures latticeScan(const fss::Mesh& ref, fss::MeshRenderer& renderer, fss::StandardView view, int res,
@@ -352,8 +356,11 @@ LatticeFigures latticeScan(const fss::Mesh& ref, fss::MeshRenderer& renderer, fs
 
 LatticeFigures latticeScan(const fss::Mesh& ref, fss::MeshRenderer& renderer, fss::StandardView view, int res,
                            fss::Lattice lattice) {
-    // The settings issue 20 measured (not yet the defaults): sliver quads dropped, six relaxation sweeps.
-    return latticeScan(ref, renderer, view, res, LatticeSetting{.lattice = lattice});
+    // The settings issue 20 measured first (not the defaults): sliver quads dropped, six relaxation sweeps.
+    return latticeScan(
+        ref, renderer, view, res,
+        LatticeSetting{
+            .lattice = lattice, .minLatticeAngleDeg = 0, .minQuadAngleDeg = 20, .relaxIterations = 6});
 }
 
 // The share of \p ref's area within 0.5 % of its bounding-box diagonal of one of \p patches (measured at
@@ -516,102 +523,254 @@ TEST(ScanPipeline, LatticeWarpedToTheSurfaceKeepsRoundTrianglesOnASphere) {
     EXPECT_LE(*w.hausdorffToRefRel, 1.5 * *a.hausdorffToRefRel);
 }
 
-// FSS_LONG_TESTS=1: single 256² scans of CGAL meshes from the seven standard views, a lattice setting
-// against the square pixel lattice of today's defaults (the figures of issue #20; the report lists which
-// meshes were tuned on). The setting from the environment: FSS_LATTICE = triangular | adaptive | square,
-// FSS_MIN_LATTICE_ANGLE (degrees, default 0), FSS_MIN_QUAD_ANGLE (default 20), FSS_RELAX (sweeps, default
-// 6), FSS_WARP (ScanOptions::warpToSurface, default 1 as the core's; 0 = the plain lattice). Coverage: the
-// patch's area over the square-lattice patch's area from the same view ("cov"), and per mesh the share of the
-// reference's area covered by the seven patches together, for both settings. FSS_LATTICE_VIEW (iso, +x, ...)
-// scans one view only; FSS_WORST describes where each patch is farthest from the reference.
-TEST(ScanPipeline, LatticeTableOverCgalMeshesLong) {
-    const char* env = std::getenv("FSS_LONG_TESTS");
-    if (!env || std::string(env) != "1") GTEST_SKIP() << "set FSS_LONG_TESTS=1";
-    const char* list = std::getenv("FSS_LATTICE_MESHES");
-    std::vector<std::string> names;
-    {
-        std::string s = list ? list
-                             : "fandisk.off,elephant.off,anchor.off,bull.off,camel.off,cow.off,homer.off,"
-                               "mushroom.off,rotor.off,pinion.off,blade.off,dragknob.off";
-        std::size_t at = 0;
-        while (at < s.size()) {
-            const std::size_t end = std::min(s.find(',', at), s.size());
-            names.push_back(s.substr(at, end - at));
-            at = end + 1;
-        }
-    }
-    LatticeSetting setting;
-    setting.lattice = latticeFromEnv("FSS_LATTICE", fss::Lattice::Triangular);
-    setting.minLatticeAngleDeg = numberFromEnv("FSS_MIN_LATTICE_ANGLE", 0);
-    setting.minQuadAngleDeg = numberFromEnv("FSS_MIN_QUAD_ANGLE", 20);
-    setting.relaxIterations = int(numberFromEnv("FSS_RELAX", 6));
-    setting.warpToSurface = numberFromEnv("FSS_WARP", fss::ScanOptions{}.warpToSurface ? 1 : 0) != 0;
-    const LatticeSetting square{.lattice = fss::Lattice::Square, .minQuadAngleDeg = 0, .relaxIterations = 0};
+namespace {
+
+// Criterion A of issue #20 over single 256² scans, a lattice setting against the square pixel lattice (no
+// mask, no quad bound, no relaxation) from the same view: per view the figures, then which views fail each
+// part (mean smallest angle ≥ 50°, ≤ 2 % below 30°, interior valence-6 share not lower by more than 0.01,
+// Hausdorff distance to the reference not larger than the square lattice's). Entries are "mesh.off" (the
+// seven standard views, and the share of the reference covered by their patches together) or
+// "mesh.off:view" (that view only). FSS_LATTICE_VIEW (iso, +x, ...) scans one view only; FSS_WORST describes
+// where each patch is farthest from the reference.
+struct CriterionA {
+    int scans = 0;
+    // "mesh view figure" of the views failing each part; nothing: views without a patch (square has one)
+    std::vector<std::string> mean, below30, valence, hausdorff, nothing;
+    double worstMean = 90, worstBelow = 0, worstValence = 1, worstHausdorffRatio = 0;
+};
+
+CriterionA latticeTable(const std::vector<std::string>& entries, const LatticeSetting& setting) {
+    const LatticeSetting square{
+        .lattice = fss::Lattice::Square, .minLatticeAngleDeg = 0, .minQuadAngleDeg = 0, .relaxIterations = 0};
     const fss::StandardView views[] = {
         fss::StandardView::Iso,  fss::StandardView::PosX, fss::StandardView::NegX, fss::StandardView::PosY,
         fss::StandardView::NegY, fss::StandardView::PosZ, fss::StandardView::NegZ};
     const char* viewNames[] = {"iso", "+x", "-x", "+y", "-y", "+z", "-z"};
-    double worstMean = 90, worstBelow = 0, worstValence = 1, worstHausdorffRatio = 0, sumMean = 0, sumCov = 0;
-    int scans = 0, missed = 0, hausdorffWorse = 0;
+    CriterionA a;
+    double sumMean = 0, sumCov = 0;
     std::printf(
         "%-14s %-4s | new: mean<  <30%%  val6   hausd    cov  umb%% | sq: mean<  <30%%  val6   hausd\n",
         "mesh", "view");
-    for (const std::string& name : names) {
+    for (const std::string& entry : entries) {
+        const std::size_t colon = entry.find(':');
+        const std::string name = entry.substr(0, colon);
+        const char* env = std::getenv("FSS_LATTICE_VIEW");
+        const std::string only = colon != std::string::npos ? entry.substr(colon + 1) : env ? env : "";
         const fss::Mesh ref = load(name);
         fss::CpuMeshRenderer renderer;
         renderer.setMesh(ref);
         std::vector<LatticeFigures> mine, theirs;
         for (int v = 0; v < 7; ++v) {
-            if (const char* only = std::getenv("FSS_LATTICE_VIEW"); only && std::string(only) != viewNames[v])
-                continue;
+            if (!only.empty() && only != viewNames[v]) continue;
+            // A view where one lattice leaves nothing (seen edge-on, or only from behind): without a patch
+            // from the setting while the square lattice has one, the view fails; without a square patch the
+            // setting's is judged on its angles only.
             LatticeFigures tri, sq;
+            std::string noTri, noSq;
             try {
                 tri = latticeScan(ref, renderer, views[v], 256, setting);
+            } catch (const fss::InvalidInputError& e) {
+                noTri = e.what();
+            }
+            try {
                 sq = latticeScan(ref, renderer, views[v], 256, square);
             } catch (const fss::InvalidInputError& e) {
-                std::printf("%-14s %-4s | %s\n", name.c_str(), viewNames[v], e.what());
+                noSq = e.what();
+            }
+            if (!noTri.empty()) {
+                std::printf("%-14s %-4s | new: %s%s\n", name.c_str(), viewNames[v], noTri.c_str(),
+                            noSq.empty() ? "  FAIL (the square lattice has a patch)" : " (square too)");
+                if (noSq.empty()) a.nothing.push_back(name + " " + viewNames[v]);
                 continue;
             }
+            if (!noSq.empty()) {
+                std::printf("%-14s %-4s | square: %s\n", name.c_str(), viewNames[v], noSq.c_str());
+                sq.valence6 = 0;
+                sq.hausdorff = std::numeric_limits<double>::infinity();
+            }
             const double cov = sq.area > 0 ? tri.area / sq.area : 0;
-            const bool miss = tri.meanMinAngle < 50 || tri.below30 > 0.02;
-            std::printf("%-14s %-4s | %9.1f %5.1f %6.3f %8.2e %5.2f %5.1f | %8.1f %5.1f %6.3f %8.2e%s\n",
-                        name.c_str(), viewNames[v], tri.meanMinAngle, 100 * tri.below30, tri.valence6,
-                        tri.hausdorff, cov, 100 * umbrellaShare(tri.patch), sq.meanMinAngle, 100 * sq.below30,
-                        sq.valence6, sq.hausdorff, miss ? "  MISSED" : "");
-            if (!tri.worst.empty())
-                std::printf("    new %s\n    sq  %s\n", tri.worst.c_str(), sq.worst.c_str());
-            worstMean = std::min(worstMean, tri.meanMinAngle);
-            worstBelow = std::max(worstBelow, tri.below30);
-            worstValence = std::min(worstValence, tri.valence6 - sq.valence6);
             // Planar views give distances of rounding size (1e-16): those count as 1e-6 of the diagonal.
             const double ratio = std::max(tri.hausdorff, 1e-6) / std::max(sq.hausdorff, 1e-6);
-            worstHausdorffRatio = std::max(worstHausdorffRatio, ratio);
-            hausdorffWorse += ratio > 1 ? 1 : 0;
+            const double dv = tri.valence6 - sq.valence6;
+            const auto fail = [&](std::vector<std::string>& list, bool failed, double figure) {
+                if (!failed) return "";
+                char buf[96];
+                std::snprintf(buf, sizeof buf, "%s %s %.3g", name.c_str(), viewNames[v], figure);
+                list.push_back(buf);
+                return "  FAIL";
+            };
+            std::printf(
+                "%-14s %-4s | %9.1f %5.1f %6.3f %8.2e %5.2f %5.1f | %8.1f %5.1f %6.3f %8.2e%s%s%s%s\n",
+                name.c_str(), viewNames[v], tri.meanMinAngle, 100 * tri.below30, tri.valence6, tri.hausdorff,
+                cov, 100 * umbrellaShare(tri.patch), sq.meanMinAngle, 100 * sq.below30, sq.valence6,
+                sq.hausdorff, fail(a.mean, tri.meanMinAngle < 50, tri.meanMinAngle),
+                fail(a.below30, tri.below30 > 0.02, 100 * tri.below30), fail(a.valence, dv < -0.01, dv),
+                fail(a.hausdorff, ratio > 1, ratio));
+            if (!tri.worst.empty())
+                std::printf("    new %s\n    sq  %s\n", tri.worst.c_str(), sq.worst.c_str());
+            a.worstMean = std::min(a.worstMean, tri.meanMinAngle);
+            a.worstBelow = std::max(a.worstBelow, tri.below30);
+            a.worstValence = std::min(a.worstValence, dv);
+            a.worstHausdorffRatio = std::max(a.worstHausdorffRatio, ratio);
             sumMean += tri.meanMinAngle;
             sumCov += cov;
-            ++scans;
-            missed += miss ? 1 : 0;
+            ++a.scans;
             mine.push_back(std::move(tri));
             theirs.push_back(std::move(sq));
         }
-        std::vector<const fss::Mesh*> a, b;
-        for (const auto& f : mine)
-            a.push_back(&f.patch);
-        for (const auto& f : theirs)
-            b.push_back(&f.patch);
+        if (mine.size() < 7) continue;
+        std::vector<const fss::Mesh*> pa, pb;
+        for (std::size_t k = 0; k < mine.size(); ++k) {
+            pa.push_back(&mine[k].patch);
+            pb.push_back(&theirs[k].patch);
+        }
         std::printf("%-14s union of the 7 views covers %.1f %% of the reference (square lattice: %.1f %%)\n",
-                    name.c_str(), 100 * unionCoverage(ref, a), 100 * unionCoverage(ref, b));
+                    name.c_str(), 100 * unionCoverage(ref, pa), 100 * unionCoverage(ref, pb));
     }
+    const auto list = [](const std::vector<std::string>& l) {
+        std::string s;
+        for (const std::string& x : l)
+            s += (s.empty() ? "" : ", ") + x;
+        return s;
+    };
     std::printf(
-        "%d scans, %d miss mean >= 50 / <= 2 %% below 30; mean of means %.1f°, mean coverage %.2f; "
-        "worst: mean smallest angle %.1f°, %.1f %% below 30°, valence-6 change %+.3f, Hausdorff ratio "
-        "to square %.2f (larger in %d scans)\n",
-        scans, missed, scans ? sumMean / scans : 0, scans ? sumCov / scans : 0, worstMean, 100 * worstBelow,
-        worstValence, worstHausdorffRatio, hausdorffWorse);
-    EXPECT_GE(worstMean, 50.0);
-    EXPECT_LE(worstBelow, 0.02);
-    EXPECT_GE(worstValence, -0.01);
-    EXPECT_LE(worstHausdorffRatio, 1.0);
+        "%d scans; mean of means %.1f°, mean coverage %.2f; worst: mean smallest angle %.1f°, %.1f %% "
+        "below 30°, valence-6 change %+.3f, Hausdorff ratio to square %.2f\n"
+        "failing mean >= 50°: %zu (%s)\nfailing <= 2 %% below 30°: %zu (%s)\n"
+        "failing valence 6 unchanged: %zu (%s)\nfailing Hausdorff <= square: %zu (%s)\n"
+        "no patch where the square lattice has one: %zu (%s)\n",
+        a.scans, a.scans ? sumMean / a.scans : 0, a.scans ? sumCov / a.scans : 0, a.worstMean,
+        100 * a.worstBelow, a.worstValence, a.worstHausdorffRatio, a.mean.size(), list(a.mean).c_str(),
+        a.below30.size(), list(a.below30).c_str(), a.valence.size(), list(a.valence).c_str(),
+        a.hausdorff.size(), list(a.hausdorff).c_str(), a.nothing.size(), list(a.nothing).c_str());
+    return a;
+}
+
+// \p scans views judged, each failing no part of criterion A unless \p known lists it ("hausdorff part.off
+// iso": the part, the mesh and the view).
+void expectCriterionA(const CriterionA& a, int scans, const std::vector<std::string>& known = {}) {
+    EXPECT_EQ(a.scans, scans);
+    const std::pair<const char*, const std::vector<std::string>*> parts[] = {{"mean", &a.mean},
+                                                                             {"below30", &a.below30},
+                                                                             {"valence", &a.valence},
+                                                                             {"hausdorff", &a.hausdorff},
+                                                                             {"nothing", &a.nothing}};
+    for (const auto& [part, failures] : parts)
+        for (const std::string& f : *failures) { // "mesh view figure"
+            const std::string key = std::string(part) + " " + f.substr(0, f.find(' ', f.find(' ') + 1));
+            EXPECT_NE(std::find(known.begin(), known.end(), key), known.end())
+                << "criterion A, part " << part << ", fails on " << f;
+        }
+}
+
+std::vector<std::string> splitList(const std::string& s) {
+    std::vector<std::string> out;
+    for (std::size_t at = 0; at < s.size();) {
+        const std::size_t end = std::min(s.find(',', at), s.size());
+        out.push_back(s.substr(at, end - at));
+        at = end + 1;
+    }
+    return out;
+}
+
+} // namespace
+
+// FSS_LONG_TESTS=1: the table above over FSS_LATTICE_MESHES (comma-separated entries) with a setting from
+// the environment, each default the product's (LatticeSetting): FSS_LATTICE = triangular | adaptive | square,
+// FSS_MIN_LATTICE_ANGLE (degrees), FSS_MIN_QUAD_ANGLE, FSS_RELAX (sweeps), FSS_WARP (1 | 0).
+TEST(ScanPipeline, LatticeTableOverCgalMeshesLong) {
+    const char* env = std::getenv("FSS_LONG_TESTS");
+    if (!env || std::string(env) != "1") GTEST_SKIP() << "set FSS_LONG_TESTS=1";
+    const char* list = std::getenv("FSS_LATTICE_MESHES");
+    const LatticeSetting d;
+    const LatticeSetting setting{.lattice = latticeFromEnv("FSS_LATTICE", d.lattice),
+                                 .minLatticeAngleDeg =
+                                     numberFromEnv("FSS_MIN_LATTICE_ANGLE", d.minLatticeAngleDeg),
+                                 .minQuadAngleDeg = numberFromEnv("FSS_MIN_QUAD_ANGLE", d.minQuadAngleDeg),
+                                 .relaxIterations = int(numberFromEnv("FSS_RELAX", d.relaxIterations)),
+                                 .warpToSurface = numberFromEnv("FSS_WARP", d.warpToSurface ? 1 : 0) != 0};
+    const CriterionA a =
+        latticeTable(splitList(list ? list : "fandisk.off,bull.off,eight.off,femur.off"), setting);
+    EXPECT_GE(a.worstMean, 50.0);
+    EXPECT_LE(a.worstBelow, 0.02);
+    EXPECT_GE(a.worstValence, -0.01);
+    EXPECT_LE(a.worstHausdorffRatio, 1.0);
+}
+
+// The wide set of issue #20 criterion A (session 18): 46 meshes none of the lattice work was tuned on, CAD
+// parts, scans, open meshes, tiny and large ones.
+constexpr const char* kWideList =
+    "ALSTOM_TEST4.off,mech-holes-shark.off,rotor_small.off,cube-meshed.off,part.off,cylinder_locally_refined."
+    "off,turbine.off,cheese.off,handle.off,tripod.off,cross.off,u.off,b9_mesh.off,helmet.off,boeing.off,"
+    "bunny00.off,armadillo.off,diplodocus.off,man.off,bear.off,ChineseDragon-10kv.off,lion-head.off,knot2."
+    "off,bones.off,blobby_3cc.off,head.off,oblong.off,retinal.off,refined_elephant.off,polygon_mesh.off,"
+    "ellipe0.003.off,larger_sphere.off,elephant-with-holes.off,holes.off,three_peaks.off,horizons.off,patch-"
+    "01.off,mesh_with_border.off,plane.off,mask_cone.off,nefertiti.off,cube.off,octahedron.off,icosahedron."
+    "off,star.off,tetrahedron.off";
+
+// FSS_LONG_TESTS=1: criterion A at the product's defaults on every view of kWideList. Session 18 (CPU
+// renderer; `fss-remesh scan` with its default GPU renderer gave the same verdicts on the 4 views checked):
+// 291 views with a patch (of 322: the rest show nothing or only the back of the surface with either
+// lattice; 4 have a patch where the square lattice has none), none with more than 2 % below 30°, valence 6
+// unchanged on all. Criterion A is NOT met on the views of kOpenViews (32 views): the test fails on any
+// other view failing a part, and prints which of these still fail.
+//  - mean smallest angle 40.8–49.9° on 23 views; octahedron's six axis views (47.9–48.0°, square 40.8°):
+//    four faces slanted 54.7° in four directions meet at the apex, and the bases they want do not come from
+//    one smooth warp (the fit compromises); patch-01 ±y and mesh_with_border +y: edge-on views where the
+//    square lattice leaves nothing.
+//  - Hausdorff distance worse than the square lattice's on 10 views, ratio 1.02–1.61, boeing ±y 107–127
+//    (the square's triangles lie in the planar faces seen face-on: 3e-16). FSS_WORST on ALSTOM_TEST4 ±y
+//    and mech-holes-shark -y: the farthest face straddles a sharp crease, at the same crease as the
+//    square's farthest face; the warped lattice's edges there up to 1.40 footprints (1.03 around) where
+//    the wanted bases jump across the crease.
+constexpr const char* kOpenViews[] = {"mean part.off iso",
+                                      "mean cheese.off iso",
+                                      "mean b9_mesh.off +y",
+                                      "mean b9_mesh.off -y",
+                                      "mean man.off -z",
+                                      "mean bones.off +x",
+                                      "mean blobby_3cc.off +x",
+                                      "mean blobby_3cc.off -x",
+                                      "mean polygon_mesh.off +x",
+                                      "mean polygon_mesh.off -x",
+                                      "mean polygon_mesh.off +y",
+                                      "mean polygon_mesh.off -y",
+                                      "mean three_peaks.off iso",
+                                      "mean three_peaks.off -y",
+                                      "mean octahedron.off +x",
+                                      "mean octahedron.off -x",
+                                      "mean octahedron.off +y",
+                                      "mean octahedron.off -y",
+                                      "mean octahedron.off +z",
+                                      "mean octahedron.off -z",
+                                      "mean patch-01.off +y",
+                                      "mean patch-01.off -y",
+                                      "mean mesh_with_border.off +y",
+                                      "hausdorff ALSTOM_TEST4.off +y",
+                                      "hausdorff ALSTOM_TEST4.off -y",
+                                      "hausdorff mech-holes-shark.off iso",
+                                      "hausdorff mech-holes-shark.off -y",
+                                      "hausdorff u.off -y",
+                                      "hausdorff boeing.off +y",
+                                      "hausdorff boeing.off -y",
+                                      "hausdorff blobby_3cc.off +x",
+                                      "hausdorff oblong.off +y",
+                                      "hausdorff oblong.off -y"};
+
+TEST(ScanPipeline, CriterionAAtTheDefaultsOnUntunedMeshesLong) {
+    const char* env = std::getenv("FSS_LONG_TESTS");
+    if (!env || std::string(env) != "1") GTEST_SKIP() << "set FSS_LONG_TESTS=1";
+    expectCriterionA(latticeTable(splitList(kWideList), LatticeSetting{}), 291,
+                     std::vector<std::string>(std::begin(kOpenViews), std::end(kOpenViews)));
+}
+
+// Criterion A at the product's defaults on three views of small meshes of the wide set (a CAD part, a
+// sphere, an open mesh with holes), each against the square lattice's Hausdorff distance measured here.
+// Session 18 (the CPU renderer, as here): rotor_small -x 58.3°, 0 % < 30°, Hausdorff 2.27e-4 (square
+// 5.41e-4); larger_sphere iso 54.2°, 0 %, 1.71e-4 (3.82e-4); holes +x 56.1°, 0 %, 4.05e-4 (5.76e-4).
+TEST(ScanPipeline, CriterionAAtTheDefaultsOnThreeUntunedViews) {
+    expectCriterionA(
+        latticeTable({"rotor_small.off:-x", "larger_sphere.off:iso", "holes.off:+x"}, LatticeSetting{}), 3);
 }
 
 // The patch relaxation (ScanParams::relaxIterations, mesh/relax.h): the same connectivity and border,

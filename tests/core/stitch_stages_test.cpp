@@ -128,6 +128,40 @@ TEST(GapTriangulation, InsidePredicateMatchesSeeds) {
     EXPECT_EQ(tb.points, tc.points);
 }
 
+// The fill does not depend on what the process allocated before (DESIGN.md §6.2: CGAL's Lloyd optimiser
+// moved vertices in the order of their addresses). Between runs the heap is left with holes of many sizes,
+// so the triangulation's blocks land in other places and orders; every run must give the same fill.
+TEST(GapTriangulation, FillDoesNotDependOnAllocationHistory) {
+    GapBoundary b;
+    addCircle(b, {0, 0}, 50, 40);
+    addCircle(b, {3, -2}, 30, 64, 0.5);
+    b.excludeSeeds.push_back({0, 0});
+    const auto first = triangulateGap(b);
+    ASSERT_TRUE(first.ok) << first.reason;
+    for (std::size_t round = 1; round <= 12; ++round) {
+        std::vector<std::vector<char>> kept;
+        {
+            std::vector<std::vector<char>> freed;
+            for (std::size_t i = 0; i < 400; ++i) {
+                const std::size_t bytes = 32 + (i * 7919 * round) % (9000 + 500 * round);
+                (i % (2 + round % 3) == 0 ? kept : freed).emplace_back(bytes, char(i));
+            }
+            // A throwaway fill of another gap allocates and frees the triangulation's own blocks too.
+            GapBoundary other;
+            addCircle(other, {1, 1}, 20 + double(round), 12 + int(round));
+            addCircle(other, {0, 0}, 8, 10);
+            other.excludeSeeds.push_back({0, 0});
+            if (round % 2) {
+                EXPECT_TRUE(triangulateGap(other).ok);
+            }
+        }
+        const auto again = triangulateGap(b);
+        ASSERT_TRUE(again.ok) << again.reason;
+        EXPECT_EQ(again.points, first.points) << "round " << round;
+        EXPECT_EQ(again.triangles, first.triangles) << "round " << round;
+    }
+}
+
 // A crease inside the gap (a constraint with both sides in the gap) stays an edge.
 TEST(GapTriangulation, CreaseInsideTheGapIsKept) {
     GapBoundary b;

@@ -15,12 +15,12 @@
 namespace fss::detail {
 
 /// A parallel camera looking along -\p from that frames \p points (plus \p margin) with square pixels of
-/// side \p footprint (auto_remesh.cpp, frameParallel).
+/// side \p footprint (auto_views.cpp).
 Camera frameParallelView(const Eigen::Vector3d& from, const std::vector<Eigen::Vector3d>& points,
                          double footprint, double margin);
 
 /// The partition of the reference surface among the views whose reference buffers are \p views: label[f]
-/// is the owning view or -1 (auto_remesh.cpp, partitionAmongViews).
+/// is the owning view or -1 (auto_views.cpp).
 std::vector<int> partitionSurface(const Mesh& reference, const std::vector<FrameBuffers>& views,
                                   double maxAngleDeg, double beta, double minIslandArea, int rounds);
 

@@ -2,16 +2,18 @@
 #include "stitch/gap_triangulation.h"
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Constrained_voronoi_diagram_2.h>
 #include <CGAL/Delaunay_mesh_face_base_2.h>
 #include <CGAL/Delaunay_mesh_size_criteria_2.h>
 #include <CGAL/Delaunay_mesh_vertex_base_2.h>
 #include <CGAL/Delaunay_mesher_no_edge_refinement_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Mesh_2/Lloyd_move_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
-#include <CGAL/lloyd_optimize_mesh_2.h>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <list>
 #include <numbers>
 #include <unordered_map>
@@ -119,6 +121,110 @@ void addExcludeSeeds(GapCdt& cdt, const std::function<bool(const Eigen::Vector2d
     }
 }
 
+// Lloyd smoothing as CGAL's lloyd_optimize_mesh_2 does it (its move function, sizing field, freeze bound and
+// convergence test, both 0.001), but with the free vertices moved in the triangulation's own vertex order:
+// CGAL's optimiser keeps them in a std::set ordered by address, so where the allocator put the
+// triangulation's blocks decided the order of the moves, hence the order of the faces and the refinement
+// after it (DESIGN.md §6.2). The vertex order depends only on the sequence of insertions and removals. The
+// density of Lloyd's moves as CGAL's Mesh_sizing_field gives it: every vertex's mean incident edge length
+// (edges of the domain) before the first move, carried along by the moves, averaged over the face holding a
+// point. Unlike CGAL's, its point location hint is forgotten once vertices move (it would name a removed
+// face).
+class GapSizing {
+public:
+    explicit GapSizing(GapCdt& cdt) : cdt_(cdt) {
+        for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v) {
+            double sum = 0;
+            int count = 0;
+            auto e = cdt.incident_edges(v);
+            const auto end = e;
+            do {
+                if (cdt.is_infinite(*e) ||
+                    !(e->first->is_in_domain() || e->first->neighbor(e->second)->is_in_domain()))
+                    continue;
+                sum += std::sqrt(CGAL::squared_distance(e->first->vertex(GapCdt::cw(e->second))->point(),
+                                                        e->first->vertex(GapCdt::ccw(e->second))->point()));
+                ++count;
+            } while (++e != end);
+            v->set_sizing_info(count ? sum / count : 1.0);
+        }
+    }
+    double operator()(const GapPoint& p) const {
+        hint_ = cdt_.locate(p, hint_);
+        if (!cdt_.is_infinite(hint_))
+            return (hint_->vertex(0)->sizing_info() + hint_->vertex(1)->sizing_info() +
+                    hint_->vertex(2)->sizing_info()) /
+                   3;
+        double sum = 0;
+        for (int i = 0; i < 3; ++i)
+            if (!cdt_.is_infinite(hint_->vertex(i))) sum += hint_->vertex(i)->sizing_info();
+        return sum / 2;
+    }
+    void forgetHint() { hint_ = GapCdt::Face_handle(); }
+
+private:
+    GapCdt& cdt_;
+    mutable GapCdt::Face_handle hint_;
+};
+
+void lloydSmooth(GapCdt& cdt, int iterations, const std::list<GapPoint>& seeds) {
+    GapSizing sizing(cdt);
+    const CGAL::Mesh_2::Lloyd_move_2<GapCdt, GapSizing> moveOf;
+    constexpr double kFreeze = 0.001, kConvergence = 0.001;
+    std::vector<GapCdt::Vertex_handle> moving;
+    for (auto v = cdt.finite_vertices_begin(); v != cdt.finite_vertices_end(); ++v)
+        if (!cdt.are_there_incident_constraints(v)) moving.push_back(v);
+    const std::size_t initial = moving.size();
+    std::vector<double> bigMoves; // the largest squared move ratios of an iteration, at most 1 % of them
+    const std::size_t bigCount = std::max<std::size_t>(1, initial / 100);
+    std::size_t movedBefore = std::numeric_limits<std::size_t>::max();
+    std::vector<std::pair<std::size_t, GapPoint>> moves;
+    for (int iteration = 0; iteration < iterations; ++iteration) {
+        CGAL::Constrained_voronoi_diagram_2<GapCdt>(cdt).tag_faces_blind();
+        moves.clear();
+        bigMoves.assign(bigCount, 0.0);
+        std::vector<GapCdt::Vertex_handle> stillMoving;
+        for (std::size_t i = 0; i < moving.size(); ++i) {
+            const GapCdt::Vertex_handle v = moving[i];
+            const GapKernel::Vector_2 move = moveOf(v, cdt, sizing);
+            double localSq = std::numeric_limits<double>::max();
+            auto f = cdt.incident_faces(v);
+            const auto end = f;
+            do {
+                if (!cdt.is_infinite(f))
+                    localSq =
+                        std::min(localSq, CGAL::squared_distance(cdt.circumcenter(f), f->vertex(0)->point()));
+            } while (++f != end);
+            const double ratio = localSq > 0 ? move.squared_length() / localSq : 0.0;
+            if (move == CGAL::NULL_VECTOR || localSq == 0 || ratio < kFreeze * kFreeze) continue; // frozen
+            if (ratio > bigMoves.back()) {
+                bigMoves.pop_back();
+                bigMoves.insert(
+                    std::find_if(bigMoves.begin(), bigMoves.end(), [&](double m) { return m < ratio; }),
+                    ratio);
+            }
+            moves.emplace_back(stillMoving.size(), v->point() + move);
+            stillMoving.push_back(v);
+        }
+        // CGAL stops where fewer than 1 % of the vertices still move and none froze in the last iteration.
+        if (movedBefore < 0.01 * double(initial) && movedBefore == stillMoving.size()) break;
+        double sum = 0;
+        for (double m : bigMoves)
+            sum += std::sqrt(m);
+        if (sum / double(bigMoves.size()) < kConvergence) break;
+        for (const auto& [index, to] : moves) {
+            const double size = stillMoving[index]->sizing_info();
+            cdt.remove(stillMoving[index]);
+            stillMoving[index] = cdt.insert(to);
+            stillMoving[index]->set_sizing_info(size);
+        }
+        sizing.forgetHint();
+        moving = std::move(stillMoving);
+        movedBefore = moving.size();
+        GapMesher::mark_facets(cdt, seeds.begin(), seeds.end(), false);
+    }
+}
+
 } // namespace
 
 GapTriangulation triangulateGap(const GapBoundary& boundary, const GapOptions& options) {
@@ -160,10 +266,7 @@ GapTriangulation triangulateGap(const GapBoundary& boundary, const GapOptions& o
         std::size_t(options.maxSteinerPerBoundaryPoint * double(boundary.points.size())) + 16;
     refineGap(cdt, criteria, seeds, budget);
     if (options.lloydIterations > 0) {
-        CGAL::lloyd_optimize_mesh_2(cdt, CGAL::parameters::max_iteration_number = options.lloydIterations,
-                                    CGAL::parameters::seeds_begin = seeds.begin(),
-                                    CGAL::parameters::seeds_end = seeds.end(),
-                                    CGAL::parameters::mark = false);
+        lloydSmooth(cdt, options.lloydIterations, seeds);
         refineGap(cdt, criteria, seeds, budget);
     }
     // Lloyd re-marks the domain with the same seeds; mark once more so the output never depends on it.

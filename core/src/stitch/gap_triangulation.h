@@ -3,7 +3,7 @@
 // mesh and the pulled-back patch, seen in the scan's view, is a planar polygon with holes whose boundary
 // vertices are all kept. It is filled by a constrained Delaunay triangulation refined for quality with CGAL's
 // 2D mesher (Steiner points in the interior only: no boundary edge is split, so the faces on either side of
-// the gap stay as they are) and smoothed by CGAL's 2D Lloyd optimisation.
+// the gap stay as they are) and smoothed by Lloyd steps (CGAL's move function, vertices in a fixed order).
 
 #include <Eigen/Core>
 

@@ -157,8 +157,10 @@ void ComponentStitcher::optimise(Local& loc, Plan& plan) {
 double ComponentStitcher::ringScore(const Local& loc,
                                     const std::vector<std::pair<VertexIndex, VertexIndex>>& ring,
                                     const std::vector<FaceIndex>& faces, const Vec3& p0, const Vec3& p1,
-                                    bool floors, Point2& uv) const {
+                                    bool floors, Point2& uv, double mustBeat) const {
     const Mesh& S = loc.star.S;
+    for (const auto& [p, q] : ring)
+        if (minAngle(p1, pt(S, p), pt(S, q)) <= mustBeat) return -1.0;
     double w;
     if (!V_.project(p1, uv, w)) return -1.0;
     double m = std::numbers::pi;
@@ -202,10 +204,10 @@ int ComponentStitcher::slideAlongEdge(Local& loc, VertexIndex v, bool search) {
     for (const auto& [p, q] : ring)
         oldMin = std::min(oldMin, minAngle(p0, pt(S, p), pt(S, q)));
     // The smallest angle around v moved to U + t (W - U), or -1 where a check fails.
-    auto score = [&](double t, Point2& uv) {
-        return ringScore(loc, ring, faces, p0, U + t * (W - U), true, uv);
-    };
     double bestMin = oldMin, bestT = -1;
+    auto score = [&](double t, Point2& uv) {
+        return ringScore(loc, ring, faces, p0, U + t * (W - U), true, uv, bestMin);
+    };
     Point2 bestUv;
     auto consider = [&](double t) {
         Point2 uv;
@@ -311,11 +313,6 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
                 d2 = std::min(d2, CGAL::to_double(CGAL::squared_distance(toPoint(p1), t)));
             return !(d2 <= maxGap * maxGap);
         };
-        // The smallest angle around v moved to p1, or -1 where a face would turn over in the view (or,
-        // unseen, against its plane) or degenerate.
-        auto score = [&](const Vec3& p1, Point2& uv) {
-            return offSurface(p1) ? -1.0 : ringScore(loc, ring, ringFaces, p0, p1, withPatch, uv);
-        };
         double oldMin = std::numbers::pi, nearest = std::numeric_limits<double>::infinity();
         for (const auto& [p, q] : ring) {
             oldMin = std::min(oldMin, minAngle(p0, pt(S, p), pt(S, q)));
@@ -324,6 +321,13 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
         Vec3 best = p0;
         Point2 bestUv = loc.uv[v];
         double bestMin = oldMin;
+        // The smallest angle around v moved to p1, or -1 where a face would turn over in the view (or,
+        // unseen, against its plane) or degenerate, or where p1 cannot beat the best so far (the point-to-
+        // triangle distances of offSurface last: they cost most).
+        auto score = [&](const Vec3& p1, Point2& uv) {
+            const double m = ringScore(loc, ring, ringFaces, p0, p1, withPatch, uv, bestMin);
+            return m < 0 || offSurface(p1) ? -1.0 : m;
+        };
         // Keeps p1 when it beats the best so far.
         auto consider = [&](const Vec3& p1) {
             Point2 uv;

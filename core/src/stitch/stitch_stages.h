@@ -431,10 +431,12 @@ private:
     // The smallest angle of the faces (v, p, q) of `ring` (faces `faces`) with v moved from p0 to p1, or -1
     // where one of them would turn over in the view (or, unseen, against its plane) or degenerate, a patch
     // face would turn its normal more than maxNormalChangeDeg, or (with `floors`) a face would fall below
-    // its floor. uv: p1 in the view.
+    // its floor. uv: p1 in the view. Also -1 (uv unset) as soon as one face's smallest angle is at most
+    // `mustBeat`: callers keep p1 only where the score beats their best so far, so they pass it and the
+    // checks are skipped for places that cannot win.
     double ringScore(const Local& loc, const std::vector<std::pair<VertexIndex, VertexIndex>>& ring,
                      const std::vector<FaceIndex>& faces, const Vec3& p0, const Vec3& p1, bool floors,
-                     Point2& uv) const;
+                     Point2& uv, double mustBeat = -1.0) const;
 
     // A seam vertex on a mesh edge (a crossing, a snapped patch vertex) slides along that edge towards the
     // centre of its neighbours where that raises the smallest angle around it: the pieces outside stay in
