@@ -88,6 +88,55 @@ void BandRemesher::findCreases() {
     std::sort(weak.begin(), weak.end());
     for (const auto& [a, b] : weak)
         removeCrease(a, b);
+    if (!stageOff("bridge")) bridgeCreases(normal);
+}
+
+void BandRemesher::bridgeCreases(const std::unordered_map<std::uint32_t, V3>& normal) {
+    // A sliver of the draft across a crease has no reliable normal, so the crease stops on both sides of it:
+    // two crease ends a short band edge apart, each held like a corner, and the short edge stays (its
+    // collapse would move a held vertex: BandCrease.ShortEdgesAtAHeldCreaseVertexKeepTheCrease). Where the
+    // two stubs continue one line (they turn by at most kStraightCreaseDeg and the gap's far end lies within
+    // kCreaseChordDev of the line), the edge across the gap is a crease too, so neither end is held.
+    auto unknownNormal = [&](FaceIndex f) {
+        auto it = normal.find(std::uint32_t(f));
+        return it == normal.end() || !(it->second.squaredNorm() > 0);
+    };
+    auto along = [&](VertexIndex v) { // v's other end on its one crease edge
+        for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(v), S_))
+            if (isCrease(v, w)) return w;
+        return Mesh::null_vertex();
+    };
+    std::vector<std::pair<VertexIndex, VertexIndex>> bridges;
+    std::vector<std::uint32_t> ends;
+    for (const auto& [v, d] : creaseDeg_)
+        if (d == 1) ends.push_back(v);
+    std::sort(ends.begin(), ends.end());
+    for (std::uint32_t ai : ends) {
+        const VertexIndex a(ai), x = along(a);
+        if (x == Mesh::null_vertex()) continue;
+        const V3 pa = detail::pos(S_, a), px = detail::pos(S_, x);
+        VertexIndex best = Mesh::null_vertex();
+        double bestTurn = kStraightCreaseDeg * kBandDeg;
+        for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(a), S_)) {
+            const VertexIndex b = S_.source(h);
+            if (std::uint32_t(b) <= ai || creaseDegree(b) != 1 || isCrease(a, b) || !interiorEdge(h))
+                continue;
+            if (!unknownNormal(S_.face(h)) && !unknownNormal(S_.face(S_.opposite(h)))) continue;
+            const VertexIndex y = along(b);
+            if (y == Mesh::null_vertex() || y == x) continue;
+            const V3 pb = detail::pos(S_, b), py = detail::pos(S_, y);
+            const double turn = detail::angleBetween(pa - px, py - pb);
+            const V3 d = (pa - px).normalized();
+            const double off = ((pb - pa) - (pb - pa).dot(d) * d).norm();
+            if (turn <= bestTurn && off <= kCreaseChordDev * (py - px).norm()) {
+                bestTurn = turn;
+                best = b;
+            }
+        }
+        if (best != Mesh::null_vertex()) bridges.push_back({a, best});
+    }
+    for (const auto& [a, b] : bridges)
+        if (creaseDegree(a) == 1 && creaseDegree(b) == 1) addCrease(a, b);
 }
 
 void BandRemesher::buildCreaseChains() {

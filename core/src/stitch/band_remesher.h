@@ -2,6 +2,7 @@
 // The state and operations of one seam band remesh (band_remesh.h): internal to band_remesh.cpp and
 // band_repair.cpp (the repair of faces still bad at the end, the band's growth and the diagnostics).
 #include "stitch/band_remesh.h"
+#include "stitch/gap_triangulation.h"
 
 #include "fss/raycast.h"
 
@@ -40,8 +41,17 @@ constexpr double kSlideCreaseDeg = 10.0;
 constexpr double kSplitFloorDeg = 20.0;
 using V3 = Eigen::Vector3d;
 
-// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,creasefilter,collapseall,short (and lift, split, smooth) turns
-// parts of the band remesh off (to measure what each brings).
+// FSS_STITCH_BAND_DIAG=2: the band prints each face below 20 deg and what its repairs tried.
+inline bool bandDiagnosticsVerbose() {
+    static const bool on = [] {
+        const char* e = std::getenv("FSS_STITCH_BAND_DIAG");
+        return e && std::string(e) == "2";
+    }();
+    return on;
+}
+
+// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,creasefilter,collapseall,short,star,bridge (and lift, split,
+// smooth) turns parts of the band remesh off (to measure what each brings).
 inline bool stageOff(const char* name) {
     static const std::string off = [] {
         const char* e = std::getenv("FSS_STITCH_BAND_OFF");
@@ -353,6 +363,42 @@ private:
     bool repairFlip(FaceIndex f);
     bool repairCollapse(FaceIndex f);
     bool repairCap(FaceIndex f);
+    // ---- the compound repair of a face no single operation improves (band_star.cpp): a small disk of band
+    // faces around it triangulated anew in the view (the gap's quality CDT), new vertices on the draft's
+    // smooth surface, kept only where the disk's smallest angle rises and every band rule holds.
+    struct StarDisk {
+        std::vector<FaceIndex> faces;   // sorted
+        std::vector<VertexIndex> loop;  // its border, counter-clockwise in the view
+        std::vector<VertexIndex> inner; // its interior vertices (free: they go)
+    };
+    struct StarPlan {
+        StarDisk disk;
+        std::vector<V3> points;                    // new vertices (GapTriangulation points past the loop's)
+        std::vector<FaceIndex> hints;              // their faces on the draft
+        std::vector<double> sizes;                 // their local sizes
+        std::vector<std::array<int, 3>> triangles; // loop indices, then n + new vertex index
+        std::vector<FaceIndex> parents;            // per triangle: the old face under its centroid
+        double minAngle = -1;                      // radians
+    };
+    // The disk seen in the view: the CDT's input (loop constraints, crease chords), each vertex's place, the
+    // disk's edges, mean normal, smallest angle and local size in pixels.
+    struct StarView {
+        const StarDisk* disk = nullptr;
+        GapBoundary gap;
+        std::unordered_map<std::uint32_t, Eigen::Vector2d> uvOf;
+        std::vector<Eigen::Vector2d> innerUv;
+        std::unordered_set<std::uint64_t> diskEdges;
+        V3 starNormal{0, 0, 0};
+        double oldMin = 0, sizePx = 0;
+    };
+    bool repairStar(FaceIndex f);
+    bool viewStar(const StarDisk& disk, StarView& sv);
+    FaceIndex starFaceAt(const StarView& sv, const Eigen::Vector2d& p, std::array<double, 3>& w) const;
+    // Empty when the triangulation t of the disk passes every rule (then in plan), else why not.
+    std::string judgeStar(const StarView& sv, const GapTriangulation& t, StarPlan& plan);
+    bool starDisk(const std::vector<FaceIndex>& faces, StarDisk& disk);
+    bool planStar(const StarDisk& disk, StarPlan& best);
+    bool applyStar(const StarPlan& plan);
 
     // ---- the smooth surface through the draft (band_crease.cpp): a point of a draft face lifted by Phong
     // tessellation (Boubekeur & Alexa 2008, shape factor 1/2: exact to second order on a sphere) with the
@@ -375,6 +421,8 @@ private:
     // The band's creases at setup (band_crease.cpp): edges between faces whose normals differ by more than
     // the crease angle, outlier faces and weak stubs left out.
     void findCreases();
+    // Crease ends facing each other across a sliver (no reliable normal) joined into one crease.
+    void bridgeCreases(const std::unordered_map<std::uint32_t, V3>& normal);
     // Whether a face has an angle above 120 deg.
     bool isCap(FaceIndex f) const;
     // The point at parameter t between crease vertices a and b on their common crease polyline (into q);

@@ -115,7 +115,8 @@ bool BandRemesher::repairPass() {
     bool changed = false;
     for (const auto& [angle, f] : bad) {
         if (S_.is_removed(f) || !inBand(f) || faceMinAngle(f) >= aim) continue;
-        if (repairFlip(f) || repairCollapse(f) || repairCap(f) || (!stageOff("split") && repairSplit(f))) {
+        if (repairFlip(f) || repairCollapse(f) || repairCap(f) || (!stageOff("split") && repairSplit(f)) ||
+            (faceMinAngle(f) < kSplitFloorDeg * kBandDeg && repairStar(f))) {
             changed = true;
             ++report_.repairs;
         }
