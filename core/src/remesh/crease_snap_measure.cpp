@@ -17,7 +17,7 @@ CreaseSnapper::Error CreaseSnapper::error(const Tri& t) const {
     return e;
 }
 
-CreaseSnapper::Error CreaseSnapper::measureError(const Tri& t) const {
+std::array<Vec, 7> CreaseSnapper::errorSamples(const Tri& t) {
     static constexpr double w[7][3] = {{1.0 / 3, 1.0 / 3, 1.0 / 3},
                                        {0.5, 0.5, 0},
                                        {0, 0.5, 0.5},
@@ -25,14 +25,40 @@ CreaseSnapper::Error CreaseSnapper::measureError(const Tri& t) const {
                                        {4.0 / 6, 1.0 / 6, 1.0 / 6},
                                        {1.0 / 6, 4.0 / 6, 1.0 / 6},
                                        {1.0 / 6, 1.0 / 6, 4.0 / 6}};
+    std::array<Vec, 7> samples;
+    for (std::size_t i = 0; i < 7; ++i)
+        samples[i] = w[i][0] * t.a + w[i][1] * t.b + w[i][2] * t.c;
+    return samples;
+}
+
+CreaseSnapper::Error CreaseSnapper::measureError(const Tri& t) const {
     Error e;
-    for (const auto& k : w) {
-        const double d = caster_.closestPoint(k[0] * t.a + k[1] * t.b + k[2] * t.c).distance;
+    for (const Vec& p : errorSamples(t)) {
+        const double d = closest_(p).distance;
         e.max = std::max(e.max, d);
         e.integral += d * d;
     }
     e.integral *= 0.5 * (t.b - t.a).cross(t.c - t.a).norm() / 7.0;
     return e;
+}
+
+void CreaseSnapper::prefetchFaces() const {
+    std::vector<Vec> centroids;
+    centroids.reserve(m_.number_of_faces());
+    for (FaceIndex f : m_.faces()) {
+        const Tri t = triangle(f);
+        centroids.push_back((t.a + t.b + t.c) / 3.0);
+    }
+    closest_.prefetch(centroids);
+    std::vector<Vec> samples;
+    for (FaceIndex f : m_.faces()) {
+        const Tri t = triangle(f);
+        const SurfacePoint sp = closest_((t.a + t.b + t.c) / 3.0);
+        if (!sp || !mayBeFar(t, sp.distance)) continue;
+        for (const Vec& p : errorSamples(t))
+            samples.push_back(p);
+    }
+    closest_.prefetch(samples);
 }
 
 bool CreaseSnapper::better(const std::vector<Tri>& before, const std::vector<Tri>& after, bool sameCount,
@@ -68,21 +94,24 @@ bool CreaseSnapper::better(const std::vector<Tri>& before, const std::vector<Tri
 }
 
 bool CreaseSnapper::liesOnReference(const Tri& t, const Vec& n) const {
-    const SurfacePoint sp = caster_.closestPoint((t.a + t.b + t.c) / 3.0);
+    const SurfacePoint sp = closest_((t.a + t.b + t.c) / 3.0);
     return sp && sp.distance <= 0.1 * L_ && referenceNormalOf(sp.face).dot(n) > 0.5;
 }
 
 Vec CreaseSnapper::referenceNormal(const Vec& p) const {
-    const SurfacePoint sp = caster_.closestPoint(p);
+    const SurfacePoint sp = closest_(p);
     return sp ? referenceNormalOf(sp.face) : Vec::Zero();
 }
 
-bool CreaseSnapper::far(const Tri& t, double centroidDistance) const {
+bool CreaseSnapper::mayBeFar(const Tri& t, double centroidDistance) const {
     Vec q;
     double d;
     const bool nearCrease = creases_.closest((t.a + t.b + t.c) / 3.0, q, d) && d <= 1.5 * L_;
-    if (!nearCrease && centroidDistance <= 0.1 * L_) return false;
-    return error(t).max > o_.errorSplitDistance * L_;
+    return nearCrease || centroidDistance > 0.1 * L_;
+}
+
+bool CreaseSnapper::far(const Tri& t, double centroidDistance) const {
+    return mayBeFar(t, centroidDistance) && error(t).max > o_.errorSplitDistance * L_;
 }
 
 Vec CreaseSnapper::referenceNormalOf(FaceIndex f) const {

@@ -150,7 +150,7 @@ std::size_t CreaseSnapper::snapSweep() {
         }
         // Farther from the crease but off the reference (the stitches' collapses leave a few vertices
         // inside a bevel): onto the closest reference point.
-        const SurfacePoint sp = caster_.closestPoint(pos(m_, v));
+        const SurfacePoint sp = closest_(pos(m_, v));
         if (sp && sp.distance > 0.1 * L_) candidates.push_back({sp.distance, v, sp.point, false});
     }
     std::sort(candidates.begin(), candidates.end(),

@@ -38,12 +38,13 @@ std::size_t CreaseSnapper::repairSweep() {
     // where the scans leave such faces): the gain 0.8.
     auto bad = [&](FaceIndex f) {
         const Tri t = triangle(f);
-        const SurfacePoint sp = caster_.closestPoint((t.a + t.b + t.c) / 3.0);
+        const SurfacePoint sp = closest_((t.a + t.b + t.c) / 3.0);
         if (!sp) return 0.0;
         const Vec n = unitNormal(t.a, t.b, t.c);
         if (n.isZero() || n.dot(referenceNormalOf(sp.face)) < 0) return 1.0;
         return far(t, sp.distance) ? 0.8 : 0.0;
     };
+    prefetchFaces();
     std::vector<FaceIndex> folded;
     for (FaceIndex f : m_.faces())
         if (bad(f) > 0) folded.push_back(f);
@@ -181,7 +182,7 @@ bool CreaseSnapper::tryCollapse(HalfedgeIndex h, double gain) {
         double dist;
         const Vec mid = 0.5 * (pa + pb);
         if (creases_.closest(mid, q, dist) && dist < L_) targets.emplace_back(q, true);
-        if (const SurfacePoint sp = caster_.closestPoint(mid)) targets.emplace_back(sp.point, false);
+        if (const SurfacePoint sp = closest_(mid)) targets.emplace_back(sp.point, false);
     }
     std::vector<Tri> before;
     std::vector<std::array<VertexIndex, 3>> ring; // the faces that stay, by their corners

@@ -88,13 +88,14 @@ VertexIndex CreaseSnapper::splitAt(HalfedgeIndex h, const Vec& q) {
 }
 
 std::size_t CreaseSnapper::errorSplitSweep() {
+    prefetchFaces();
     std::vector<FaceIndex> faces(m_.faces().begin(), m_.faces().end());
     std::size_t splits = 0;
     for (FaceIndex f : faces) {
         if (m_.is_removed(f)) continue;
         HalfedgeIndex h = m_.halfedge(f);
         const Tri t = triangle(f);
-        const SurfacePoint sp = caster_.closestPoint((t.a + t.b + t.c) / 3.0);
+        const SurfacePoint sp = closest_((t.a + t.b + t.c) / 3.0);
         if (!sp || !far(t, sp.distance)) continue;
         for (HalfedgeIndex k : CGAL::halfedges_around_face(m_.halfedge(f), m_))
             if ((pos(m_, m_.source(k)) - pos(m_, m_.target(k))).squaredNorm() >
@@ -109,7 +110,7 @@ std::size_t CreaseSnapper::errorSplitSweep() {
         double d;
         bool crease = creases_.closest(mid, q, d) && d < o_.snapRadius * L_;
         if (!crease) {
-            const SurfacePoint sp = caster_.closestPoint(mid);
+            const SurfacePoint sp = closest_(mid);
             if (!sp) continue;
             q = sp.point;
         }

@@ -4,6 +4,7 @@
 // the reference and the acceptance tests), crease_snap_moves.cpp (corner and crease snaps, valence-3
 // removals), crease_snap_repair.cpp (repairs of faces turned over or far) and crease_snap_split.cpp (splits,
 // flips).
+#include "remesh/closest_points.h"
 #include "remesh/crease_index.h"
 #include "remesh/crease_snap.h"
 
@@ -29,7 +30,7 @@ class CreaseSnapper {
 public:
     CreaseSnapper(Mesh& mesh, const Mesh& reference, const CreaseSnapOptions& o)
         : m_(mesh), ref_(reference), o_(o), L_(o.edgeLength),
-          floor_(o.minAngleDeg * std::numbers::pi / 180.0), caster_(reference),
+          floor_(o.minAngleDeg * std::numbers::pi / 180.0), caster_(reference), closest_(caster_),
           creases_(reference, o.creaseAngleDeg, o.edgeLength) {}
 
     std::size_t creaseEdges() const { return creases_.size(); }
@@ -52,6 +53,7 @@ private:
     const CreaseSnapOptions& o_;
     const double L_, floor_;
     RayCaster caster_;
+    ClosestPoints closest_; // every closest-point query, memoized
     CreaseIndex creases_;
     std::vector<char> frozen_;   // vertices that never move: border vertices
     std::vector<char> onCrease_; // vertices this step put on a crease
@@ -83,6 +85,11 @@ private:
     mutable std::unordered_map<TriKey, Error, TriKeyHash> errors_; // error() of the triangles measured
     Error error(const Tri& t) const;
     Error measureError(const Tri& t) const;
+    /// The points error() samples: the centroid, the edge midpoints and three inner points.
+    static std::array<Vec, 7> errorSamples(const Tri& t);
+    /// Answers, in parallel, the closest-point queries the sweeps over every face ask first: the faces'
+    /// centroids, and the samples of the faces whose distance `far` measures.
+    void prefetchFaces() const;
     /// Whether the triangles \p after may replace \p before: no degenerate face, no normal turned by 90° or
     /// more (each face against its own old normal when \p sameCount, else against the old faces' mean
     /// normal), no angle below the floor (or the smallest old angle), a largest distance to the reference
@@ -118,6 +125,8 @@ private:
     /// than a tenth of an edge length (\p centroidDistance): a face whose centroid lies on the reference is
     /// that far from it only across a crease.
     bool far(const Tri& t, double centroidDistance) const;
+    /// Whether `far` measures \p t (near a crease, or its centroid off the reference).
+    bool mayBeFar(const Tri& t, double centroidDistance) const;
     Vec referenceNormalOf(FaceIndex f) const;
     bool turnedOver(const Tri& t) const;
     /// The smallest angle and the largest distance to the reference of the faces an operation replaces.
