@@ -6,6 +6,7 @@
 #include "fss/metrics.h"
 
 #include <CGAL/Polygon_mesh_processing/border.h>
+#include <CGAL/Polygon_mesh_processing/refine.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Polygon_mesh_processing/shape_predicates.h>
 #include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
@@ -52,20 +53,10 @@ void appendInputFaces(Mesh& out, const Mesh& reference, const std::vector<char>&
 
 /// The advancing front that closes the gaps between the patches of \p mesh (auto_v2.cpp, step 3): border
 /// edges take the border vertex within \p reach of them that sees them under the largest angle, when the
-/// new face turns by less than \p maxFoldDeg against the faces next to it and has no angle below
-/// \p minAngleDeg; the roundest such faces (largest smallest angle) are added first, ears (faces closing two
-/// border edges) before the others. Returns the number of faces added.
-/// FSS_AUTO_V2_WIDEN=1: the gap closing refuses crossing faces and autoRemeshV2 widens the input regions
-/// (experimental, off by default: it lowered the torus's coverage 0.9896 -> 0.9839 and elephant's 0.690 ->
-/// 0.428 while four more meshes passed the join's validation).
-bool refuseCrossing() {
-    static const bool on = [] {
-        const char* e = std::getenv("FSS_AUTO_V2_WIDEN");
-        return e && std::string(e) == "1";
-    }();
-    return on;
-}
-
+/// new face turns by less than \p maxFoldDeg against the faces next to it, has no angle below
+/// \p minAngleDeg and crosses no face already there (tested against the faces in the grid cells its box
+/// meets); the roundest such faces (largest smallest angle) are added first, ears (faces closing two border
+/// edges) before the others. Returns the number of faces added.
 class GapCloser {
 public:
     /// With \p onSurface, a face whose centroid lies farther than \p maxGap from that surface is not added
@@ -104,7 +95,7 @@ public:
                 continue;
             // A face that would cross one already there (measured on couplingdown: 506 of the 509 face pairs
             // that intersected after the gap closing were its own) is refused; the edge looks for another.
-            if (refuseCrossing() && crosses(u, w, c.p)) {
+            if (crosses(u, w, c.p)) {
                 refused_.insert(pairKey(c.h, c.p));
                 push(c.h);
                 continue;
@@ -255,6 +246,38 @@ private:
     std::unordered_set<std::uint64_t> refused_;
 };
 
+/// Fills the pinched boundary cycle through border halfedge \p h (CGAL's hole triangulation returns no face
+/// for a cycle that passes a vertex twice: measured on couplingdown, 20 of its 105 cycles, all of them
+/// pinched and no other) loop by loop: each simple loop is triangulated as a polyline (no new vertex) and
+/// its triangles added in the loop's order, the orientation of the border halfedges, then refined as
+/// triangulate_and_refine_hole refines a fill. Returns the new faces; \p newVertices receives the
+/// refinement's.
+std::vector<FaceIndex> fillPinchedCycle(Mesh& mesh, HalfedgeIndex h, std::vector<VertexIndex>& newVertices) {
+    std::vector<VertexIndex> cycle;
+    for (HalfedgeIndex g : CGAL::halfedges_around_face(h, mesh))
+        cycle.push_back(mesh.source(g));
+    std::vector<FaceIndex> added;
+    for (const std::vector<VertexIndex>& loop : pinchedCycleLoops(cycle)) {
+        std::vector<Point3> points;
+        for (VertexIndex v : loop)
+            points.push_back(mesh.point(v));
+        std::vector<CGAL::Triple<int, int, int>> triangles;
+        CGAL::Polygon_mesh_processing::triangulate_hole_polyline(points, std::back_inserter(triangles));
+        for (const CGAL::Triple<int, int, int>& t : triangles) {
+            const FaceIndex f = mesh.add_face(loop[std::size_t(t.first)], loop[std::size_t(t.second)],
+                                              loop[std::size_t(t.third)]);
+            if (f != Mesh::null_face()) added.push_back(f);
+        }
+    }
+    // The refinement returns the faces it adds; those it splits keep their index.
+    std::vector<FaceIndex> refined;
+    if (!added.empty())
+        CGAL::Polygon_mesh_processing::refine(mesh, added, std::back_inserter(refined),
+                                              std::back_inserter(newVertices));
+    added.insert(added.end(), refined.begin(), refined.end());
+    return added;
+}
+
 /// Fills every boundary cycle of \p mesh left by the gap closing with CGAL's hole triangulation and
 /// refinement; the new faces take the scan id and quality of a face next to them.
 void fillHoles(Mesh& mesh) {
@@ -265,19 +288,38 @@ void fillHoles(Mesh& mesh) {
     for (HalfedgeIndex h : cycles) {
         if (!mesh.is_border(h)) continue;
         const FaceIndex next = mesh.face(mesh.opposite(h));
+        // For FSS_AUTO_V2_DEBUG, the cycle before it is filled: its length, how many of its vertices it
+        // passes more than once (a pinched cycle) and how many of its vertex pairs two apart are already
+        // joined by an edge of the mesh (the triangulation may not create an edge twice).
+        std::string cycleText;
+        if (std::getenv("FSS_AUTO_V2_DEBUG")) {
+            std::vector<VertexIndex> cycle;
+            for (HalfedgeIndex g : CGAL::halfedges_around_face(h, mesh))
+                cycle.push_back(mesh.target(g));
+            std::vector<VertexIndex> sorted = cycle;
+            std::sort(sorted.begin(), sorted.end());
+            const std::size_t repeated =
+                sorted.size() - std::size_t(std::unique(sorted.begin(), sorted.end()) - sorted.begin());
+            std::size_t chords = 0;
+            for (std::size_t i = 0; i < cycle.size() && cycle.size() > 3; ++i)
+                chords += mesh.halfedge(cycle[i], cycle[(i + 2) % cycle.size()]) != Mesh::null_halfedge();
+            cycleText = std::to_string(cycle.size()) + " edges, " + std::to_string(repeated) +
+                        " repeated vertices, " + std::to_string(chords) + " chords";
+        }
         std::vector<FaceIndex> added;
         std::vector<VertexIndex> newVertices;
         // Refined (vertices inserted at the edge length of the hole's border), so that the seam relaxation
         // can move the fill onto the reference (it projects zone vertices that lie off it).
         CGAL::Polygon_mesh_processing::triangulate_and_refine_hole(mesh, h, std::back_inserter(added),
                                                                    std::back_inserter(newVertices));
+        if (added.empty() && mesh.is_border(h)) added = fillPinchedCycle(mesh, h, newVertices);
         for (FaceIndex f : added) {
             ids[f] = next != Mesh::null_face() ? ids[next] : 0;
             quality[f] = next != Mesh::null_face() ? quality[next] : 0.f;
         }
-        if (std::getenv("FSS_AUTO_V2_DEBUG"))
-            std::fprintf(stderr, "v2 fill: cycle -> %zu faces, %zu new vertices\n", added.size(),
-                         newVertices.size());
+        if (!cycleText.empty())
+            std::fprintf(stderr, "v2 fill: cycle of %s -> %zu faces, %zu new vertices\n", cycleText.c_str(),
+                         added.size(), newVertices.size());
     }
 }
 
@@ -397,6 +439,28 @@ Eigen::Vector3d centroid(const Mesh& m, FaceIndex f) {
 }
 
 } // namespace
+
+std::vector<std::vector<VertexIndex>> pinchedCycleLoops(const std::vector<VertexIndex>& cycle) {
+    std::vector<std::vector<VertexIndex>> out;
+    std::vector<VertexIndex> path;
+    std::unordered_map<std::uint32_t, std::size_t> position;
+    for (VertexIndex v : cycle) {
+        const auto it = position.find(v.idx());
+        if (it == position.end()) {
+            position[v.idx()] = path.size();
+            path.push_back(v);
+            continue;
+        }
+        // path[it->second] == v: the vertices after it up to here close a loop through v.
+        std::vector<VertexIndex> loop(path.begin() + std::ptrdiff_t(it->second), path.end());
+        for (std::size_t i = it->second + 1; i < path.size(); ++i)
+            position.erase(path[i].idx());
+        path.resize(it->second + 1);
+        if (loop.size() >= 3) out.push_back(std::move(loop));
+    }
+    if (path.size() >= 3) out.push_back(std::move(path));
+    return out;
+}
 
 /// Adds the faces of \p patch to \p out (scan id and quality kept).
 void appendPatch(Mesh& out, const Mesh& patch) {

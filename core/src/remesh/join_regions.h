@@ -58,6 +58,12 @@ std::vector<std::vector<FaceIndex>> faceComponents(const Mesh& mesh, Member&& me
     return out;
 }
 
+/// The simple loops of the boundary cycle \p cycle (its vertices in order) that passes some vertices more
+/// than once (a pinched cycle, where two fans of faces meet at one vertex): cut at each repeated vertex,
+/// every loop in the cycle's order, loops of fewer than three vertices left out. The hole filling fills a
+/// pinched cycle loop by loop: CGAL's hole triangulation returns no face for it.
+std::vector<std::vector<VertexIndex>> pinchedCycleLoops(const std::vector<VertexIndex>& cycle);
+
 /// Adds the faces of \p patch to \p out (scan id and quality kept).
 void appendPatch(Mesh& out, const Mesh& patch);
 
