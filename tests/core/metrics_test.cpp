@@ -290,11 +290,32 @@ TEST(Metrics, ValenceAndMinAngleStopsWhenAsked) {
     const fss::ValenceAndMinAngle plain = fss::valenceAndMinAngle(torus);
     EXPECT_EQ(whole.fracValence6Interior, plain.fracValence6Interior);
     EXPECT_EQ(whole.minAngleDeg, plain.minAngleDeg);
-    ASSERT_EQ(seen.size(), 2u + 10u); // "valence", 10 in the loop (0, 4096, … 36864), the final 1
-    EXPECT_EQ(seen.front().first, "valence");
+    // The valence count visits 120000 halfedges and 20000 vertices: 35 reports (0, 4096, … 139264 steps).
+    const double steps = double(torus.number_of_halfedges() + torus.number_of_vertices());
+    ASSERT_EQ(steps, 140000.0);
+    ASSERT_EQ(seen.size(),
+              35u + 10u + 1u); // 35 "valence", 10 in the angle loop (0, 4096, … 36864), the final 1
+    for (std::size_t k = 0; k < 35; ++k) {
+        EXPECT_EQ(seen[k].first, "valence") << k;
+        EXPECT_EQ(seen[k].second, double(k * fss::kFiguresProgressFaces) / steps) << k;
+    }
     for (std::size_t k = 0; k < 10; ++k)
-        EXPECT_EQ(seen[1 + k].second, double(k * fss::kFiguresProgressFaces) / faces) << k;
+        EXPECT_EQ(seen[35 + k].second, double(k * fss::kFiguresProgressFaces) / faces) << k;
     EXPECT_EQ(seen.back().second, 1.0);
+
+    // A stop at the second report of the valence count leaves it after exactly kFiguresProgressFaces steps,
+    // before any face's angle (session 17's count could not be stopped).
+    std::size_t valenceReports = 0, angleReports = 0;
+    const fss::Progress stopInValence([&](double, std::string_view stage) {
+        if (stage != "valence") {
+            ++angleReports;
+            return true;
+        }
+        return ++valenceReports < 2;
+    });
+    EXPECT_THROW(fss::valenceAndMinAngle(torus, stopInValence), fss::CancelledError);
+    EXPECT_EQ(valenceReports, 2u);
+    EXPECT_EQ(angleReports, 0u);
 
     std::size_t loopReports = 0;
     double stoppedAt = -1;
@@ -306,6 +327,42 @@ TEST(Metrics, ValenceAndMinAngleStopsWhenAsked) {
     EXPECT_THROW(fss::valenceAndMinAngle(torus, stop), fss::CancelledError);
     EXPECT_EQ(loopReports, 2u);
     EXPECT_EQ(stoppedAt * faces, double(fss::kFiguresProgressFaces));
+}
+
+// valenceAndMinAngle measures a mesh holding garbage as it is (no dense copy, which could not be stopped):
+// its figures and its step and face counts are those of the collected mesh, and computeMetrics' on it.
+TEST(Metrics, ValenceAndMinAngleMeasuresAMeshWithGarbageInPlace) {
+    Mesh holed = fss::shapes::torus(60, 30, 1.0, 0.4);
+    std::size_t removed = 0;
+    const std::vector<fss::FaceIndex> faces(holed.faces().begin(), holed.faces().end());
+    for (fss::FaceIndex f : faces) // every 7th face (and the edges and vertices it leaves alone)
+        if (std::size_t(f) % 7 == 3) {
+            CGAL::Euler::remove_face(holed.halfedge(f), holed);
+            ++removed;
+        }
+    ASSERT_GT(removed, 200u);
+    ASSERT_TRUE(holed.has_garbage());
+    Mesh dense = holed;
+    dense.collect_garbage();
+    ASSERT_EQ(holed.number_of_faces(), dense.number_of_faces());
+    ASSERT_LT(holed.number_of_faces(), holed.num_faces()); // removed faces are still stored
+    auto counted = [](const Mesh& m, std::size_t& valence, std::size_t& angle) {
+        return fss::valenceAndMinAngle(m, fss::Progress([&](double, std::string_view stage) {
+                                           ++(stage == "valence" ? valence : angle);
+                                           return true;
+                                       }));
+    };
+    std::size_t valenceHoled = 0, angleHoled = 0, valenceDense = 0, angleDense = 0;
+    const fss::ValenceAndMinAngle inPlace = counted(holed, valenceHoled, angleHoled);
+    const fss::ValenceAndMinAngle collected = counted(dense, valenceDense, angleDense);
+    const fss::Metrics reference = fss::computeMetrics(dense);
+    EXPECT_EQ(inPlace.fracValence6Interior, reference.fracValence6Interior);
+    EXPECT_EQ(inPlace.minAngleDeg, reference.minAngleDeg);
+    EXPECT_EQ(collected.fracValence6Interior, reference.fracValence6Interior);
+    EXPECT_EQ(collected.minAngleDeg, reference.minAngleDeg);
+    EXPECT_LT(reference.interiorVertices, std::size_t(60 * 30)); // the holes' corners are border vertices
+    EXPECT_EQ(valenceHoled, valenceDense);
+    EXPECT_EQ(angleHoled, angleDense);
 }
 
 TEST(Metrics, PinchedVertexIsNonManifold) {

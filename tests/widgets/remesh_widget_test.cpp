@@ -985,8 +985,9 @@ private slots:
 
     // The trials' whole-mesh measure stops when a newer one is requested (a user who scans again on a large
     // mesh no longer waits for the abandoned trial's measure): a measure of 1M faces on a worker thread,
-    // then another request on this thread. Counted in faces, not timed: the first one measured fewer than
-    // all of its faces and gave no figures; the second one's figures are valenceAndMinAngle's.
+    // then another request on this thread. Counted in valence steps and faces, not timed: the first one
+    // ended inside its valence count, before any face, and gave no figures; the second one's figures are
+    // valenceAndMinAngle's.
     void figuresMeasureIsStoppedByANewerRequest() {
         const fss::Mesh big = fss::shapes::torus(1000, 500, 1.0, 0.4);
         const fss::Mesh small = fss::shapes::icosphere(3);
@@ -998,16 +999,21 @@ private slots:
             std::this_thread::yield(); // the first request has begun (it may not have measured a face yet)
         const fss::widgets::FiguresResult second = measurer.measure(small);
         worker.join();
+        // The valence count (3M halfedges, 500k vertices) is stopped too: the newer request comes while it
+        // runs (it would come after it only if this thread slept for the whole count), at one of its checks.
+        const std::size_t bigSteps = big.number_of_halfedges() + big.number_of_vertices();
         QVERIFY(!first.figures);
-        QVERIFY(first.facesMeasured < big.number_of_faces());
-        QCOMPARE(first.facesMeasured % fss::kFiguresProgressFaces, std::size_t(0)); // stopped at a check
+        QVERIFY(first.valenceSteps < bigSteps);
+        QCOMPARE(first.valenceSteps % fss::kFiguresProgressFaces, std::size_t(0)); // stopped at a check
+        QCOMPARE(first.facesMeasured, std::size_t(0));
         QVERIFY(second.figures);
+        QCOMPARE(second.valenceSteps, std::size_t(small.number_of_halfedges() + small.number_of_vertices()));
         QCOMPARE(second.facesMeasured, std::size_t(small.number_of_faces()));
         const fss::ValenceAndMinAngle expected = fss::valenceAndMinAngle(small);
         QCOMPARE(second.figures->valence6, expected.fracValence6Interior);
         QCOMPARE(second.figures->minAngle, expected.minAngleDeg);
-        qInfo("the first measure ended after %zu of %zu faces", first.facesMeasured,
-              std::size_t(big.number_of_faces()));
+        qInfo("the first measure ended after %zu of %zu valence steps, %zu of %zu faces", first.valenceSteps,
+              bigSteps, first.facesMeasured, std::size_t(big.number_of_faces()));
         // A request whose own token is stopped ends at once and leaves a running one alone; stop() ends
         // the running one.
         std::stop_source cancelled;
@@ -1021,7 +1027,8 @@ private slots:
         measurer.stop();
         again.join();
         QVERIFY(!third.figures);
-        QVERIFY(third.facesMeasured < big.number_of_faces());
+        QVERIFY(third.valenceSteps < bigSteps);
+        QCOMPARE(third.facesMeasured, std::size_t(0));
     }
 
     // The widget's accept latency with the trial's result (figures) and without (accept at once: the trial is

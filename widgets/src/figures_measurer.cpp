@@ -15,8 +15,13 @@ namespace {
 FiguresResult measureUntil(const Mesh& mesh, const std::stop_token& mine, const std::stop_token& stop) {
     FiguresResult result;
     const double faces = double(mesh.number_of_faces());
+    const double steps = double(mesh.number_of_halfedges() + mesh.number_of_vertices());
     const Progress progress([&](double fraction, std::string_view stage) {
-        if (stage == "smallest angle") result.facesMeasured = std::size_t(std::llround(fraction * faces));
+        if (stage == "valence") result.valenceSteps = std::size_t(std::llround(fraction * steps));
+        if (stage == "smallest angle") {
+            result.valenceSteps = std::size_t(steps);
+            result.facesMeasured = std::size_t(std::llround(fraction * faces));
+        }
         return !mine.stop_requested() && !stop.stop_requested();
     });
     try {

@@ -267,7 +267,7 @@ RemeshWidget::~RemeshWidget() {
 }
 
 const Mesh& RemeshWidget::mesh() const {
-    return d_->mesh;
+    return *d_->mesh;
 }
 const Mesh& RemeshWidget::referenceMesh() const {
     return d_->session ? d_->session->reference() : d_->empty;
@@ -401,11 +401,11 @@ void RemeshWidget::redoStep() {
 }
 
 void RemeshWidget::afterMeshChange() {
-    d_->mesh = d_->session->current();
+    d_->mesh = std::make_shared<const Mesh>(d_->session->current());
     d_->updatingView = true;
-    bridge::showMeshKeepCamera(d_->view, d_->mesh);
+    bridge::showMeshKeepCamera(d_->view, *d_->mesh);
     d_->updatingView = false;
-    d_->qualityPanel->setMesh(d_->mesh);
+    d_->qualityPanel->setMesh(*d_->mesh);
     showPreview();
     emit meshChanged();
 }

@@ -69,7 +69,7 @@ void RemeshWidget::installSession(std::unique_ptr<Session> session, const QStrin
     d_->memoryInput.reset();
     d_->cpuRenderer = cpuRenderer;
     d_->curvature = curvature;
-    d_->mesh = d_->session->current();
+    d_->mesh = std::make_shared<const Mesh>(d_->session->current());
     // Mirror the session's history on the undo stack: applied steps, then the redo-able ones undone.
     const std::vector<ScanStep> steps = d_->session->steps();
     d_->syncingStack = true;
@@ -86,10 +86,10 @@ void RemeshWidget::installSession(std::unique_ptr<Session> session, const QStrin
     d_->fishbone->clear();
     d_->view->clearPreviewMesh();
     d_->updatingView = true;
-    d_->view->setMesh(d_->mesh);
+    d_->view->setMesh(*d_->mesh);
     d_->updatingView = false;
     setGhostVisible(ghost_);
-    d_->qualityPanel->setMesh(d_->mesh);
+    d_->qualityPanel->setMesh(*d_->mesh);
     d_->scanPanel->updateEdgeLength(d_->view->camera(), boundingBox(d_->session->reference()).center());
     d_->scanPanel->setInputEdgeLength(meanEdgeLength(d_->session->reference()));
     d_->scanTool->setPreviewPending(false);

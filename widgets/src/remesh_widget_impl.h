@@ -86,7 +86,8 @@ struct Trial {
     std::stop_source stop;                     // Cancel, a newer preview, an accept
     std::shared_ptr<FiguresMeasurer> measurer; // the widget's: its whole-mesh measures stop when asked
     std::atomic<double> fraction{0.0};
-    Mesh mesh; // the current mesh, stitched in place
+    std::shared_ptr<const Mesh> current; // the widget's current mesh (immutable, shared with the GUI)
+    Mesh mesh;                           // its copy, made on the thread after the figures before, stitched
     Mesh patch;
     Camera camera;
     StitchOptions options;
@@ -107,8 +108,9 @@ struct Trial {
             return !stop.stop_requested();
         });
         try {
-            before = figuresOf(measurer->measure(mesh, stop.get_token()));
-            progress.report(0.0, "stitch");
+            before = figuresOf(measurer->measure(*current, stop.get_token()));
+            progress.report(0.0, "stitch"); // an abandoned trial ends here, before the copy
+            mesh = *current;
             report = stitchPatch(mesh, patch, camera, options, faceIds, progress, &stitched);
             if (mesh.has_garbage()) mesh.collect_garbage();
             progress.report(0.95, "figures");
@@ -175,8 +177,9 @@ struct RemeshWidget::Impl {
     QScrollArea* sideScroll = nullptr;
     Mesh empty;
     // The GUI thread's copy of the session's current mesh: the worker may be replacing the session's
-    // own while the GUI reads this one.
-    Mesh mesh;
+    // own while the GUI reads this one. Never changed once made (a mesh change makes a new one), so a
+    // trial's thread reads it while the GUI goes on (no copy on the GUI thread when a scan starts a trial).
+    std::shared_ptr<const Mesh> mesh = std::make_shared<const Mesh>();
     VtkView* view = nullptr;
     ScanPanel* scanPanel = nullptr;
     QualityPanel* qualityPanel = nullptr;

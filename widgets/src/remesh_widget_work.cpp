@@ -272,8 +272,9 @@ void RemeshWidget::startTrial() {
     t->session = d_->session.get();
     t->scanId = p.step.params.scan.scanId;
     t->measurer = d_->figures;
-    // The inputs of Session::accept, copied: the thread never touches the session.
-    t->mesh = d_->mesh;
+    // The inputs of Session::accept, copied (the current mesh shared: the thread copies it): the thread never
+    // touches the session.
+    t->current = d_->mesh;
     t->patch = p.patch.mesh;
     t->camera = p.step.fishbone ? fishboneSamplingCamera(p.step.params.camera, *p.step.fishbone)
                                 : p.step.params.camera;

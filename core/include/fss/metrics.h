@@ -111,7 +111,9 @@ Metrics computeMetrics(const Mesh& mesh, const MetricsOptions& options = {}, con
 /// of valence 6 and the smallest corner angle, exactly computeMetrics' fracValence6Interior and minAngleDeg
 /// (the same doubles), without its other measures and mostly without atan2 (a corner clearly wider than the
 /// smallest so far is skipped by a sign test): a fraction of computeMetrics' time on large meshes.
-/// Reports progress through \p progress before the valences (0, stage "valence") and then every
+/// Measures \p mesh as it is, garbage included (no copy). Reports progress through \p progress every
+/// kFiguresProgressFaces steps of the valence count, which visits every halfedge and then every vertex
+/// (fraction = steps done / (halfedges + vertices), stage "valence", from 0), then every
 /// kFiguresProgressFaces faces of the angle loop (fraction = faces measured / faces, stage "smallest
 /// angle"; 1 at the end), so a caller on another thread can stop it (RemeshWidget's trials).
 /// \pre every face of \p mesh is a triangle. \throw InvalidInputError when a face is not a triangle;

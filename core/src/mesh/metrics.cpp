@@ -97,11 +97,16 @@ using detail::DisjointSets;
 // Pinched vertices: the fan reached by circulating differs from all incident halfedges, or the circulation
 // meets more than one border (two fans linked through the border cycle). The others without a border are
 // interior: their valences and the share of valence 6.
-void countInteriorValences(const Mesh& m, Metrics& out) {
-    std::vector<std::size_t> incoming(m.number_of_vertices(), 0);
-    for (HalfedgeIndex h : m.halfedges())
+// \p tick is called before each halfedge of the first loop and each vertex of the second (valenceAndMinAngle
+// reports progress through it). Skips removed elements: \p m may hold garbage.
+template <class Tick> void countInteriorValences(const Mesh& m, Metrics& out, Tick&& tick) {
+    std::vector<std::size_t> incoming(m.num_vertices(), 0); // indexed by vertex index, removed ones too
+    for (HalfedgeIndex h : m.halfedges()) {
+        tick();
         ++incoming[idx(m.target(h))];
+    }
     for (VertexIndex v : m.vertices()) {
+        tick();
         const HalfedgeIndex h0 = m.halfedge(v);
         if (h0 == Mesh::null_halfedge()) continue; // isolated vertex
         std::size_t around = 0, borders = 0;
@@ -155,7 +160,7 @@ void measureTopology(const Mesh& m, Metrics& out) {
     for (FaceIndex f : m.faces())
         if (sets.find(idx(f)) == idx(f)) ++out.components;
 
-    countInteriorValences(m, out);
+    countInteriorValences(m, out, [] {});
 }
 
 // ---- triangle shape ----------------------------------------------------------------------------------
@@ -493,13 +498,16 @@ Metrics computeMetrics(const Mesh& mesh, const MetricsOptions& options, const Pr
     return out;
 }
 
-ValenceAndMinAngle valenceAndMinAngle(const Mesh& mesh, const Progress& progress) {
-    const DenseMesh dense(mesh);
-    const Mesh& m = dense.get();
-    requireTriangles(m, "mesh");
-    progress.report(0.0, "valence");
+ValenceAndMinAngle valenceAndMinAngle(const Mesh& m, const Progress& progress) {
+    // Measured on \p m itself, garbage and all (every loop skips removed elements, the figures do not depend
+    // on the order of the elements): no dense copy, which a caller could not stop.
+    const double steps = double(m.number_of_halfedges() + m.number_of_vertices());
+    std::size_t stepsDone = 0;
     Metrics counts;
-    countInteriorValences(m, counts);
+    countInteriorValences(m, counts, [&] {
+        if (stepsDone % kFiguresProgressFaces == 0) progress.report(double(stepsDone) / steps, "valence");
+        ++stepsDone;
+    });
     ValenceAndMinAngle out;
     out.fracValence6Interior = counts.fracValence6Interior;
     if (m.number_of_faces() == 0) return out;
@@ -525,6 +533,7 @@ ValenceAndMinAngle valenceAndMinAngle(const Mesh& mesh, const Progress& progress
     for (FaceIndex f : m.faces()) {
         if (done % kFiguresProgressFaces == 0) progress.report(double(done) / faces, "smallest angle");
         ++done;
+        if (m.degree(f) != 3) requireTriangles(m, "mesh"); // throws, naming the first such face
         const auto [a, b, c] = corners(m, f);
         const Vector3 ab = b - a, bc = c - b, ca = a - c;
         corner(ab, -ca);

@@ -3,7 +3,8 @@
 /// FiguresMeasurer: the whole-mesh figures an accept shows before → after (the share of interior vertices
 /// of valence 6 and the smallest corner angle, valenceAndMinAngle in fss/metrics.h), measured on the
 /// caller's worker thread in a way another thread can stop: a stop token checked every
-/// kFiguresProgressFaces faces, and a newer request stops the older one. RemeshWidget's trial stitches and
+/// kFiguresProgressFaces steps of the valence count and faces of the angle loop (no copy of the mesh, even
+/// one with garbage), and a newer request stops the older one. RemeshWidget's trial stitches and
 /// accepts measure through one, so a user who scans again on a large mesh does not wait for the abandoned
 /// trial's measure of the whole mesh to end.
 
@@ -23,10 +24,12 @@ struct MeshFigures {
     double minAngle = 0; ///< smallest corner angle, degrees
 };
 
-/// What one request measured: the figures (none when it was stopped) and the number of faces its angle
+/// What one request measured: the figures (none when it was stopped), the steps its valence count had
+/// taken (halfedges and vertices visited; all of them when it got past that count) and the faces its angle
 /// loop had measured when it ended (all of them when it finished).
 struct FiguresResult {
     std::optional<MeshFigures> figures;
+    std::size_t valenceSteps = 0;
     std::size_t facesMeasured = 0;
 };
 
