@@ -15,6 +15,7 @@
 #include "test_math.h"
 
 #include "expect_valid_mesh.h"
+#include "mesh_text.h"
 #include "test_data.h"
 
 #include <gtest/gtest.h>
@@ -577,18 +578,6 @@ constexpr double V2_TORUS_MIN_ANGLE = 0.8, V2_TORUS_MEAN_MIN_ANGLE = 51.0, V2_TO
 constexpr double V2_PART_MIN_ANGLE = 4.0, V2_PART_MEAN_MIN_ANGLE = 52.0, V2_PART_VALENCE6 = 0.87,
                  V2_PART_HAUSDORFF_FROM = 0.02;
 
-std::string meshBytes(const fss::Mesh& m) {
-    std::string out;
-    for (fss::VertexIndex v : m.vertices()) {
-        const auto& p = m.point(v);
-        out += std::to_string(p.x()) + " " + std::to_string(p.y()) + " " + std::to_string(p.z()) + "\n";
-    }
-    for (fss::FaceIndex f : m.faces())
-        for (fss::VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m))
-            out += std::to_string(v.idx()) + " ";
-    return out;
-}
-
 } // namespace
 
 // auto v2 on an icosphere (CPU renderer): closed, manifold, no self-intersection, the vertex count within 5
@@ -604,7 +593,7 @@ TEST(AutoRemeshV2, SphereIsJoinedInOnePassAndTheSameForAnyThreadCount) {
     const fss::AutoResult two = fss::autoRemesh(sphere, o);
     fss::setScanThreads(0);
     const fss::Metrics m = checkV2(sphere, one);
-    EXPECT_EQ(meshBytes(one.mesh), meshBytes(two.mesh));
+    EXPECT_EQ(fss::test::exactMeshText(one.mesh), fss::test::exactMeshText(two.mesh));
     EXPECT_GE(m.minAngleDeg, V2_SPHERE_MIN_ANGLE);
     EXPECT_GE(m.meanMinAngleDeg, V2_SPHERE_MEAN_MIN_ANGLE);
     EXPECT_GE(m.fracValence6Interior, V2_SPHERE_VALENCE6);

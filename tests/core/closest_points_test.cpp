@@ -8,6 +8,7 @@
 #include "fss/auto_remesh.h"
 #include "fss/raycast.h"
 #include "fss/shapes.h"
+#include "mesh_text.h"
 
 #include <gtest/gtest.h>
 
@@ -26,21 +27,6 @@ std::vector<Eigen::Vector3d> randomPoints(std::size_t n, unsigned seed) {
     for (std::size_t i = 0; i < n; ++i)
         points.emplace_back(u(rng), u(rng), u(rng));
     return points;
-}
-
-// Exact text of a mesh: every vertex position (17 digits) and every face's corners.
-std::string exactBytes(const fss::Mesh& m) {
-    std::string out;
-    char buffer[96];
-    for (fss::VertexIndex v : m.vertices()) {
-        const auto& p = m.point(v);
-        std::snprintf(buffer, sizeof buffer, "%.17g %.17g %.17g\n", p.x(), p.y(), p.z());
-        out += buffer;
-    }
-    for (fss::FaceIndex f : m.faces())
-        for (fss::VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m))
-            out += std::to_string(v.idx()) + " ";
-    return out;
 }
 
 } // namespace
@@ -91,8 +77,8 @@ TEST(ClosestPoints, RelaxationAndCreaseRecoveryAreTheSameForOneAndTwoThreads) {
         EXPECT_GT(cr.snaps, 0u);
         const fss::detail::SeamRelaxReport rr = fss::detail::relaxSeams(m, cube, ro);
         EXPECT_GT(rr.moves + rr.flips, 0u);
-        results.push_back(exactBytes(m));
+        results.push_back(fss::test::exactMeshText(m));
     }
-    EXPECT_NE(results[0], exactBytes(plain.mesh));
+    EXPECT_NE(results[0], fss::test::exactMeshText(plain.mesh));
     EXPECT_EQ(results[0], results[1]);
 }
