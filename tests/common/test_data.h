@@ -1,5 +1,6 @@
 #pragma once
 // Paths of test data and scratch files, configured by CMake (never hard-coded absolute paths).
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -13,6 +14,13 @@ inline std::filesystem::path meshPath(const std::string& name) {
 /// A scratch file path inside the build tree, unique per test name.
 inline std::filesystem::path tmpPath(const std::string& name) {
     return std::filesystem::path(FSS_TEST_TMP_DIR) / name;
+}
+
+/// Whether the opt-in long measurements run (FSS_LONG_TESTS=1): tables over many meshes and views that take
+/// minutes; CI runs without them.
+inline bool longTests() {
+    const char* env = std::getenv("FSS_LONG_TESTS");
+    return env && std::string(env) == "1";
 }
 
 #ifdef FSS_REMESH_EXE

@@ -249,7 +249,7 @@ static std::string closedText(const fss::FishboneScanResult& r) {
 // build/bin/core_tests
 // --gtest_filter='FishboneScan.SliverTable'
 TEST(FishboneScan, SliverTable) {
-    if (!std::getenv("FSS_LONG_TESTS")) GTEST_SKIP() << "set FSS_LONG_TESTS=1";
+    if (!fss::test::longTests()) GTEST_SKIP() << "set FSS_LONG_TESTS=1";
     const CreaseScene scene;
     const Mesh lens = lensTorus(720, 60);
     std::vector<Mesh> cgal;

@@ -679,8 +679,7 @@ std::vector<std::string> splitList(const std::string& s) {
 // the environment, each default the product's (LatticeSetting): FSS_LATTICE = triangular | adaptive | square,
 // FSS_MIN_LATTICE_ANGLE (degrees), FSS_MIN_QUAD_ANGLE, FSS_RELAX (sweeps), FSS_WARP (1 | 0).
 TEST(ScanPipeline, LatticeTableOverCgalMeshesLong) {
-    const char* env = std::getenv("FSS_LONG_TESTS");
-    if (!env || std::string(env) != "1") GTEST_SKIP() << "set FSS_LONG_TESTS=1";
+    if (!fss::test::longTests()) GTEST_SKIP() << "set FSS_LONG_TESTS=1";
     const char* list = std::getenv("FSS_LATTICE_MESHES");
     const LatticeSetting d;
     const LatticeSetting setting{.lattice = latticeFromEnv("FSS_LATTICE", d.lattice),
@@ -758,8 +757,7 @@ constexpr const char* kOpenViews[] = {"mean part.off iso",
                                       "hausdorff oblong.off -y"};
 
 TEST(ScanPipeline, CriterionAAtTheDefaultsOnUntunedMeshesLong) {
-    const char* env = std::getenv("FSS_LONG_TESTS");
-    if (!env || std::string(env) != "1") GTEST_SKIP() << "set FSS_LONG_TESTS=1";
+    if (!fss::test::longTests()) GTEST_SKIP() << "set FSS_LONG_TESTS=1";
     expectCriterionA(latticeTable(splitList(kWideList), LatticeSetting{}), 291,
                      std::vector<std::string>(std::begin(kOpenViews), std::end(kOpenViews)));
 }

@@ -969,8 +969,7 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
 const int kPatches = [] {
     const char* env = std::getenv("FSS_STITCH_PROPERTY_SCANS");
     if (env) return std::max(1, std::atoi(env));
-    const char* longTests = std::getenv("FSS_LONG_TESTS");
-    return longTests && std::string(longTests) == "1" ? 200 : 3;
+    return fss::test::longTests() ? 200 : 3;
 }();
 
 INSTANTIATE_TEST_SUITE_P(Meshes, StitchProperty,
