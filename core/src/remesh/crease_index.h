@@ -17,8 +17,6 @@ namespace fss::detail::creases {
 
 using Vec = Eigen::Vector3d;
 
-using Vec = Eigen::Vector3d;
-
 /// Closest points of segments [p1, q1] and [p2, q2] (Ericson, Real-Time Collision Detection, 5.1.9): the
 /// parameters s (on the first) and t (on the second).
 inline void closestSegmentParameters(const Vec& p1, const Vec& q1, const Vec& p2, const Vec& q2, double& s,
