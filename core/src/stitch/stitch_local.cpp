@@ -229,6 +229,8 @@ bool ComponentStitcher::coreFits(Local& loc) {
 }
 
 bool ComponentStitcher::buildAndOptimise(Attempt& a) {
+    heldRim_.clear();
+    bandMinAfterDeg_ = -1;
     Local loc;
     Mesh& S = loc.star.S;
     StageClock::lap("other");
@@ -421,6 +423,16 @@ bool ComponentStitcher::remeshBand(Local& loc, Plan& plan) {
                 break;
             }
     }
+    // Built again past held rim vertices (growPastHeldRim): their whole stars join the band.
+    for (std::uint32_t c : rimStars_) {
+        const VertexIndex* v = loc.star.fromCurrent.find(c);
+        if (!v || S.halfedge(*v) == Mesh::null_halfedge()) continue;
+        for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(*v), S))
+            if (!S.is_border(h) && !loc.star.kept[S.face(h)] && !loc.patchSide[S.face(h)])
+                in.band.push_back(S.face(h));
+    }
+    std::sort(in.band.begin(), in.band.end());
+    in.band.erase(std::unique(in.band.begin(), in.band.end()), in.band.end());
     if (in.band.empty()) return true;
     in.camera = &V_.camera();
     in.fixed = [&](VertexIndex v) { return bool(loc.locked[v]); };
@@ -478,6 +490,8 @@ bool ComponentStitcher::remeshBand(Local& loc, Plan& plan) {
             in.band.size(), r.grown, r.minAngleBeforeDeg, r.minAngleAfterDeg, worse ? " WORSE (v1 kept)" : "",
             r.below20Free, r.below20Held, r.below20Beyond, r.below20Unseen);
     if (worse) return false;
+    bandMinAfterDeg_ = r.minAngleAfterDeg;
+    noteHeldRim(loc, r.faces);
     // Moved and new vertices: their place in the view; a mesh vertex that moved becomes a new vertex
     // (the old one goes with the replaced faces around it: its whole star is in the band).
     for (VertexIndex v : r.touched) {

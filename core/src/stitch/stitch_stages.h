@@ -232,6 +232,7 @@ public:
         StageClock::lap("assemble");
         progress_.step(5, kSteps);
         if (!buildAndOptimise(a)) return a;
+        growPastHeldRim(a);
         a.ok = true;
         return a;
     }
@@ -405,6 +406,15 @@ private:
     bool retryWithoutRemesh(Attempt& a);
     // False when the band came out worse than version 1's (the caller then builds the component again).
     bool remeshBand(Local& loc, Plan& plan);
+    // ---- the band grown past held rim vertices (stitch_rim.cpp, DESIGN.md §6.2 session 19): where a band
+    // face below 20 deg has a corner held only by kept faces of the current mesh (the band's rim), those
+    // faces are opened as themselves and the component is built again with the corner's whole star in the
+    // band; the result is kept where the band's smallest angle rises, else \p a stays as it was.
+    void growPastHeldRim(Attempt& a);
+    // Called by remeshBand after a remesh that is kept: the held corners of its faces below 20 deg whose
+    // every face is either kept (and could be opened: a triangle the view sees) or one the band may grow
+    // into (into heldRim_, as current-mesh vertices).
+    void noteHeldRim(Local& loc, const std::vector<FaceIndex>& bandFaces);
 
     Refill refillSeam(Local& loc);
 
@@ -523,6 +533,12 @@ private:
     Region reg_;                 // findRegion, splitRegion
     LocalProblem cut_;           // cut, gap triangulation (buildLocalVertices … assemble)
     std::vector<char> coreMask_; // findCore: the core's faces by position in faces_ (empty: no core)
+    // The band grown past held rim vertices (growPastHeldRim): the held corners the last kept band remesh
+    // left below 20 deg, its smallest angle (-1: no band remesh kept), and for the build again the corners
+    // whose whole star joins the band (current-mesh vertices).
+    std::vector<std::uint32_t> heldRim_;
+    double bandMinAfterDeg_ = -1;
+    std::unordered_set<std::uint32_t> rimStars_;
 };
 
 } // namespace fss::detail::stitching
