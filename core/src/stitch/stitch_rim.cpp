@@ -43,11 +43,12 @@ void ComponentStitcher::noteHeldRim(Local& loc, const std::vector<FaceIndex>& ba
                     continue;
                 }
                 ++kept;
-                // The kept face in the current mesh: a triangle the view sees (it joins the band as one).
+                // The kept face in the current mesh: a triangle (one the view does not see joins the band as
+                // a piece of a face the view does not see: it keeps its own orientation).
                 const HalfedgeIndex mh = M_.halfedge(VertexIndex(loc.star.cur[S.source(h)]),
                                                      VertexIndex(loc.star.cur[S.target(h)]));
                 const FaceIndex g = mh == Mesh::null_halfedge() ? Mesh::null_face() : M_.face(mh);
-                ok = ok && g != Mesh::null_face() && M_.next(M_.next(M_.next(mh))) == mh && acceptable(g);
+                ok = ok && g != Mesh::null_face() && M_.next(M_.next(M_.next(mh))) == mh;
             }
             if (ok && kept > 0) heldRim_.push_back(loc.star.cur[v]);
         }
@@ -68,7 +69,8 @@ void ComponentStitcher::growPastHeldRim(Attempt& a) {
         for (std::uint32_t c : heldRim_) {
             rimStars_.insert(c);
             for (FaceIndex g : CGAL::faces_around_target(M_.halfedge(VertexIndex(c)), M_))
-                if (g != Mesh::null_face() && taken.insert(std::uint32_t(g)).second) openAsItself(g, false);
+                if (g != Mesh::null_face() && taken.insert(std::uint32_t(g)).second)
+                    openAsItself(g, !acceptable(g));
         }
         const std::size_t held = heldRim_.size();
         Attempt b;
