@@ -26,6 +26,20 @@ constexpr double kRimBelowDeg = 20.0;
 
 void ComponentStitcher::noteHeldRim(Local& loc, const std::vector<FaceIndex>& bandFaces) {
     const Mesh& S = loc.star.S;
+    if (O_.seamRings < 1) return;
+    // Only corners of the region's faces (seam faces, faces under the patch): the faces opened around them
+    // then lie one ring from the region, as the seamRings ring does, within the seam neighbourhood (a corner
+    // of a face of that ring would put them two rings out, past it where a region face barely meets the
+    // patch: measured on couplingdown, a changed face outside the neighbourhood).
+    std::unordered_set<std::uint32_t> regionVertices;
+    auto inRegion = [&](std::uint32_t c) {
+        if (regionVertices.empty())
+            for (const auto* list : {&reg_.faces, &reg_.interior})
+                for (FaceIndex f : *list)
+                    for (VertexIndex w : faceVertices(f))
+                        regionVertices.insert(std::uint32_t(w));
+        return regionVertices.count(c) > 0;
+    };
     for (FaceIndex f : bandFaces) {
         const HalfedgeIndex fh = S.halfedge(f);
         if (minAngle(pt(S, S.source(fh)), pt(S, S.target(fh)), pt(S, S.target(S.next(fh)))) >=
@@ -33,7 +47,9 @@ void ComponentStitcher::noteHeldRim(Local& loc, const std::vector<FaceIndex>& ba
             continue;
         for (VertexIndex v : CGAL::vertices_around_face(fh, S)) {
             // Held by kept faces only: not on the local mesh's border (its whole star is in S), not new.
-            if (!loc.locked[v] || S.is_border(v) || !loc.star.isFull(v) || loc.star.cur[v] == kNone) continue;
+            if (!loc.locked[v] || S.is_border(v) || !loc.star.isFull(v) || loc.star.cur[v] == kNone ||
+                !inRegion(loc.star.cur[v]))
+                continue;
             bool ok = true;
             int kept = 0;
             for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(v), S)) {
