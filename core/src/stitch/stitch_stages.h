@@ -411,9 +411,9 @@ private:
     // faces are opened as themselves and the component is built again with the corner's whole star in the
     // band; the result is kept where the band's smallest angle rises, else \p a stays as it was.
     void growPastHeldRim(Attempt& a);
-    // Called by remeshBand after a remesh that is kept: the held corners of its faces below 20 deg whose
-    // every face is either kept (and could be opened: a triangle the view sees) or one the band may grow
-    // into (into heldRim_, as current-mesh vertices).
+    // Called by remeshBand after a remesh that is kept: the corners of its faces below 20 deg that are held
+    // only by kept faces (whole star in the local mesh, the other faces ones the band may grow into) and are
+    // corners of region faces (into heldRim_, as current-mesh vertices).
     void noteHeldRim(Local& loc, const std::vector<FaceIndex>& bandFaces);
 
     Refill refillSeam(Local& loc);
