@@ -88,9 +88,10 @@ struct ScanOptions {
     /// on every 2nd row and column instead of every 4th (warpLatticeToSurface's \p followFit): the two
     /// sides of a sharp crease, or faces slanted in different directions around an apex, then get bases a
     /// lattice can join, and the lattice bends where they meet. On by default (issue #20, session 19: of
-    /// 291 untuned views, those below a mean smallest angle of 50° from 23 to 7, those with a larger
-    /// Hausdorff distance than the square lattice from 10 to 5). Session files record it as
-    /// "scan.warp_follows_fit" (version 5) when on; absent = off, so older files scan as recorded.
+    /// 282 untuned views, those below a mean smallest angle of 50° from 23 to 8, those with a larger
+    /// Hausdorff distance than the square lattice from 10 to 8, 4 of the 16 made worse; DESIGN.md §1).
+    /// Session files record it as "scan.warp_follows_fit" (version 5) when on; absent = off, so older files
+    /// scan as recorded.
     bool warpFollowsFit = true;
 
     /// Checks the ranges: qualityAngleLimitDeg in (0, 90), maxSnapFootprints finite and ≥ 0, lattice one of
