@@ -167,16 +167,18 @@ TEST(ParallelStages, WarpedLatticeIsTheSameForEveryThreadCount) {
     const fss::LatticeBasis basis = fss::chooseAdaptiveLattice(buffers, reference, 1.0, 35.0);
     const Eigen::Vector2d origin(-40.0, -30.0);
     const int rows = 320, cols = 300;
-    auto warp = [&](int threads) {
+    // Both fits (ScanOptions::warpFollowsFit): the session 17 one, as old session files replay, and the
+    // default, whose edge targets (turned by the fit's node bases) are computed in row blocks too.
+    auto warp = [&](int threads, bool followFit) {
         ThreadsGuard guard(threads);
-        return fss::warpLatticeToSurface(buffers, reference, 1.0, basis, origin, rows, cols);
+        return fss::warpLatticeToSurface(buffers, reference, 1.0, basis, origin, rows, cols, followFit);
     };
     auto lattice = [&](int threads) {
         ThreadsGuard guard(threads);
         fss::ScanWorkspace workspace;
         return fss::sampleLattice(buffers, reference, workspace, {.scanId = 7}); // adaptive, warped
     };
-    const std::vector<Eigen::Vector2d> serial = warp(1);
+    const std::vector<Eigen::Vector2d> serial = warp(1, false), serialFollow = warp(1, true);
     const fss::SampleGrid serialGrid = lattice(1);
     ASSERT_EQ(serial.size(), std::size_t(rows) * std::size_t(cols));
     // The warp moves the lattice (fandisk's iso view is slanted differently on every face).
@@ -189,12 +191,16 @@ TEST(ParallelStages, WarpedLatticeIsTheSameForEveryThreadCount) {
     EXPECT_GT(serialGrid.admissibleCount(), 10000u);
     for (int threads : {2, 3}) {
         SCOPED_TRACE(threads);
-        const std::vector<Eigen::Vector2d> parallel = warp(threads);
+        const std::vector<Eigen::Vector2d> parallel = warp(threads, false), follow = warp(threads, true);
         ASSERT_EQ(parallel.size(), serial.size());
-        std::size_t differing = 0;
-        for (std::size_t i = 0; i < serial.size(); ++i)
+        ASSERT_EQ(follow.size(), serial.size());
+        std::size_t differing = 0, differingFollow = 0;
+        for (std::size_t i = 0; i < serial.size(); ++i) {
             differing += serial[i] == parallel[i] ? 0 : 1;
+            differingFollow += serialFollow[i] == follow[i] ? 0 : 1;
+        }
         EXPECT_EQ(differing, 0u);
+        EXPECT_EQ(differingFollow, 0u);
         expectSameSamples(serialGrid, lattice(threads));
     }
 }

@@ -707,68 +707,65 @@ constexpr const char* kWideList =
     "01.off,mesh_with_border.off,plane.off,mask_cone.off,nefertiti.off,cube.off,octahedron.off,icosahedron."
     "off,star.off,tetrahedron.off";
 
-// FSS_LONG_TESTS=1: criterion A at the product's defaults on every view of kWideList. Session 18 (CPU
-// renderer; `fss-remesh scan` with its default GPU renderer gave the same verdicts on the 4 views checked):
-// 291 views with a patch (of 322: the rest show nothing or only the back of the surface with either
-// lattice; 4 have a patch where the square lattice has none), none with more than 2 % below 30°, valence 6
-// unchanged on all. Criterion A is NOT met on the views of kOpenViews (32 views): the test fails on any
-// other view failing a part, and prints which of these still fail.
-//  - mean smallest angle 40.8–49.9° on 23 views; octahedron's six axis views (47.9–48.0°, square 40.8°):
-//    four faces slanted 54.7° in four directions meet at the apex, and the bases they want do not come from
-//    one smooth warp (the fit compromises); patch-01 ±y and mesh_with_border +y: edge-on views where the
-//    square lattice leaves nothing.
-//  - Hausdorff distance worse than the square lattice's on 10 views, ratio 1.02–1.61, boeing ±y 107–127
-//    (the square's triangles lie in the planar faces seen face-on: 3e-16). FSS_WORST on ALSTOM_TEST4 ±y
-//    and mech-holes-shark -y: the farthest face straddles a sharp crease, at the same crease as the
-//    square's farthest face; the warped lattice's edges there up to 1.40 footprints (1.03 around) where
-//    the wanted bases jump across the crease.
-constexpr const char* kOpenViews[] = {"mean part.off iso",
-                                      "mean cheese.off iso",
-                                      "mean b9_mesh.off +y",
-                                      "mean b9_mesh.off -y",
-                                      "mean man.off -z",
+// FSS_LONG_TESTS=1: criterion A at the product's defaults on every view of kWideList (CPU renderer).
+// 282 views with a patch (of 322: the rest show nothing or only the back of the surface with either
+// lattice; session 18 wrote 291, but its own binary gives 282 — measured again in session 19), none with
+// more than 2 % below 30°, valence 6 unchanged on all. Session 18 (warp fit turned towards the affine
+// lattice): 23 views below a mean smallest angle of 50°, 10 with a larger Hausdorff distance than the square
+// lattice. Session 19 (ScanOptions::warpFollowsFit, tuned on octahedron +z, ALSTOM_TEST4 +y, polygon_mesh +x
+// and part iso): 8 and 8; fixed: the octahedron's six axis views (47.9–48.0° -> 50.2°), polygon_mesh's four,
+// part iso, cheese iso, b9_mesh ±y, blobby_3cc +x, three_peaks iso (mean) and ALSTOM_TEST4 ±y,
+// mech-holes-shark iso, blobby_3cc +x, oblong -y (Hausdorff); made worse: icosahedron iso (50.6° -> 49.3°),
+// mech-holes-shark +y, man iso, elephant-with-holes +z (Hausdorff ratios 0.67–0.85 -> 1.01–1.05). Criterion
+// A is NOT met on the views of kOpenViews (16 views): the test fails on any other view failing a part, and
+// prints which of these still fail.
+//  - mean smallest angle 40.6–49.4° on 8 views: patch-01 ±y and mesh_with_border +y are edge-on views where
+//    the square lattice leaves nothing; icosahedron iso: five faces meet at each apex (angle sum 300°) and
+//    the warp now keeps 2.05 of the square lattice's area (was 1.66), more of it slanted; man -z, bones +x,
+//    blobby_3cc -x, three_peaks -y (47.9–49.4°, up 0.2–1.5° from session 18) not analysed further. Six
+//    relaxation sweeps (ScanParams::relaxIterations) raise them by 0.0–1.2° (bones +x to 50.1°) but make the
+//    Hausdorff distance worse on 6 of the 16 views: the relaxation stays off.
+//  - Hausdorff distance worse than the square lattice's on 8 views, ratio 1.01–1.13, boeing ±y 94–97 (the
+//    square's triangles lie in the planar faces seen face-on: 3e-16; the warped patch covers 21–23 times
+//    their area). FSS_WORST on mech-holes-shark -y, man iso, elephant-with-holes +z, u -y: the farthest face
+//    1–2 lattice steps from the patch border, edges 1.0–1.5 footprints (the square's farthest faces 1.4–2.4),
+//    where the patch ends at a crease or fold.
+constexpr const char* kOpenViews[] = {"mean man.off -z",
                                       "mean bones.off +x",
-                                      "mean blobby_3cc.off +x",
                                       "mean blobby_3cc.off -x",
-                                      "mean polygon_mesh.off +x",
-                                      "mean polygon_mesh.off -x",
-                                      "mean polygon_mesh.off +y",
-                                      "mean polygon_mesh.off -y",
-                                      "mean three_peaks.off iso",
                                       "mean three_peaks.off -y",
-                                      "mean octahedron.off +x",
-                                      "mean octahedron.off -x",
-                                      "mean octahedron.off +y",
-                                      "mean octahedron.off -y",
-                                      "mean octahedron.off +z",
-                                      "mean octahedron.off -z",
                                       "mean patch-01.off +y",
                                       "mean patch-01.off -y",
                                       "mean mesh_with_border.off +y",
-                                      "hausdorff ALSTOM_TEST4.off +y",
-                                      "hausdorff ALSTOM_TEST4.off -y",
-                                      "hausdorff mech-holes-shark.off iso",
+                                      "mean icosahedron.off iso",
+                                      "hausdorff mech-holes-shark.off +y",
                                       "hausdorff mech-holes-shark.off -y",
                                       "hausdorff u.off -y",
                                       "hausdorff boeing.off +y",
                                       "hausdorff boeing.off -y",
-                                      "hausdorff blobby_3cc.off +x",
+                                      "hausdorff man.off iso",
                                       "hausdorff oblong.off +y",
-                                      "hausdorff oblong.off -y"};
+                                      "hausdorff elephant-with-holes.off +z"};
 
 TEST(ScanPipeline, CriterionAAtTheDefaultsOnUntunedMeshesLong) {
     if (!fss::test::longTests()) GTEST_SKIP() << "set FSS_LONG_TESTS=1";
-    expectCriterionA(latticeTable(splitList(kWideList), LatticeSetting{}), 291,
+    expectCriterionA(latticeTable(splitList(kWideList), LatticeSetting{}), 282,
                      std::vector<std::string>(std::begin(kOpenViews), std::end(kOpenViews)));
 }
 
-// Criterion A at the product's defaults on three views of small meshes of the wide set (a CAD part, a
-// sphere, an open mesh with holes), each against the square lattice's Hausdorff distance measured here.
-// Session 18 (the CPU renderer, as here): rotor_small -x 58.3°, 0 % < 30°, Hausdorff 2.27e-4 (square
-// 5.41e-4); larger_sphere iso 54.2°, 0 %, 1.71e-4 (3.82e-4); holes +x 56.1°, 0 %, 4.05e-4 (5.76e-4).
-TEST(ScanPipeline, CriterionAAtTheDefaultsOnThreeUntunedViews) {
-    expectCriterionA(
-        latticeTable({"rotor_small.off:-x", "larger_sphere.off:iso", "holes.off:+x"}, LatticeSetting{}), 3);
+// Criterion A at the product's defaults on five views of small meshes of the wide set (a CAD part, a
+// sphere, an open mesh with holes, a terrain, a part with holes), each against the square lattice's
+// Hausdorff distance measured here. Session 18 (the CPU renderer, as here): rotor_small -x 58.3°, 0 % < 30°,
+// Hausdorff 2.27e-4 (square 5.41e-4); larger_sphere iso 54.2°, 0 %, 1.71e-4 (3.82e-4); holes +x 56.1°, 0 %,
+// 4.05e-4 (5.76e-4). Session 19 adds two views that failed the mean smallest angle with the session 17 fit
+// and pass with the warp following the fit (ScanOptions::warpFollowsFit; neither was tuned on):
+// three_peaks iso 49.0° -> 53.6° (Hausdorff 4.70e-4, square 6.22e-4), cheese iso 48.5° -> 52.7° (1.14e-3,
+// square 2.44e-3).
+TEST(ScanPipeline, CriterionAAtTheDefaultsOnFiveUntunedViews) {
+    expectCriterionA(latticeTable({"rotor_small.off:-x", "larger_sphere.off:iso", "holes.off:+x",
+                                   "three_peaks.off:iso", "cheese.off:iso"},
+                                  LatticeSetting{}),
+                     5);
 }
 
 // The patch relaxation (ScanParams::relaxIterations, mesh/relax.h): the same connectivity and border,

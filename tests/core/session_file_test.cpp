@@ -89,6 +89,7 @@ void expectSame(const fss::ScanStep& a, const fss::ScanStep& b) {
     EXPECT_TRUE(sameBits(a.params.scan.spacingWorld, b.params.scan.spacingWorld));
     EXPECT_TRUE(sameBits(a.params.scan.minLatticeAngleDeg, b.params.scan.minLatticeAngleDeg));
     EXPECT_EQ(a.params.scan.warpToSurface, b.params.scan.warpToSurface);
+    EXPECT_EQ(a.params.scan.warpFollowsFit, b.params.scan.warpFollowsFit);
     EXPECT_EQ(a.params.relaxIterations, b.params.relaxIterations);
     EXPECT_TRUE(sameBits(a.params.triangulate.minQuadAngleDeg, b.params.triangulate.minQuadAngleDeg));
     EXPECT_TRUE(sameBits(a.params.quality.margin, b.params.quality.margin));
@@ -410,10 +411,10 @@ TEST_F(BadSessionFile, GoodFileLoads) {
 
 TEST_F(BadSessionFile, WrongFormatOrVersion) {
     Json j = good_;
-    // What an FSS reading versions 1 to 3 says of the version 4 files this one writes (the fishbone's
-    // crease-backbone keys), here one version further.
-    j["version"] = 5;
-    EXPECT_EQ(load(j), ": version is 5, but this FSS reads versions 1 to 4 only.");
+    // What an FSS reading versions 1 to 4 says of the version 5 files this one writes (the warp's
+    // follow-fit key), here one version further.
+    j["version"] = 6;
+    EXPECT_EQ(load(j), ": version is 6, but this FSS reads versions 1 to 5 only.");
     j["version"] = "1";
     EXPECT_EQ(load(j), ": version must be a positive integer.");
     j = good_;
@@ -622,15 +623,15 @@ TEST_F(BadSessionFile, WarpToSurfaceIsAlwaysWrittenAndOffWhenAbsent) {
             .step.params.scan.warpToSurface;
     };
     EXPECT_TRUE(fss::ScanOptions{}.warpToSurface);
-    EXPECT_EQ(fss::kSessionFileVersion, 4); // version 4 (session 16): the fishbone's crease-backbone keys
-    EXPECT_EQ(good_["version"], 4);
+    EXPECT_EQ(fss::kSessionFileVersion, 5); // version 5 (session 19): the warp's follow-fit key
+    EXPECT_EQ(good_["version"], 5);
     ASSERT_EQ(good_["events"][0]["step"]["scan"]["warp_to_surface"], false); // sampleFile's step: off
     EXPECT_FALSE(warpOf(good_));
     EXPECT_EQ(good_["events"][1]["step"]["scan"]["warp_to_surface"], true); // the fishbone step: default
     Json j = good_;
     j["events"][0]["step"]["scan"]["warp_to_surface"] = true;
     EXPECT_TRUE(warpOf(j));
-    for (int version : {1, 2, 3, 4}) {
+    for (int version : {1, 2, 3, 4, 5}) {
         j["version"] = version;
         j["events"][0]["step"]["scan"].erase("warp_to_surface");
         EXPECT_FALSE(warpOf(j)) << "version " << version;
@@ -644,6 +645,35 @@ TEST_F(BadSessionFile, WarpToSurfaceIsAlwaysWrittenAndOffWhenAbsent) {
     const Json on = Json::parse(fss::sessionFileToJson(f));
     EXPECT_EQ(on["events"][0]["step"]["scan"]["warp_to_surface"], true);
     EXPECT_TRUE(warpOf(on));
+}
+
+// Version 5 (issue #20, session 19): the warp's fit turned towards the fitted lattice is on by default and
+// written only when on; files without the key (versions 1 to 4) were recorded with the session 17 fit and
+// load so, whatever their version number, which keeps their replay to the same bytes.
+TEST_F(BadSessionFile, WarpFollowsFitIsWrittenWhenOnAndOffWhenAbsent) {
+    auto followOf = [&](const Json& j) {
+        return fss::sessionFileFromJson(j.dump(2), "s.json", ".", {.verifyMesh = false})
+            .events.at(0)
+            .step.params.scan.warpFollowsFit;
+    };
+    EXPECT_TRUE(fss::ScanOptions{}.warpFollowsFit);
+    fss::SessionFile f = sampleFile(mesh_);
+    f.events.at(0).step.params.scan.warpFollowsFit = true;
+    Json j = Json::parse(fss::sessionFileToJson(f));
+    EXPECT_EQ(j["events"][0]["step"]["scan"]["warp_follows_fit"], true);
+    EXPECT_TRUE(followOf(j));
+    for (int version : {1, 2, 3, 4, 5}) {
+        j["version"] = version;
+        j["events"][0]["step"]["scan"].erase("warp_follows_fit");
+        EXPECT_FALSE(followOf(j)) << "version " << version;
+    }
+    f.events.at(0).step.params.scan.warpFollowsFit = false;
+    const Json off = Json::parse(fss::sessionFileToJson(f));
+    EXPECT_FALSE(off["events"][0]["step"]["scan"].contains("warp_follows_fit"));
+    EXPECT_FALSE(followOf(off));
+    j = off;
+    j["events"][0]["step"]["scan"]["warp_follows_fit"] = "yes";
+    EXPECT_EQ(load(j), ": events[0].step.scan.warp_follows_fit must be true or false.");
 }
 
 TEST_F(BadSessionFile, WrongTypesAndValues) {

@@ -83,6 +83,16 @@ struct ScanOptions {
     /// angle, 12 without). Ignored by the other lattices. Session files record it as
     /// "scan.warp_to_surface" (version 3); a file without it (version 1 or 2) was recorded without the warp.
     bool warpToSurface = true;
+    /// warpToSurface only: the warp's fit turns each wanted basis towards the fitted lattice's own basis
+    /// there at every round (an as-rigid-as-possible fit) instead of towards the affine lattice's, and ends
+    /// on every 2nd row and column instead of every 4th (warpLatticeToSurface's \p followFit): the two
+    /// sides of a sharp crease, or faces slanted in different directions around an apex, then get bases a
+    /// lattice can join, and the lattice bends where they meet. On by default (issue #20, session 19: of
+    /// 282 untuned views, those below a mean smallest angle of 50° from 23 to 8, those with a larger
+    /// Hausdorff distance than the square lattice from 10 to 8, 4 of the 16 made worse; DESIGN.md §1).
+    /// Session files record it as "scan.warp_follows_fit" (version 5) when on; absent = off, so older files
+    /// scan as recorded.
+    bool warpFollowsFit = true;
 
     /// Checks the ranges: qualityAngleLimitDeg in (0, 90), maxSnapFootprints finite and ≥ 0, lattice one of
     /// the enumerators, spacingPixels finite and in [0.25, 1024], spacingWorld finite and ≥ 0,
@@ -198,12 +208,16 @@ LatticeBasis chooseAdaptiveLattice(const FrameBuffers& referenceBuffers, const M
 /// equilateral with side spacing × the pixel footprint on the plane of the face under the pixel (the
 /// linearised map of latticeAngleOnPlane), turned to be closest to the affine basis; the positions are
 /// the weighted least-squares fit of the grid's edges (a, b, a + b in (row, column)) to those local
-/// bases (Poisson: 2 direct rounds on every 8th row and column, bases re-read, then 50 CG steps on every
-/// 4th). Uncovered pixels keep the affine basis with a small weight. Deterministic, the same for any thread
-/// count.
+/// bases (Poisson: 2 direct rounds on every 8th row and column, bases re-read, then one direct round on
+/// every 4th, on the nodes in the image and two around). With \p followFit (ScanOptions::warpFollowsFit)
+/// each wanted basis is turned to be closest to the fitted lattice's basis there instead of the affine one
+/// from the second round on (as-rigid-as-possible), with 4 rounds on every 8th row and column and 2 on
+/// every 2nd. Uncovered pixels keep the affine basis with a small weight. Deterministic, the same for any
+/// thread count.
 std::vector<Eigen::Vector2d> warpLatticeToSurface(const FrameBuffers& referenceBuffers, const Mesh& reference,
                                                   double spacing, const LatticeBasis& basis,
-                                                  const Eigen::Vector2d& origin, int rows, int cols);
+                                                  const Eigen::Vector2d& origin, int rows, int cols,
+                                                  bool followFit = false);
 
 /// The lattice-angle mask (ScanOptions::minLatticeAngleDeg): every admissible sample of \p grid (a
 /// regular lattice: its basis is read from the screen positions of samples (0, 0), (0, 1), (1, 1)) whose

@@ -6,9 +6,9 @@
 /// Replaying the log on the same input with the same renderer reproduces the recording session's current
 /// mesh exactly (byte-identical when written).
 ///
-/// Format (version 3; every field is required unless marked optional, unknown fields are errors):
+/// Format (version 5; every field is required unless marked optional, unknown fields are errors):
 /// \code
-/// { "format": "fss-session", "version": 3,
+/// { "format": "fss-session", "version": 5,
 ///   "description": "...",                                   (optional)
 ///   "mesh": { "path": "../meshes/part.off", "sha256": "<64 hex digits>" },
 ///   "renderer": "cpu" | "gpu",
@@ -24,9 +24,11 @@
 ///         "relax_iterations": 6,                           (optional: written only when not 0, absent = 0)
 ///         "scan": { "scan_id": 0, "quality_angle_limit_deg": 85, "max_snap_footprints": 2,
 ///                   "lattice": "adaptive" | "triangular" | "square", "spacing_px": 1, "spacing_world": 0,
-///                   "min_lattice_angle_deg": 35, "warp_to_surface": true },
-///                                    (the last five always written; each optional, absent = "square", 1, 0,
-///                                     0, false: files before issue #20; warp_to_surface since version 3)
+///                   "min_lattice_angle_deg": 35, "warp_to_surface": true, "warp_follows_fit": true },
+///                                    (lattice to warp_to_surface always written; each optional, absent =
+///                                     "square", 1, 0, 0, false: files before issue #20; warp_to_surface
+///                                     since version 3; warp_follows_fit since version 5, written only when
+///                                     on, absent = false)
 ///         "quality_mask": { "margin": 0.1, "force_replace": false, "search_rings": 2 },
 ///         "triangulate": { "max_edge_footprints": 3, "max_sampling_angle_deg": 80,
 ///                          "min_quad_angle_deg": 20 },  (optional: written only when not 0, absent = 0)
@@ -90,8 +92,10 @@ namespace fss {
 /// 16): fishbone steps carry "tracing.crease_backbone" and "tracing.continuous_key_ribs" (on by default,
 /// written only when on, absent = off, so older files replay their fishbone scans as recorded); the warp's
 /// solver and the seam band's outlier-cap rule changed, so version 1 to 3 files replay to different bytes
-/// than before.
-inline constexpr int kSessionFileVersion = 4;
+/// than before. Version 5 (issue #20, session 19): "scan.warp_follows_fit" (ScanOptions::warpFollowsFit, on
+/// by default) is written when on; absent = off, so version 1 to 4 files warp with the fit they were
+/// recorded with and replay to the same bytes.
+inline constexpr int kSessionFileVersion = 5;
 
 /// A session file in memory.
 struct SessionFile {

@@ -436,7 +436,8 @@ SampleGrid sampleLattice(const FrameBuffers& referenceBuffers, const Mesh& refer
         rows = int(std::ceil(rMax + margin * (rMax - rMin)) - r0) + 1;
         origin = centre + c0 * a + r0 * b;
         if (options.warpToSurface) {
-            warped = warpLatticeToSurface(referenceBuffers, reference, spacing, basis, origin, rows, cols);
+            warped = warpLatticeToSurface(referenceBuffers, reference, spacing, basis, origin, rows, cols,
+                                          options.warpFollowsFit);
             cropToImage(warped, w, h, rows, cols);
         }
     } else {

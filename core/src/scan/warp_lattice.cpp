@@ -66,7 +66,7 @@ Eigen::Matrix2d withSingularValuesAtMost(const Eigen::Matrix2d& m, double limit)
 bool surfaceBasisAt(const CameraProjector& projector, const Mesh& reference, FaceIndex face, int x, int y,
                     float depth, const Eigen::Matrix2d& equilateral,
                     const Eigen::Matrix2d& towardsEquilateral, const Eigen::Matrix2d& affine,
-                    Eigen::Matrix2d& local) {
+                    Eigen::Matrix2d& local, Eigen::Matrix2d& toTangent) {
     const FaceGeometry g = faceGeometry(reference, face);
     const auto [point, ray] = projector.unprojectPixelCentreWithRay(x, y, depth);
     if (!(g.normal.squaredNorm() > 0) || !(g.normal.dot(ray.direction) < 0)) return false;
@@ -83,6 +83,7 @@ bool surfaceBasisAt(const CameraProjector& projector, const Mesh& reference, Fac
     const Eigen::Matrix2d result = mf.inverse() * q * equilateral;
     if (!result.allFinite() || !(result.determinant() * affine.determinant() > 0)) return false;
     local = result;
+    toTangent = mf;
     return true;
 }
 
@@ -93,6 +94,11 @@ struct WantedBases {
     const Eigen::Matrix2d& affine;
     const std::vector<Eigen::Matrix2d>& wanted;
     const std::vector<double>& weight;
+    // Per pixel with weight 1: the screen-to-tangent map in footprints (surfaceBasisAt's mf), and the
+    // equilateral basis and its inverse, for the bases turned towards the fit (ScanOptions::warpFollowsFit).
+    const std::vector<Eigen::Matrix2d>& toTangent;
+    const Eigen::Matrix2d& equilateral;
+    const Eigen::Matrix2d& equilateralInverse;
 
     const Eigen::Matrix2d& at(const Eigen::Vector2d& p, double& wt) const {
         const int x = int(std::floor(p.x())), y = int(std::floor(p.y()));
@@ -103,6 +109,21 @@ struct WantedBases {
         const std::size_t i = std::size_t(y) * std::size_t(width) + std::size_t(x);
         wt = weight[i];
         return wanted[i];
+    }
+
+    // The basis at \p p that is equilateral on the surface and turned to be closest to \p fitted (the
+    // local step of an as-rigid-as-possible fit) instead of to the affine basis; the affine-closest one
+    // where that would turn the lattice over.
+    Eigen::Matrix2d towards(const Eigen::Vector2d& p, const Eigen::Matrix2d& fitted, double& wt) const {
+        const Eigen::Matrix2d& fixed = at(p, wt);
+        if (wt < 1) return fixed;
+        const std::size_t i =
+            std::size_t(std::floor(p.y())) * std::size_t(width) + std::size_t(std::floor(p.x()));
+        const Eigen::Matrix2d& mf = toTangent[i];
+        const Eigen::Matrix2d result =
+            mf.inverse() * closestOrthogonal(mf * fitted * equilateralInverse) * equilateral;
+        if (!result.allFinite() || !(result.determinant() * affine.determinant() > 0)) return fixed;
+        return result;
     }
 };
 
@@ -143,10 +164,26 @@ struct FitSystem {
 // with their weights, and every node weakly towards \p anchor (keeps the system definite and the grid in
 // place). The same pattern for any positions.
 FitSystem assembleFit(const FitGrid& g, const Eigen::MatrixX2d& phi, const Eigen::MatrixX2d& anchor,
-                      const WantedBases& field) {
+                      const WantedBases& field, bool followFit) {
     constexpr double kAnchor = 1e-5;
     constexpr int steps[3][2] = {{0, 1}, {1, 0}, {1, 1}}; // (dr, dc) of the grid's edges a, b, a + b
     const int n = g.size();
+    // With followFit, every node's basis (a, b) under the positions phi (central differences, one-sided at
+    // the grid's ends), which the wanted bases along its edges are turned towards.
+    std::vector<Eigen::Matrix2d> fitted;
+    if (followFit) {
+        fitted.resize(std::size_t(n));
+        const auto node = [&](int r, int c) { return phi.row(r * g.cols + c).transpose(); };
+        for (int r = 0; r < g.rows; ++r)
+            for (int c = 0; c < g.cols; ++c) {
+                const int c0 = std::max(c - 1, 0), c1 = std::min(c + 1, g.cols - 1);
+                const int r0 = std::max(r - 1, 0), r1 = std::min(r + 1, g.rows - 1);
+                Eigen::Matrix2d j;
+                j.col(0) = (node(r, c1) - node(r, c0)) / double(g.k * (c1 - c0));
+                j.col(1) = (node(r1, c) - node(r0, c)) / double(g.k * (r1 - r0));
+                fitted[std::size_t(r * g.cols + c)] = j;
+            }
+    }
     std::vector<Eigen::Vector2d> edgeTarget(std::size_t(n) * 3);
     std::vector<double> edgeWeight(std::size_t(n) * 3, 0.0);
     // Every edge's target step and weight (each depends only on the positions: rows of nodes in blocks, one
@@ -161,11 +198,14 @@ FitSystem assembleFit(const FitGrid& g, const Eigen::MatrixX2d& phi, const Eigen
                     // The wanted bases along the edge, averaged with their weights.
                     Eigen::Matrix2d local = Eigen::Matrix2d::Zero();
                     double wt = 0;
+                    const Eigen::Matrix2d edgeFit =
+                        followFit ? Eigen::Matrix2d(0.5 * (fitted[std::size_t(i)] + fitted[std::size_t(j)]))
+                                  : Eigen::Matrix2d::Zero();
                     for (int k = 0; k < g.k; ++k) {
                         const double t = (double(k) + 0.5) / double(g.k);
+                        const Eigen::Vector2d p = ((1 - t) * phi.row(i) + t * phi.row(j)).transpose();
                         double wk = 0;
-                        const Eigen::Matrix2d& m =
-                            field.at(((1 - t) * phi.row(i) + t * phi.row(j)).transpose(), wk);
+                        const Eigen::Matrix2d m = followFit ? field.towards(p, edgeFit, wk) : field.at(p, wk);
                         local += wk * m;
                         wt += wk;
                     }
@@ -219,7 +259,8 @@ FitSystem assembleFit(const FitGrid& g, const Eigen::MatrixX2d& phi, const Eigen
 
 std::vector<Eigen::Vector2d> warpLatticeToSurface(const FrameBuffers& referenceBuffers, const Mesh& reference,
                                                   double spacing, const LatticeBasis& basis,
-                                                  const Eigen::Vector2d& origin, int rows, int cols) {
+                                                  const Eigen::Vector2d& origin, int rows, int cols,
+                                                  bool followFit) {
     detail::checkBuffers(referenceBuffers);
     std::vector<Eigen::Vector2d> out(std::size_t(std::max(rows, 0)) * std::size_t(std::max(cols, 0)));
     for (int r = 0; r < rows; ++r)
@@ -240,6 +281,7 @@ std::vector<Eigen::Vector2d> warpLatticeToSurface(const FrameBuffers& referenceB
     const Eigen::Matrix2d towardsEquilateral = affine * equilateral.inverse(); // K·R of the chosen lattice
     std::vector<Eigen::Matrix2d> wanted(std::size_t(w) * std::size_t(h), affine);
     std::vector<double> weight(wanted.size(), 0.01);
+    std::vector<Eigen::Matrix2d> toTangent(wanted.size(), Eigen::Matrix2d::Identity());
     const std::size_t faceCount = reference.number_of_faces() + reference.number_of_removed_faces();
     // Every pixel's basis depends only on that pixel: rows in blocks, one per thread, give the same result
     // for any number of threads.
@@ -252,11 +294,13 @@ std::vector<Eigen::Vector2d> warpLatticeToSurface(const FrameBuffers& referenceB
                     continue;
                 const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
                 if (surfaceBasisAt(projector, reference, FaceIndex(id), x, y, referenceBuffers.depthAt(x, y),
-                                   equilateral, towardsEquilateral, affine, wanted[i]))
+                                   equilateral, towardsEquilateral, affine, wanted[i], toTangent[i]))
                     weight[i] = 1.0;
             }
     });
-    const WantedBases field{w, h, affine, wanted, weight};
+    const Eigen::Matrix2d equilateralInverse = equilateral.inverse();
+    const WantedBases field{w, h, affine, wanted, weight, toTangent, equilateral, equilateralInverse};
+
     // The fit is made on a coarse grid, every kFit-th row and column (the warp is smooth; the solve costs
     // ~1/16 of the fine grid's), and the fine positions interpolated bilinearly in (row, column). Its
     // rounds (the bases re-read under the moved edges) run first on a grid twice as coarse, solved directly
@@ -267,13 +311,23 @@ std::vector<Eigen::Vector2d> warpLatticeToSurface(const FrameBuffers& referenceB
     // conjugate-gradient steps on the whole kFit grid, stopped far from the solution where the wanted bases
     // change fast (the lattice 1.4–2× too long on the surface there, and its Hausdorff distance worse than
     // the square lattice's in 2 of 70 views: femur +y, pig +y); 500 steps reach the direct solution.
-    constexpr int kFit = 4, kCoarseRounds = 2, kCropMargin = 2;
-    const FitGrid coarse(2 * kFit, rows, cols), fine(kFit, rows, cols);
+    //
+    // With followFit (session 19) the bases are turned towards the fit's own at every round after the
+    // first (an as-rigid-as-possible fit: local step = the turn, global step = the solve), and the last
+    // rounds run on every 2nd row and column: where the wanted bases jump (a sharp crease, faces slanted
+    // in different directions around an apex) the turn of the session 17 fit, fixed by the affine lattice,
+    // gave the two sides bases that no continuous lattice joins, and the fit compromised over rows around;
+    // bases turned to agree along the crease are joined by a lattice that bends there, which a grid of
+    // every 4th row and column blurred over 4–8 rows. Rounds and steps measured on 4 views of issue #20's
+    // wide set (octahedron +z, ALSTOM_TEST4 +y, polygon_mesh +x, part iso; DESIGN.md §1, session 19).
+    const int kFit = followFit ? 2 : 4, kCoarseRounds = followFit ? 4 : 2, kFineRounds = followFit ? 2 : 1;
+    constexpr int kCoarse = 8, kCropMargin = 2;
+    const FitGrid coarse(kCoarse, rows, cols), fine(kFit, rows, cols);
     const Eigen::MatrixX2d coarseAnchor = coarse.affinePositions(origin, basis);
     Eigen::MatrixX2d coarsePhi = coarseAnchor;
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
     for (int round = 0; round < kCoarseRounds; ++round) {
-        const FitSystem system = assembleFit(coarse, coarsePhi, coarseAnchor, field);
+        const FitSystem system = assembleFit(coarse, coarsePhi, coarseAnchor, field, followFit && round > 0);
         if (round == 0) ldlt.analyzePattern(system.matrix);
         ldlt.factorize(system.matrix);
         if (ldlt.info() == Eigen::Success) {
@@ -311,15 +365,19 @@ std::vector<Eigen::Vector2d> warpLatticeToSurface(const FrameBuffers& referenceB
                     (origin + double(kFit * (c0 + c)) * basis.a + double(kFit * (r0 + r)) * basis.b)
                         .transpose();
             }
-        const FitSystem system = assembleFit(crop, cropPhi, cropAnchor, field);
-        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> direct(system.matrix);
-        if (direct.info() == Eigen::Success) {
-            const Eigen::MatrixX2d x = direct.solve(system.rhs);
-            if (x.allFinite())
-                for (int r = 0; r < crop.rows; ++r)
-                    for (int c = 0; c < crop.cols; ++c)
-                        phi.row((r0 + r) * fine.cols + c0 + c) = x.row(r * crop.cols + c);
+        Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> direct;
+        for (int round = 0; round < kFineRounds; ++round) {
+            const FitSystem system = assembleFit(crop, cropPhi, cropAnchor, field, followFit);
+            if (round == 0) direct.analyzePattern(system.matrix);
+            direct.factorize(system.matrix);
+            if (direct.info() == Eigen::Success) {
+                const Eigen::MatrixX2d x = direct.solve(system.rhs);
+                if (x.allFinite()) cropPhi = x;
+            }
         }
+        for (int r = 0; r < crop.rows; ++r)
+            for (int c = 0; c < crop.cols; ++c)
+                phi.row((r0 + r) * fine.cols + c0 + c) = cropPhi.row(r * crop.cols + c);
     }
     for (int r = 0; r < rows; ++r)
         for (int c = 0; c < cols; ++c)

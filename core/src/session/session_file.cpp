@@ -188,6 +188,9 @@ struct Writer {
             number(p.scan.minLatticeAngleDeg, f + ".scan.min_lattice_angle_deg");
         // Always written (version 3, issue #20): files without it were recorded without the warp.
         j["scan"]["warp_to_surface"] = p.scan.warpToSurface;
+        // Written only when on (version 5, issue #20 session 19): files without it were recorded with the
+        // session 17 fit.
+        if (p.scan.warpFollowsFit) j["scan"]["warp_follows_fit"] = true;
         j["quality_mask"] = {{"margin", number(p.quality.margin, f + ".quality_mask.margin")},
                              {"force_replace", p.quality.forceReplace},
                              {"search_rings", p.quality.searchRings}};
@@ -556,7 +559,7 @@ ScanStep readStep(const Node& n) {
     p.relaxIterations = n.has("relax_iterations") ? intField(n.at("relax_iterations")) : 0;
     const Node scan = n.at("scan");
     scan.onlyKeys({"scan_id", "quality_angle_limit_deg", "max_snap_footprints", "lattice", "spacing_px",
-                   "spacing_world", "min_lattice_angle_deg", "warp_to_surface"});
+                   "spacing_world", "min_lattice_angle_deg", "warp_to_surface", "warp_follows_fit"});
     p.scan.scanId = std::int32_t(scan.at("scan_id").integer(std::numeric_limits<std::int32_t>::min(),
                                                             std::numeric_limits<std::int32_t>::max(),
                                                             "a 32-bit integer"));
@@ -574,6 +577,8 @@ ScanStep readStep(const Node& n) {
     p.scan.spacingWorld = scan.has("spacing_world") ? scan.at("spacing_world").number() : 0.0;
     // Files written before version 3 scanned without the warp (issue #20).
     p.scan.warpToSurface = scan.has("warp_to_surface") && scan.at("warp_to_surface").boolean();
+    // Files written before version 5 warped with the session 17 fit (issue #20, session 19).
+    p.scan.warpFollowsFit = scan.has("warp_follows_fit") && scan.at("warp_follows_fit").boolean();
     const Node quality = n.at("quality_mask");
     quality.onlyKeys({"margin", "force_replace", "search_rings"});
     p.quality.margin = quality.at("margin").number();
