@@ -512,9 +512,19 @@ void ComponentStitcher::flip(Local& loc, HalfedgeIndex h, bool nearPlanar) {
 void ComponentStitcher::flipPass(Local& loc, Plan& plan) {
     Mesh& S = loc.star.S;
     const auto near = seamNeighbourhood(loc);
+    // Degrees and border flags, read once per vertex and pass and kept by the pass's flips (a flip changes
+    // the degree of its four vertices by one and never which vertices are on the border): the score reads
+    // them eight times per edge, each a walk around the vertex.
+    std::vector<int> degree(S.num_vertices(), -1);
+    std::vector<char> border(S.num_vertices(), 0);
     auto valenceCost = [&](VertexIndex v, int delta) {
-        const int target = S.is_border(v) ? 4 : 6;
-        return std::abs(int(S.degree(v)) + delta - target);
+        const std::size_t i = std::size_t(v);
+        if (degree[i] < 0) {
+            degree[i] = int(S.degree(v));
+            border[i] = char(S.is_border(v));
+        }
+        const int target = border[i] ? 4 : 6;
+        return std::abs(degree[i] + delta - target);
     };
     std::deque<EdgeIndex> queue;
     std::vector<char> queued(S.num_edges(), 0); // by edge index (a flip adds no edge)
@@ -543,8 +553,10 @@ void ComponentStitcher::flipPass(Local& loc, Plan& plan) {
                           z2 = S.target(S.next(o));
         if (!near.count(std::uint32_t(x)) || !near.count(std::uint32_t(y))) continue;
         const Vec3 X = pt(S, x), Y = pt(S, y), Z1 = pt(S, z1), Z2 = pt(S, z2);
-        const double before = std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2));
-        const double after = std::min(minAngle(X, Z2, Z1), minAngle(Z2, Y, Z1));
+        const auto [before, after] = loc.flipAngles.get(std::size_t(h), X, Y, Z1, Z2, [&] {
+            return std::pair{std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2)),
+                             std::min(minAngle(X, Z2, Z1), minAngle(Z2, Y, Z1))};
+        });
         if (after < std::min(before, 20.0 * kDeg)) continue;
         const int devOld = valenceCost(x, 0) + valenceCost(y, 0) + valenceCost(z1, 0) + valenceCost(z2, 0);
         const int devNew = valenceCost(x, -1) + valenceCost(y, -1) + valenceCost(z1, 1) + valenceCost(z2, 1);
@@ -557,6 +569,11 @@ void ComponentStitcher::flipPass(Local& loc, Plan& plan) {
         if (!(gain > 0.5) || newMin < std::min(oldMin, 20.0 * kDeg)) continue;
         flip(loc, h, nearPlanar);
         ++flips;
+        // (all four degrees are known: the score read them)
+        --degree[std::size_t(x)];
+        --degree[std::size_t(y)];
+        ++degree[std::size_t(z1)];
+        ++degree[std::size_t(z2)];
         for (HalfedgeIndex g : {S.next(h), S.prev(h), S.next(o), S.prev(o)}) {
             const EdgeIndex ge = S.edge(g);
             if (!queued[std::uint32_t(ge)]) {

@@ -356,7 +356,8 @@ private:
         Mesh::Property_map<FaceIndex, double> minAllowed; // smallest angle accepted (radians)
         Mesh::Property_map<FaceIndex, bool> offView;      // piece of a mesh face the view does not see
         SeamEdges seam;
-        Star pristine; // the star as copied from the current mesh, for the rehearsal
+        detail::FlipAngleMemo flipAngles; // flipPass's angles per halfedge, while its four corners stay
+        Star pristine;                    // the star as copied from the current mesh, for the rehearsal
         // After a strip refill (v2): `seam` holds the fill's edges; the seam line's figures as glued.
         bool refilled = false;
         bool remeshed = false; // the seam band was remeshed in 3D (band_remesh.h): `seam` holds its edges
