@@ -2,6 +2,8 @@
 
 #include "stitch/stitch_stages.h"
 
+#include <boost/container/small_vector.hpp>
+
 namespace fss::detail::stitching {
 
 namespace {
@@ -159,8 +161,12 @@ double ComponentStitcher::ringScore(const Local& loc,
                                     const std::vector<FaceIndex>& faces, const Vec3& p0, const Vec3& p1,
                                     bool floors, Point2& uv, double mustBeat) const {
     const Mesh& S = loc.star.S;
-    for (const auto& [p, q] : ring)
-        if (minAngle(p1, pt(S, p), pt(S, q)) <= mustBeat) return -1.0;
+    // Each face's smallest angle at p1 once: the early test and the score below read the same doubles.
+    boost::container::small_vector<double, 16> after;
+    for (const auto& [p, q] : ring) {
+        after.push_back(minAngle(p1, pt(S, p), pt(S, q)));
+        if (after.back() <= mustBeat) return -1.0;
+    }
     double w;
     if (!V_.project(p1, uv, w)) return -1.0;
     double m = std::numbers::pi;
@@ -173,9 +179,8 @@ double ComponentStitcher::ringScore(const Local& loc,
             angleBetween(normalOf(p0, pt(S, p), pt(S, q)), normalOf(p1, pt(S, p), pt(S, q))) >
                 O_.maxNormalChangeDeg * kDeg)
             return -1.0;
-        const double after = minAngle(p1, pt(S, p), pt(S, q));
-        if (floors && after < loc.minAllowed[faces[i]]) return -1.0;
-        m = std::min(m, after);
+        if (floors && after[i] < loc.minAllowed[faces[i]]) return -1.0;
+        m = std::min(m, after[i]);
     }
     return m;
 }
@@ -526,11 +531,15 @@ void ComponentStitcher::flipPass(Local& loc, Plan& plan) {
         const int target = border[i] ? 4 : 6;
         return std::abs(degree[i] + delta - target);
     };
+    // `near` as a mask by vertex index: the loop below asks it twice per edge it takes from the queue.
+    std::vector<char> isNear(S.num_vertices(), 0);
+    for (std::uint32_t v : near)
+        isNear[v] = 1;
     std::deque<EdgeIndex> queue;
     std::vector<char> queued(S.num_edges(), 0); // by edge index (a flip adds no edge)
     for (EdgeIndex e : edgesAround(S, near)) {
         const HalfedgeIndex h = S.halfedge(e);
-        if (near.count(std::uint32_t(S.source(h))) && near.count(std::uint32_t(S.target(h)))) {
+        if (isNear[std::size_t(S.source(h))] && isNear[std::size_t(S.target(h))]) {
             queue.push_back(e);
             queued[std::uint32_t(e)] = 1;
         }
@@ -551,7 +560,7 @@ void ComponentStitcher::flipPass(Local& loc, Plan& plan) {
             continue;
         const VertexIndex x = S.source(h), y = S.target(h), z1 = S.target(S.next(h)),
                           z2 = S.target(S.next(o));
-        if (!near.count(std::uint32_t(x)) || !near.count(std::uint32_t(y))) continue;
+        if (!isNear[std::size_t(x)] || !isNear[std::size_t(y)]) continue;
         const Vec3 X = pt(S, x), Y = pt(S, y), Z1 = pt(S, z1), Z2 = pt(S, z2);
         const auto [before, after] = loc.flipAngles.get(std::size_t(h), X, Y, Z1, Z2, [&] {
             return std::pair{std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2)),
