@@ -36,13 +36,17 @@ inline double minAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const
     // that one goes through atan2: the result is the same double as the minimum of the three atan2 values,
     // which is taken otherwise.
     const Eigen::Vector3d e[3] = {b - a, c - b, a - c};
+    // (x > 0 exactly when sqrt(x) > 0: Eigen's norm() is the square root of squaredNorm().) Each edge's
+    // length once: corner i is between u = −e[i + 2] and v = e[i], and (−w)² = w² exactly.
+    for (int i = 0; i < 3; ++i)
+        if (!(e[i].squaredNorm() > 0)) return 0;
     double y[3], x[3];
     for (int i = 0; i < 3; ++i) {
-        const Eigen::Vector3d u = -e[(i + 2) % 3], v = e[i];
-        // (x > 0 exactly when sqrt(x) > 0: Eigen's norm() is the square root of squaredNorm().)
-        if (!(u.squaredNorm() > 0) || !(v.squaredNorm() > 0)) return 0;
-        y[i] = u.cross(v).norm();
-        x[i] = u.dot(v);
+        // With u = −w: u × v = −(w × v) and u · v = −(w · v) exactly (IEEE negation commutes with every
+        // rounded product and sum), so the same doubles come without negating w.
+        const Eigen::Vector3d& w = e[(i + 2) % 3];
+        y[i] = w.cross(e[i]).norm();
+        x[i] = -w.dot(e[i]);
     }
     auto clearlyBelow = [&](int i, int j) {
         const double d = y[i] * x[j] - x[i] * y[j];
