@@ -159,13 +159,19 @@ void ComponentStitcher::optimise(Local& loc, Plan& plan) {
 double ComponentStitcher::ringScore(const Local& loc,
                                     const std::vector<std::pair<VertexIndex, VertexIndex>>& ring,
                                     const std::vector<FaceIndex>& faces, const Vec3& p0, const Vec3& p1,
-                                    bool floors, Point2& uv, double mustBeat) const {
+                                    bool floors, Point2& uv, double mustBeat, std::size_t* first) const {
     const Mesh& S = loc.star.S;
     // Each face's smallest angle at p1 once: the early test and the score below read the same doubles.
-    boost::container::small_vector<double, 16> after;
-    for (const auto& [p, q] : ring) {
-        after.push_back(minAngle(p1, pt(S, p), pt(S, q)));
-        if (after.back() <= mustBeat) return -1.0;
+    const std::size_t n = ring.size();
+    boost::container::small_vector<double, 16> after(n, 0.0);
+    const std::size_t start = first && *first < n ? *first : 0;
+    for (std::size_t j = 0; j < n; ++j) {
+        const std::size_t i = (start + j) % n;
+        after[i] = minAngle(p1, pt(S, ring[i].first), pt(S, ring[i].second));
+        if (after[i] <= mustBeat) {
+            if (first) *first = i;
+            return -1.0;
+        }
     }
     double w;
     if (!V_.project(p1, uv, w)) return -1.0;
@@ -210,8 +216,9 @@ int ComponentStitcher::slideAlongEdge(Local& loc, VertexIndex v, bool search) {
         oldMin = std::min(oldMin, minAngle(p0, pt(S, p), pt(S, q)));
     // The smallest angle around v moved to U + t (W - U), or -1 where a check fails.
     double bestMin = oldMin, bestT = -1;
+    std::size_t firstFace = 0; // ringScore's first face to test
     auto score = [&](double t, Point2& uv) {
-        return ringScore(loc, ring, faces, p0, U + t * (W - U), true, uv, bestMin);
+        return ringScore(loc, ring, faces, p0, U + t * (W - U), true, uv, bestMin, &firstFace);
     };
     Point2 bestUv;
     auto consider = [&](double t) {
@@ -329,8 +336,9 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
         // The smallest angle around v moved to p1, or -1 where a face would turn over in the view (or,
         // unseen, against its plane) or degenerate, or where p1 cannot beat the best so far (the point-to-
         // triangle distances of offSurface last: they cost most).
+        std::size_t firstFace = 0; // ringScore's first face to test
         auto score = [&](const Vec3& p1, Point2& uv) {
-            const double m = ringScore(loc, ring, ringFaces, p0, p1, withPatch, uv, bestMin);
+            const double m = ringScore(loc, ring, ringFaces, p0, p1, withPatch, uv, bestMin, &firstFace);
             return m < 0 || offSurface(p1) ? -1.0 : m;
         };
         // Keeps p1 when it beats the best so far.
