@@ -7,7 +7,11 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
+#include <utility>
+#include <vector>
 
 namespace fss::detail {
 
@@ -32,13 +36,17 @@ inline double minAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const
     // that one goes through atan2: the result is the same double as the minimum of the three atan2 values,
     // which is taken otherwise.
     const Eigen::Vector3d e[3] = {b - a, c - b, a - c};
+    // (x > 0 exactly when sqrt(x) > 0: Eigen's norm() is the square root of squaredNorm().) Each edge's
+    // length once: corner i is between u = −e[i + 2] and v = e[i], and (−w)² = w² exactly.
+    for (int i = 0; i < 3; ++i)
+        if (!(e[i].squaredNorm() > 0)) return 0;
     double y[3], x[3];
     for (int i = 0; i < 3; ++i) {
-        const Eigen::Vector3d u = -e[(i + 2) % 3], v = e[i];
-        // (x > 0 exactly when sqrt(x) > 0: Eigen's norm() is the square root of squaredNorm().)
-        if (!(u.squaredNorm() > 0) || !(v.squaredNorm() > 0)) return 0;
-        y[i] = u.cross(v).norm();
-        x[i] = u.dot(v);
+        // With u = −w: u × v = −(w × v) and u · v = −(w · v) exactly (IEEE negation commutes with every
+        // rounded product and sum), so the same doubles come without negating w.
+        const Eigen::Vector3d& w = e[(i + 2) % 3];
+        y[i] = w.cross(e[i]).norm();
+        x[i] = -w.dot(e[i]);
     }
     auto clearlyBelow = [&](int i, int j) {
         const double d = y[i] * x[j] - x[i] * y[j];
@@ -81,5 +89,35 @@ inline bool angleAtMost(const Eigen::Vector3d& u, const Eigen::Vector3d& v, cons
     if (d * d > 1e-18 * (x * x + y * y)) return d < 0;
     return std::atan2(y, x) <= bound.limit;
 }
+
+/// The two smallest angles a flip test of an edge reads (before and after the flip), remembered per
+/// halfedge together with the four corner positions they came from. The flip passes test every edge near
+/// the seam again and again while most corners stay where they were; a test whose four corners are exactly
+/// where they were gets the doubles computed then (minAngle is a pure function of the positions), without
+/// the four minAngle calls. Positions are compared exactly, so a stale entry is never used.
+class FlipAngleMemo {
+public:
+    /// (before, after) of the quad (a, b, c, d) tested through halfedge \p h: computed by \p compute (a
+    /// callable returning that pair) unless the entry for \p h holds these four positions.
+    template <class Compute>
+    std::pair<double, double> get(std::size_t h, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                  const Eigen::Vector3d& c, const Eigen::Vector3d& d, Compute&& compute) {
+        if (entries_.size() <= h) entries_.resize(h + 1);
+        Entry& e = entries_[h];
+        if (e.known && e.p[0] == a && e.p[1] == b && e.p[2] == c && e.p[3] == d) return e.angles;
+        e.p = {a, b, c, d};
+        e.angles = compute();
+        e.known = true;
+        return e.angles;
+    }
+
+private:
+    struct Entry {
+        std::array<Eigen::Vector3d, 4> p;
+        std::pair<double, double> angles{0, 0};
+        bool known = false;
+    };
+    std::vector<Entry> entries_;
+};
 
 } // namespace fss::detail

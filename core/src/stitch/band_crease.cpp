@@ -188,17 +188,18 @@ void BandRemesher::buildCreaseChains() {
 void BandRemesher::smoothNormals() {
     const double creaseCos = std::cos(in_.creaseAngleDeg * kBandDeg);
     cornerNormal_.assign(ref_.num_halfedges(), V3(0, 0, 0));
-    auto area = [&](FaceIndex g) {
+    // Each face's area vector and reliability once (every corner around a face reads them, ~18 times).
+    std::vector<V3> areas(ref_.num_faces(), V3(0, 0, 0));
+    std::vector<char> reliables(ref_.num_faces(), 0);
+    for (FaceIndex g : ref_.faces()) {
         const HalfedgeIndex h = ref_.halfedge(g);
-        const V3 a = detail::pos(ref_, ref_.source(h));
-        return V3(
-            (detail::pos(ref_, ref_.target(h)) - a).cross(detail::pos(ref_, ref_.target(ref_.next(h))) - a));
-    };
-    auto reliable = [&](FaceIndex g) {
-        const HalfedgeIndex h = ref_.halfedge(g);
-        return detail::minAngle(detail::pos(ref_, ref_.source(h)), detail::pos(ref_, ref_.target(h)),
-                                detail::pos(ref_, ref_.target(ref_.next(h)))) >= kSliverDeg * kBandDeg;
-    };
+        const V3 a = detail::pos(ref_, ref_.source(h)), b = detail::pos(ref_, ref_.target(h)),
+                 c = detail::pos(ref_, ref_.target(ref_.next(h)));
+        areas[std::size_t(g)] = V3((b - a).cross(c - a));
+        reliables[std::size_t(g)] = detail::minAngle(a, b, c) >= kSliverDeg * kBandDeg;
+    }
+    auto area = [&](FaceIndex g) { return areas[std::size_t(g)]; };
+    auto reliable = [&](FaceIndex g) { return reliables[std::size_t(g)] != 0; };
     for (FaceIndex f : ref_.faces()) {
         const V3 nf = area(f).normalized();
         const bool fReliable = reliable(f);

@@ -549,9 +549,26 @@ private:
 
     // ---- flips towards valence 6 and larger angles
     void flipPass() {
+        // Degrees and border flags, read once per vertex and pass and kept by the pass's flips (a flip
+        // changes the degree of its four vertices by one and never which vertices are on the border): the
+        // tests below read them up to twelve times per edge, each a walk around the vertex.
+        std::vector<int> degree(S_.num_vertices(), -1);
+        std::vector<char> border(S_.num_vertices(), 0);
+        auto know = [&](VertexIndex v) {
+            const std::size_t i = std::size_t(v);
+            if (degree[i] < 0) {
+                degree[i] = int(S_.degree(v));
+                border[i] = char(S_.is_border(v));
+            }
+        };
         auto cost = [&](VertexIndex v, int delta) {
-            const int target = S_.is_border(v) ? 4 : 6;
-            return std::abs(int(S_.degree(v)) + delta - target);
+            const int target = border[std::size_t(v)] ? 4 : 6;
+            return std::abs(degree[std::size_t(v)] + delta - target);
+        };
+        auto valenceFits = [&](VertexIndex v, int delta) { // valenceOk on the pass's degrees
+            if (delta == 0 || border[std::size_t(v)]) return true;
+            const int n = degree[std::size_t(v)] + delta;
+            return delta > 0 ? n <= 8 : n >= 4;
         };
         // Within a pass only the flips change what the tests below read (positions, creases, band, hints and
         // face data stay), and a flip changes the degree of each of its four vertices, so every face, degree
@@ -578,14 +595,19 @@ private:
                     continue;
                 l = Left{stamp, {a, b, c, d}}; // (cleared below when it flips)
                 if (isCrease(a, b) || !detail::canFlip(S_, h)) continue;
-                if (!valenceOk(a, -1) || !valenceOk(b, -1) || !valenceOk(c, 1) || !valenceOk(d, 1)) continue;
+                for (VertexIndex v : {a, b, c, d})
+                    know(v);
+                if (!valenceFits(a, -1) || !valenceFits(b, -1) || !valenceFits(c, 1) || !valenceFits(d, 1))
+                    continue;
                 if (unseen(S_.face(h)) != unseen(S_.face(S_.opposite(h)))) continue;
                 const V3 pa = detail::pos(S_, a), pb = detail::pos(S_, b), pc = detail::pos(S_, c),
                          pd = detail::pos(S_, d);
                 // New faces (a, d, c) and (b, c, d). The tests are pure: the cheap gain test comes first
                 // (most candidates fail it), then the faces' orientation and normals, then the projection.
-                const double oldMin = std::min(detail::minAngle(pa, pb, pc), detail::minAngle(pb, pa, pd));
-                const double newMin = std::min(detail::minAngle(pa, pd, pc), detail::minAngle(pb, pc, pd));
+                const auto [oldMin, newMin] = flipAngles_.get(std::size_t(h), pa, pb, pc, pd, [&] {
+                    return std::pair{std::min(detail::minAngle(pa, pb, pc), detail::minAngle(pb, pa, pd)),
+                                     std::min(detail::minAngle(pa, pd, pc), detail::minAngle(pb, pc, pd))};
+                });
                 const int devOld = cost(a, 0) + cost(b, 0) + cost(c, 0) + cost(d, 0);
                 const int devNew = cost(a, -1) + cost(b, -1) + cost(c, 1) + cost(d, 1);
                 // Score (as version 1's flips): smallest angle in degrees minus 3 deg per unit of valence
@@ -607,6 +629,10 @@ private:
                 ++stamp;
                 for (VertexIndex v : {a, b, c, d})
                     flippedAt[std::size_t(v)] = stamp;
+                --degree[std::size_t(a)];
+                --degree[std::size_t(b)];
+                ++degree[std::size_t(c)];
+                ++degree[std::size_t(d)];
                 l.stamp = 0;
             }
             report_.flips += flips;
@@ -714,6 +740,7 @@ private:
     std::vector<std::vector<V3>> chainPts_;     // the draft's crease polylines (band_crease.cpp)
     std::vector<std::vector<double>> chainArc_; // their cumulative arc lengths
     std::unordered_map<std::uint32_t, std::vector<CreasePos>> creasePos_; // per crease vertex of S_
+    detail::FlipAngleMemo flipAngles_; // flipPass's angles per halfedge, while its four corners stay
     BandRemeshReport report_;
 };
 

@@ -2,6 +2,8 @@
 
 #include "stitch/stitch_stages.h"
 
+#include <boost/container/small_vector.hpp>
+
 namespace fss::detail::stitching {
 
 namespace {
@@ -157,10 +159,20 @@ void ComponentStitcher::optimise(Local& loc, Plan& plan) {
 double ComponentStitcher::ringScore(const Local& loc,
                                     const std::vector<std::pair<VertexIndex, VertexIndex>>& ring,
                                     const std::vector<FaceIndex>& faces, const Vec3& p0, const Vec3& p1,
-                                    bool floors, Point2& uv, double mustBeat) const {
+                                    bool floors, Point2& uv, double mustBeat, std::size_t* first) const {
     const Mesh& S = loc.star.S;
-    for (const auto& [p, q] : ring)
-        if (minAngle(p1, pt(S, p), pt(S, q)) <= mustBeat) return -1.0;
+    // Each face's smallest angle at p1 once: the early test and the score below read the same doubles.
+    const std::size_t n = ring.size();
+    boost::container::small_vector<double, 16> after(n, 0.0);
+    const std::size_t start = first && *first < n ? *first : 0;
+    for (std::size_t j = 0; j < n; ++j) {
+        const std::size_t i = (start + j) % n;
+        after[i] = minAngle(p1, pt(S, ring[i].first), pt(S, ring[i].second));
+        if (after[i] <= mustBeat) {
+            if (first) *first = i;
+            return -1.0;
+        }
+    }
     double w;
     if (!V_.project(p1, uv, w)) return -1.0;
     double m = std::numbers::pi;
@@ -173,9 +185,8 @@ double ComponentStitcher::ringScore(const Local& loc,
             angleBetween(normalOf(p0, pt(S, p), pt(S, q)), normalOf(p1, pt(S, p), pt(S, q))) >
                 O_.maxNormalChangeDeg * kDeg)
             return -1.0;
-        const double after = minAngle(p1, pt(S, p), pt(S, q));
-        if (floors && after < loc.minAllowed[faces[i]]) return -1.0;
-        m = std::min(m, after);
+        if (floors && after[i] < loc.minAllowed[faces[i]]) return -1.0;
+        m = std::min(m, after[i]);
     }
     return m;
 }
@@ -205,8 +216,9 @@ int ComponentStitcher::slideAlongEdge(Local& loc, VertexIndex v, bool search) {
         oldMin = std::min(oldMin, minAngle(p0, pt(S, p), pt(S, q)));
     // The smallest angle around v moved to U + t (W - U), or -1 where a check fails.
     double bestMin = oldMin, bestT = -1;
+    std::size_t firstFace = 0; // ringScore's first face to test
     auto score = [&](double t, Point2& uv) {
-        return ringScore(loc, ring, faces, p0, U + t * (W - U), true, uv, bestMin);
+        return ringScore(loc, ring, faces, p0, U + t * (W - U), true, uv, bestMin, &firstFace);
     };
     Point2 bestUv;
     auto consider = [&](double t) {
@@ -324,8 +336,9 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
         // The smallest angle around v moved to p1, or -1 where a face would turn over in the view (or,
         // unseen, against its plane) or degenerate, or where p1 cannot beat the best so far (the point-to-
         // triangle distances of offSurface last: they cost most).
+        std::size_t firstFace = 0; // ringScore's first face to test
         auto score = [&](const Vec3& p1, Point2& uv) {
-            const double m = ringScore(loc, ring, ringFaces, p0, p1, withPatch, uv, bestMin);
+            const double m = ringScore(loc, ring, ringFaces, p0, p1, withPatch, uv, bestMin, &firstFace);
             return m < 0 || offSurface(p1) ? -1.0 : m;
         };
         // Keeps p1 when it beats the best so far.
@@ -512,15 +525,29 @@ void ComponentStitcher::flip(Local& loc, HalfedgeIndex h, bool nearPlanar) {
 void ComponentStitcher::flipPass(Local& loc, Plan& plan) {
     Mesh& S = loc.star.S;
     const auto near = seamNeighbourhood(loc);
+    // Degrees and border flags, read once per vertex and pass and kept by the pass's flips (a flip changes
+    // the degree of its four vertices by one and never which vertices are on the border): the score reads
+    // them eight times per edge, each a walk around the vertex.
+    std::vector<int> degree(S.num_vertices(), -1);
+    std::vector<char> border(S.num_vertices(), 0);
     auto valenceCost = [&](VertexIndex v, int delta) {
-        const int target = S.is_border(v) ? 4 : 6;
-        return std::abs(int(S.degree(v)) + delta - target);
+        const std::size_t i = std::size_t(v);
+        if (degree[i] < 0) {
+            degree[i] = int(S.degree(v));
+            border[i] = char(S.is_border(v));
+        }
+        const int target = border[i] ? 4 : 6;
+        return std::abs(degree[i] + delta - target);
     };
+    // `near` as a mask by vertex index: the loop below asks it twice per edge it takes from the queue.
+    std::vector<char> isNear(S.num_vertices(), 0);
+    for (std::uint32_t v : near)
+        isNear[v] = 1;
     std::deque<EdgeIndex> queue;
     std::vector<char> queued(S.num_edges(), 0); // by edge index (a flip adds no edge)
     for (EdgeIndex e : edgesAround(S, near)) {
         const HalfedgeIndex h = S.halfedge(e);
-        if (near.count(std::uint32_t(S.source(h))) && near.count(std::uint32_t(S.target(h)))) {
+        if (isNear[std::size_t(S.source(h))] && isNear[std::size_t(S.target(h))]) {
             queue.push_back(e);
             queued[std::uint32_t(e)] = 1;
         }
@@ -541,10 +568,12 @@ void ComponentStitcher::flipPass(Local& loc, Plan& plan) {
             continue;
         const VertexIndex x = S.source(h), y = S.target(h), z1 = S.target(S.next(h)),
                           z2 = S.target(S.next(o));
-        if (!near.count(std::uint32_t(x)) || !near.count(std::uint32_t(y))) continue;
+        if (!isNear[std::size_t(x)] || !isNear[std::size_t(y)]) continue;
         const Vec3 X = pt(S, x), Y = pt(S, y), Z1 = pt(S, z1), Z2 = pt(S, z2);
-        const double before = std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2));
-        const double after = std::min(minAngle(X, Z2, Z1), minAngle(Z2, Y, Z1));
+        const auto [before, after] = loc.flipAngles.get(std::size_t(h), X, Y, Z1, Z2, [&] {
+            return std::pair{std::min(minAngle(X, Y, Z1), minAngle(Y, X, Z2)),
+                             std::min(minAngle(X, Z2, Z1), minAngle(Z2, Y, Z1))};
+        });
         if (after < std::min(before, 20.0 * kDeg)) continue;
         const int devOld = valenceCost(x, 0) + valenceCost(y, 0) + valenceCost(z1, 0) + valenceCost(z2, 0);
         const int devNew = valenceCost(x, -1) + valenceCost(y, -1) + valenceCost(z1, 1) + valenceCost(z2, 1);
@@ -557,6 +586,11 @@ void ComponentStitcher::flipPass(Local& loc, Plan& plan) {
         if (!(gain > 0.5) || newMin < std::min(oldMin, 20.0 * kDeg)) continue;
         flip(loc, h, nearPlanar);
         ++flips;
+        // (all four degrees are known: the score read them)
+        --degree[std::size_t(x)];
+        --degree[std::size_t(y)];
+        ++degree[std::size_t(z1)];
+        ++degree[std::size_t(z2)];
         for (HalfedgeIndex g : {S.next(h), S.prev(h), S.next(o), S.prev(o)}) {
             const EdgeIndex ge = S.edge(g);
             if (!queued[std::uint32_t(ge)]) {

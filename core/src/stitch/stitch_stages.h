@@ -357,7 +357,8 @@ private:
         Mesh::Property_map<FaceIndex, double> minAllowed; // smallest angle accepted (radians)
         Mesh::Property_map<FaceIndex, bool> offView;      // piece of a mesh face the view does not see
         SeamEdges seam;
-        Star pristine; // the star as copied from the current mesh, for the rehearsal
+        detail::FlipAngleMemo flipAngles; // flipPass's angles per halfedge, while its four corners stay
+        Star pristine;                    // the star as copied from the current mesh, for the rehearsal
         // After a strip refill (v2): `seam` holds the fill's edges; the seam line's figures as glued.
         bool refilled = false;
         bool remeshed = false; // the seam band was remeshed in 3D (band_remesh.h): `seam` holds its edges
@@ -443,10 +444,12 @@ private:
     // face would turn its normal more than maxNormalChangeDeg, or (with `floors`) a face would fall below
     // its floor. uv: p1 in the view. Also -1 (uv unset) as soon as one face's smallest angle is at most
     // `mustBeat`: callers keep p1 only where the score beats their best so far, so they pass it and the
-    // checks are skipped for places that cannot win.
+    // checks are skipped for places that cannot win. `first`, when given, is the ring face tested first
+    // against mustBeat and is set to the one that failed (the same answer, sooner: in a search most places
+    // fail, mostly at the same face).
     double ringScore(const Local& loc, const std::vector<std::pair<VertexIndex, VertexIndex>>& ring,
                      const std::vector<FaceIndex>& faces, const Vec3& p0, const Vec3& p1, bool floors,
-                     Point2& uv, double mustBeat = -1.0) const;
+                     Point2& uv, double mustBeat = -1.0, std::size_t* first = nullptr) const;
 
     // A seam vertex on a mesh edge (a crossing, a snapped patch vertex) slides along that edge towards the
     // centre of its neighbours where that raises the smallest angle around it: the pieces outside stay in
