@@ -90,7 +90,8 @@ Patch regionPatch(const Mesh& reference, const FrameBuffers& buffers, const std:
     MaskStages stages;
     // The opening (radius 1) removes single samples and one-sample spikes, which the join cannot close
     // cleanly (measured on elephant: without it 1168 intersecting face pairs after the join, 79 with it).
-    stages.morphology = {.radius = 1, .dilateRadius = 1};
+    const int open = std::getenv("FSS_AUTO_V2_OPEN") ? std::atoi(std::getenv("FSS_AUTO_V2_OPEN")) : 1;
+    stages.morphology = {.radius = open, .dilateRadius = open};
     stages.atQuality = stages.atMorphology = stages.atTriangulate = {};
     stages.nothingBetter = stages.nothingLeft = "The view owns no part of the surface.";
     MaskedPatch out = maskAndTriangulate(grid, stages, workspace);
@@ -251,7 +252,8 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         for (std::size_t i = 0; i < nv; ++i)
             std::fprintf(stderr, "v2 region %zu: area %.4f expected %.0f verts, cos %.2f: %s\n", i,
                          regionArea[i], regionArea[i] / (std::sqrt(3.0) / 2 * L * L),
-                         regionArea[i] > 0 ? cosArea[i] / regionArea[i] : 0.0, dbg[i].c_str());
+                         regionArea[i] > 0 ? cosArea[i] / regionArea[i] : 0.0,
+                         dbg[i].empty() ? notes[i].c_str() : dbg[i].c_str());
 
     // 3. One join.
     progress.report(0.5, "join");
@@ -275,7 +277,12 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
     // Two ways to join; the first whose result passes validateJoin is kept (else the first): the faces no
     // region sampled kept as a region of their own, joined in one pass (JoinStyle::InputRegions), then
     // session 15's join (JoinStyle::TwoPasses), which bridges those parts with the hole filling.
-    const std::vector<char> unsampled = unsampledFaces(reference, patches, L);
+    std::vector<Eigen::Vector3d> viewDirections;
+    for (const FrameBuffers& b : buffers)
+        viewDirections.push_back(b.camera.viewDirection());
+    const double facing = std::getenv("FSS_AUTO_V2_FACING") ? std::atof(std::getenv("FSS_AUTO_V2_FACING")) : -1.0;
+    const std::vector<char> unsampled = unsampledFaces(reference, patches, L, viewDirections, facing);
+    const ReferenceBorder border = closedInput ? ReferenceBorder{} : referenceBorder(reference, L);
     patches.clear();
     const RayCaster caster(reference);
     MetricsOptions referenceTopology;
@@ -299,13 +306,13 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
             for (std::size_t i = 0; i < inputFaces.size(); ++i)
                 widened[i] = inputFaces[i] && !unsampled[i];
             removePatchFacesNear(joined, reference, widened, L);
-            joinRegions(joined, reference, &inputFaces, caster, JoinStyle::InputRegions, L, closedInput,
+            joinRegions(joined, reference, &inputFaces, caster, border, JoinStyle::InputRegions, L, closedInput,
                         debug, 0);
             Mesh repaired = joined;
-            repairJoin(repaired, closedInput, 4, debug);
+            repairJoin(repaired, border, closedInput, 4, debug);
             repaired.collect_garbage();
             // Measured on elephant: two input faces no patch reached, each closed on itself by the filling.
-            dropSmallPieces(repaired, target.components, 8);
+            dropSmallPieces(repaired, target.components, std::getenv("FSS_AUTO_V2_DROP") ? std::size_t(std::atoi(std::getenv("FSS_AUTO_V2_DROP"))) : 8);
             const char* widen = std::getenv("FSS_AUTO_V2_WIDEN");
             if (round == kWidenRounds || !(widen && std::string(widen) == "1") ||
                 validateJoin(repaired, target).empty()) {
@@ -325,7 +332,8 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         if (why.empty()) {
             current = std::move(joined);
         } else {
-            joinRegions(current, reference, nullptr, caster, JoinStyle::TwoPasses, L, closedInput, debug, 4);
+            joinRegions(current, reference, nullptr, caster, border, JoinStyle::TwoPasses, L, closedInput, debug,
+                        4);
             const std::string other = validateJoin(current, target);
             if (debug)
                 std::fprintf(stderr, "v2: join in two passes: %s\n", other.empty() ? "valid" : other.c_str());
