@@ -64,6 +64,11 @@ double since(Clock::time_point t0) {
 /// of the target at 1).
 constexpr double kDensity = 0.97;
 
+/// Largest distance of the result's vertices and face centroids from the reference, in edge lengths: the
+/// lattice's samples lie on it and the crease recovery's bevels within L/2; measured on blade 0.7 L (its
+/// thin rims), rotor_small's cap across a handle 5 L.
+constexpr double kMaxDistance = 1.5;
+
 /// Rounds of the join that turn the reference's faces around what the join left wrong into input faces
 /// (autoRemeshV2, step 3).
 constexpr int kWidenRounds = 3;
@@ -90,8 +95,7 @@ Patch regionPatch(const Mesh& reference, const FrameBuffers& buffers, const std:
     MaskStages stages;
     // The opening (radius 1) removes single samples and one-sample spikes, which the join cannot close
     // cleanly (measured on elephant: without it 1168 intersecting face pairs after the join, 79 with it).
-    const int open = std::getenv("FSS_AUTO_V2_OPEN") ? std::atoi(std::getenv("FSS_AUTO_V2_OPEN")) : 1;
-    stages.morphology = {.radius = open, .dilateRadius = open};
+    stages.morphology = {.radius = 1, .dilateRadius = 1};
     stages.atQuality = stages.atMorphology = stages.atTriangulate = {};
     stages.nothingBetter = stages.nothingLeft = "The view owns no part of the surface.";
     MaskedPatch out = maskAndTriangulate(grid, stages, workspace);
@@ -144,6 +148,12 @@ std::string validateJoin(const Mesh& mesh, const JoinTarget& target) {
     if (m.components != target.components)
         return "the joined mesh has " + std::to_string(m.components) + " connected components, the input " +
                std::to_string(target.components);
+    if (target.eulerCharacteristic) {
+        const long euler = long(m.vertices) - long(m.edges) + long(m.faces);
+        if (euler != *target.eulerCharacteristic)
+            return "the joined mesh has Euler characteristic " + std::to_string(euler) + ", the input " +
+                   std::to_string(*target.eulerCharacteristic);
+    }
     // Parts of the surface no region sampled are bridged by the hole filling: far fewer vertices than a
     // regular triangulation of the whole surface means parts of it were cut off.
     if (std::abs(double(m.vertices) - target.vertices) > 0.1 * target.vertices)
@@ -156,6 +166,20 @@ std::string validateJoin(const Mesh& mesh, const JoinTarget& target) {
         return "the joined mesh has " + std::to_string(m.nonManifoldVertices) + " pinched vertices";
     if (m.degenerateFaces > 0)
         return "the joined mesh has " + std::to_string(m.degenerateFaces) + " degenerate faces";
+    if (target.reference) {
+        double far = 0;
+        for (VertexIndex v : mesh.vertices())
+            far = std::max(far, target.reference->closestPoint(at(mesh, v)).distance);
+        for (FaceIndex f : mesh.faces()) {
+            Eigen::Vector3d c(0, 0, 0);
+            for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
+                c += at(mesh, v) / 3.0;
+            far = std::max(far, target.reference->closestPoint(c).distance);
+        }
+        if (far > target.maxDistance)
+            return "the joined mesh lies up to " + std::to_string(far / target.maxDistance) +
+                   " times the allowed distance from the input";
+    }
     if (m.selfIntersections.value_or(0) > 0)
         return "the joined mesh intersects itself (" + std::to_string(*m.selfIntersections) + " face pairs)";
     return {};
@@ -223,17 +247,20 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
     t = Clock::now();
     const std::size_t nv = buffers.size();
     std::vector<double> cosArea(nv, 0), regionArea(nv, 0);
+    std::vector<Eigen::Vector3d> viewDirections;
+    for (const FrameBuffers& b : buffers)
+        viewDirections.push_back(b.camera.viewDirection());
+    std::vector<Patch> patches(nv);
+    std::vector<std::string> notes(nv), dbg(nv);
+    progress.report(0.2, "scan");
     for (FaceIndex f : reference.faces()) {
         const int o = owner[f.idx()];
         if (o < 0) continue;
         const double a = faceArea(reference, f);
         regionArea[std::size_t(o)] += a;
         cosArea[std::size_t(o)] +=
-            a * std::max(0.0, -faceNormal(reference, f).dot(buffers[std::size_t(o)].camera.viewDirection()));
+            a * std::max(0.0, -faceNormal(reference, f).dot(viewDirections[std::size_t(o)]));
     }
-    std::vector<Patch> patches(nv);
-    std::vector<std::string> notes(nv), dbg(nv);
-    progress.report(0.2, "scan");
     parallelItems(nv, 1, [&](std::size_t i) {
         if (regionArea[i] <= 0) {
             notes[i] = "The view owns no part of the surface.";
@@ -277,11 +304,7 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
     // Two ways to join; the first whose result passes validateJoin is kept (else the first): the faces no
     // region sampled kept as a region of their own, joined in one pass (JoinStyle::InputRegions), then
     // session 15's join (JoinStyle::TwoPasses), which bridges those parts with the hole filling.
-    std::vector<Eigen::Vector3d> viewDirections;
-    for (const FrameBuffers& b : buffers)
-        viewDirections.push_back(b.camera.viewDirection());
-    const double facing = std::getenv("FSS_AUTO_V2_FACING") ? std::atof(std::getenv("FSS_AUTO_V2_FACING")) : -1.0;
-    const std::vector<char> unsampled = unsampledFaces(reference, patches, L, viewDirections, facing);
+    const std::vector<char> unsampled = unsampledFaces(reference, patches, L);
     const ReferenceBorder border = closedInput ? ReferenceBorder{} : referenceBorder(reference, L);
     patches.clear();
     const RayCaster caster(reference);
@@ -291,7 +314,12 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
     const JoinTarget target{.closed = closedInput,
                             .components = referenceMetrics.components,
                             .boundaryLoops = referenceMetrics.boundaryLoops,
-                            .vertices = result.area / (std::sqrt(3.0) / 2.0 * L * L)};
+                            .vertices = result.area / (std::sqrt(3.0) / 2.0 * L * L),
+                            .eulerCharacteristic = long(referenceMetrics.vertices) -
+                                                   long(referenceMetrics.edges) +
+                                                   long(referenceMetrics.faces),
+                            .reference = &caster,
+                            .maxDistance = kMaxDistance * L};
     std::vector<char> inputFaces = unsampled;
     {
         // When the repaired join fails validation, the reference's own faces within 2 L of what the join
@@ -306,13 +334,13 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
             for (std::size_t i = 0; i < inputFaces.size(); ++i)
                 widened[i] = inputFaces[i] && !unsampled[i];
             removePatchFacesNear(joined, reference, widened, L);
-            joinRegions(joined, reference, &inputFaces, caster, border, JoinStyle::InputRegions, L, closedInput,
-                        debug, 0);
+            joinRegions(joined, reference, &inputFaces, caster, border, JoinStyle::InputRegions, L,
+                        closedInput, debug, 0);
             Mesh repaired = joined;
             repairJoin(repaired, border, closedInput, 4, debug);
             repaired.collect_garbage();
             // Measured on elephant: two input faces no patch reached, each closed on itself by the filling.
-            dropSmallPieces(repaired, target.components, std::getenv("FSS_AUTO_V2_DROP") ? std::size_t(std::atoi(std::getenv("FSS_AUTO_V2_DROP"))) : 8);
+            dropSmallPieces(repaired, target.components, 8);
             const char* widen = std::getenv("FSS_AUTO_V2_WIDEN");
             if (round == kWidenRounds || !(widen && std::string(widen) == "1") ||
                 validateJoin(repaired, target).empty()) {
@@ -332,8 +360,8 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         if (why.empty()) {
             current = std::move(joined);
         } else {
-            joinRegions(current, reference, nullptr, caster, border, JoinStyle::TwoPasses, L, closedInput, debug,
-                        4);
+            joinRegions(current, reference, nullptr, caster, border, JoinStyle::TwoPasses, L, closedInput,
+                        debug, 4);
             const std::string other = validateJoin(current, target);
             if (debug)
                 std::fprintf(stderr, "v2: join in two passes: %s\n", other.empty() ? "valid" : other.c_str());

@@ -67,15 +67,10 @@ std::vector<std::vector<VertexIndex>> pinchedCycleLoops(const std::vector<Vertex
 /// Adds the faces of \p patch to \p out (scan id and quality kept).
 void appendPatch(Mesh& out, const Mesh& patch);
 
-/// Flags the faces of \p reference whose centroid lies farther than \p reach from every vertex of \p patches
-/// whose view (patch i: \p viewDirections[i], none given: every patch) faces it, the cosine of the angle
-/// between the view ray and the face normal at least \p minFacingCos: the parts of the surface no region
-/// sampled (thin pieces the opening removed, regions whose patch failed, faces no view sees, and the rim of
-/// a thin part whose two sides are sampled by views that see the rim edge-on, where no gap face could join
-/// the two sides without folding over).
-std::vector<char> unsampledFaces(const Mesh& reference, const std::vector<Patch>& patches, double reach,
-                                 const std::vector<Eigen::Vector3d>& viewDirections = {},
-                                 double minFacingCos = -1.0);
+/// Flags the faces of \p reference whose centroid lies farther than \p reach from every vertex of \p patches:
+/// the parts of the surface no region sampled (thin pieces the opening removed, regions whose patch failed,
+/// faces no view sees).
+std::vector<char> unsampledFaces(const Mesh& reference, const std::vector<Patch>& patches, double reach);
 
 /// The boundary of an open reference, sampled: a boundary cycle of the join that runs along it is the
 /// reference's own border, which the hole filling leaves open (none on a closed reference).
