@@ -421,7 +421,9 @@ Defects findDefects(const Mesh& mesh, bool closed) {
         }
         // Two boundary fans at one vertex (two gaps meeting there) pinch it as well: computeMetrics counts
         // it (measured on mech-holes-shark: the only defect left after the repair, so validation failed).
-        pinched[v.idx()] = around != incoming[v.idx()] || borders > 1;
+        // On a closed reference every face at a boundary is bad anyway; marking the whole fan there as well
+        // changed elephant's repair for the worse (Hausdorff from it 0.005 -> 0.026 of the diagonal).
+        pinched[v.idx()] = around != incoming[v.idx()] || (!closed && borders > 1);
     }
     for (HalfedgeIndex h : mesh.halfedges())
         out.borderEdges += mesh.is_border(h);
