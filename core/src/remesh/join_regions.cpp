@@ -397,8 +397,9 @@ struct Defects {
 };
 
 /// The faces of \p mesh that intersect another, are degenerate, touch a pinched vertex (a vertex whose faces
-/// form several fans) or (\p closed) lie at a boundary the hole filling could not close.
-Defects findDefects(const Mesh& mesh, bool closed) {
+/// form several fans; with \p twoFans also a vertex with two boundary fans, where two gaps meet) or
+/// (\p closed) lie at a boundary the hole filling could not close.
+Defects findDefects(const Mesh& mesh, bool closed, bool twoFans = false) {
     namespace PMP = CGAL::Polygon_mesh_processing;
     Defects out;
     out.bad.assign(mesh.number_of_faces() + mesh.number_of_removed_faces(), 0);
@@ -421,9 +422,11 @@ Defects findDefects(const Mesh& mesh, bool closed) {
         }
         // Two boundary fans at one vertex (two gaps meeting there) pinch it as well: computeMetrics counts
         // it (measured on mech-holes-shark: the only defect left after the repair, so validation failed).
-        // On a closed reference every face at a boundary is bad anyway; marking the whole fan there as well
-        // changed elephant's repair for the worse (Hausdorff from it 0.005 -> 0.026 of the diagonal).
-        pinched[v.idx()] = around != incoming[v.idx()] || (!closed && borders > 1);
+        // Only where the caller asks (repairJoin on an open reference): on a closed one every face at a
+        // boundary is bad anyway, and marking the whole fan there too changed elephant's repair for the
+        // worse (Hausdorff from it 0.005 -> 0.026 of the diagonal); in the repair inside the join in two
+        // passes it made blade's refill merge a gap with its border (1 boundary loop of 2).
+        pinched[v.idx()] = around != incoming[v.idx()] || (twoFans && borders > 1);
     }
     for (HalfedgeIndex h : mesh.halfedges())
         out.borderEdges += mesh.is_border(h);
@@ -437,12 +440,13 @@ Defects findDefects(const Mesh& mesh, bool closed) {
     return out;
 }
 
-/// Repairs what the gap closing left wrong (findDefects): the bad faces, with one ring of faces around them,
-/// are removed and the holes (with those left open) are filled again (fillHoles); up to \p rounds times.
-/// Returns true when the mesh is then free of defects.
-bool repairDefects(Mesh& mesh, const ReferenceBorder& border, bool closed, int rounds, bool debug) {
+/// Repairs what the gap closing left wrong (findDefects, \p twoFans passed on): the bad faces, with one ring
+/// of faces around them, are removed and the holes (with those left open) are filled again (fillHoles); up to
+/// \p rounds times. Returns true when the mesh is then free of defects.
+bool repairDefects(Mesh& mesh, const ReferenceBorder& border, bool closed, int rounds, bool debug,
+                   bool twoFans) {
     for (int round = 0;; ++round) {
-        const Defects d = findDefects(mesh, closed);
+        const Defects d = findDefects(mesh, closed, twoFans);
         if (debug)
             std::fprintf(stderr,
                          "v2 repair %d: %zu faces, %zu intersecting pairs, %zu bad faces, %zu border edges\n",
@@ -543,7 +547,7 @@ std::size_t widenInputRegions(const Mesh& reference, const Mesh& joined, bool cl
 }
 
 bool repairJoin(Mesh& mesh, const ReferenceBorder& border, bool closed, int rounds, bool debug) {
-    return repairDefects(mesh, border, closed, rounds, debug);
+    return repairDefects(mesh, border, closed, rounds, debug, !closed);
 }
 
 std::size_t dropSmallPieces(Mesh& mesh, std::size_t components, std::size_t maxFaces) {
@@ -640,7 +644,7 @@ void joinRegions(Mesh& mesh, const Mesh& reference, const std::vector<char>* uns
     // On an open reference only the cycles off its boundary (gaps between patches) are filled.
     fillJoinHoles(mesh, border);
     if (debug) std::fprintf(stderr, "v2: %zu border edges after the hole filling\n", borderEdges());
-    repairDefects(mesh, border, closed, repairRounds, debug);
+    repairDefects(mesh, border, closed, repairRounds, debug, false);
     mesh.collect_garbage();
     pieces("after the repair");
 }

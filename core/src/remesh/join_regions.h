@@ -112,6 +112,7 @@ void joinRegions(Mesh& mesh, const Mesh& reference, const std::vector<char>* uns
                  bool closed, bool debug, int repairRounds);
 
 /// Repairs what the join left wrong: the faces that intersect another, are degenerate, touch a pinched vertex
+/// (on an open reference also one with two boundary fans, where two gaps meet)
 /// or (\p closed) an unclosed boundary are removed with a ring of faces around them and the holes filled
 /// again, up to \p rounds times. Returns true when none is left.
 bool repairJoin(Mesh& mesh, const ReferenceBorder& border, bool closed, int rounds, bool debug);
