@@ -1,12 +1,17 @@
 // The one-pass join of auto v2 (internal, remesh/join_regions.h): the hole filling's split of a pinched
 // boundary cycle (one that passes a vertex twice) into simple loops, which CGAL's hole triangulation can
-// fill.
+// fill; the hole filling and repair on an open reference.
 #include "remesh/join_regions.h"
 
 #include "fss/mesh.h"
+#include "fss/metrics.h"
+#include "fss/shapes.h"
 
 #include <gtest/gtest.h>
 
+#include <CGAL/boost/graph/Euler_operations.h>
+
+#include <cmath>
 #include <vector>
 
 // Session 18 measured on couplingdown (FSS_AUTO_V2_DEBUG=1): 20 of the 105 boundary cycles the gap closing
@@ -30,4 +35,87 @@ TEST(AutoJoin, PinchedCycleIsCutIntoSimpleLoops) {
     // (1 4: two vertices).
     EXPECT_EQ(fss::detail::pinchedCycleLoops(v({1, 2, 3, 1, 4, 5, 6, 4})),
               (Loops{v({1, 2, 3}), v({4, 5, 6})}));
+}
+
+namespace {
+
+// The interior vertex of fss::shapes::grid nearest (x, y).
+fss::VertexIndex gridVertex(const fss::Mesh& m, double x, double y) {
+    fss::VertexIndex best;
+    double bestD = 1e300;
+    for (fss::VertexIndex v : m.vertices()) {
+        const double d = std::hypot(m.point(v).x() - x, m.point(v).y() - y);
+        if (d < bestD) bestD = d, best = v;
+    }
+    return best;
+}
+
+fss::Metrics topology(const fss::Mesh& m) {
+    return fss::computeMetrics(m, fss::MetricsOptions{.selfIntersections = false});
+}
+
+} // namespace
+
+// Session 19 measured on the open meshes of issue 23: the join's repair refilled every boundary cycle, the
+// reference's own borders too, so mech-holes-shark came out with 2 of its 4 holes and blade (a tube open at
+// both ends) with 1 of its 2 loops. In miniature: an 8 x 8 grid (one border loop of 32 edges) with a hole
+// around an interior vertex; filled with the grid's border known, the hole closes and the border stays.
+TEST(AutoJoin, HoleFillingLeavesTheReferenceBorderOpen) {
+    const fss::Mesh reference = fss::shapes::grid(8, 8, 1.0);
+    fss::Mesh holed = reference;
+    const fss::VertexIndex centre = gridVertex(holed, 4.0, 4.0);
+    std::vector<fss::FaceIndex> around;
+    for (fss::FaceIndex f : CGAL::faces_around_target(holed.halfedge(centre), holed))
+        around.push_back(f);
+    ASSERT_EQ(around.size(), 6u);
+    for (fss::FaceIndex f : around)
+        CGAL::Euler::remove_face(holed.halfedge(f), holed);
+    holed.remove_vertex(centre);
+    holed.collect_garbage();
+    ASSERT_EQ(topology(holed).boundaryLoops, 2u);
+
+    // Without the border every cycle is filled: the grid's own border is capped as well (the old repair).
+    fss::Mesh everything = holed;
+    fss::detail::fillJoinHoles(everything, {});
+    EXPECT_EQ(topology(everything).boundaryLoops, 0u);
+
+    fss::Mesh filled = holed;
+    const fss::detail::ReferenceBorder border = fss::detail::referenceBorder(reference, 1.0);
+    EXPECT_EQ(border.samples.size(), 64u); // 32 border edges of length 1, two samples each
+    fss::detail::fillJoinHoles(filled, border);
+    const fss::Metrics m = topology(filled);
+    EXPECT_EQ(m.boundaryLoops, 1u);
+    EXPECT_EQ(m.boundaryEdges, 32u);
+    EXPECT_EQ(m.nonManifoldVertices, 0u);
+    EXPECT_GE(m.faces, 128u - 6u + 4u); // the hexagonal hole takes at least 4 triangles
+}
+
+// A vertex where two gaps meet (two boundary fans) is pinched; the repair missed it (it compared the
+// halfedges around the vertex with those pointing at it, equal here), so on mech-holes-shark the join passed
+// the repair with one pinched vertex and failed validation. In miniature: two opposite faces of an interior
+// vertex's fan removed from a grid.
+TEST(AutoJoin, RepairFindsAVertexWhereTwoGapsMeet) {
+    const fss::Mesh reference = fss::shapes::grid(6, 6, 1.0);
+    fss::Mesh mesh = reference;
+    const fss::VertexIndex v = gridVertex(mesh, 3.0, 3.0);
+    std::vector<fss::FaceIndex> fan;
+    for (fss::FaceIndex f : CGAL::faces_around_target(mesh.halfedge(v), mesh))
+        fan.push_back(f);
+    ASSERT_EQ(fan.size(), 6u);
+    CGAL::Euler::remove_face(mesh.halfedge(fan[0]), mesh);
+    CGAL::Euler::remove_face(mesh.halfedge(fan[3]), mesh);
+    mesh.collect_garbage();
+    ASSERT_EQ(topology(mesh).nonManifoldVertices, 1u);
+    // Reach 0.5: the repair's hole (the faces at the vertex and a ring around them) ends one edge from the
+    // grid's border, and a cycle within the reach of the border counts as the border.
+    const fss::detail::ReferenceBorder border = fss::detail::referenceBorder(reference, 0.5);
+    // No repair round: only whether a defect is found.
+    fss::Mesh found = mesh;
+    EXPECT_FALSE(fss::detail::repairJoin(found, border, false, 0, false));
+    // Two rounds: the faces around the vertex removed and the hole filled, the grid's border kept.
+    EXPECT_TRUE(fss::detail::repairJoin(mesh, border, false, 2, false));
+    const fss::Metrics m = topology(mesh);
+    EXPECT_EQ(m.nonManifoldVertices, 0u);
+    EXPECT_EQ(m.boundaryLoops, 1u);
+    EXPECT_EQ(m.boundaryEdges, 24u);
 }

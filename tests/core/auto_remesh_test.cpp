@@ -666,6 +666,16 @@ TEST(AutoRemeshV2, ElephantJoinKeepsTheUnsampledPartsAndPassesValidation) {
 
 namespace {
 
+// A JoinTarget with the topology checks only (no genus, no distance).
+fss::detail::JoinTarget joinTarget(bool closed, std::size_t components, std::size_t loops, double vertices) {
+    fss::detail::JoinTarget t;
+    t.closed = closed;
+    t.components = components;
+    t.boundaryLoops = loops;
+    t.vertices = vertices;
+    return t;
+}
+
 // Two icospheres side by side in one mesh (two connected components, closed).
 fss::Mesh twoSpheres() {
     fss::Mesh m = fss::shapes::icosphere(2, 1.0);
@@ -698,15 +708,10 @@ TEST(AutoRemeshV2, ValidationCountsConnectedComponents) {
     const fss::Mesh two = twoSpheres();
     ASSERT_EQ(one.number_of_vertices(), 162u);
     ASSERT_EQ(two.number_of_vertices(), 324u);
-    EXPECT_EQ(fss::detail::validateJoin(
-                  one, {.closed = true, .components = 1, .boundaryLoops = 0, .vertices = 162}),
-              "");
-    EXPECT_EQ(fss::detail::validateJoin(
-                  two, {.closed = true, .components = 1, .boundaryLoops = 0, .vertices = 324}),
+    EXPECT_EQ(fss::detail::validateJoin(one, joinTarget(true, 1, 0, 162)), "");
+    EXPECT_EQ(fss::detail::validateJoin(two, joinTarget(true, 1, 0, 324)),
               "the joined mesh has 2 connected components, the input 1");
-    EXPECT_EQ(fss::detail::validateJoin(
-                  two, {.closed = true, .components = 2, .boundaryLoops = 0, .vertices = 324}),
-              "");
+    EXPECT_EQ(fss::detail::validateJoin(two, joinTarget(true, 2, 0, 324)), "");
 }
 
 // validateJoin counts boundary loops: an open join must end on the input's own borders (as many loops), and a
@@ -718,18 +723,44 @@ TEST(AutoRemeshV2, ValidationCountsBoundaryLoops) {
     const fss::MetricsOptions topologyOnly{.selfIntersections = false};
     ASSERT_EQ(fss::computeMetrics(oneHole, topologyOnly).boundaryLoops, 1u);
     ASSERT_EQ(fss::computeMetrics(twoHoles, topologyOnly).boundaryLoops, 2u);
-    EXPECT_EQ(fss::detail::validateJoin(
-                  oneHole, {.closed = true, .components = 1, .boundaryLoops = 0, .vertices = 162}),
+    EXPECT_EQ(fss::detail::validateJoin(oneHole, joinTarget(true, 1, 0, 162)),
               "the joined mesh has 1 boundary loops, the input 0");
-    EXPECT_EQ(fss::detail::validateJoin(
-                  twoHoles, {.closed = false, .components = 1, .boundaryLoops = 1, .vertices = 162}),
+    EXPECT_EQ(fss::detail::validateJoin(twoHoles, joinTarget(false, 1, 1, 162)),
               "the joined mesh has 2 boundary loops, the input 1");
-    EXPECT_EQ(fss::detail::validateJoin(
-                  twoHoles, {.closed = false, .components = 1, .boundaryLoops = 2, .vertices = 162}),
-              "");
+    EXPECT_EQ(fss::detail::validateJoin(twoHoles, joinTarget(false, 1, 2, 162)), "");
     // The vertex count: 162 against a target of 200 is 19 % short.
-    EXPECT_NE(fss::detail::validateJoin(
-                  oneHole, {.closed = false, .components = 1, .boundaryLoops = 1, .vertices = 200})
+    EXPECT_NE(fss::detail::validateJoin(oneHole, joinTarget(false, 1, 1, 200))
                   .find("parts of the surface were not sampled"),
               std::string::npos);
+}
+
+// validateJoin checks the genus (Euler characteristic) and the distance from the reference: session 19
+// measured joins that had the input's loop and component counts and were wrong all the same (elephant's join
+// in two passes: Euler characteristic 2 for the input's -4, its handles capped; rotor_small: a cap 5 L off
+// the surface). A sphere for a torus, and a sphere 20 % larger than its reference, are refused.
+TEST(AutoRemeshV2, ValidationChecksTheGenusAndTheDistanceFromTheInput) {
+    const fss::Mesh sphere = fss::shapes::icosphere(2, 1.0);
+    const fss::Mesh torus = fss::shapes::torus(24, 12, 1.0, 0.35);
+    const fss::MetricsOptions topologyOnly{.selfIntersections = false};
+    const fss::Metrics t = fss::computeMetrics(torus, topologyOnly);
+    ASSERT_EQ(long(t.vertices) - long(t.edges) + long(t.faces), 0);
+    fss::detail::JoinTarget genus = joinTarget(true, 1, 0, 162);
+    genus.eulerCharacteristic = 0;
+    EXPECT_EQ(fss::detail::validateJoin(sphere, genus),
+              "the joined mesh has Euler characteristic 2, the input 0");
+    genus.eulerCharacteristic = 2;
+    EXPECT_EQ(fss::detail::validateJoin(sphere, genus), "");
+    const fss::RayCaster onSphere(sphere);
+    fss::Mesh larger = sphere;
+    for (fss::VertexIndex v : larger.vertices()) {
+        const fss::Point3 p = larger.point(v);
+        larger.point(v) = fss::Point3(1.2 * p.x(), 1.2 * p.y(), 1.2 * p.z());
+    }
+    fss::detail::JoinTarget near = joinTarget(true, 1, 0, 162);
+    near.reference = &onSphere;
+    near.maxDistance = 0.1;
+    // The icosphere's own face centroids lie within 0.03 of it; every vertex of the larger one lies 0.2 off.
+    EXPECT_EQ(fss::detail::validateJoin(sphere, near), "");
+    EXPECT_EQ(fss::detail::validateJoin(larger, near),
+              "the joined mesh lies up to 2.000000 times the allowed distance from the input");
 }

@@ -6,9 +6,11 @@
 #include "fss/frame_buffers.h"
 #include "fss/mesh.h"
 #include "fss/progress.h"
+#include "fss/raycast.h"
 
 #include <Eigen/Core>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,11 +40,20 @@ struct JoinTarget {
     std::size_t components = 1;    ///< connected components (faces connected by edges), the reference's
     std::size_t boundaryLoops = 0; ///< boundary loops, the reference's
     double vertices = 0;           ///< the target's vertex count; the mesh must be within 10 % of it
+    /// The reference's Euler characteristic V − E + F (its genus, with the loops and components); none:
+    /// not checked. A hole filling that caps both ends of a gap around a handle keeps the loop and component
+    /// counts and cuts the handle (measured on rotor_small).
+    std::optional<long> eulerCharacteristic;
+    /// The reference, to check that every vertex and face centroid lies within maxDistance of it; none: not
+    /// checked (a cap the hole filling laid over a gap far from the surface, measured on rotor_small: 5 L).
+    const RayCaster* reference = nullptr;
+    double maxDistance = 0;
 };
 
 /// Why \p mesh is not an acceptable result of auto v2 (an empty string when it is): a boundary loop or
-/// connected component count other than \p target's, a vertex count more than 10 % off (parts of the
-/// surface not sampled), open when it must be closed, a pinched vertex, a degenerate face, a
+/// connected component count other than \p target's, another Euler characteristic (genus), a vertex count
+/// more than 10 % off (parts of the surface not sampled), open when it must be closed, a pinched vertex, a
+/// degenerate face, a vertex or face centroid farther than target.maxDistance from the reference, a
 /// self-intersection. The first failure found is named, in that order.
 std::string validateJoin(const Mesh& mesh, const JoinTarget& target);
 

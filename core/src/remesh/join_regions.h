@@ -72,6 +72,25 @@ void appendPatch(Mesh& out, const Mesh& patch);
 /// faces no view sees).
 std::vector<char> unsampledFaces(const Mesh& reference, const std::vector<Patch>& patches, double reach);
 
+/// The boundary of an open reference, sampled: a boundary cycle of the join that runs along it is the
+/// reference's own border, which the hole filling leaves open (none on a closed reference).
+struct ReferenceBorder {
+    std::vector<Eigen::Vector3d> samples; ///< points on the reference's boundary edges, at most reach/2 apart
+    double reach = 0;                     ///< a join edge whose midpoint lies this close is on the border
+};
+
+/// The samples of \p reference's boundary edges for ReferenceBorder with \p reach.
+ReferenceBorder referenceBorder(const Mesh& reference, double reach);
+
+/// Whether the boundary cycle of \p mesh through border halfedge \p h runs along \p border: at least half
+/// of its edges have their midpoint within border.reach of it.
+bool cycleOnBorder(const Mesh& mesh, HalfedgeIndex h, const ReferenceBorder& border);
+
+/// Fills every boundary cycle of \p mesh that does not run along \p border (cycleOnBorder) with CGAL's hole
+/// triangulation and refinement (a pinched cycle loop by loop, pinchedCycleLoops); the new faces take the
+/// scan id and quality of a face next to them.
+void fillJoinHoles(Mesh& mesh, const ReferenceBorder& border);
+
 /// How joinRegions closes the gaps between the regions.
 enum class JoinStyle {
     /// The faces of the reference no patch reaches are added as a region left from the input; one pass of
@@ -87,14 +106,16 @@ enum class JoinStyle {
 /// faces that intersect another, are degenerate, touch a pinched vertex or (\p closed) an unclosed boundary
 /// are removed with a ring around them and the holes filled again, up to \p repairRounds times.
 /// \p unsampled: the reference's faces to add as input faces (JoinStyle::InputRegions).
+/// \p border: the reference's boundary (its cycles stay open; empty when the reference is closed).
 void joinRegions(Mesh& mesh, const Mesh& reference, const std::vector<char>* unsampled,
-                 const RayCaster& caster, JoinStyle style, double L, bool closed, bool debug,
-                 int repairRounds);
+                 const RayCaster& caster, const ReferenceBorder& border, JoinStyle style, double L,
+                 bool closed, bool debug, int repairRounds);
 
 /// Repairs what the join left wrong: the faces that intersect another, are degenerate, touch a pinched vertex
+/// (on an open reference also one with two boundary fans, where two gaps meet)
 /// or (\p closed) an unclosed boundary are removed with a ring of faces around them and the holes filled
 /// again, up to \p rounds times. Returns true when none is left.
-bool repairJoin(Mesh& mesh, bool closed, int rounds, bool debug);
+bool repairJoin(Mesh& mesh, const ReferenceBorder& border, bool closed, int rounds, bool debug);
 
 /// Removes the smallest connected pieces of \p mesh of at most \p maxFaces faces while it has more than
 /// \p components pieces (an input face no patch reached, closed on itself by the hole filling); returns how
