@@ -54,6 +54,14 @@ fss::Metrics topology(const fss::Mesh& m) {
     return fss::computeMetrics(m, fss::MetricsOptions{.selfIntersections = false});
 }
 
+// The faces around an interior vertex, in CGAL's order around it.
+std::vector<fss::FaceIndex> facesAround(const fss::Mesh& mesh, fss::VertexIndex v) {
+    std::vector<fss::FaceIndex> faces;
+    for (fss::FaceIndex f : CGAL::faces_around_target(mesh.halfedge(v), mesh))
+        faces.push_back(f);
+    return faces;
+}
+
 } // namespace
 
 // Session 19 measured on the open meshes of issue 23: the join's repair refilled every boundary cycle, the
@@ -64,9 +72,7 @@ TEST(AutoJoin, HoleFillingLeavesTheReferenceBorderOpen) {
     const fss::Mesh reference = fss::shapes::grid(8, 8, 1.0);
     fss::Mesh holed = reference;
     const fss::VertexIndex centre = gridVertex(holed, 4.0, 4.0);
-    std::vector<fss::FaceIndex> around;
-    for (fss::FaceIndex f : CGAL::faces_around_target(holed.halfedge(centre), holed))
-        around.push_back(f);
+    const std::vector<fss::FaceIndex> around = facesAround(holed, centre);
     ASSERT_EQ(around.size(), 6u);
     for (fss::FaceIndex f : around)
         CGAL::Euler::remove_face(holed.halfedge(f), holed);
@@ -98,9 +104,7 @@ TEST(AutoJoin, RepairFindsAVertexWhereTwoGapsMeet) {
     const fss::Mesh reference = fss::shapes::grid(6, 6, 1.0);
     fss::Mesh mesh = reference;
     const fss::VertexIndex v = gridVertex(mesh, 3.0, 3.0);
-    std::vector<fss::FaceIndex> fan;
-    for (fss::FaceIndex f : CGAL::faces_around_target(mesh.halfedge(v), mesh))
-        fan.push_back(f);
+    const std::vector<fss::FaceIndex> fan = facesAround(mesh, v);
     ASSERT_EQ(fan.size(), 6u);
     CGAL::Euler::remove_face(mesh.halfedge(fan[0]), mesh);
     CGAL::Euler::remove_face(mesh.halfedge(fan[3]), mesh);
