@@ -31,6 +31,7 @@
 #include "fss/stitch.h"
 #include "fss/triangulate.h"
 
+#include "stitch_property_diag.h"
 #include "test_data.h"
 
 #include <CGAL/AABB_face_graph_triangle_primitive.h>
@@ -457,6 +458,8 @@ struct Figures {
     double createdMinAngle = 180, worstStitchFrac30 = 1;
     std::size_t createdFaces = 0, createdAbove30 = 0, createdExempt = 0;
     int stitchesCreatedAbove20 = 0, stitchesCreated98Above30 = 0, stitchesValence90 = 0;
+    int stitchesAllFour =
+        0; // >= 20 deg, >= 98 % >= 30 deg, >= 90 % valence 5-7, Hausdorff within a footprint
 };
 
 double seamAngleDeg(const Vec3& a, const Vec3& b, const Vec3& c) {
@@ -737,6 +740,7 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
         // Seam figures (issue 19), from the mesh alone: seam vertices are the vertices of changed faces
         // that also touch an unchanged face or a face of another scan id (where the patch meets the old
         // mesh, and the rim of the changed region); seam faces are the changed faces with a seam vertex.
+        bool angleCriteria = false; // issue 19's three shape criteria on this stitch
         {
             auto sid = current.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId);
             std::unordered_set<std::uint32_t> changed;
@@ -809,6 +813,7 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
             for (FaceIndex f : scan.patch.mesh.faces())
                 patchFaces.insert(keyOf(scan.patch.mesh, f));
             double created = 180;
+            FaceIndex worstFace;
             std::size_t n = 0, above30 = 0;
             for (FaceIndex f : changedAfter) {
                 if (patchFaces.count(keyOf(current, f))) continue;
@@ -821,6 +826,7 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
                     ++fig.createdExempt;
                     continue;
                 }
+                if (a < created) worstFace = f;
                 created = std::min(created, a);
             }
             const double frac30 = n ? double(above30) / double(n) : 1.0;
@@ -839,6 +845,16 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
             fig.stitchesCreated98Above30 += frac30 >= 0.98;
             fig.stitchesValence90 += fracValence >= 0.9;
             fig.worstStitchFrac30 = std::min(fig.worstStitchFrac30, frac30);
+            angleCriteria = created >= 20 && frac30 >= 0.98 && fracValence >= 0.9;
+            if (fss::test::stitchPropertyDiag() && created < 20) {
+                std::set<std::array<double, 3>> patchPoints;
+                for (auto v : scan.patch.mesh.vertices()) {
+                    const Point3& p = scan.patch.mesh.point(v);
+                    patchPoints.insert({p.x(), p.y(), p.z()});
+                }
+                fss::test::printWorstCreatedFace(cs.file, scanId, created, before, current, worstFace,
+                                                 changed, patchPoints);
+            }
         }
 
         // Seam neighbourhood: every changed face of `before` within seamRings vertex rings of a face that
@@ -890,6 +906,7 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
                 toReference(current, f, worst, where);
             EXPECT_LE(worst, 1.0) << "current -> reference: " << where;
             fig.worstToRef = std::max(fig.worstToRef, worst);
+            const bool toRefOk = worst <= 1.0;
 
             CGAL::Bbox_3 b;
             double fpMax = 0;
@@ -909,6 +926,7 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
                     fromReference(current, tree, p, worst, where);
             EXPECT_LE(worst, 1.0) << "reference -> current: " << where;
             fig.worstFromRef = std::max(fig.worstFromRef, worst);
+            fig.stitchesAllFour += angleCriteria && toRefOk && worst <= 1.0 && !HasFailure();
         }
         fig.checkSeconds += seconds(t);
         if (HasFailure()) {
@@ -958,6 +976,8 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
                 fig.stitchesCreated98Above30, fig.stitched, fig.worstStitchFrac30, fig.stitchesValence90,
                 fig.stitched, fig.createdFaces ? double(fig.createdAbove30) / double(fig.createdFaces) : 1.0,
                 fig.createdFaces);
+    std::printf("  issue 19's seam criterion (all four on one stitch): %d of %d stitches\n",
+                fig.stitchesAllFour, fig.stitched);
     EXPECT_GE(fig.createdMinAngle, cs.createdMinDeg) << "a face a stitch created is below issue 19's bound";
     EXPECT_GE(fig.stitched + fig.refused, cs.patches) << "too few scans produced a patch";
     // Most patches stitch (a majority); the refused ones are listed above with their reasons.
