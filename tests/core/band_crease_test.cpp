@@ -96,4 +96,71 @@ TEST(BandCrease, ShortEdgesAtAHeldCreaseVertexKeepTheCrease) {
     }
 }
 
+// A crease that ends inside the band (issue 19: the main job's variant with lattice angle 30 ends at 11.75
+// deg at such a crease end): a 12 x 12 grid of unit edges, flat (z = 0) for y <= 5 and a roof
+// z = -0.4 |x - 6| for y >= 6 (a crease along x = 6 from c = (6, 6) up; the faces between rows 5 and 6 turn
+// by less than the crease angle). The vertex below c, held by the caller as a rim vertex is, sits at
+// (6, 5.85), so the faces at the short edge between it and c are thin. c is a crease end: the band held it
+// like a corner and no flip, collapse or split there helps (FSS_STITCH_BAND_OFF=endslide: 4.64 -> 7.93 deg, c
+// unmoved). Now c slides along its one crease edge, on the crease line (measured 4.64 -> 28.91 deg, c at
+// (6, 6.44, 0)).
+TEST(BandCrease, CreaseEndSlidesAlongItsCrease) {
+    fss::Mesh m = fss::shapes::grid(12, 12, 1.0);
+    auto surface = [](double x, double y) { return y >= 6 ? -0.4 * std::abs(x - 6) : 0.0; };
+    for (fss::VertexIndex v : m.vertices()) {
+        const auto p = m.point(v);
+        m.point(v) = fss::Point3(p.x(), p.y(), surface(p.x(), p.y()));
+    }
+    const fss::VertexIndex c = vertexAt(m, 6, 6), h = vertexAt(m, 6, 5);
+    ASSERT_NE(c, fss::Mesh::null_vertex());
+    ASSERT_NE(h, fss::Mesh::null_vertex());
+    m.point(h) = fss::Point3(6, 5.85, 0);
+    std::vector<fss::FaceIndex> band;
+    for (fss::FaceIndex f : m.faces()) {
+        double x = 0, y = 0;
+        for (auto v : CGAL::vertices_around_face(m.halfedge(f), m)) {
+            x += m.point(v).x() / 3;
+            y += m.point(v).y() / 3;
+        }
+        if (x > 2.5 && x < 9.5 && y > 2.5 && y < 9.5) band.push_back(f);
+    }
+    fss::Camera camera;
+    camera.eye = {6, 6, 25};
+    camera.focal = {6, 6, 0};
+    camera.width = camera.height = 256;
+    fss::stitch::BandRemeshInput in;
+    in.mesh = &m;
+    in.band = band;
+    in.camera = &camera;
+    in.edgeLength = 1.0;
+    in.fixed = [&](fss::VertexIndex v) { return v == h; };
+    const auto r = fss::stitch::remeshBand(in);
+    ASSERT_TRUE(m.is_valid(false));
+    double after = 180;
+    for (fss::FaceIndex f : r.faces) {
+        const auto e = m.halfedge(f);
+        after = std::min(after, fss::stitch::smallestAngleDeg(at(m, m.source(e)), at(m, m.target(e)),
+                                                              at(m, m.target(m.next(e)))));
+    }
+    std::printf("crease end at a held vertex: smallest angle %.2f -> %.2f deg; crease end now at (%.3f, "
+                "%.3f, %.3f)\n",
+                r.minAngleBeforeDeg, after, m.point(c).x(), m.point(c).y(), m.point(c).z());
+    EXPECT_EQ(at(m, h), Eigen::Vector3d(6, 5.85, 0)); // held
+    EXPECT_LT(r.minAngleBeforeDeg, 10.0);
+    EXPECT_GE(after, 20.0);
+    // c went along its crease line (x = 6, z = 0 on the roof), not past the next crease vertex; every vertex
+    // stays near the surface (the band lifts its places onto the draft's smooth Phong surface, which leaves
+    // the roof's planes by up to 0.011 beside the rows between the plane and the roof, measured).
+    EXPECT_NEAR(m.point(c).x(), 6.0, 1e-9);
+    EXPECT_NEAR(m.point(c).z(), 0.0, 1e-9);
+    EXPECT_GT(m.point(c).y(), 6.0);
+    EXPECT_LT(m.point(c).y(), 7.0);
+    for (fss::VertexIndex v : m.vertices()) {
+        const auto p = m.point(v);
+        if (p.y() >= 6 - 1e-12 || p.y() <= 5 + 1e-12) {
+            EXPECT_NEAR(p.z(), surface(p.x(), p.y()), 0.02);
+        }
+    }
+}
+
 } // namespace

@@ -50,8 +50,8 @@ inline bool bandDiagnosticsVerbose() {
     return on;
 }
 
-// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,creasefilter,collapseall,short,star,bridge (and lift, split,
-// smooth) turns parts of the band remesh off (to measure what each brings).
+// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,endslide,creasefilter,collapseall,short,star,bridge (and lift,
+// split, smooth) turns parts of the band remesh off (to measure what each brings).
 inline bool stageOff(const char* name) {
     static const std::string off = [] {
         const char* e = std::getenv("FSS_STITCH_BAND_OFF");
@@ -107,6 +107,7 @@ public:
             const bool merged = !stageOff("short") && shortEdgePass();
             const bool changed = repairPass() || merged;
             if (!stageOff("slide")) slidePass();
+            if (!stageOff("endslide")) slideCreaseEndPass();
             improvePass();
             flipPass();
             if (!changed) break;
@@ -696,6 +697,8 @@ private:
     // Crease vertices of faces below the aim slide along their (nearly straight) crease: candidates on the
     // two crease edges, the one that maximises the star's smallest angle wins.
     void slidePass();
+    // Crease ends of faces below the aim slide along their one crease edge (band_crease_end.cpp).
+    void slideCreaseEndPass();
     double starMinAngle(VertexIndex v, const V3& at) const {
         double m = std::numbers::pi;
         for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {

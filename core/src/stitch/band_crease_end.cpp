@@ -1,0 +1,60 @@
+// Stitch v2, design B: crease ends slid along their crease (band_remesher.h). The band holds a vertex with
+// one crease edge (a crease end) like a crease corner, so a face below the aim with such a corner stays as
+// it is wherever no flip, collapse or split around it helps (issue 19: the main job's variant with
+// lattice angle 30 ends at 11.75 deg there). A crease end whose whole star is in the band and that the
+// caller does not hold may instead move along its one crease edge, onto the draft's crease polyline where
+// it has a place on it: the crease then ends a little earlier, on the same line. Only where the smallest
+// angle of its star rises and every face of the star stays facing and within the normal bound.
+#include "stitch/band_remesher.h"
+
+namespace fss::stitch::band {
+
+void BandRemesher::slideCreaseEndPass() {
+    const double aim = in_.minAngleDeg * kBandDeg, maxTurn = in_.maxNormalTurnDeg * kBandDeg;
+    std::vector<VertexIndex> ends;
+    std::unordered_set<std::uint32_t> seen;
+    for (std::size_t f = 0; f < band_.size(); ++f) {
+        const FaceIndex g(static_cast<std::uint32_t>(f));
+        if (!band_[f] || S_.is_removed(g) || faceMinAngle(g) >= aim) continue;
+        for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_))
+            if (creaseDegree(v) == 1 && wholeStarInBand(v) && !(in_.fixed && in_.fixed(v)) &&
+                seen.insert(std::uint32_t(v)).second)
+                ends.push_back(v);
+    }
+    std::sort(ends.begin(), ends.end());
+    for (VertexIndex v : ends) {
+        VertexIndex e = Mesh::null_vertex();
+        for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(v), S_))
+            if (isCrease(v, w)) e = w;
+        if (e == Mesh::null_vertex()) continue;
+        const V3 p = detail::pos(S_, v), pe = detail::pos(S_, e);
+        double best = starMinAngle(v, p);
+        V3 bestP = p;
+        CreasePos bestPos;
+        for (double t : {0.1, 0.2, 0.3, 0.4}) {
+            V3 q = p + t * (pe - p);
+            const CreasePos cp = creaseBetween(v, e, t, q);
+            const double a = starMinAngle(v, q);
+            if (a > best + 1e-9 && starAcceptable(v, q, maxTurn)) {
+                best = a;
+                bestP = q;
+                bestPos = cp;
+            }
+        }
+        if (bestP == p) continue;
+        S_.point(v) = Point3(bestP.x(), bestP.y(), bestP.z());
+        if (bestPos.chain >= 0)
+            creasePos_[std::uint32_t(v)] = {bestPos};
+        else
+            creasePos_.erase(std::uint32_t(v));
+        const FaceIndex hint = at(hint_, std::size_t(v), Mesh::null_face());
+        if (hint != Mesh::null_face()) {
+            const SurfacePoint sp = near2_(bestP, hint);
+            if (sp) hint_[std::size_t(v)] = sp.face;
+        }
+        touch(v);
+        ++report_.moves;
+    }
+}
+
+} // namespace fss::stitch::band
