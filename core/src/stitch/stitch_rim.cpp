@@ -48,8 +48,16 @@ void ComponentStitcher::noteHeldRim(Local& loc, const std::vector<FaceIndex>& ba
         for (VertexIndex v : CGAL::vertices_around_face(fh, S)) {
             // Held by kept faces only: not on the local mesh's border (its whole star is in S), not new.
             if (!loc.locked[v] || S.is_border(v) || !loc.star.isFull(v) || loc.star.cur[v] == kNone ||
-                !inRegion(loc.star.cur[v]))
+                !inRegion(loc.star.cur[v])) {
+                if (loc.locked[v] && stitch::band::bandDiagnosticsVerbose())
+                    std::fprintf(stderr, "  rim: corner %u of a face below 20 deg not grown past: %s\n",
+                                 std::uint32_t(v),
+                                 S.is_border(v)             ? "on the local mesh's border"
+                                 : !loc.star.isFull(v)      ? "star not whole"
+                                 : loc.star.cur[v] == kNone ? "new vertex"
+                                                            : "not a corner of a region face");
                 continue;
+            }
             bool ok = true;
             int kept = 0;
             for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(v), S)) {
@@ -67,6 +75,10 @@ void ComponentStitcher::noteHeldRim(Local& loc, const std::vector<FaceIndex>& ba
                 ok = ok && g != Mesh::null_face() && M_.next(M_.next(M_.next(mh))) == mh;
             }
             if (ok && kept > 0) heldRim_.push_back(loc.star.cur[v]);
+            if (!(ok && kept > 0) && stitch::band::bandDiagnosticsVerbose())
+                std::fprintf(stderr, "  rim: corner %u of a face below 20 deg not grown past: %s\n",
+                             std::uint32_t(v),
+                             kept ? "a patch face or a non-triangle around it" : "no kept face");
         }
     }
     std::sort(heldRim_.begin(), heldRim_.end());
