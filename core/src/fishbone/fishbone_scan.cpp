@@ -8,6 +8,7 @@
 #include "fishbone/crease_backbone.h"
 #include "fishbone/crease_index.h"
 #include "fishbone/fishbone_options.h"
+#include "fishbone/lasso_clip.h"
 #include "mesh/features.h"
 
 #include <CGAL/boost/graph/iterator.h>
@@ -567,6 +568,8 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
     if ((options.stopRibsAtCreases || straight) && fb.creaseAngleDeg > 0)
         result.counts.creaseStopped =
             stops().stopRibsAtCreases(result.fishbone, options.spareFollowedCrease || straight);
+    if (options.clipRibsAtLasso && params.lasso)
+        result.counts.lassoClipped = detail::clipRibsAtLasso(result.fishbone, *params.lasso, 0.5);
     result.timings.tracing = secondsSince(t);
     result.counts.directionPixels = backboneField.computedPixels() + ribField.computedPixels();
     result.counts.rows = result.fishbone.rows;
@@ -596,6 +599,13 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
     if (result.counts.frontFacing == 0)
         throw InvalidInputError("No rib vertex of the fishbone lands on the front of the surface.");
 
+    // Rib ends whose quads make thin triangles are peeled (peelRibEndsDeg), inside the lasso (the mask below
+    // drops the same samples again).
+    if (options.peelRibEndsDeg > 0) {
+        if (params.lasso) applyLasso(result.grid, *params.lasso);
+        result.counts.peeled =
+            detail::peelSliverRibEnds(result.grid, result.fishbone.backboneColumn, options.peelRibEndsDeg, 3);
+    }
     MaskStages stages;
     if (params.lasso) stages.lasso = &*params.lasso;
     if (!currentIsReference) {
