@@ -123,6 +123,8 @@ void expectSame(const fss::ScanStep& a, const fss::ScanStep& b) {
         EXPECT_EQ(fa.tracing.minComponentFaces, fb.tracing.minComponentFaces);
         EXPECT_EQ(fa.tracing.creaseBackbone, fb.tracing.creaseBackbone);
         EXPECT_EQ(fa.tracing.continuousKeyRibs, fb.tracing.continuousKeyRibs);
+        EXPECT_EQ(fa.tracing.clipRibsAtLasso, fb.tracing.clipRibsAtLasso);
+        EXPECT_TRUE(sameBits(fa.tracing.peelRibEndsDeg, fb.tracing.peelRibEndsDeg));
         expectSame(fa.tracing.backboneTracing, fb.tracing.backboneTracing);
         expectSame(fa.tracing.ribTracing, fb.tracing.ribTracing);
         EXPECT_TRUE(sameBits(fa.minSeedAnisotropy, fb.minSeedAnisotropy));
@@ -233,6 +235,8 @@ fss::ScanStep fishboneStep() {
     fb.tracing.spareFollowedCrease = true;
     fb.tracing.minFaceAngleDeg = 22.5;
     fb.tracing.minComponentFaces = 30;
+    fb.tracing.clipRibsAtLasso = true;
+    fb.tracing.peelRibEndsDeg = 27.5;
     fb.tracing.backboneTracing.step = 0.3;
     fb.tracing.backboneTracing.minStep = 0.01;
     fb.tracing.backboneTracing.maxLength = 77.5;
@@ -510,7 +514,8 @@ TEST_F(BadSessionFile, FishboneSliverRulesAreOffWhenAbsentAndOnByDefault) {
     const std::vector<const char*> keys{
         "min_rib_gap",           "max_rib_turn_deg",    "max_rib_aspect",           "stop_ribs_at_creases",
         "spare_followed_crease", "close_loops",         "stop_backbone_at_creases", "isotropic_ribs",
-        "min_face_angle_deg",    "min_component_faces", "crease_backbone",          "continuous_key_ribs"};
+        "min_face_angle_deg",    "min_component_faces", "crease_backbone",          "continuous_key_ribs",
+        "clip_ribs_at_lasso",    "peel_rib_ends_deg"};
     for (const char* k : keys)
         ASSERT_TRUE(t.contains(k)) << k;
     const fss::FishboneOptions on = tracingOf(j);
@@ -520,6 +525,8 @@ TEST_F(BadSessionFile, FishboneSliverRulesAreOffWhenAbsentAndOnByDefault) {
     EXPECT_EQ(on.minComponentFaces, 30);
     EXPECT_TRUE(on.creaseBackbone);
     EXPECT_TRUE(on.continuousKeyRibs);
+    EXPECT_TRUE(on.clipRibsAtLasso);
+    EXPECT_EQ(on.peelRibEndsDeg, 27.5);
     for (const char* k : keys)
         t.erase(k);
     const fss::FishboneOptions off = tracingOf(j);
@@ -535,14 +542,18 @@ TEST_F(BadSessionFile, FishboneSliverRulesAreOffWhenAbsentAndOnByDefault) {
     EXPECT_EQ(off.minComponentFaces, 0);
     EXPECT_FALSE(off.creaseBackbone);
     EXPECT_FALSE(off.continuousKeyRibs);
+    EXPECT_FALSE(off.clipRibsAtLasso);
+    EXPECT_EQ(off.peelRibEndsDeg, 0.0);
     // New scans: the loop closing, the face-angle bound and the small-part drop are on (SliverTable's
     // figures, issue 20's report); the others stay off.
     const fss::FishboneOptions fresh;
     EXPECT_TRUE(fresh.closeLoops);
     EXPECT_EQ(fresh.minFaceAngleDeg, 20.0);
     EXPECT_EQ(fresh.minComponentFaces, 24);
-    EXPECT_TRUE(fresh.creaseBackbone);    // session 16: backbones on creases
-    EXPECT_TRUE(fresh.continuousKeyRibs); // session 18: key-ribs between samples
+    EXPECT_TRUE(fresh.creaseBackbone);     // session 16: backbones on creases
+    EXPECT_TRUE(fresh.continuousKeyRibs);  // session 18: key-ribs between samples
+    EXPECT_FALSE(fresh.clipRibsAtLasso);   // session 20: an option (no better than the peel alone)
+    EXPECT_EQ(fresh.peelRibEndsDeg, 30.0); // session 20: thin rib ends peeled
     EXPECT_FALSE(fresh.stopRibsAtCreases);
     EXPECT_EQ(fresh.maxRibAspect, 0.0);
 }

@@ -127,6 +127,22 @@ struct FishboneOptions {
     /// (TriangulateOptions::minComponentFaces): the fragments left between crease stops and dropped
     /// quads. ≥ 0; 0 = none (files written before it); 24 by default (four rows of three quads).
     int minComponentFaces = 24;
+    /// With a lasso (ScanParams::lasso), the fishbone scan clips every half-rib at it: each edge of a
+    /// half-rib that crosses the lasso gets a vertex on the crossing (its outer vertex moved there when the
+    /// crossing lies at least half the edge out, else its inner one, never the backbone sample), instead of
+    /// ending at whichever whole sample is still inside. false by default and in files written before it:
+    /// measured in SliverTable (session 20), it makes last edges of ½–1½ h whose trapezoids have triangles
+    /// down to 20° (lens torus top with lasso 36.9° → 20.3°, side 5.4 → 6.6 % below 30°); with peelRibEndsDeg
+    /// it is about even (side 0.0 %, top 32.5°), so the peel alone is the default.
+    bool clipRibsAtLasso = false;
+    /// The fishbone scan drops the end sample of a run of samples along a rib (at the lasso, a silhouette, a
+    /// crease stop, a trimmed rib) where a triangle of its quads with the rib's previous sample has a 3D
+    /// angle below this, up to three times inwards (after the ray cast and the lasso;
+    /// detail::peelSliverRibEnds): rib ends cut obliquely by the patch's border made most of the faces below
+    /// 30° left by minFaceAngleDeg. Degrees in [0, 60); 0 = off (files written before it). 30 by default
+    /// (session 20: every SliverTable default row ≥ 24.6°, the lens torus side view with its lasso 5.4 → 0.1
+    /// % below 30°).
+    double peelRibEndsDeg = 30.0;
     /// The surface length of the screen segment a – b in pixel footprints (set by the fishbone scan for
     /// isotropicRibs; empty: no surface spacing). A rib's surface spacing is capped at 2.5 h of it (the
     /// triangulation drops edges longer than 3 h footprints). Must be safe to call from several threads. Not
@@ -134,9 +150,9 @@ struct FishboneOptions {
     std::function<double(const Eigen::Vector2d& a, const Eigen::Vector2d& b)> surfaceLength{};
 
     /// Checks the ranges: spacing finite and > 0, minRibGap in [0, 1), maxRibTurnDeg in (0, 180],
-    /// maxRibAspect 0 or in [1, 100], minFaceAngleDeg in [0, 60), minComponentFaces ≥ 0, and both tracings
-    /// (StreamlineOptions::validate, named "FishboneOptions::backboneTracing.step" ...). \throw
-    /// InvalidOptionError naming the field.
+    /// maxRibAspect 0 or in [1, 100], minFaceAngleDeg and peelRibEndsDeg in [0, 60), minComponentFaces ≥ 0,
+    /// and both tracings (StreamlineOptions::validate, named "FishboneOptions::backboneTracing.step" ...).
+    /// \throw InvalidOptionError naming the field.
     void validate() const;
 };
 

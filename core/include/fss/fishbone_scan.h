@@ -163,6 +163,8 @@ struct FishboneCounts {
     std::size_t ribVertices = 0;     ///< present entries of the fishbone grid
     std::size_t trimmed = 0;         ///< rib vertices removed by trimRibs (automatic mode)
     std::size_t creaseStopped = 0;   ///< rib vertices removed by FishboneOptions::stopRibsAtCreases
+    std::size_t lassoClipped = 0;    ///< rib vertices removed by FishboneOptions::clipRibsAtLasso
+    std::size_t peeled = 0;          ///< samples dropped by FishboneOptions::peelRibEndsDeg
     std::size_t directionPixels = 0; ///< direction field pixels computed (backbone's + ribs' fields)
     std::size_t covered = 0;         ///< rays that hit the reference
     std::size_t frontFacing = 0;     ///< of those, on front-facing faces

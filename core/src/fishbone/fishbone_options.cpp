@@ -66,6 +66,7 @@ void FishboneOptions::validate() const {
     check.inRange("maxRibTurnDeg", maxRibTurnDeg, 0, 180, true, false);
     if (maxRibAspect != 0) check.inRange("maxRibAspect", maxRibAspect, 1, 100, false, false);
     check.inRange("minFaceAngleDeg", minFaceAngleDeg, 0, 60, false, true);
+    check.inRange("peelRibEndsDeg", peelRibEndsDeg, 0, 60, false, true);
     check.intAtLeast("minComponentFaces", minComponentFaces, 0);
     detail::nestedOptions(owner, "backboneTracing.", [&] { backboneTracing.validate(); });
     detail::nestedOptions(owner, "ribTracing.", [&] { ribTracing.validate(); });

@@ -8,6 +8,7 @@
 #include "fishbone/crease_backbone.h"
 #include "fishbone/crease_index.h"
 #include "fishbone/fishbone_options.h"
+#include "fishbone/lasso_clip.h"
 #include "mesh/features.h"
 
 #include <CGAL/boost/graph/iterator.h>
@@ -427,6 +428,20 @@ FishboneGrid keyRibGrid(const DirectionField& ribField, const Backbone& backbone
     return keyRibFishbone(backbone, std::move(keys), options, W, H);
 }
 
+// The half-ribs clipped at the lasso (FishboneOptions::clipRibsAtLasso): the number of vertices dropped.
+std::size_t clipAtLasso(FishboneScanResult& result, const ScanParams& params) {
+    return detail::clipRibsAtLasso(result.fishbone, *params.lasso, 0.5);
+}
+
+// Rib ends whose quads make thin triangles peeled (FishboneOptions::peelRibEndsDeg), inside the lasso (the
+// mask drops the same samples again).
+void peelRibEnds(FishboneScanResult& result, const ScanParams& params, const FishboneOptions& options) {
+    if (!(options.peelRibEndsDeg > 0)) return;
+    if (params.lasso) applyLasso(result.grid, *params.lasso);
+    result.counts.peeled =
+        detail::peelSliverRibEnds(result.grid, result.fishbone.backboneColumn, options.peelRibEndsDeg, 3);
+}
+
 // The scan on its sampling image: \p params and \p fb are already scaled to it (and validated); \p k is
 // the sampling factor, only for the positions in error messages (which the user gave in scan pixels).
 FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& referenceRenderer,
@@ -567,6 +582,7 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
     if ((options.stopRibsAtCreases || straight) && fb.creaseAngleDeg > 0)
         result.counts.creaseStopped =
             stops().stopRibsAtCreases(result.fishbone, options.spareFollowedCrease || straight);
+    if (options.clipRibsAtLasso && params.lasso) result.counts.lassoClipped = clipAtLasso(result, params);
     result.timings.tracing = secondsSince(t);
     result.counts.directionPixels = backboneField.computedPixels() + ribField.computedPixels();
     result.counts.rows = result.fishbone.rows;
@@ -596,6 +612,7 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
     if (result.counts.frontFacing == 0)
         throw InvalidInputError("No rib vertex of the fishbone lands on the front of the surface.");
 
+    peelRibEnds(result, params, options);
     MaskStages stages;
     if (params.lasso) stages.lasso = &*params.lasso;
     if (!currentIsReference) {

@@ -412,6 +412,7 @@ AutoResult autoRemesh(const Mesh& reference, const AutoOptions& options, const P
                 fb.tracing.closeLoops = false;
                 fb.tracing.minFaceAngleDeg = 0;
                 fb.tracing.minComponentFaces = 0;
+                fb.tracing.peelRibEndsDeg = 0; // session 20's rib-end peel likewise
                 step.camera = params.camera;
                 auto ts = Clock::now();
                 FishboneScanResult scan = scanFishbonePatch(reference, *referenceRenderer, current,

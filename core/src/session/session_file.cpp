@@ -119,6 +119,9 @@ struct Writer {
         if (p.tracing.stopBackboneAtCreases) t["stop_backbone_at_creases"] = true;
         if (p.tracing.creaseBackbone) t["crease_backbone"] = true;
         if (p.tracing.continuousKeyRibs) t["continuous_key_ribs"] = true;
+        if (p.tracing.clipRibsAtLasso) t["clip_ribs_at_lasso"] = true;
+        if (p.tracing.peelRibEndsDeg != 0)
+            t["peel_rib_ends_deg"] = number(p.tracing.peelRibEndsDeg, f + ".tracing.peel_rib_ends_deg");
         if (p.tracing.isotropicRibs) t["isotropic_ribs"] = true;
         if (p.tracing.maxRibTurnDeg != 180)
             t["max_rib_turn_deg"] = number(p.tracing.maxRibTurnDeg, f + ".tracing.max_rib_turn_deg");
@@ -476,7 +479,7 @@ FishboneParams readFishbone(const Node& n) {
     t.onlyKeys({"spacing", "extend_beyond_key_ribs", "backbone", "ribs", "min_rib_gap", "max_rib_turn_deg",
                 "stop_ribs_at_creases", "close_loops", "stop_backbone_at_creases", "isotropic_ribs",
                 "max_rib_aspect", "spare_followed_crease", "min_face_angle_deg", "min_component_faces",
-                "crease_backbone", "continuous_key_ribs"});
+                "crease_backbone", "continuous_key_ribs", "clip_ribs_at_lasso", "peel_rib_ends_deg"});
     p.tracing.spacing = t.at("spacing").number();
     p.tracing.extendBeyondKeyRibs = t.at("extend_beyond_key_ribs").boolean();
     p.tracing.minRibGap = t.has("min_rib_gap") ? t.at("min_rib_gap").number() : 0.0;
@@ -488,6 +491,8 @@ FishboneParams readFishbone(const Node& n) {
     p.tracing.isotropicRibs = t.has("isotropic_ribs") && t.at("isotropic_ribs").boolean();
     p.tracing.creaseBackbone = t.has("crease_backbone") && t.at("crease_backbone").boolean();
     p.tracing.continuousKeyRibs = t.has("continuous_key_ribs") && t.at("continuous_key_ribs").boolean();
+    p.tracing.clipRibsAtLasso = t.has("clip_ribs_at_lasso") && t.at("clip_ribs_at_lasso").boolean();
+    p.tracing.peelRibEndsDeg = t.has("peel_rib_ends_deg") ? t.at("peel_rib_ends_deg").number() : 0.0;
     p.tracing.maxRibAspect = t.has("max_rib_aspect") ? t.at("max_rib_aspect").number() : 0.0;
     p.tracing.spareFollowedCrease = t.has("spare_followed_crease") && t.at("spare_followed_crease").boolean();
     p.tracing.minFaceAngleDeg = t.has("min_face_angle_deg") ? t.at("min_face_angle_deg").number() : 0.0;
