@@ -389,6 +389,8 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
     // region sampled kept as a region of their own, joined in one pass (JoinStyle::InputRegions), then
     // session 15's join (JoinStyle::TwoPasses), which bridges those parts with the hole filling.
     const std::vector<char> unsampled = unsampledFaces(reference, patches, L);
+    const char* widenEnv = std::getenv("FSS_AUTO_V2_WIDEN");
+    const bool widen = widenEnv && std::string(widenEnv) == "1";
     const ReferenceBorder border = closedInput ? ReferenceBorder{} : referenceBorder(reference, L);
     patches.clear();
     const RayCaster caster(reference);
@@ -409,8 +411,12 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
                             .maxDistanceFromInput = kMaxDistanceFromInput * L};
     // The join is chosen on its topology only: the hole filling's vertices lie off the reference until the
     // seam relaxation projects them (measured on bunny00: 1.6 L after the join, 0.22 L at the end).
+    // The distance from the input too is checked at the end only: with it in the join's choice the widening
+    // below ran on bunny00 and left 2 components (measured, session 20).
     JoinTarget joinTarget = target;
     joinTarget.reference = nullptr;
+    joinTarget.inputSamples = nullptr;
+    if (widen) joinTarget.inputSamples = &samples;
     std::vector<char> inputFaces = unsampled;
     {
         // When the repaired join fails validation, the reference's own faces within 2 L of what the join
@@ -432,22 +438,20 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
             repaired.collect_garbage();
             // Measured on elephant: two input faces no patch reached, each closed on itself by the filling.
             dropSmallPieces(repaired, target.components, 8);
-            const char* widen = std::getenv("FSS_AUTO_V2_WIDEN");
             const std::string roundWhy = validateJoin(repaired, joinTarget);
             if (debug)
                 std::fprintf(stderr, "v2: join round %d: %s\n", round,
                              roundWhy.empty() ? "valid" : roundWhy.c_str());
-            if (round == kWidenRounds || roundWhy.empty()) {
+            if (round == kWidenRounds || !widen || roundWhy.empty()) {
                 joined = std::move(repaired);
                 break;
             }
-            // The reference's faces the repaired join does not cover (centroid farther than L from it) become
-            // input faces (measured on mech-holes-shark: the repair's hole around intersecting faces next to
-            // a hole of the part merged with the hole's border cycle, which the filling leaves open: a notch
-            // 12 L wide, 2.8 L deep).
+            // With FSS_AUTO_V2_WIDEN=1: the reference's faces the repaired join does not cover (centroid
+            // farther than L from it) become input faces (measured on mech-holes-shark: the repair's hole
+            // around intersecting faces next to a hole of the part merged with the hole's border cycle, which
+            // the filling leaves open: a notch 12 L wide, 2.8 L deep).
             std::size_t added = flagUncoveredFaces(reference, repaired, L, inputFaces);
-            if (widen && std::string(widen) == "1")
-                added += widenInputRegions(reference, joined, closedInput, 2 * L, inputFaces);
+            added += widenInputRegions(reference, joined, closedInput, 2 * L, inputFaces);
             if (debug) std::fprintf(stderr, "v2: widen round %d: %zu input faces more\n", round, added);
             if (added == 0) {
                 joined = std::move(repaired);
