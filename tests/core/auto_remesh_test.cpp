@@ -764,3 +764,15 @@ TEST(AutoRemeshV2, ValidationChecksTheGenusAndTheDistanceFromTheInput) {
     EXPECT_EQ(fss::detail::validateJoin(larger, near),
               "the joined mesh lies up to 2.000000 times the allowed distance from the input");
 }
+
+// mech-holes-shark (session 20): the join left a gap next to one of the part's holes open, merged with the
+// hole's border (Hausdorff from the input 0.048 of the diagonal, CGAL 0.0024), and passed validation with
+// the right loop count and genus. The distance from the input's vertices and face centroids now refuses it.
+TEST(AutoRemeshV2, SharkJoinThatLeavesAGapOpenIsRefused) {
+    const fss::Mesh part = fss::readMesh(fss::test::meshPath("mech-holes-shark.off"));
+    fss::AutoOptions o;
+    o.engine = fss::AutoEngine::V2;
+    o.fallbackToV1 = false;
+    const fss::AutoResult r = fss::autoRemesh(part, o);
+    EXPECT_NE(r.engineNote.find("leaves parts of the input uncovered"), std::string::npos) << r.engineNote;
+}

@@ -48,13 +48,23 @@ struct JoinTarget {
     /// checked (a cap the hole filling laid over a gap far from the surface, measured on rotor_small: 5 L).
     const RayCaster* reference = nullptr;
     double maxDistance = 0;
+    /// Points of the reference (its vertices and face centroids) that must each lie within
+    /// maxDistanceFromInput of the mesh: the one-sided distance from the input, which catches the parts of
+    /// the input the mesh does not cover (measured on mech-holes-shark: a gap between two patches joined to
+    /// a hole's border and left open, the loop count right); none: not checked.
+    const std::vector<Eigen::Vector3d>* inputSamples = nullptr;
+    double maxDistanceFromInput = 0;
 };
+
+/// The points of \p reference whose distance to a join validateJoin bounds: its vertices and face centroids.
+std::vector<Eigen::Vector3d> inputSamples(const Mesh& reference);
 
 /// Why \p mesh is not an acceptable result of auto v2 (an empty string when it is): a boundary loop or
 /// connected component count other than \p target's, another Euler characteristic (genus), a vertex count
 /// more than 10 % off (parts of the surface not sampled), open when it must be closed, a pinched vertex, a
-/// degenerate face, a vertex or face centroid farther than target.maxDistance from the reference, a
-/// self-intersection. The first failure found is named, in that order.
+/// degenerate face, a vertex or face centroid farther than target.maxDistance from the reference, a point of
+/// target.inputSamples farther than target.maxDistanceFromInput from the mesh, a self-intersection. The first
+/// failure found is named, in that order.
 std::string validateJoin(const Mesh& mesh, const JoinTarget& target);
 
 /// autoRemesh with AutoEngine::V2 (auto_v2.cpp). Throws what autoRemesh throws; returns a result whose

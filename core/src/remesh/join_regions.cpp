@@ -305,6 +305,87 @@ std::vector<FaceIndex> fillPinchedCycle(Mesh& mesh, HalfedgeIndex h, std::vector
     return added;
 }
 
+/// Closes the inlets of the boundary cycle through border halfedge \p h, which runs along the reference's
+/// border: a run of its edges whose midpoints lie off the border (farther than border.reach), from vertex a
+/// to vertex b, that goes into the surface and comes back (a gap between two patches that reaches the
+/// border: its path at least kInletRatio times the chord a-b, the chord at most kInletChord reaches) is
+/// triangulated as a polygon closed by the chord (no new vertex), then refined. Measured on
+/// mech-holes-shark: such a gap merged with a hole's border cycle, which the hole filling then left open.
+/// Returns the faces added; \p newVertices receives the refinement's.
+std::vector<FaceIndex> closeBorderInlets(Mesh& mesh, HalfedgeIndex h, const PointGrid& near, double reach,
+                                         std::vector<VertexIndex>& newVertices) {
+    constexpr double kInletRatio = 2.5, kInletChord = 4.0;
+    std::vector<VertexIndex> cycle;
+    std::vector<char> off;
+    for (HalfedgeIndex g : CGAL::halfedges_around_face(h, mesh)) {
+        cycle.push_back(mesh.source(g));
+        off.push_back(!near.near(0.5 * (at(mesh, mesh.source(g)) + at(mesh, mesh.target(g)))));
+    }
+    const std::size_t n = cycle.size();
+    std::size_t start = n;
+    for (std::size_t i = 0; i < n && start == n; ++i)
+        if (!off[i]) start = i; // a run never wraps past an edge on the border
+    if (start == n) return {};
+    std::vector<std::vector<VertexIndex>> inlets;
+    for (std::size_t k = 1; k <= n; ++k) {
+        const std::size_t i = (start + k) % n;
+        if (!off[i]) continue;
+        std::vector<VertexIndex> run{cycle[i]};
+        double path = 0;
+        std::size_t j = i;
+        while (off[j]) {
+            const std::size_t next = (j + 1) % n;
+            path += (at(mesh, cycle[next]) - at(mesh, cycle[j])).norm();
+            run.push_back(cycle[next]);
+            j = next;
+            ++k;
+        }
+        const double chord = (at(mesh, run.back()) - at(mesh, run.front())).norm();
+        std::vector<VertexIndex> sorted = run;
+        std::sort(sorted.begin(), sorted.end());
+        const bool simple = std::unique(sorted.begin(), sorted.end()) == sorted.end();
+        const bool accept = run.size() >= 4 && simple && chord <= kInletChord * reach &&
+                            path >= kInletRatio * chord &&
+                            mesh.halfedge(run.back(), run.front()) == Mesh::null_halfedge();
+        if (std::getenv("FSS_AUTO_V2_DEBUG") && run.size() >= 3)
+            std::fprintf(stderr, "v2 inlet: %zu of %zu edges, chord %.2f reach, path %.2f chords, %s: %s\n",
+                         run.size() - 1, n, chord / reach, path / std::max(chord, 1e-300),
+                         simple ? "simple" : "not simple", accept ? "closed" : "left");
+        if (accept) inlets.push_back(std::move(run));
+    }
+    std::vector<FaceIndex> added;
+    for (const std::vector<VertexIndex>& loop : inlets) {
+        std::vector<Point3> points;
+        for (VertexIndex v : loop)
+            points.push_back(mesh.point(v));
+        std::vector<CGAL::Triple<int, int, int>> triangles;
+        CGAL::Polygon_mesh_processing::triangulate_hole_polyline(points, std::back_inserter(triangles));
+        std::vector<FaceIndex> faces;
+        bool ok = !triangles.empty();
+        for (const CGAL::Triple<int, int, int>& t : triangles) {
+            const FaceIndex f = mesh.add_face(loop[std::size_t(t.first)], loop[std::size_t(t.second)],
+                                              loop[std::size_t(t.third)]);
+            if (f == Mesh::null_face()) {
+                ok = false;
+                break;
+            }
+            faces.push_back(f);
+        }
+        if (!ok) {
+            for (FaceIndex f : faces)
+                CGAL::Euler::remove_face(mesh.halfedge(f), mesh);
+            continue;
+        }
+        added.insert(added.end(), faces.begin(), faces.end());
+    }
+    std::vector<FaceIndex> refined;
+    if (!added.empty())
+        CGAL::Polygon_mesh_processing::refine(mesh, added, std::back_inserter(refined),
+                                              std::back_inserter(newVertices));
+    added.insert(added.end(), refined.begin(), refined.end());
+    return added;
+}
+
 Eigen::Vector3d centroid(const Mesh& m, FaceIndex f) {
     Eigen::Vector3d c(0, 0, 0);
     for (VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m))
@@ -340,16 +421,28 @@ bool cycleOnBorder(const Mesh& mesh, HalfedgeIndex h, const ReferenceBorder& bor
     return 2 * near >= edges;
 }
 
-void fillJoinHoles(Mesh& mesh, const ReferenceBorder& border) {
+void fillJoinHoles(Mesh& mesh, const ReferenceBorder& border, bool closeInlets) {
     auto ids = mesh.add_property_map<FaceIndex, std::int32_t>(props::faceScanId, -1).first;
     auto quality = mesh.add_property_map<FaceIndex, float>(props::faceQuality, 0.f).first;
     std::vector<HalfedgeIndex> cycles;
     CGAL::Polygon_mesh_processing::extract_boundary_cycles(mesh, std::back_inserter(cycles));
+    PointGrid borderGrid(border.reach > 0 ? border.reach : 1.0);
+    for (const Eigen::Vector3d& p : border.samples)
+        borderGrid.add(p);
     for (HalfedgeIndex h : cycles) {
         if (!mesh.is_border(h)) continue;
         // A cycle along the reference's own boundary stays open (measured on mech-holes-shark: the repair's
         // refill closed two of its four holes; on blade it capped an end and bridged the two sides).
-        if (cycleOnBorder(mesh, h, border)) continue;
+        if (cycleOnBorder(mesh, h, border)) {
+            if (!closeInlets) continue;
+            std::vector<VertexIndex> newVertices;
+            const FaceIndex next = mesh.face(mesh.opposite(h));
+            for (FaceIndex f : closeBorderInlets(mesh, h, borderGrid, border.reach, newVertices)) {
+                ids[f] = next != Mesh::null_face() ? ids[next] : 0;
+                quality[f] = next != Mesh::null_face() ? quality[next] : 0.f;
+            }
+            continue;
+        }
         const FaceIndex next = mesh.face(mesh.opposite(h));
         // For FSS_AUTO_V2_DEBUG, the cycle before it is filled: its length, how many of its vertices it
         // passes more than once (a pinched cycle) and how many of its vertex pairs two apart are already
@@ -568,16 +661,28 @@ std::size_t dropSmallPieces(Mesh& mesh, std::size_t components, std::size_t maxF
     return dropped;
 }
 
-void removePatchFacesNear(Mesh& mesh, const Mesh& reference, const std::vector<char>& faces, double reach) {
-    PointGrid grid(reach);
-    std::size_t n = 0;
+std::size_t flagUncoveredFaces(const Mesh& reference, const Mesh& joined, double reach,
+                               std::vector<char>& inputFaces) {
+    const RayCaster onJoin(joined);
+    std::size_t added = 0;
     for (FaceIndex f : reference.faces())
-        if (faces[f.idx()]) grid.add(centroid(reference, f)), ++n;
-    if (n == 0) return;
+        if (!inputFaces[f.idx()] && onJoin.closestPoint(centroid(reference, f)).distance > reach)
+            inputFaces[f.idx()] = 1, ++added;
+    return added;
+}
+
+void removePatchFacesNear(Mesh& mesh, const Mesh& reference, const std::vector<char>& faces, double reach) {
+    // The distance to the flagged faces themselves, not to their centroids: a long face of a CAD part has
+    // patch faces over its far ends (measured on mech-holes-shark: 49 intersecting face pairs at the input
+    // faces of every round when the centroids were used).
+    Mesh flagged;
+    appendInputFaces(flagged, reference, faces);
+    if (flagged.number_of_faces() == 0) return;
+    const RayCaster onFlagged(flagged);
     std::vector<FaceIndex> remove;
     for (FaceIndex f : mesh.faces())
         for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh))
-            if (grid.near(at(mesh, v))) {
+            if (onFlagged.closestPoint(at(mesh, v)).distance <= reach) {
                 remove.push_back(f);
                 break;
             }

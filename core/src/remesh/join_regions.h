@@ -89,7 +89,9 @@ bool cycleOnBorder(const Mesh& mesh, HalfedgeIndex h, const ReferenceBorder& bor
 /// Fills every boundary cycle of \p mesh that does not run along \p border (cycleOnBorder) with CGAL's hole
 /// triangulation and refinement (a pinched cycle loop by loop, pinchedCycleLoops); the new faces take the
 /// scan id and quality of a face next to them.
-void fillJoinHoles(Mesh& mesh, const ReferenceBorder& border);
+/// With \p closeInlets, a cycle along the border has its inlets closed (closeBorderInlets: a gap between two
+/// patches that reaches the border); off in the join (measured on blade: it cost a border loop).
+void fillJoinHoles(Mesh& mesh, const ReferenceBorder& border, bool closeInlets = false);
 
 /// How joinRegions closes the gaps between the regions.
 enum class JoinStyle {
@@ -126,6 +128,11 @@ std::size_t dropSmallPieces(Mesh& mesh, std::size_t components, std::size_t maxF
 /// \p joined left wrong (as joinRegions' repair finds them); returns how many were flagged.
 std::size_t widenInputRegions(const Mesh& reference, const Mesh& joined, bool closed, double reach,
                               std::vector<char>& inputFaces);
+
+/// Flags in \p inputFaces the faces of \p reference whose centroid lies farther than \p reach from \p joined
+/// (parts of the input the join does not cover); returns how many were flagged.
+std::size_t flagUncoveredFaces(const Mesh& reference, const Mesh& joined, double reach,
+                               std::vector<char>& inputFaces);
 
 /// Removes from \p mesh the faces with a vertex within \p reach of the centroid of a face of \p reference
 /// flagged in \p faces (so that those faces are as far from the patches as unsampledFaces' are).
