@@ -697,13 +697,12 @@ private:
     // two crease edges, the one that maximises the star's smallest angle wins.
     void slidePass();
     double starMinAngle(VertexIndex v, const V3& at) const {
-        double m = std::numbers::pi;
+        detail::MinAngleOfMany m; // the same double as the minimum of minAngle face by face
         for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
             if (S_.is_border(h)) continue;
-            m = std::min(m, detail::minAngle(detail::pos(S_, S_.source(h)), at,
-                                             detail::pos(S_, S_.target(S_.next(h)))));
+            m.add(detail::pos(S_, S_.source(h)), at, detail::pos(S_, S_.target(S_.next(h))));
         }
-        return m;
+        return m.value();
     }
     bool starAcceptable(VertexIndex v, const V3& at, double maxTurn) const {
         V3 star(0, 0, 0);
