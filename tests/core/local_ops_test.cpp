@@ -2,6 +2,7 @@
 // refuses exactly the operation that would break the mesh (a border edge, a valence below 3, a doubled edge,
 // the link condition, a face turned over or an angle below the floor) and allows the others.
 #include "mesh/local_ops.h"
+#include "mesh/triangle_geometry.h"
 
 #include "fss/shapes.h"
 
@@ -11,7 +12,10 @@
 #include <CGAL/boost/graph/helpers.h>
 
 #include <array>
+#include <cmath>
+#include <cstdint>
 #include <numbers>
+#include <vector>
 
 namespace {
 
@@ -143,3 +147,49 @@ TEST(LocalOps, MoveRefusedWhenAFaceTurnsOverOrAnAngleFallsBelowTheFloor) {
 }
 
 } // namespace
+
+// The star's smallest angle through MinAngleOfMany and the floor test minAngleBelow
+// (mesh/triangle_geometry.h) give exactly the doubles and answers of minAngle face by face, also where
+// corners tie (isosceles and equilateral faces, a grid's right isosceles triangles), for degenerate faces and
+// near the floor.
+TEST(TriangleGeometry, StarMinAngleAndFloorTestMatchMinAngle) {
+    using V = Eigen::Vector3d;
+    std::vector<std::array<V, 3>> tris = {
+        {V(0, 0, 0), V(1, 0, 0), V(0, 1, 0)},                    // 45, 45, 90
+        {V(0, 0, 0), V(1, 0, 0), V(0.5, std::sqrt(3.0) / 2, 0)}, // equilateral
+        {V(0, 0, 0), V(1, 0, 0), V(0.5, 0.1, 0)},                // isosceles cap
+        {V(0, 0, 0), V(1, 0, 0), V(2, 0, 0)},                    // collinear
+        {V(0, 0, 0), V(0, 0, 0), V(0, 1, 0)},                    // an edge of length zero
+    };
+    std::uint64_t s = 12345;
+    auto rnd = [&] {
+        s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+        return double(s >> 11) / double(1ULL << 53);
+    };
+    for (int i = 0; i < 2000; ++i)
+        tris.push_back({V(rnd(), rnd(), rnd()), V(rnd(), rnd(), rnd()), V(rnd(), rnd(), rnd())});
+    // Stars of 1..9 faces taken from the list (runs of ties included), also with the degenerate ones.
+    for (std::size_t start = 0; start < tris.size(); start += 3)
+        for (std::size_t n = 1; n <= 9 && start + n <= tris.size(); n += 4) {
+            fss::detail::MinAngleOfMany many;
+            double expect = std::numbers::pi;
+            for (std::size_t k = start; k < start + n; ++k) {
+                many.add(tris[k][0], tris[k][1], tris[k][2]);
+                expect = std::min(expect, fss::detail::minAngle(tris[k][0], tris[k][1], tris[k][2]));
+            }
+            EXPECT_EQ(many.value(), expect) << start << " " << n;
+        }
+    fss::detail::MinAngleOfMany repeated; // the same face twice: every corner ties with another
+    repeated.add(tris[0][0], tris[0][1], tris[0][2]);
+    repeated.add(tris[0][0], tris[0][1], tris[0][2]);
+    EXPECT_EQ(repeated.value(), fss::detail::minAngle(tris[0][0], tris[0][1], tris[0][2]));
+    EXPECT_EQ(fss::detail::MinAngleOfMany().value(), std::numbers::pi);
+    for (const auto& t : tris) {
+        const double m = fss::detail::minAngle(t[0], t[1], t[2]);
+        for (double limit : {m, std::nextafter(m, 0.0), std::nextafter(m, 4.0), 0.3, 0.6, 1.0, 1e-12}) {
+            if (!(limit > 0)) continue;
+            EXPECT_EQ(fss::detail::minAngleBelow(t[0], t[1], t[2], fss::detail::AngleLimit(limit)),
+                      m < limit);
+        }
+    }
+}

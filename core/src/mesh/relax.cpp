@@ -58,13 +58,13 @@ struct Ring {
 Ring ringOf(const Mesh& m, VertexIndex v, const Eigen::Vector3d& at, const Ring* before, double cosTurn,
             const Camera* facing) {
     Ring ring;
-    ring.minAngle = std::numbers::pi;
+    MinAngleOfMany smallest; // the same double as the minimum of minAngle over the faces
     std::size_t k = 0;
     for (HalfedgeIndex h : CGAL::halfedges_around_target(m.halfedge(v), m)) {
         if (m.is_border(h)) continue;
         const Eigen::Vector3d b = pos(m, m.source(h)), c = pos(m, m.target(m.next(h)));
         const Eigen::Vector3d n = unitNormal(b, at, c); // the face (source, v, next's target) in its order
-        ring.minAngle = std::min(ring.minAngle, minAngle(b, at, c));
+        smallest.add(b, at, c);
         ring.normals.push_back(n);
         if (!(n.squaredNorm() > 0)) ring.ok = false;
         if (before && k < before->normals.size() && before->normals[k].dot(n) < cosTurn) ring.ok = false;
@@ -76,6 +76,7 @@ Ring ringOf(const Mesh& m, VertexIndex v, const Eigen::Vector3d& at, const Ring*
         }
         ++k;
     }
+    ring.minAngle = smallest.value();
     return ring;
 }
 
@@ -85,6 +86,7 @@ Ring ringOf(const Mesh& m, VertexIndex v, const Eigen::Vector3d& at, const Ring*
 // face's smallest angle only once its normal passed (most refused moves fail early).
 bool moveAccepted(const Mesh& m, VertexIndex v, const Eigen::Vector3d& at, const Ring& before, double cosTurn,
                   const Camera* facing) {
+    std::optional<AngleLimit> floor; // before's smallest angle, once a face reaches that test
     std::size_t k = 0;
     for (HalfedgeIndex h : CGAL::halfedges_around_target(m.halfedge(v), m)) {
         if (m.is_border(h)) continue;
@@ -98,7 +100,8 @@ bool moveAccepted(const Mesh& m, VertexIndex v, const Eigen::Vector3d& at, const
                                                               : Eigen::Vector3d(facing->eye - centroid);
             if (!(n.dot(toViewer) > 0)) return false;
         }
-        if (minAngle(b, at, c) < before.minAngle) return false;
+        if (!floor) floor.emplace(before.minAngle);
+        if (minAngleBelow(b, at, c, *floor)) return false;
         ++k;
     }
     return true;

@@ -700,13 +700,12 @@ private:
     // Crease ends of faces below the aim slide along their one crease edge (band_crease_end.cpp).
     void slideCreaseEndPass();
     double starMinAngle(VertexIndex v, const V3& at) const {
-        double m = std::numbers::pi;
+        detail::MinAngleOfMany m; // the same double as the minimum of minAngle face by face
         for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
             if (S_.is_border(h)) continue;
-            m = std::min(m, detail::minAngle(detail::pos(S_, S_.source(h)), at,
-                                             detail::pos(S_, S_.target(S_.next(h)))));
+            m.add(detail::pos(S_, S_.source(h)), at, detail::pos(S_, S_.target(S_.next(h))));
         }
-        return m;
+        return m.value();
     }
     bool starAcceptable(VertexIndex v, const V3& at, double maxTurn) const {
         V3 star(0, 0, 0);
