@@ -10,7 +10,7 @@
 // stitch_cpu_ms (fss::stitchPatch of the same preview into a copy, untimed), overhead_cpu_ms = accept −
 // stitch (copies, garbage collection, history record), accept_over_stitch_cpu.
 // The widget's share (RemeshWidget::accept: the worker's accept plus the view's update) is measured by
-// the widget test `widgets_remesh_widget_test acceptLatency` with FSS_BENCH_ACCEPT=1.
+// the widget test `widgets_remesh_widget_accept_test acceptLatency` with FSS_BENCH_ACCEPT=1.
 #include "fss/session.h"
 #include "fss/shapes.h"
 #include "fss/stitch.h"
