@@ -149,8 +149,10 @@ inline AngleFigures angleFigures(const Mesh& m) {
     return a;
 }
 
-// The crease scene's ring from 75° above its centre: the whole ridge is in view, a closed curve on the
-// screen (as in RibTrimmingFiguresOnTheCreasedRing).
+// The crease scene's ring from 75° above its centre: the ridge is a closed curve on the screen (as in
+// RibTrimmingFiguresOnTheCreasedRing), but on the silhouette all round, and edge-on where the view grazes the
+// band (near (-0.27, ±2.85, 0), measured in session 21): the crease backbone walks 53 samples each way from
+// the near side and stops there, so its grid cannot close.
 inline fss::Camera topCamera(const CreaseScene& scene) {
     fss::Camera top = scene.camera;
     const double up = 75 * std::numbers::pi / 180;

@@ -567,11 +567,23 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
                 trim.minRibGap = std::max(trim.minRibGap, 0.5);
                 trim.maxRibAspect = trim.maxRibAspect >= 1 ? std::min(trim.maxRibAspect, 1.5) : 1.5;
             }
+            const FishboneGrid untrimmed = straight ? result.fishbone : FishboneGrid{};
             result.counts.trimmed = trimRibs(result.fishbone, backbone, trim); // as automaticFishbone
+            auto tooFew = [&] {
+                return result.fishbone.presentCount() < 2 * std::size_t(result.fishbone.rows);
+            };
             // Fewer rib vertices than rows: a crease on the silhouette whose one visible side is seen so
-            // obliquely that its ribs are foreshortened below 1:1.5 and trimmed away (the creased ring's
-            // ridge from 75° above: 194 rows, 13 rib vertices left). The traced backbone instead.
-            if (!straight || result.fishbone.presentCount() >= 2 * std::size_t(result.fishbone.rows)) break;
+            // obliquely that its ribs are foreshortened below 1:1.5 on the screen and trimmed away (the
+            // creased ring's ridge from 75° above: 107 rows, 13 rib vertices left). The straight ribs step
+            // h footprints on the surface, so their quads are square there: trimmed again with the aspect on
+            // the surface, they stay (an aspect on the surface for every crease grid shrinks the patch of
+            // fandisk -z). Only where that leaves too few as well, the traced backbone instead.
+            if (straight && tooFew() && !trim.surfaceLength) {
+                result.fishbone = untrimmed;
+                trim.surfaceLength = surfaceMetric(buffers, caster, fb.raycast);
+                result.counts.trimmed = trimRibs(result.fishbone, backbone, trim);
+            }
+            if (!straight || !tooFew()) break;
             onCrease.reset();
             backbone = traceSeedBackbone();
         }
