@@ -725,6 +725,10 @@ constexpr const char* kWideList =
 //    blobby_3cc -x, three_peaks -y (47.9–49.4°, up 0.2–1.5° from session 18) not analysed further. Six
 //    relaxation sweeps (ScanParams::relaxIterations) raise them by 0.0–1.2° (bones +x to 50.1°) but make the
 //    Hausdorff distance worse on 6 of the 16 views: the relaxation stays off.
+//    Session 21 tried those sweeps with a move refused when it raises the largest distance to the reference
+//    of its ring's face centroids and edge midpoints: +0.0–0.8° on 12 of these views, none reaching 50°
+//    (bones +x 49.4 -> 49.8°, man -z 48.8 -> 49.2°, blobby_3cc -x 48.5 -> 48.9°, 12 sweeps as 6), the
+//    Hausdorff distance unchanged on the Hausdorff views but blobby_3cc -x 4.69e-4 -> 5.26e-4: not kept.
 //  - Hausdorff distance worse than the square lattice's on 8 views, ratio 1.01–1.13, boeing ±y 94–97 (the
 //    square's triangles lie in the planar faces seen face-on: 3e-16; the warped patch covers 21–23 times
 //    their area). FSS_WORST on mech-holes-shark -y, man iso, elephant-with-holes +z, u -y: the farthest face
