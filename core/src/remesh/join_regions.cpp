@@ -273,6 +273,18 @@ private:
     std::unordered_map<std::int64_t, std::vector<Eigen::Vector3d>> cells_;
 };
 
+/// Refines the faces \p added (a fill) and returns them with the faces the refinement adds (those it
+/// splits keep their index); \p newVertices receives the refinement's vertices.
+std::vector<FaceIndex> refineAdded(Mesh& mesh, std::vector<FaceIndex> added,
+                                   std::vector<VertexIndex>& newVertices) {
+    std::vector<FaceIndex> refined;
+    if (!added.empty())
+        CGAL::Polygon_mesh_processing::refine(mesh, added, std::back_inserter(refined),
+                                              std::back_inserter(newVertices));
+    added.insert(added.end(), refined.begin(), refined.end());
+    return added;
+}
+
 /// Fills the pinched boundary cycle through border halfedge \p h (CGAL's hole triangulation returns no face
 /// for a cycle that passes a vertex twice: measured on couplingdown, 20 of its 105 cycles, all of them
 /// pinched and no other) loop by loop: each simple loop is triangulated as a polyline (no new vertex) and
@@ -296,13 +308,7 @@ std::vector<FaceIndex> fillPinchedCycle(Mesh& mesh, HalfedgeIndex h, std::vector
             if (f != Mesh::null_face()) added.push_back(f);
         }
     }
-    // The refinement returns the faces it adds; those it splits keep their index.
-    std::vector<FaceIndex> refined;
-    if (!added.empty())
-        CGAL::Polygon_mesh_processing::refine(mesh, added, std::back_inserter(refined),
-                                              std::back_inserter(newVertices));
-    added.insert(added.end(), refined.begin(), refined.end());
-    return added;
+    return refineAdded(mesh, std::move(added), newVertices);
 }
 
 /// Closes the inlets of the boundary cycle through border halfedge \p h, which runs along the reference's
@@ -378,12 +384,7 @@ std::vector<FaceIndex> closeBorderInlets(Mesh& mesh, HalfedgeIndex h, const Poin
         }
         added.insert(added.end(), faces.begin(), faces.end());
     }
-    std::vector<FaceIndex> refined;
-    if (!added.empty())
-        CGAL::Polygon_mesh_processing::refine(mesh, added, std::back_inserter(refined),
-                                              std::back_inserter(newVertices));
-    added.insert(added.end(), refined.begin(), refined.end());
-    return added;
+    return refineAdded(mesh, std::move(added), newVertices);
 }
 
 Eigen::Vector3d centroid(const Mesh& m, FaceIndex f) {
