@@ -415,19 +415,23 @@ void BandRemesher::slidePass() {
                 }
             }
         if (bestP == p) continue;
-        S_.point(v) = Point3(bestP.x(), bestP.y(), bestP.z());
-        if (bestPos.chain >= 0)
-            creasePos_[std::uint32_t(v)] = {bestPos};
-        else
-            creasePos_.erase(std::uint32_t(v));
-        const FaceIndex hint = at(hint_, std::size_t(v), Mesh::null_face());
-        if (hint != Mesh::null_face()) {
-            const SurfacePoint sp = near2_(bestP, hint);
-            if (sp) hint_[std::size_t(v)] = sp.face;
-        }
-        touch(v);
-        ++report_.moves;
+        moveAlongCrease(v, bestP, bestPos);
     }
+}
+
+void BandRemesher::moveAlongCrease(VertexIndex v, const V3& p, const CreasePos& pos) {
+    S_.point(v) = Point3(p.x(), p.y(), p.z());
+    if (pos.chain >= 0)
+        creasePos_[std::uint32_t(v)] = {pos};
+    else
+        creasePos_.erase(std::uint32_t(v));
+    const FaceIndex hint = at(hint_, std::size_t(v), Mesh::null_face());
+    if (hint != Mesh::null_face()) {
+        const SurfacePoint sp = near2_(p, hint);
+        if (sp) hint_[std::size_t(v)] = sp.face;
+    }
+    touch(v);
+    ++report_.moves;
 }
 
 } // namespace fss::stitch::band

@@ -42,18 +42,7 @@ void BandRemesher::slideCreaseEndPass() {
             }
         }
         if (bestP == p) continue;
-        S_.point(v) = Point3(bestP.x(), bestP.y(), bestP.z());
-        if (bestPos.chain >= 0)
-            creasePos_[std::uint32_t(v)] = {bestPos};
-        else
-            creasePos_.erase(std::uint32_t(v));
-        const FaceIndex hint = at(hint_, std::size_t(v), Mesh::null_face());
-        if (hint != Mesh::null_face()) {
-            const SurfacePoint sp = near2_(bestP, hint);
-            if (sp) hint_[std::size_t(v)] = sp.face;
-        }
-        touch(v);
-        ++report_.moves;
+        moveAlongCrease(v, bestP, bestPos);
     }
 }
 

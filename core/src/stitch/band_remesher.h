@@ -699,6 +699,9 @@ private:
     void slidePass();
     // Crease ends of faces below the aim slide along their one crease edge (band_crease_end.cpp).
     void slideCreaseEndPass();
+    // Puts crease vertex v at p, at its place pos on the draft's crease polyline (none: chain < 0), with
+    // its hint and the touched set kept up to date; both slide passes end with it.
+    void moveAlongCrease(VertexIndex v, const V3& p, const CreasePos& pos);
     double starMinAngle(VertexIndex v, const V3& at) const {
         detail::MinAngleOfMany m; // the same double as the minimum of minAngle face by face
         for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_)) {
