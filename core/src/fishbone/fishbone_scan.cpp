@@ -369,6 +369,35 @@ Backbone seedBackbone(const DirectionField& backboneField, const FishboneParams&
     return traced;
 }
 
+// Fewer rib vertices than twice the rows: what makes a crease grid fall back to the traced backbone.
+bool tooFewRibVertices(const FishboneGrid& grid) {
+    return grid.presentCount() < 2 * std::size_t(grid.rows);
+}
+
+// trimRibs for the fishbone scan. Straight ribs (a crease backbone's) converge on a crease's concave side and
+// fan out on its convex side: they are always trimmed where their quads get thinner than 1:1.5 (whose
+// triangles keep 33.7°) or where neighbours come closer than h/2 (the options' own bounds when tighter).
+// Fewer rib vertices left than rows: a crease on the silhouette whose one visible side is seen so obliquely
+// that its ribs are foreshortened below 1:1.5 on the screen and trimmed away (the creased ring's ridge from
+// 75° above: 107 rows, 13 rib vertices left). The straight ribs step h footprints on the surface, so their
+// quads are square there: trimmed again with the aspect on the surface (\p surface), they stay (an aspect on
+// the surface for every crease grid shrinks the patch of fandisk -z). Returns the vertices removed.
+std::size_t trimScanRibs(
+    FishboneGrid& grid, const Backbone& backbone, const FishboneOptions& options, bool straight,
+    const std::function<std::function<double(const Eigen::Vector2d&, const Eigen::Vector2d&)>()>& surface) {
+    FishboneOptions trim = options;
+    if (straight) {
+        trim.minRibGap = std::max(trim.minRibGap, 0.5);
+        trim.maxRibAspect = trim.maxRibAspect >= 1 ? std::min(trim.maxRibAspect, 1.5) : 1.5;
+    }
+    const FishboneGrid untrimmed = straight ? grid : FishboneGrid{};
+    const std::size_t removed = trimRibs(grid, backbone, trim); // as automaticFishbone
+    if (!straight || !tooFewRibVertices(grid) || trim.surfaceLength) return removed;
+    grid = untrimmed;
+    trim.surfaceLength = surface();
+    return trimRibs(grid, backbone, trim);
+}
+
 // What the crease backbone and its ribs need (FishboneOptions::creaseBackbone; crease_backbone.h).
 detail::CreaseBackboneInput creaseInput(const Mesh& reference, const FishboneParams& fb,
                                         const FishboneOptions& options, const FrameBuffers& buffers,
@@ -559,31 +588,9 @@ FishboneScanResult scanOnSamplingImage(const Mesh& reference, MeshRenderer& refe
                 straight ? detail::creaseRibs(creaseInput(reference, fb, options, buffers, cache), *onCrease)
                          : traceAllRibs(ribField, backbone, options),
                 h, W, H);
-            // Straight ribs converge on a crease's concave side and fan out on its convex side: they are
-            // always trimmed where their quads get thinner than 1:1.5 (whose triangles keep 33.7°) or where
-            // neighbours come closer than h/2 (the options' own bounds when tighter).
-            FishboneOptions trim = options;
-            if (straight) {
-                trim.minRibGap = std::max(trim.minRibGap, 0.5);
-                trim.maxRibAspect = trim.maxRibAspect >= 1 ? std::min(trim.maxRibAspect, 1.5) : 1.5;
-            }
-            const FishboneGrid untrimmed = straight ? result.fishbone : FishboneGrid{};
-            result.counts.trimmed = trimRibs(result.fishbone, backbone, trim); // as automaticFishbone
-            auto tooFew = [&] {
-                return result.fishbone.presentCount() < 2 * std::size_t(result.fishbone.rows);
-            };
-            // Fewer rib vertices than rows: a crease on the silhouette whose one visible side is seen so
-            // obliquely that its ribs are foreshortened below 1:1.5 on the screen and trimmed away (the
-            // creased ring's ridge from 75° above: 107 rows, 13 rib vertices left). The straight ribs step
-            // h footprints on the surface, so their quads are square there: trimmed again with the aspect on
-            // the surface, they stay (an aspect on the surface for every crease grid shrinks the patch of
-            // fandisk -z). Only where that leaves too few as well, the traced backbone instead.
-            if (straight && tooFew() && !trim.surfaceLength) {
-                result.fishbone = untrimmed;
-                trim.surfaceLength = surfaceMetric(buffers, caster, fb.raycast);
-                result.counts.trimmed = trimRibs(result.fishbone, backbone, trim);
-            }
-            if (!straight || !tooFew()) break;
+            result.counts.trimmed = trimScanRibs(result.fishbone, backbone, options, straight,
+                                                 [&] { return surfaceMetric(buffers, caster, fb.raycast); });
+            if (!straight || !tooFewRibVertices(result.fishbone)) break;
             onCrease.reset();
             backbone = traceSeedBackbone();
         }
