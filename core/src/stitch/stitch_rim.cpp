@@ -22,7 +22,103 @@ namespace {
 constexpr int kRimRounds = 2;
 // Faces below this (degrees) ask for it: issue 19's bound on the faces a stitch creates.
 constexpr double kRimBelowDeg = 20.0;
+
+// The patch's footprint in the scan's image: the pixels of its vertices, dilated by one pixel.
+std::unordered_set<std::uint64_t> patchFootprint(const PatchData& P, const Camera& cam) {
+    std::unordered_set<std::uint64_t> fp;
+    for (const Vec3& p : P.pos) {
+        const Eigen::Vector3d s = cam.project(p);
+        const int x = int(std::floor(s.x())), y = int(std::floor(s.y()));
+        if (x < 0 || y < 0 || x >= cam.width || y >= cam.height) continue;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int X = x + dx, Y = y + dy;
+                if (X >= 0 && Y >= 0 && X < cam.width && Y < cam.height)
+                    fp.insert(std::uint64_t(std::uint32_t(Y)) << 32 | std::uint32_t(X));
+            }
+    }
+    return fp;
+}
+
+// Does face f of m touch the footprint (a corner in a footprint pixel, or a footprint pixel's centre inside
+// its projection)?
+bool touchesFootprint(const Mesh& m, FaceIndex f, const Camera& cam,
+                      const std::unordered_set<std::uint64_t>& fp) {
+    auto at = [&](int x, int y) {
+        return x >= 0 && y >= 0 && x < cam.width && y < cam.height &&
+               fp.count(std::uint64_t(std::uint32_t(y)) << 32 | std::uint32_t(x)) > 0;
+    };
+    Eigen::Vector3d s[3];
+    int k = 0;
+    for (VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m)) {
+        if (k == 3) return false;
+        const Vec3 p = toVec(m.point(v));
+        if (cam.viewDepth(p) <= 0) return false;
+        s[k] = cam.project(p);
+        if (at(int(std::floor(s[k].x())), int(std::floor(s[k].y())))) return true;
+        ++k;
+    }
+    if (k != 3) return false;
+    const double area =
+        (s[1].x() - s[0].x()) * (s[2].y() - s[0].y()) - (s[1].y() - s[0].y()) * (s[2].x() - s[0].x());
+    if (area == 0 || !std::isfinite(area)) return false;
+    auto inside = [&](double px, double py) {
+        for (int i = 0; i < 3; ++i) {
+            const Eigen::Vector3d &p = s[(i + 1) % 3], &q = s[(i + 2) % 3];
+            if (((q.x() - p.x()) * (py - p.y()) - (q.y() - p.y()) * (px - p.x())) / area < 0) return false;
+        }
+        return true;
+    };
+    const int x0 = std::max(0, int(std::floor(std::min({s[0].x(), s[1].x(), s[2].x()}))));
+    const int x1 = std::min(cam.width - 1, int(std::ceil(std::max({s[0].x(), s[1].x(), s[2].x()}))));
+    const int y0 = std::max(0, int(std::floor(std::min({s[0].y(), s[1].y(), s[2].y()}))));
+    const int y1 = std::min(cam.height - 1, int(std::ceil(std::max({s[0].y(), s[1].y(), s[2].y()}))));
+    if (double(x1 - x0 + 1) * double(y1 - y0 + 1) > double(fp.size())) {
+        for (std::uint64_t key : fp) {
+            const int x = int(key & 0xffffffffu), y = int(key >> 32);
+            if (x >= x0 && x <= x1 && y >= y0 && y <= y1 && inside(x + 0.5, y + 0.5)) return true;
+        }
+        return false;
+    }
+    for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x)
+            if (at(x, y) && inside(x + 0.5, y + 0.5)) return true;
+    return false;
+}
 } // namespace
+
+// Is every face of current-mesh vertex c's star within seamRings vertex rings of a face that touches the
+// patch's footprint (the seam neighbourhood, as the property test defines it)?
+bool ComponentStitcher::starInSeamNeighbourhood(std::uint32_t c) {
+    const Camera& cam = V_.camera();
+    if (!footprintBuilt_) {
+        footprint_ = patchFootprint(P_, cam);
+        footprintBuilt_ = true;
+    }
+    auto touching = [&](FaceIndex f) {
+        auto [it, fresh] = touchesCache_.try_emplace(std::uint32_t(f), false);
+        if (fresh) it->second = touchesFootprint(M_, f, cam, footprint_);
+        return it->second;
+    };
+    for (FaceIndex q : CGAL::faces_around_target(M_.halfedge(VertexIndex(c)), M_)) {
+        if (q == Mesh::null_face()) continue;
+        std::unordered_set<std::uint32_t> seen{std::uint32_t(q)};
+        std::vector<FaceIndex> ring{q};
+        bool ok = touching(q);
+        for (int r = 0; r < O_.seamRings && !ok; ++r) {
+            std::vector<FaceIndex> next;
+            for (FaceIndex g : ring)
+                for (VertexIndex w : CGAL::vertices_around_face(M_.halfedge(g), M_))
+                    for (FaceIndex h : CGAL::faces_around_target(M_.halfedge(w), M_))
+                        if (h != Mesh::null_face() && seen.insert(std::uint32_t(h)).second) next.push_back(h);
+            for (FaceIndex g : next)
+                ok = ok || touching(g);
+            ring.swap(next);
+        }
+        if (!ok) return false;
+    }
+    return true;
+}
 
 void ComponentStitcher::noteHeldRim(Local& loc, const std::vector<FaceIndex>& bandFaces) {
     const Mesh& S = loc.star.S;
@@ -48,14 +144,15 @@ void ComponentStitcher::noteHeldRim(Local& loc, const std::vector<FaceIndex>& ba
         for (VertexIndex v : CGAL::vertices_around_face(fh, S)) {
             // Held by kept faces only: not on the local mesh's border (its whole star is in S), not new.
             if (!loc.locked[v] || S.is_border(v) || !loc.star.isFull(v) || loc.star.cur[v] == kNone ||
-                !inRegion(loc.star.cur[v])) {
+                (!inRegion(loc.star.cur[v]) && !starInSeamNeighbourhood(loc.star.cur[v]))) {
                 if (loc.locked[v] && stitch::band::bandDiagnosticsVerbose())
                     std::fprintf(stderr, "  rim: corner %u of a face below 20 deg not grown past: %s\n",
                                  std::uint32_t(v),
-                                 S.is_border(v)             ? "on the local mesh's border"
-                                 : !loc.star.isFull(v)      ? "star not whole"
-                                 : loc.star.cur[v] == kNone ? "new vertex"
-                                                            : "not a corner of a region face");
+                                 S.is_border(v)        ? "on the local mesh's border"
+                                 : !loc.star.isFull(v) ? "star not whole"
+                                 : loc.star.cur[v] == kNone
+                                     ? "new vertex"
+                                     : "not a corner of a region face, star not in the seam neighbourhood");
                 continue;
             }
             bool ok = true;

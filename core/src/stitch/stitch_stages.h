@@ -414,8 +414,12 @@ private:
     void growPastHeldRim(Attempt& a);
     // Called by remeshBand after a remesh that is kept: the corners of its faces below 20 deg that are held
     // only by kept faces (whole star in the local mesh, the other faces ones the band may grow into) and are
-    // corners of region faces (into heldRim_, as current-mesh vertices).
+    // corners of region faces or whose whole star lies in the seam neighbourhood (into heldRim_, as
+    // current-mesh vertices).
     void noteHeldRim(Local& loc, const std::vector<FaceIndex>& bandFaces);
+    // Whether every face of current-mesh vertex c's star lies within seamRings vertex rings of a face that
+    // touches the patch's footprint (its vertices' pixels dilated by one; the property test's definition).
+    bool starInSeamNeighbourhood(std::uint32_t c);
 
     Refill refillSeam(Local& loc);
 
@@ -540,6 +544,9 @@ private:
     // left below 20 deg, its smallest angle (-1: no band remesh kept), and for the build again the corners
     // whose whole star joins the band (current-mesh vertices).
     std::vector<std::uint32_t> heldRim_;
+    std::unordered_set<std::uint64_t> footprint_; // starInSeamNeighbourhood, built on first use
+    bool footprintBuilt_ = false;
+    std::unordered_map<std::uint32_t, bool> touchesCache_;
     double bandMinAfterDeg_ = -1;
     std::unordered_set<std::uint32_t> rimStars_;
 };
