@@ -2,12 +2,13 @@
 // creases and corners are known exactly. Each test damages a regular triangulation of the cube in one way
 // the stitches do (a corner cut off, a vertex standing off a face, a fold) and checks that snapToCreases
 // repairs exactly that: the result is measured against the cube itself, never against the code's own view.
-#include "mesh_text.h"
 #include "remesh/crease_snap.h"
 #include "remesh/seam_relax.h"
+
+#include "auto_cube.h"
+#include "mesh_text.h"
 #include "test_math.h"
 
-#include "fss/auto_remesh.h"
 #include "fss/metrics.h"
 #include "fss/shapes.h"
 
@@ -236,11 +237,7 @@ TEST(CreaseSnap, CollapsesAShortEdgeBetweenTwoVerticesOnACrease) {
 TEST(CreaseSnap, KnownFreeSkipsOnlyTheEntryTestAndFreeAfterHolds) {
     namespace PMP = CGAL::Polygon_mesh_processing;
     const fss::Mesh cube = fss::shapes::cube(8, 1.0);
-    fss::AutoOptions o;
-    o.targetVertices = 900;
-    o.seamRelaxRounds = 0;
-    o.creaseSnapRounds = 0;
-    const fss::AutoResult plain = fss::autoRemesh(cube, o);
+    const fss::AutoResult plain = fss::test::cubeBeforeRelaxation(cube);
     ASSERT_FALSE(PMP::does_self_intersect(plain.mesh));
     fss::detail::CreaseSnapOptions co;
     co.edgeLength = plain.edgeLength;
