@@ -8,6 +8,8 @@
 #include "fss/auto_remesh.h"
 #include "fss/raycast.h"
 #include "fss/shapes.h"
+
+#include "auto_cube.h"
 #include "mesh_text.h"
 
 #include <gtest/gtest.h>
@@ -60,11 +62,7 @@ TEST(ClosestPoints, AnswersAreTheRayCastersForAnyThreadCount) {
 // bevelled creases): the same mesh, to the last bit, with one and with two TBB threads; and each changes it.
 TEST(ClosestPoints, RelaxationAndCreaseRecoveryAreTheSameForOneAndTwoThreads) {
     const fss::Mesh cube = fss::shapes::cube(8, 1.0);
-    fss::AutoOptions o;
-    o.targetVertices = 900;
-    o.seamRelaxRounds = 0;
-    o.creaseSnapRounds = 0;
-    const fss::AutoResult plain = fss::autoRemesh(cube, o);
+    const fss::AutoResult plain = fss::test::cubeBeforeRelaxation(cube);
     fss::detail::SeamRelaxOptions ro;
     ro.edgeLength = plain.edgeLength;
     fss::detail::CreaseSnapOptions co;

@@ -3,6 +3,10 @@
 // the stitches do (a corner cut off, a vertex standing off a face, a fold) and checks that snapToCreases
 // repairs exactly that: the result is measured against the cube itself, never against the code's own view.
 #include "remesh/crease_snap.h"
+#include "remesh/seam_relax.h"
+
+#include "auto_cube.h"
+#include "mesh_text.h"
 #include "test_math.h"
 
 #include "fss/metrics.h"
@@ -12,6 +16,7 @@
 
 #include <gtest/gtest.h>
 
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/boost/graph/Euler_operations.h>
 
 #include <Eigen/Geometry>
@@ -222,4 +227,49 @@ TEST(CreaseSnap, CollapsesAShortEdgeBetweenTwoVerticesOnACrease) {
     fss::test::expectClosedValidMesh(after);
     EXPECT_NEAR(after.minAngleDeg, 45.0, 1e-9);
     EXPECT_NEAR(after.area, 6.0 * kSide * kSide, 1e-9);
+}
+
+// knownFree (CreaseSnapOptions, SeamRelaxOptions) only skips the whole-mesh entry test: on a cube remeshed by
+// `auto` without the crease recovery and the relaxation (free of self-intersections, CGAL says), both give
+// the same mesh to the last bit with and without it, and report their result free (freeAfter), which CGAL
+// confirms. With a vertex pushed through the cube (the mesh intersects itself on entry) nothing is known
+// after.
+TEST(CreaseSnap, KnownFreeSkipsOnlyTheEntryTestAndFreeAfterHolds) {
+    namespace PMP = CGAL::Polygon_mesh_processing;
+    const fss::Mesh cube = fss::shapes::cube(8, 1.0);
+    const fss::AutoResult plain = fss::test::cubeBeforeRelaxation(cube);
+    ASSERT_FALSE(PMP::does_self_intersect(plain.mesh));
+    fss::detail::CreaseSnapOptions co;
+    co.edgeLength = plain.edgeLength;
+    fss::detail::SeamRelaxOptions ro;
+    ro.edgeLength = plain.edgeLength;
+    std::vector<std::string> results;
+    for (bool known : {false, true}) {
+        SCOPED_TRACE(known ? "known free" : "tested");
+        fss::Mesh m = plain.mesh;
+        co.knownFree = known;
+        const fss::detail::CreaseSnapReport cr = fss::detail::snapToCreases(m, cube, co);
+        EXPECT_GT(cr.snaps, 0u);
+        EXPECT_TRUE(cr.freeAfter);
+        EXPECT_FALSE(PMP::does_self_intersect(m));
+        ro.knownFree = known && cr.freeAfter;
+        const fss::detail::SeamRelaxReport rr = fss::detail::relaxSeams(m, cube, ro);
+        EXPECT_GT(rr.moves + rr.flips, 0u);
+        EXPECT_TRUE(rr.freeAfter);
+        EXPECT_FALSE(PMP::does_self_intersect(m));
+        results.push_back(fss::test::exactMeshText(m));
+    }
+    EXPECT_EQ(results[0], results[1]);
+
+    fss::Mesh pierced = plain.mesh;
+    fss::VertexIndex top = *pierced.vertices().begin();
+    for (fss::VertexIndex v : pierced.vertices())
+        if (pierced.point(v).z() > pierced.point(top).z()) top = v;
+    const fss::Point3 p = pierced.point(top);
+    pierced.point(top) = fss::Point3(p.x(), p.y(), -1.0); // through the bottom side (z = -1/2)
+    ASSERT_TRUE(PMP::does_self_intersect(pierced));
+    fss::Mesh relaxed = pierced;
+    EXPECT_FALSE(fss::detail::snapToCreases(pierced, cube, options()).freeAfter);
+    ro.knownFree = false;
+    EXPECT_FALSE(fss::detail::relaxSeams(relaxed, cube, ro).freeAfter);
 }

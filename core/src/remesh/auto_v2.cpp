@@ -197,9 +197,15 @@ std::vector<Unowned> unownedPieces(const Mesh& reference, const std::vector<int>
 } // namespace v2
 } // namespace
 
-std::string validateJoin(const Mesh& mesh, const JoinTarget& target) {
+std::string validateJoin(const Mesh& mesh, const JoinTarget& target, bool knownFree, bool* freeAfter) {
     MetricsOptions mo;
-    const Metrics m = computeMetrics(mesh, mo);
+    mo.selfIntersections = !knownFree;
+    Metrics m = computeMetrics(mesh, mo);
+    if (knownFree) m.selfIntersections = 0;
+    // PMP::self_intersections reports a degenerate face f as (f, f), which computeMetrics counts in
+    // degenerateFaces only: free means neither.
+    if (freeAfter)
+        *freeAfter = knownFree || (m.selfIntersections == std::size_t(0) && m.degenerateFaces == 0);
     if (mesh.number_of_faces() == 0) return "the joined mesh has no face";
     if (m.boundaryLoops != target.boundaryLoops)
         return "the joined mesh has " + std::to_string(m.boundaryLoops) + " boundary loops, the input " +
@@ -414,6 +420,9 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
     // The distance from the input too is checked at the end only: with it in the join's choice the widening
     // below ran on bunny00 and left 2 components (measured, session 20).
     JoinTarget joinTarget = target;
+    // Whether `current` is known not to intersect itself: the last whole-mesh test (or a stage that keeps
+    // a free mesh free) said so of exactly this mesh. Each stage below then skips its own entry test.
+    bool currentFree = false;
     joinTarget.reference = nullptr;
     joinTarget.inputSamples = nullptr;
     if (widen) joinTarget.inputSamples = &samples;
@@ -428,6 +437,9 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         // Every way out of the loop keeps the repaired join, whose validation is then roundWhy: it is not
         // run again (measured on bunny00: one whole-mesh validation in four).
         std::string why;
+        // Whether `joined` (then `current`) is known not to intersect itself (validateJoin's freeAfter): the
+        // stages after the join then skip their whole-mesh entry test.
+        bool joinedFree = false;
         for (int round = 0;; ++round) {
             joined = current;
             std::vector<char> widened(inputFaces.size(), 0);
@@ -441,7 +453,7 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
             repaired.collect_garbage();
             // Measured on elephant: two input faces no patch reached, each closed on itself by the filling.
             dropSmallPieces(repaired, target.components, 8);
-            const std::string roundWhy = validateJoin(repaired, joinTarget);
+            const std::string roundWhy = validateJoin(repaired, joinTarget, false, &joinedFree);
             if (debug)
                 std::fprintf(stderr, "v2: join round %d: %s\n", round,
                              roundWhy.empty() ? "valid" : roundWhy.c_str());
@@ -461,18 +473,20 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
                 joined = std::move(repaired);
                 break;
             }
+            joinedFree = false; // `joined` is the unrepaired join now
         }
         if (debug)
             std::fprintf(stderr, "v2: join with input regions: %s\n", why.empty() ? "valid" : why.c_str());
         if (why.empty()) {
             current = std::move(joined);
+            currentFree = joinedFree;
         } else {
             joinRegions(current, reference, nullptr, caster, border, JoinStyle::TwoPasses, L, closedInput,
                         debug, 4);
-            const std::string other = validateJoin(current, joinTarget);
+            const std::string other = validateJoin(current, joinTarget, false, &currentFree);
             if (debug)
                 std::fprintf(stderr, "v2: join in two passes: %s\n", other.empty() ? "valid" : other.c_str());
-            if (!other.empty()) current = std::move(joined);
+            if (!other.empty()) current = std::move(joined), currentFree = joinedFree;
         }
     }
     if (debug)
@@ -493,15 +507,19 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         ro.maxNormalChangeDeg = options.stitch.maxNormalChangeDeg;
         ro.featureAngleDeg = options.featureAngleDeg;
         ro.collapses = options.seamRelaxCollapses;
+        ro.knownFree = currentFree;
         const SeamRelaxReport rr = relaxSeams(current, reference, ro);
+        currentFree = rr.freeAfter;
         result.seamFlips += rr.flips;
         result.seamCollapses += rr.collapses;
         result.seamMoves += rr.moves;
         result.seamRelaxDiscarded = result.seamRelaxDiscarded || rr.reverted;
         result.relaxSeconds += since(t0);
     };
-    if (options.flipSliversBelowDeg > 0)
+    if (options.flipSliversBelowDeg > 0) {
         result.sliverFlips = flipSliverFaces(current, options.flipSliversBelowDeg, 20.0, 8);
+        if (result.sliverFlips > 0) currentFree = false;
+    }
     result.relaxSeconds = since(t);
     relax();
     if (debug)
@@ -514,7 +532,9 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         co.creaseAngleDeg = options.featureAngleDeg;
         co.minAngleDeg = options.stitch.minAngleFloorDeg;
         co.rounds = options.creaseSnapRounds;
+        co.knownFree = currentFree;
         const CreaseSnapReport cr = snapToCreases(current, reference, co);
+        currentFree = cr.freeAfter;
         result.creaseSnaps = cr.snaps;
         result.creaseSplits = cr.splits;
         result.creaseFlips = cr.flips;
@@ -533,7 +553,7 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
     // 5. Validation; v1 when it fails.
     progress.report(0.95, "validate");
     t = Clock::now();
-    const std::string why = validateJoin(current, target);
+    const std::string why = validateJoin(current, target, currentFree);
     if (debug) {
         const RayCaster onResult(current);
         double from = 0, to = 0;

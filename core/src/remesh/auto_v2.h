@@ -65,7 +65,13 @@ std::vector<Eigen::Vector3d> inputSamples(const Mesh& reference);
 /// degenerate face, a vertex or face centroid farther than target.maxDistance from the reference, a point of
 /// target.inputSamples farther than target.maxDistanceFromInput from the mesh, a self-intersection. The first
 /// failure found is named, in that order.
-std::string validateJoin(const Mesh& mesh, const JoinTarget& target);
+/// \p knownFree: the caller knows that \p mesh does not intersect itself (PMP::does_self_intersect is false:
+/// a whole-mesh test of exactly this mesh, or a stage that keeps a free mesh free, said so); the whole-mesh
+/// self-intersection count, the slowest check, is then skipped (its answer is 0). \p freeAfter, when not
+/// null, is set to whether \p mesh is known not to intersect itself: knownFree, or no pair and no degenerate
+/// face counted (whatever else failed), so that the next stage can skip its own test.
+std::string validateJoin(const Mesh& mesh, const JoinTarget& target, bool knownFree = false,
+                         bool* freeAfter = nullptr);
 
 /// autoRemesh with AutoEngine::V2 (auto_v2.cpp). Throws what autoRemesh throws; returns a result whose
 /// engineUsed is V1 (and engineNote the reason) when the V2 mesh failed validation and \p fallback ran.

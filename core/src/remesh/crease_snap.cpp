@@ -69,20 +69,45 @@ namespace {
 
 namespace PMP = CGAL::Polygon_mesh_processing;
 using creases::CreaseSnapper;
+
+/// Whether \p a and \p b are the same mesh: the same elements (removed ones too), points and connectivity.
+bool sameMesh(const Mesh& a, const Mesh& b) {
+    if (a.num_vertices() != b.num_vertices() || a.num_halfedges() != b.num_halfedges() ||
+        a.num_faces() != b.num_faces())
+        return false;
+    for (VertexIndex v : a.vertices())
+        if (b.is_removed(v) || a.point(v) != b.point(v) || a.halfedge(v) != b.halfedge(v)) return false;
+    for (HalfedgeIndex h : a.halfedges())
+        if (b.is_removed(h) || a.target(h) != b.target(h) || a.next(h) != b.next(h) || a.face(h) != b.face(h))
+            return false;
+    for (FaceIndex f : a.faces())
+        if (b.is_removed(f) || a.halfedge(f) != b.halfedge(f)) return false;
+    return a.number_of_vertices() == b.number_of_vertices() && a.number_of_faces() == b.number_of_faces();
+}
 } // namespace
 
 CreaseSnapReport snapToCreases(Mesh& mesh, const Mesh& reference, const CreaseSnapOptions& options) {
     CreaseSnapReport report;
-    if (options.rounds <= 0 || mesh.is_empty() || reference.is_empty()) return report;
+    if (options.rounds <= 0 || mesh.is_empty() || reference.is_empty()) {
+        report.freeAfter = options.knownFree;
+        return report;
+    }
     CreaseSnapper snapper(mesh, reference, options);
     report.creaseEdges = snapper.creaseEdges();
-    const bool intersectedBefore = PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh);
+    const bool intersectedBefore =
+        !options.knownFree && PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh);
+    // Whether the mesh is the one tested last (or known free on entry): a round without operations is not
+    // tested, so it counts only when it left the mesh exactly as it was.
+    bool tested = !intersectedBefore;
     for (int round = 0; round < options.rounds; ++round) {
         const Mesh before = mesh;
         std::vector<char> marksBefore = snapper.creaseMarks();
         CreaseSnapReport r;
         snapper.round(r);
-        if (r.snaps + r.splits + r.flips + r.removals + r.repairs == 0) break;
+        if (r.snaps + r.splits + r.flips + r.removals + r.repairs == 0) {
+            tested = tested && sameMesh(mesh, before);
+            break;
+        }
         if (!intersectedBefore && PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh)) {
             mesh = before;
             snapper.setCreaseMarks(std::move(marksBefore));
@@ -97,6 +122,7 @@ CreaseSnapReport snapToCreases(Mesh& mesh, const Mesh& reference, const CreaseSn
     }
     snapper.markCreaseVertices();
     mesh.collect_garbage();
+    report.freeAfter = tested;
     return report;
 }
 

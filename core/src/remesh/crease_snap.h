@@ -41,6 +41,10 @@ struct CreaseSnapOptions {
     double errorSplitDistance = 0.15;
     /// Rounds of (snaps, splits, flips); 0 = nothing.
     int rounds = 3;
+    /// The caller knows that the mesh does not intersect itself (PMP::does_self_intersect is false: a
+    /// whole-mesh test of exactly this mesh, or a stage that keeps a free mesh free, said so, e.g.
+    /// SeamRelaxReport::freeAfter): snapToCreases skips its own whole-mesh test on entry.
+    bool knownFree = false;
 };
 
 /// What snapToCreases did.
@@ -55,6 +59,9 @@ struct CreaseSnapReport {
     std::size_t repairs = 0;
     /// Rounds whose result intersected itself (while the mesh before did not) and were undone.
     int roundsReverted = 0;
+    /// The mesh returned does not intersect itself (PMP::does_self_intersect is false): it did not on entry
+    /// and every round kept was tested on the whole mesh (a round undone leaves the mesh before it).
+    bool freeAfter = false;
 };
 
 /// Brings the faces of \p mesh near the creases of \p reference onto them (see the file comment). Border

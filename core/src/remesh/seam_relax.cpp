@@ -410,10 +410,12 @@ private:
 } // namespace
 
 SeamRelaxReport relaxSeams(Mesh& mesh, const Mesh& reference, const SeamRelaxOptions& options) {
-    if (options.rounds <= 0 || mesh.is_empty()) return {};
-    const bool intersectedBefore = PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh);
+    if (options.rounds <= 0 || mesh.is_empty()) return {.freeAfter = options.knownFree};
+    const bool intersectedBefore =
+        !options.knownFree && PMP::does_self_intersect<CGAL::Parallel_if_available_tag>(mesh);
     SeamRelaxReport report = Relaxer(mesh, reference, options).run(!intersectedBefore);
     mesh.collect_garbage();
+    report.freeAfter = !intersectedBefore;
     return report;
 }
 

@@ -42,6 +42,10 @@ struct SeamRelaxOptions {
     bool collapses = true;
     /// Smoothing step as a fraction of the way to the centroid of the neighbours, in (0, 1].
     double smoothingStep = 0.5;
+    /// The caller knows that the mesh does not intersect itself (PMP::does_self_intersect is false: a
+    /// whole-mesh test of exactly this mesh, or a stage that keeps a free mesh free, said so, e.g.
+    /// CreaseSnapReport::freeAfter): relaxSeams skips its own whole-mesh test on entry.
+    bool knownFree = false;
 };
 
 /// What relaxSeams did.
@@ -56,6 +60,10 @@ struct SeamRelaxReport {
     /// before relaxSeams did not: that stage was undone (the counts are those of the stages kept) and that
     /// kind of stage was not run again.
     bool reverted = false;
+    /// The mesh returned does not intersect itself (PMP::does_self_intersect is false): it did not on entry,
+    /// so every stage kept was checked (the pairs of intersecting faces are all among those a stage changed
+    /// and their neighbours, which are tested) and every stage undone left the mesh before it.
+    bool freeAfter = false;
 };
 
 /// Improves the valences and the shapes of the faces on the seams of \p mesh (see SeamRelaxOptions) with
