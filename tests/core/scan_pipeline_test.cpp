@@ -717,7 +717,7 @@ constexpr const char* kWideList =
 // part iso, cheese iso, b9_mesh ±y, blobby_3cc +x, three_peaks iso (mean) and ALSTOM_TEST4 ±y,
 // mech-holes-shark iso, blobby_3cc +x, oblong -y (Hausdorff); made worse: icosahedron iso (50.6° -> 49.3°),
 // mech-holes-shark +y, man iso, elephant-with-holes +z (Hausdorff ratios 0.67–0.85 -> 1.01–1.05). Criterion
-// A is NOT met on the views of kOpenViews (16 views): the test fails on any other view failing a part, and
+// A is NOT met on the views of kOpenViews (13 views): the test fails on any other view failing a part, and
 // prints which of these still fail.
 //  - mean smallest angle 40.6–49.4° on 8 views: patch-01 ±y and mesh_with_border +y are edge-on views where
 //    the square lattice leaves nothing; icosahedron iso: five faces meet at each apex (angle sum 300°) and
@@ -733,7 +733,12 @@ constexpr const char* kWideList =
 //    square's triangles lie in the planar faces seen face-on: 3e-16; the warped patch covers 21–23 times
 //    their area). FSS_WORST on mech-holes-shark -y, man iso, elephant-with-holes +z, u -y: the farthest face
 //    1–2 lattice steps from the patch border, edges 1.0–1.5 footprints (the square's farthest faces 1.4–2.4),
-//    where the patch ends at a crease or fold.
+//    where the patch ends at a crease or fold. Session 21 (scanPatch drops the warped patch's border faces
+//    farther than 0.2 footprints from the reference, two rings): mech-holes-shark -y 1.13 -> 0.53, man iso
+//    1.01 -> 0.38, elephant-with-holes +z 1.01 -> 0.68 (now pass); mech-holes-shark +y (1.05), u -y (1.05),
+//    oblong +y (1.03) unchanged: the bound does not reach their farthest faces (oblong's 2 steps in,
+//    sampling angle 69°); 0.05 of the longest edge fixes shark +y but takes bull +x 0.80 -> 0.53 of the
+//    square's area.
 constexpr const char* kOpenViews[] = {"mean man.off -z",
                                       "mean bones.off +x",
                                       "mean blobby_3cc.off -x",
@@ -743,13 +748,10 @@ constexpr const char* kOpenViews[] = {"mean man.off -z",
                                       "mean mesh_with_border.off +y",
                                       "mean icosahedron.off iso",
                                       "hausdorff mech-holes-shark.off +y",
-                                      "hausdorff mech-holes-shark.off -y",
                                       "hausdorff u.off -y",
                                       "hausdorff boeing.off +y",
                                       "hausdorff boeing.off -y",
-                                      "hausdorff man.off iso",
-                                      "hausdorff oblong.off +y",
-                                      "hausdorff elephant-with-holes.off +z"};
+                                      "hausdorff oblong.off +y"};
 
 TEST(ScanPipeline, CriterionAAtTheDefaultsOnUntunedMeshesLong) {
     if (!fss::test::longTests()) GTEST_SKIP() << "set FSS_LONG_TESTS=1";

@@ -2,14 +2,17 @@
 
 #include "fss/error.h"
 #include "fss/mask_triangulate.h"
+#include "fss/raycast.h"
 
 #include "mesh/relax.h"
 
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -67,6 +70,48 @@ double edgeLimitScale(const SampleGrid& grid, const ScanOptions& options) {
     const Eigen::Vector2d a = grid.at(0, 1).screen - grid.at(0, 0).screen;
     const Eigen::Vector2d b = grid.at(1, 1).screen - grid.at(0, 1).screen;
     return std::max({a.norm(), b.norm(), (a + b).norm()}) / std::sqrt(2.0);
+}
+
+// The border faces of the patch farther from the reference than \p chordFootprints of their corners'
+// smallest pixel footprint (the largest distance of the centroid and the edge midpoints, closestPointNear
+// from a corner's sample face): their border corners' samples lose `valid`. Returns whether any did.
+bool maskFarBorderFaces(const Patch& patch, SampleGrid& grid, const Mesh& reference, double chordFootprints) {
+    const Mesh& mesh = patch.mesh;
+    const auto [gridIndex, found] = mesh.property_map<VertexIndex, GridIndex>(props::vertexGridIndex);
+    if (!found || !(chordFootprints > 0)) return false;
+    std::vector<std::size_t> drop;
+    for (FaceIndex f : mesh.faces()) {
+        bool border = false;
+        for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh))
+            border = border || mesh.is_border(mesh.opposite(h));
+        if (!border) continue;
+        std::array<Eigen::Vector3d, 3> p;
+        std::array<VertexIndex, 3> vs;
+        FaceIndex hint;
+        int k = 0;
+        for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
+            const auto& q = mesh.point(v);
+            vs[std::size_t(k)] = v;
+            p[std::size_t(k++)] = Eigen::Vector3d(q.x(), q.y(), q.z());
+            const Sample& s = grid.at(gridIndex[v].row, gridIndex[v].col);
+            if (hint == FaceIndex() && s.face != Sample::kNoFace) hint = FaceIndex(s.face);
+        }
+        if (hint == FaceIndex()) continue;
+        double d = closestPointNear(reference, (p[0] + p[1] + p[2]) / 3.0, hint).distance;
+        for (std::size_t i = 0; i < 3; ++i)
+            d = std::max(d, closestPointNear(reference, 0.5 * (p[i] + p[(i + 1) % 3]), hint).distance);
+        double footprint = std::numeric_limits<double>::infinity();
+        for (VertexIndex v : vs)
+            footprint = std::min(footprint, double(grid.at(gridIndex[v].row, gridIndex[v].col).footprint));
+        if (!(d > chordFootprints * footprint)) continue;
+        for (VertexIndex v : vs)
+            if (mesh.is_border(v))
+                drop.push_back(std::size_t(gridIndex[v].row) * std::size_t(grid.cols) +
+                               std::size_t(gridIndex[v].col));
+    }
+    for (std::size_t i : drop)
+        grid.samples[i].valid = grid.samples[i].admissible = false;
+    return !drop.empty();
 }
 
 } // namespace
@@ -184,6 +229,13 @@ ScanResult scanPatch(const Mesh& reference, MeshRenderer& referenceRenderer, con
     stages.triangulate.maxEdgeFootprints *= edgeLimitScale(result.grid, params.scan);
     MaskedPatch masked = maskAndTriangulate(result.grid, stages, workspace, progress);
     result.patch = std::move(masked.patch);
+    // A warped lattice's patch where it ends at a crease or a fold: its border faces 1–2 lattice steps
+    // from there bridge the crease and lie farther from the reference than the square lattice's faces
+    // (issue #20, criterion A, Hausdorff part). Those farther than 0.2 footprints are dropped, two rings.
+    if (params.scan.lattice == Lattice::Adaptive && params.scan.warpToSurface) {
+        for (int pass = 0; pass < 2 && maskFarBorderFaces(result.patch, result.grid, reference, 0.2); ++pass)
+            result.patch = triangulateGrid(result.grid, stages.triangulate, workspace);
+    }
     result.counts.afterLasso = masked.counts.afterLasso;
     result.counts.afterQuality = masked.counts.afterQuality;
     result.counts.afterMorphology = masked.counts.afterMorphology;
