@@ -399,24 +399,29 @@ void BandRemesher::slidePass() {
         // Along the draft's crease polyline where v has a place on it (a curved crease too); else along a
         // nearly straight crease's chords.
         const bool straight = detail::angleBetween(p - e0, e1 - p) <= kSlideCreaseDeg * kBandDeg;
-        double best = starMinAngle(v, p);
-        V3 bestP = p;
-        CreasePos bestPos;
-        for (VertexIndex e : ends)
-            for (double t : {0.1, 0.2, 0.3, 0.4}) {
-                V3 q = p + t * (detail::pos(S_, e) - p);
-                const CreasePos cp = stageOff("lift") ? CreasePos{} : creaseBetween(v, e, t, q);
-                if (cp.chain < 0 && !straight) continue;
-                const double a = starMinAngle(v, q);
-                if (a > best + 1e-9 && starAcceptable(v, q, maxTurn)) {
-                    best = a;
-                    bestP = q;
-                    bestPos = cp;
-                }
-            }
-        if (bestP == p) continue;
-        moveAlongCrease(v, bestP, bestPos);
+        slideTowards(v, ends, !stageOff("lift"), straight, maxTurn);
     }
+}
+
+void BandRemesher::slideTowards(VertexIndex v, const std::vector<VertexIndex>& ends, bool lift, bool chords,
+                                double maxTurn) {
+    const V3 p = detail::pos(S_, v);
+    double best = starMinAngle(v, p);
+    V3 bestP = p;
+    CreasePos bestPos;
+    for (VertexIndex e : ends)
+        for (double t : {0.1, 0.2, 0.3, 0.4}) {
+            V3 q = p + t * (detail::pos(S_, e) - p);
+            const CreasePos cp = lift ? creaseBetween(v, e, t, q) : CreasePos{};
+            if (cp.chain < 0 && !chords) continue;
+            const double a = starMinAngle(v, q);
+            if (a > best + 1e-9 && starAcceptable(v, q, maxTurn)) {
+                best = a;
+                bestP = q;
+                bestPos = cp;
+            }
+        }
+    if (bestP != p) moveAlongCrease(v, bestP, bestPos);
 }
 
 void BandRemesher::moveAlongCrease(VertexIndex v, const V3& p, const CreasePos& pos) {

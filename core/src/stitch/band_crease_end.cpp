@@ -27,22 +27,7 @@ void BandRemesher::slideCreaseEndPass() {
         for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(v), S_))
             if (isCrease(v, w)) e = w;
         if (e == Mesh::null_vertex()) continue;
-        const V3 p = detail::pos(S_, v), pe = detail::pos(S_, e);
-        double best = starMinAngle(v, p);
-        V3 bestP = p;
-        CreasePos bestPos;
-        for (double t : {0.1, 0.2, 0.3, 0.4}) {
-            V3 q = p + t * (pe - p);
-            const CreasePos cp = creaseBetween(v, e, t, q);
-            const double a = starMinAngle(v, q);
-            if (a > best + 1e-9 && starAcceptable(v, q, maxTurn)) {
-                best = a;
-                bestP = q;
-                bestPos = cp;
-            }
-        }
-        if (bestP == p) continue;
-        moveAlongCrease(v, bestP, bestPos);
+        slideTowards(v, {e}, true, true, maxTurn);
     }
 }
 

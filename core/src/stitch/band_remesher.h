@@ -701,6 +701,12 @@ private:
     void slideCreaseEndPass();
     // Puts crease vertex v at p, at its place pos on the draft's crease polyline (none: chain < 0), with
     // its hint and the touched set kept up to date; both slide passes end with it.
+    /// Slides crease vertex v to the best of the points 0.1–0.4 of the way towards each of \p ends where its
+    /// star's smallest angle rises and stays acceptable (starAcceptable): on the draft's crease polyline
+    /// (creaseBetween; not looked up when \p lift is false) or, where v has no place on it, along the chord
+    /// only when \p chords. Both slide passes (crease vertices and crease ends) use it.
+    void slideTowards(VertexIndex v, const std::vector<VertexIndex>& ends, bool lift, bool chords,
+                      double maxTurn);
     void moveAlongCrease(VertexIndex v, const V3& p, const CreasePos& pos);
     double starMinAngle(VertexIndex v, const V3& at) const {
         detail::MinAngleOfMany m; // the same double as the minimum of minAngle face by face
