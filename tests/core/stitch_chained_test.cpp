@@ -20,29 +20,13 @@ std::vector<std::uint32_t> rasterizeIds(const Mesh& m, const Camera& cam) {
             s[k++] = cam.project(p);
         }
         if (!ok) continue;
-        const double x0 = std::min({s[0].x(), s[1].x(), s[2].x()}),
-                     x1 = std::max({s[0].x(), s[1].x(), s[2].x()});
-        const double y0 = std::min({s[0].y(), s[1].y(), s[2].y()}),
-                     y1 = std::max({s[0].y(), s[1].y(), s[2].y()});
-        const double area =
-            (s[1].x() - s[0].x()) * (s[2].y() - s[0].y()) - (s[1].y() - s[0].y()) * (s[2].x() - s[0].x());
-        if (area == 0) continue;
-        for (int y = std::max(0, int(std::floor(y0))); y <= std::min(H - 1, int(std::ceil(y1))); ++y)
-            for (int x = std::max(0, int(std::floor(x0))); x <= std::min(W - 1, int(std::ceil(x1))); ++x) {
-                const double px = x + 0.5, py = y + 0.5;
-                double b[3];
-                for (int i = 0; i < 3; ++i) {
-                    const Vec3 &p = s[(i + 1) % 3], &q = s[(i + 2) % 3];
-                    b[i] = ((q.x() - p.x()) * (py - p.y()) - (q.y() - p.y()) * (px - p.x())) / area;
-                }
-                if (b[0] < 0 || b[1] < 0 || b[2] < 0) continue;
-                const double z = b[0] * s[0].z() + b[1] * s[1].z() + b[2] * s[2].z();
-                const std::size_t i = std::size_t(y) * std::size_t(W) + std::size_t(x);
-                if (z < depth[i]) {
-                    depth[i] = z;
-                    ids[i] = std::uint32_t(f);
-                }
+        forEachCoveredPixel(s, W, H, [&](int x, int y, double z) {
+            const std::size_t i = std::size_t(y) * std::size_t(W) + std::size_t(x);
+            if (z < depth[i]) {
+                depth[i] = z;
+                ids[i] = std::uint32_t(f);
             }
+        });
     }
     return ids;
 }

@@ -115,6 +115,29 @@ inline Mesh makePatch(const Camera& cam, const std::function<bool(int, int)>& ma
     return m;
 }
 
+// The pixels (x, y) of a W x H image whose centres lie in the screen triangle s (closed edge functions in
+// double; a triangle of zero area covers none), with the depth interpolated affinely there: visit(x, y, z).
+template <class Visit> void forEachCoveredPixel(const Vec3 (&s)[3], int W, int H, Visit&& visit) {
+    const double area =
+        (s[1].x() - s[0].x()) * (s[2].y() - s[0].y()) - (s[1].y() - s[0].y()) * (s[2].x() - s[0].x());
+    if (!(area != 0)) return;
+    const int x0 = std::max(0, int(std::floor(std::min({s[0].x(), s[1].x(), s[2].x()}) - 0.5)));
+    const int x1 = std::min(W - 1, int(std::ceil(std::max({s[0].x(), s[1].x(), s[2].x()}))));
+    const int y0 = std::max(0, int(std::floor(std::min({s[0].y(), s[1].y(), s[2].y()}) - 0.5)));
+    const int y1 = std::min(H - 1, int(std::ceil(std::max({s[0].y(), s[1].y(), s[2].y()}))));
+    for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+            const double px = x + 0.5, py = y + 0.5;
+            double b[3];
+            for (int i = 0; i < 3; ++i) {
+                const Vec3 &p = s[(i + 1) % 3], &q = s[(i + 2) % 3];
+                b[i] = ((q.x() - p.x()) * (py - p.y()) - (q.y() - p.y()) * (px - p.x())) / area;
+            }
+            if (b[0] < 0 || b[1] < 0 || b[2] < 0) continue;
+            visit(x, y, b[0] * s[0].z() + b[1] * s[1].z() + b[2] * s[2].z());
+        }
+}
+
 // ---- invariants
 inline std::size_t boundaryLoops(const Mesh& m) {
     std::set<std::uint32_t> seen;

@@ -46,30 +46,14 @@ public:
                 s[k++] = proj.project(p);
             }
             if (!ok) continue;
-            const double area =
-                (s[1].x() - s[0].x()) * (s[2].y() - s[0].y()) - (s[1].y() - s[0].y()) * (s[2].x() - s[0].x());
-            if (!(area != 0)) continue;
-            const int x0 = std::max(0, int(std::floor(std::min({s[0].x(), s[1].x(), s[2].x()}) - 0.5)));
-            const int x1 = std::min(W - 1, int(std::ceil(std::max({s[0].x(), s[1].x(), s[2].x()}))));
-            const int y0 = std::max(0, int(std::floor(std::min({s[0].y(), s[1].y(), s[2].y()}) - 0.5)));
-            const int y1 = std::min(H - 1, int(std::ceil(std::max({s[0].y(), s[1].y(), s[2].y()}))));
-            for (int y = y0; y <= y1; ++y)
-                for (int x = x0; x <= x1; ++x) {
-                    const double px = x + 0.5, py = y + 0.5;
-                    double b[3];
-                    for (int i = 0; i < 3; ++i) {
-                        const Vec3 &p = s[(i + 1) % 3], &q = s[(i + 2) % 3];
-                        b[i] = ((q.x() - p.x()) * (py - p.y()) - (q.y() - p.y()) * (px - p.x())) / area;
-                    }
-                    if (b[0] < 0 || b[1] < 0 || b[2] < 0) continue;
-                    const double z = b[0] * s[0].z() + b[1] * s[1].z() + b[2] * s[2].z();
-                    if (!(z >= 0 && z <= 1)) continue;
-                    const std::size_t i = std::size_t(y) * std::size_t(W) + std::size_t(x);
-                    if (z < depth[i]) {
-                        depth[i] = z;
-                        fb.faceId[i] = std::uint32_t(f);
-                    }
+            stitch_test_helpers::forEachCoveredPixel(s, W, H, [&](int x, int y, double z) {
+                if (!(z >= 0 && z <= 1)) return;
+                const std::size_t i = std::size_t(y) * std::size_t(W) + std::size_t(x);
+                if (z < depth[i]) {
+                    depth[i] = z;
+                    fb.faceId[i] = std::uint32_t(f);
                 }
+            });
         }
         fb.depth.resize(depth.size());
         for (std::size_t i = 0; i < depth.size(); ++i)
