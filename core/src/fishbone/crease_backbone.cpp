@@ -242,7 +242,8 @@ std::vector<Rib> creaseRibs(const CreaseBackboneInput& in, const CreaseBackbone&
             const Eigen::Vector3d towards = at.point - q[r];
             if (towards.norm() > 0.1 * step) {
                 const SurfacePoint near = in.caster->closestPoint(q[r] + 0.1 * step * towards.normalized());
-                if (near && unitNormal(*in.mesh, near.face).dot(unitNormal(*in.mesh, at.face)) > 0.5) at = near;
+                if (near && unitNormal(*in.mesh, near.face).dot(unitNormal(*in.mesh, at.face)) > 0.5)
+                    at = near;
             }
             Eigen::Vector3d n3 = unitNormal(*in.mesh, at.face), u = n3.cross(tangent).normalized();
             if ((screen(q[r] + step * u) - p0).dot(side * normal) < 0) u = -u;
