@@ -2,6 +2,7 @@
 #include "fishbone/lasso_clip.h"
 
 #include "fss/mask.h"
+#include "fss/sample_grid.h"
 
 #include <gtest/gtest.h>
 
@@ -52,4 +53,30 @@ TEST(FishboneLassoClip, HalfRibsEndOnTheLasso) {
         EXPECT_FALSE(g.isPresent(r, 4));
         EXPECT_DOUBLE_EQ(g.at(r, 5).x(), 35.0);
     }
+}
+
+// peelSliverRibEnds on a planar cast grid (5 ribs of 5 samples, unit squares, backbone column 2): the
+// positive end of the middle rib pulled in to 0.2 beyond its inner neighbour makes triangles of 11.3° and
+// 6.3° with the ribs beside it, in quads that end those ribs too: at 30° the three ends are peeled in one
+// pass, and the next pass finds square ends (45°) and stops; the negative ends and the other samples stay; at
+// 5° nothing goes.
+TEST(FishboneLassoClip, PeelDropsTheRibEndsOfThinQuads) {
+    auto grid = [] {
+        fss::SampleGrid g(5, 5);
+        for (int r = 0; r < 5; ++r)
+            for (int c = 0; c < 5; ++c) {
+                fss::Sample& s = g.at(r, c);
+                s.point = Eigen::Vector3d(c, r, 0);
+                s.hit = s.valid = s.admissible = true;
+            }
+        g.at(2, 4).point.x() = 3.2;
+        return g;
+    };
+    fss::SampleGrid g = grid();
+    EXPECT_EQ(fss::detail::peelSliverRibEnds(g, 2, 30.0, 3), 3u);
+    for (int r = 0; r < 5; ++r)
+        for (int c = 0; c < 5; ++c)
+            EXPECT_EQ(g.at(r, c).valid, !(c == 4 && r >= 1 && r <= 3)) << r << ", " << c;
+    fss::SampleGrid loose = grid();
+    EXPECT_EQ(fss::detail::peelSliverRibEnds(loose, 2, 5.0, 3), 0u);
 }

@@ -234,7 +234,17 @@ std::vector<Rib> creaseRibs(const CreaseBackboneInput& in, const CreaseBackbone&
         for (const int side : {1, -1}) {
             SurfacePoint at = surfaceAt(p0 + 0.5 * in.spacing * side * normal);
             if (!at) continue;
-            // Perpendicular to the crease in the face beside it, towards this side on the screen.
+            // Perpendicular to the crease in the face beside it, towards this side on the screen: the face
+            // at the crease on the side of the one seen h/2 beside (the nearest face to a point a tenth of a
+            // step from the crease towards that one). The face seen beside lies 1.8 steps out where the side
+            // is seen obliquely (the creased ring from 75° above), its plane tilted by the side's curvature
+            // there, and the first step ended 0.4 steps off the surface, 1.4 steps from the crease.
+            const Eigen::Vector3d towards = at.point - q[r];
+            if (towards.norm() > 0.1 * step) {
+                const SurfacePoint near = in.caster->closestPoint(q[r] + 0.1 * step * towards.normalized());
+                if (near && unitNormal(*in.mesh, near.face).dot(unitNormal(*in.mesh, at.face)) > 0.5)
+                    at = near;
+            }
             Eigen::Vector3d n3 = unitNormal(*in.mesh, at.face), u = n3.cross(tangent).normalized();
             if ((screen(q[r] + step * u) - p0).dot(side * normal) < 0) u = -u;
             Polyline2& half = side > 0 ? ribs[r].positive : ribs[r].negative;
@@ -245,12 +255,17 @@ std::vector<Rib> creaseRibs(const CreaseBackboneInput& in, const CreaseBackbone&
                 // straightest line on a curved one. It ends off the surface, at a depth jump (the surface
                 // point farther than half a step from the step's end) and where its screen edges shrink.
                 const Eigen::Vector3d to = from + step * u;
-                if (!(cam.viewDepth(to) > 0)) break;
-                const Eigen::Vector2d s = screen(to);
+                // The surface point nearest to the step's end, seen there: the viewing ray through its
+                // projection hits it (the ray through the end's own projection slides along a surface seen
+                // obliquely, by 0.1 step per step on the creased ring from 75° above).
+                const SurfacePoint nearest = in.caster->closestPoint(to);
+                if (!nearest || (nearest.point - to).norm() > 0.5 * step) break;
+                if (!(cam.viewDepth(nearest.point) > 0)) break;
+                const Eigen::Vector2d s = screen(nearest.point);
                 const double edge = (s - half.back()).norm();
                 if (edge < 0.3 * in.spacing || length + edge > in.ribMaxLength) break;
                 const SurfacePoint hit = surfaceAt(s);
-                if (!hit || (hit.point - to).norm() > 0.5 * step) break;
+                if (!hit || (hit.point - nearest.point).norm() > 0.05 * step) break;
                 length += edge;
                 half.push_back(s);
                 n3 = unitNormal(*in.mesh, hit.face);
