@@ -11,7 +11,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
+#include <string>
 #include <vector>
 
 namespace fss::detail {
@@ -32,6 +34,8 @@ SliverCensus sliverCensus(const Mesh& mesh, const Mesh& reference, double edgeLe
     SliverCensus census;
     const double floor = belowDeg * std::numbers::pi / 180.0;
     // The reference's crease corners, and its vertices where two creases meet below the bound (forced).
+    const char* env = std::getenv("FSS_AUTO_V2_SLIVERS");
+    const bool verbose = env && std::string(env) == "2";
     const std::vector<char> refSharp = sharpEdges(reference, featureAngleDeg);
     const creases::CreaseIndex creases(reference, featureAngleDeg, edgeLength);
     std::vector<Eigen::Vector3d> corners, forced;
@@ -107,6 +111,24 @@ SliverCensus sliverCensus(const Mesh& mesh, const Mesh& reference, double edgeLe
                                       : seam       ? SliverCensus::Seam
                                                    : SliverCensus::Inside;
         ++census.faces[std::size_t(c)];
+        if (verbose) {
+            std::fprintf(stderr, "  sliver class %d:", int(c));
+            for (VertexIndex v : vs) {
+                const Eigen::Vector3d p = pos(mesh, v);
+                int sharpCount = 0;
+                for (HalfedgeIndex h : CGAL::halfedges_around_target(mesh.halfedge(v), mesh))
+                    sharpCount += sharp[mesh.edge(h).idx()];
+                Eigen::Vector3d q;
+                double d = -1;
+                creases.closest(p, q, d);
+                std::fprintf(stderr, " [deg %zu sharp %d mark %d crease %.3f L]", std::size_t(mesh.degree(v)),
+                             sharpCount, int(haveMarks && onCrease[v]), d / edgeLength);
+            }
+            const Eigen::Vector3d p0 = pos(mesh, vs[0]), p1 = pos(mesh, vs[1]), p2 = pos(mesh, vs[2]);
+            std::fprintf(stderr, " angles %.1f %.1f at (%.4f %.4f %.4f)\n",
+                         angleBetween(p1 - p0, p2 - p0) * 180 / std::numbers::pi,
+                         angleBetween(p2 - p1, p0 - p1) * 180 / std::numbers::pi, p0.x(), p0.y(), p0.z());
+        }
     }
     return census;
 }

@@ -14,6 +14,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <optional>
 #include <vector>
@@ -63,9 +65,21 @@ public:
                 if (pairs.empty()) {
                     report.flips += flips, report.collapses += collapses, report.moves += moves;
                     before = m_;
+                    // The next round looks only at the slivers around what this one changed.
+                    active_.assign(m_.number_of_vertices() + m_.number_of_removed_vertices(), 0);
+                    for (VertexIndex v : touched_)
+                        if (!m_.is_removed(v)) {
+                            active_[v.idx()] = 1;
+                            for (VertexIndex w : CGAL::vertices_around_target(m_.halfedge(v), m_))
+                                active_[w.idx()] = 1;
+                        }
                     break;
                 }
                 ++report.sweepsReverted;
+                if (std::getenv("FSS_AUTO_V2_DEBUG"))
+                    std::fprintf(stderr,
+                                 "v2 slivers: round %d attempt %d: %zu operations, %zu intersecting pairs\n",
+                                 round, attempt, ops, pairs.size());
                 std::vector<VertexIndex> stuck;
                 for (const auto& [f, g] : pairs)
                     for (FaceIndex h : {f, g})
@@ -97,6 +111,9 @@ private:
     std::vector<char> fixed_, fixedEdge_;
     std::vector<int> creaseDegree_;
     std::vector<VertexIndex> touched_, frozen_;
+    /// After the first round: the vertices around the operations of the last sweep kept (the slivers
+    /// elsewhere were tried already).
+    std::vector<char> active_;
     const creases::CreaseIndex creases_;
     PointGrid corners_; // the corners of the reference's creases
 
@@ -177,16 +194,22 @@ private:
         return m;
     }
 
-    /// Whether \p after may replace \p before: a smallest angle higher by kGain, no face farther from the
-    /// reference than the old ones (or the tolerance), no normal turned from the reference's farther than
-    /// the crease angle (or the old faces' largest such angle).
-    bool acceptable(const Measure& old, const std::vector<Tri>& after, double& newMin) const {
-        const Measure a = measure(after, true);
-        if (a.minAngle < old.minAngle + kGain) return false;
+    /// Whether \p after may replace \p before and beats the best candidate so far (\p best, its smallest
+    /// angle): a smallest angle higher by kGain than the old one and higher than \p best, no face farther
+    /// from the reference than the old ones (or the tolerance), no normal turned from the reference's
+    /// farther than the crease angle (or the old faces' largest such angle). The cheap angle test first: the
+    /// distances are measured only for a candidate that passes it.
+    bool acceptable(const std::vector<Tri>& before, const std::vector<Tri>& after, double best,
+                    double& newMin) const {
+        const double oldMin = measure(before, true).minAngle, a = measure(after, true).minAngle;
+        if (a < oldMin + kGain || a <= best) return false;
         const Measure full = measure(after);
-        if (full.gap > std::max(old.gap, tolerance_)) return false;
-        if (full.deviation > std::max(old.deviation, feature_)) return false;
-        newMin = a.minAngle;
+        if (full.gap > tolerance_ || full.deviation > feature_) {
+            const Measure old = measure(before);
+            if (full.gap > std::max(old.gap, tolerance_)) return false;
+            if (full.deviation > std::max(old.deviation, feature_)) return false;
+        }
+        newMin = a;
         return true;
     }
 
@@ -204,6 +227,8 @@ private:
         const HalfedgeIndex o = m_.opposite(h);
         const VertexIndex a = m_.source(h), b = m_.target(h);
         const VertexIndex c = m_.target(m_.next(h)), d = m_.target(m_.next(o));
+        for (VertexIndex v : {a, b, c, d})
+            if (fixed_[v.idx()] == 2) return; // frozen
         const Vec pa = pos(m_, a), pb = pos(m_, b), pc = pos(m_, c), pd = pos(m_, d);
         const std::vector<Tri> before{{pa, pb, pc}, {pb, pa, pd}}, after{{pa, pd, pc}, {pd, pb, pc}};
         const Vec n1 = normalOf(after[0]), n2 = normalOf(after[1]);
@@ -212,7 +237,7 @@ private:
         const double oldFold = angleBetween(normalOf(before[0]), normalOf(before[1]));
         if (angleBetween(n1, n2) > std::max(0.5 * feature_, oldFold)) return;
         double newMin = 0;
-        if (!acceptable(measure(before), after, newMin) || newMin <= best.newMin) return;
+        if (!acceptable(before, after, best.newMin, newMin)) return;
         best = {Candidate::Flip, h, {}, {0, 0, 0}, newMin};
     }
 
@@ -239,7 +264,7 @@ private:
     void tryCollapse(HalfedgeIndex h, const Vec& at, Candidate& best) const {
         const EdgeIndex e = m_.edge(h);
         const VertexIndex keep = m_.source(h), gone = m_.target(h);
-        if (fixedEdge_[e.idx()] == 2 || fixed_[gone.idx()] == 2) return;
+        if (fixedEdge_[e.idx()] == 2 || fixed_[gone.idx()] == 2 || fixed_[keep.idx()] == 2) return;
         if (fixedEdge_[e.idx()] == 1) {
             // Along a crease: the vertex removed lies on this crease only (two crease edges), the one kept
             // stays where it is.
@@ -262,7 +287,7 @@ private:
             longestAfter = std::max({longestAfter, (t.b - t.a).norm(), (t.c - t.a).norm()});
         if (longestAfter > std::max(1.5 * o_.edgeLength, longestBefore)) return;
         double newMin = 0;
-        if (!acceptable(measure(before), after, newMin) || newMin <= best.newMin) return;
+        if (!acceptable(before, after, best.newMin, newMin)) return;
         best = {Candidate::Collapse, h, {}, at, newMin};
     }
 
@@ -276,7 +301,7 @@ private:
         std::vector<Tri> before, after;
         if (!starWith(v, to, Mesh::null_face(), Mesh::null_face(), before, after)) return;
         double newMin = 0;
-        if (!acceptable(measure(before), after, newMin) || newMin <= best.newMin) return;
+        if (!acceptable(before, after, best.newMin, newMin)) return;
         best = {Candidate::Move, {}, v, to, newMin};
     }
 
@@ -344,6 +369,11 @@ private:
             Candidate best;
             const HalfedgeIndex h0 = m_.halfedge(f);
             const HalfedgeIndex hs[3] = {h0, m_.next(h0), m_.next(m_.next(h0))};
+            if (!active_.empty() && std::none_of(std::begin(hs), std::end(hs), [&](HalfedgeIndex h) {
+                    const std::size_t i = m_.target(h).idx();
+                    return i < active_.size() && active_[i];
+                }))
+                continue;
             for (HalfedgeIndex h : hs)
                 tryFlip(h, best);
             HalfedgeIndex shortest = hs[0];
