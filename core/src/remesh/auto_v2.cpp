@@ -20,7 +20,8 @@
 //     within L/4 of the reference; Surface_mesh::add_face refuses whatever would make the mesh non-manifold.
 //     CGAL's hole filling closes what is left (junctions of three regions), on an open reference only the
 //     cycles that do not run along its own boundary (ReferenceBorder).
-//  4. Seam relaxation and crease recovery once, as v1 ends (seam_relax.h, crease_snap.h).
+//  4. Seam relaxation and crease recovery once, as v1 ends (seam_relax.h, crease_snap.h), then the repair of
+//     the faces below 20° (sliver_repair.h; FSS_AUTO_V2_SLIVERS=1 prints where they lie before and after).
 //  5. Validation (validateJoin): as many boundary loops and connected components as the reference and the
 //     same Euler characteristic (genus), a vertex count within 10 % of the target (else parts went
 //     unsampled), closed when the reference is, no pinched vertex, no degenerate face, every vertex and face
