@@ -194,15 +194,37 @@ private:
         return m;
     }
 
+    /// A candidate operation: its kind, where, and the smallest angle it reaches.
+    struct Candidate {
+        enum Kind { None, Flip, Collapse, Move } kind = None;
+        HalfedgeIndex h;   // flip: the edge; collapse: the halfedge whose target is removed
+        VertexIndex v;     // move: the vertex
+        Vec to{0, 0, 0};   // collapse, move: the new position
+        double newMin = 0; // the smallest angle of the new faces
+        int valence = 0;   // the change in the number of vertices of valence ≠ 6 it makes
+    };
+
+    static int irregular(std::size_t degree) { return degree != 6; }
+
+    /// Whether an operation reaching \p newMin with the valence change \p valence beats \p best: among
+    /// operations that lift every face they make to the bound, the one that leaves fewer irregular vertices
+    /// (then the higher angle); else the higher angle.
+    bool beats(double newMin, int valence, const Candidate& best) const {
+        if (best.kind == Candidate::None) return true;
+        if (newMin >= floor_ && best.newMin >= floor_)
+            return valence < best.valence || (valence == best.valence && newMin > best.newMin);
+        return newMin > best.newMin;
+    }
+
     /// Whether \p after may replace \p before and beats the best candidate so far (\p best, its smallest
     /// angle): a smallest angle higher by kGain than the old one and higher than \p best, no face farther
     /// from the reference than the old ones (or the tolerance), no normal turned from the reference's
     /// farther than the crease angle (or the old faces' largest such angle). The cheap angle test first: the
     /// distances are measured only for a candidate that passes it.
-    bool acceptable(const std::vector<Tri>& before, const std::vector<Tri>& after, double best,
-                    double& newMin) const {
+    bool acceptable(const std::vector<Tri>& before, const std::vector<Tri>& after, const Candidate& best,
+                    int valence, double& newMin) const {
         const double oldMin = measure(before, true).minAngle, a = measure(after, true).minAngle;
-        if (a < oldMin + kGain || a <= best) return false;
+        if (a < oldMin + kGain || !beats(a, valence, best)) return false;
         const Measure full = measure(after);
         if (full.gap > tolerance_ || full.deviation > feature_) {
             const Measure old = measure(before);
@@ -212,15 +234,6 @@ private:
         newMin = a;
         return true;
     }
-
-    /// A candidate operation: its kind, where, and the smallest angle it reaches.
-    struct Candidate {
-        enum Kind { None, Flip, Collapse, Move } kind = None;
-        HalfedgeIndex h;   // flip: the edge; collapse: the halfedge whose target is removed
-        VertexIndex v;     // move: the vertex
-        Vec to{0, 0, 0};   // collapse, move: the new position
-        double newMin = 0; // the smallest angle of the new faces
-    };
 
     void tryFlip(HalfedgeIndex h, Candidate& best) const {
         if (fixedEdge_[m_.edge(h).idx()] || !canFlip(m_, h)) return;
@@ -236,9 +249,13 @@ private:
         // No new crease between the two new faces (unless the old two met at a sharper one).
         const double oldFold = angleBetween(normalOf(before[0]), normalOf(before[1]));
         if (angleBetween(n1, n2) > std::max(0.5 * feature_, oldFold)) return;
+        const int valence = irregular(m_.degree(a) - 1) + irregular(m_.degree(b) - 1) +
+                            irregular(m_.degree(c) + 1) + irregular(m_.degree(d) + 1) -
+                            irregular(m_.degree(a)) - irregular(m_.degree(b)) - irregular(m_.degree(c)) -
+                            irregular(m_.degree(d));
         double newMin = 0;
-        if (!acceptable(before, after, best.newMin, newMin)) return;
-        best = {Candidate::Flip, h, {}, {0, 0, 0}, newMin};
+        if (!acceptable(before, after, best, valence, newMin)) return;
+        best = {Candidate::Flip, h, {}, {0, 0, 0}, newMin, valence};
     }
 
     /// The triangles around \p v but those of \p skip1, \p skip2, with \p v at \p at; false when one turns
@@ -286,9 +303,13 @@ private:
         for (const Tri& t : after)
             longestAfter = std::max({longestAfter, (t.b - t.a).norm(), (t.c - t.a).norm()});
         if (longestAfter > std::max(1.5 * o_.edgeLength, longestBefore)) return;
+        const VertexIndex x = m_.target(m_.next(h)), y = m_.target(m_.next(m_.opposite(h)));
+        const int valence = irregular(m_.degree(keep) + m_.degree(gone) - 4) + irregular(m_.degree(x) - 1) +
+                            irregular(m_.degree(y) - 1) - irregular(m_.degree(keep)) -
+                            irregular(m_.degree(gone)) - irregular(m_.degree(x)) - irregular(m_.degree(y));
         double newMin = 0;
-        if (!acceptable(before, after, best.newMin, newMin)) return;
-        best = {Candidate::Collapse, h, {}, at, newMin};
+        if (!acceptable(before, after, best, valence, newMin)) return;
+        best = {Candidate::Collapse, h, {}, at, newMin, valence};
     }
 
     void tryMove(VertexIndex v, const Vec& target, Candidate& best) const {
@@ -301,8 +322,8 @@ private:
         std::vector<Tri> before, after;
         if (!starWith(v, to, Mesh::null_face(), Mesh::null_face(), before, after)) return;
         double newMin = 0;
-        if (!acceptable(before, after, best.newMin, newMin)) return;
-        best = {Candidate::Move, {}, v, to, newMin};
+        if (!acceptable(before, after, best, 0, newMin)) return;
+        best = {Candidate::Move, {}, v, to, newMin, 0};
     }
 
     /// Slides \p v, a vertex on one crease (two crease edges, no other fixed edge, not at a corner of the
