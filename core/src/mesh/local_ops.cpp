@@ -96,4 +96,14 @@ std::vector<std::pair<FaceIndex, FaceIndex>> intersectionsAround(const Mesh& mes
     return pairs;
 }
 
+std::vector<VertexIndex> cornersOf(const Mesh& mesh,
+                                   const std::vector<std::pair<FaceIndex, FaceIndex>>& pairs) {
+    std::vector<VertexIndex> out;
+    for (const auto& [f, g] : pairs)
+        for (FaceIndex h : {f, g})
+            for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(h), mesh))
+                out.push_back(v);
+    return out;
+}
+
 } // namespace fss::detail

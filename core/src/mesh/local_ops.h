@@ -52,4 +52,9 @@ bool moveKeepsStar(const Mesh& mesh, VertexIndex v, const Eigen::Vector3d& to, d
 std::vector<std::pair<FaceIndex, FaceIndex>> intersectionsAround(const Mesh& mesh,
                                                                  const std::vector<VertexIndex>& touched);
 
+/// The corners of the faces of \p pairs (with repeats), e.g. the vertices a stage that made those
+/// intersections leaves alone when it runs again.
+std::vector<VertexIndex> cornersOf(const Mesh& mesh,
+                                   const std::vector<std::pair<FaceIndex, FaceIndex>>& pairs);
+
 } // namespace fss::detail

@@ -49,11 +49,7 @@ public:
                 if (checkStages) {
                     const std::vector<std::pair<FaceIndex, FaceIndex>> pairs = intersectionsAtTouched();
                     if (!pairs.empty()) {
-                        std::vector<VertexIndex> frozen;
-                        for (const auto& [f, g] : pairs)
-                            for (FaceIndex h : {f, g})
-                                for (VertexIndex v : CGAL::vertices_around_face(m_.halfedge(h), m_))
-                                    frozen.push_back(v);
+                        const std::vector<VertexIndex> frozen = cornersOf(m_, pairs);
                         m_ = before; // vertex indices are those of `before` (stages only remove vertices)
                         fixed_ = fixedBefore;
                         fixedEdge_ = fixedEdgeBefore;

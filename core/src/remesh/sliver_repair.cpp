@@ -80,11 +80,7 @@ public:
                     std::fprintf(stderr,
                                  "v2 slivers: round %d attempt %d: %zu operations, %zu intersecting pairs\n",
                                  round, attempt, ops, pairs.size());
-                std::vector<VertexIndex> stuck;
-                for (const auto& [f, g] : pairs)
-                    for (FaceIndex h : {f, g})
-                        for (VertexIndex v : CGAL::vertices_around_face(m_.halfedge(h), m_))
-                            stuck.push_back(v);
+                const std::vector<VertexIndex> stuck = cornersOf(m_, pairs);
                 m_ = before; // vertex indices are those of `before` (the collapses only remove vertices)
                 for (VertexIndex v : stuck)
                     frozen_.push_back(v);
