@@ -92,7 +92,7 @@ struct Row {
     std::string note;    // FSS only: why v2 fell back to v1
     // FSS only: plan, scan, join, relax, crease (AutoResult; join, relax and crease are 0 for v1, whose
     // stitches, relaxation and crease recovery are all in "join").
-    double stages[5] = {};
+    double stages[6] = {};
     bool have = false;
 };
 
@@ -172,9 +172,12 @@ void BM_FssAuto(benchmark::State& state, std::string name, int engine) {
         row.irregular = irregularVertices(res.mesh, o.featureAngleDeg);
         row.note = res.engineNote;
         const double rest = res.stitchSeconds - res.joinSeconds - res.relaxSeconds - res.creaseSeconds;
-        const double stages[5] = {res.planSeconds, res.scanSeconds,
-                                  res.joinSeconds + (res.joinSeconds > 0 ? 0 : rest), res.relaxSeconds,
-                                  res.creaseSeconds};
+        const double stages[6] = {res.planSeconds,
+                                  res.scanSeconds,
+                                  res.joinSeconds + (res.joinSeconds > 0 ? 0 : rest - res.sliverSeconds),
+                                  res.relaxSeconds,
+                                  res.creaseSeconds,
+                                  res.sliverSeconds};
         std::copy(std::begin(stages), std::end(stages), std::begin(row.stages));
         row.have = true;
         state.ResumeTiming();
@@ -225,9 +228,9 @@ void printTable() {
         "same target edge length; renderer: %s, fishbone: %s, v2 falls back to v1: %s\n",
         gpuAvailable() ? "gpu" : "cpu", autoOptions().fishbone ? "auto" : "off",
         autoOptions().fallbackToV1 ? "yes" : "no");
-    std::printf("%-16s %-4s %8s %7s %7s %6s %6s %4s %4s %4s %4s %4s %4s %6s %6s %6s %9s %9s\n", "mesh", "who",
-                "L", "verts", "time_s", "t/cgal", "cover", "clsd", "cmp", "loop", "pnch", "SI", "dgn", "val6",
-                "minang", "meanmn", "H_to_rel", "H_from_rel");
+    std::printf("%-16s %-4s %8s %7s %7s %6s %6s %4s %4s %4s %4s %4s %4s %6s %6s %6s %6s %9s %9s\n", "mesh",
+                "who", "L", "verts", "time_s", "t/cgal", "cover", "clsd", "cmp", "loop", "pnch", "SI", "dgn",
+                "val6", "minang", "meanmn", "lt30", "H_to_rel", "H_from_rel");
     for (const std::string& name : meshOrder) {
         const MeshResults& r = results()[name];
         const char* who[3] = {"v1", "v2", "cgal"};
@@ -236,18 +239,19 @@ void printTable() {
             if (!row.have) continue;
             const fss::Metrics& m = row.metrics;
             std::printf("%-16s %-4s %8.5f %7zu %7.2f %6.2f %6.4f %4s %4zu %4zu %4zu %4zu %4zu %6.4f %6.2f "
-                        "%6.2f %9s %9s%s%s\n",
+                        "%6.2f %6.4f %9s %9s%s%s\n",
                         name.c_str(), who[w], r.edgeLength, m.vertices, row.seconds,
                         r.cgal.have ? row.seconds / r.cgal.seconds : 0.0, w < 2 ? row.coverage : 1.0,
                         m.closed ? "yes" : "no", m.components, m.boundaryLoops, m.nonManifoldVertices,
                         m.selfIntersections.value_or(0), m.degenerateFaces, m.fracValence6Interior,
-                        m.minAngleDeg, m.meanMinAngleDeg, opt(m.hausdorffToRefRel).c_str(),
-                        opt(m.hausdorffFromRefRel).c_str(), row.note.empty() ? "" : "  ", row.note.c_str());
+                        m.minAngleDeg, m.meanMinAngleDeg, m.fracMinAngleBelow30,
+                        opt(m.hausdorffToRefRel).c_str(), opt(m.hausdorffFromRefRel).c_str(),
+                        row.note.empty() ? "" : "  ", row.note.c_str());
         }
     }
     std::printf("\nFSS: seconds by stage (v1: stitches, relaxation and crease recovery all in join)\n");
-    std::printf("%-16s %-4s %7s %7s %7s %7s %7s %7s\n", "mesh", "who", "plan", "scan", "join", "relax",
-                "crease", "total");
+    std::printf("%-16s %-4s %7s %7s %7s %7s %7s %7s %7s\n", "mesh", "who", "plan", "scan", "join", "relax",
+                "crease", "sliver", "total");
     for (const std::string& name : meshOrder)
         for (int w = 0; w < 2; ++w) {
             const Row& row = results()[name].fss[w];

@@ -292,6 +292,8 @@ TEST(Options, AutoOptionsNameTheField) {
             {"seamRelaxRounds", [](A& o) { o.seamRelaxRounds = -1; }, "must be at least 0, not -1"},
             {"seamRelaxMinAngleDeg", [](A& o) { o.seamRelaxMinAngleDeg = 60; }, "must be in [0, 60), not 60"},
             {"creaseSnapRounds", [](A& o) { o.creaseSnapRounds = -1; }, "must be at least 0, not -1"},
+            {"repairSliversBelowDeg", [](A& o) { o.repairSliversBelowDeg = 60; },
+             "must be in [0, 60), not 60"},
             {"stitch.minAngleFloorDeg", [](A& o) { o.stitch.minAngleFloorDeg = 30; },
              "must be in [0, 30), not 30"},
             {"qualityMargin", [](A& o) { o.qualityMargin = 1; }, "must be in [0, 1), not 1"},

@@ -170,6 +170,9 @@ struct AutoOptions {
     /// Rounds of crease recovery after the seam relaxation (file comment, step 7; 0 = none): each round
     /// snaps vertices onto the creases, splits edges at them, then flips edges to follow them.
     int creaseSnapRounds = 3;
+    /// AutoEngine::V2 only: after the crease recovery, the faces whose smallest angle is below this (degrees;
+    /// 0 = none) are repaired by local flips, collapses and tangential moves (sliver_repair.h).
+    double repairSliversBelowDeg = 20.0;
     /// Options of every stitch. Faces with a smallest angle under 10° are refused (trimmed and retried), and
     /// trimming peels the patch boundary (StitchOptions::peelTrim): the regions of a small or strongly curved
     /// mesh are only a few pixels wide at the target edge length, and the wide trims cut them apart.
@@ -183,9 +186,9 @@ struct AutoOptions {
     /// finite and ≥ 0; regionMarginPx in [0, 16]; regionFillPasses, followUpRounds, seamRelaxRounds and
     /// creaseSnapRounds ≥ 0; minViewAreaFraction and coverageGoal in [0, 1]; maxViews ≥ 1; footprintRatio in
     /// (0.1, 4]; featureAngleDeg in [0, 180); fishboneBandWidth finite and > 0; morphologyRadius in
-    /// [0, 1024]; flipSliversBelowDeg and seamRelaxMinAngleDeg in [0, 60); qualityMargin in [0, 1); stitch
-    /// (StitchOptions::validate, named "AutoOptions::stitch.minAngleFloorDeg" ...).
-    /// \throw InvalidOptionError naming the first field out of range and its range.
+    /// [0, 1024]; flipSliversBelowDeg, seamRelaxMinAngleDeg and repairSliversBelowDeg in [0, 60);
+    /// qualityMargin in [0, 1); stitch (StitchOptions::validate, named "AutoOptions::stitch.minAngleFloorDeg"
+    /// ...). \throw InvalidOptionError naming the first field out of range and its range.
     void validate() const;
 
     /// StitchOptions with minAngleFloorDeg = 10, peelTrim on and the seam band remesh off (issue 19): auto
@@ -246,6 +249,10 @@ struct AutoResult {
     /// Faces turned over against the reference, or near a crease and far from it, repaired by a flip, a move
     /// onto the crease or a collapse.
     std::size_t creaseRepairs = 0;
+    /// AutoEngine::V2: the sliver repair (AutoOptions::repairSliversBelowDeg): faces below the bound before
+    /// and after it, its flips, collapses and moves.
+    std::size_t sliversBefore = 0, sliversAfter = 0, sliverRepairFlips = 0, sliverCollapses = 0,
+                sliverMoves = 0;
     /// True when a stage of the seam relaxation was undone because its result intersected itself.
     bool seamRelaxDiscarded = false;
     /// The design that made `mesh` (AutoOptions::engine, or V1 after a V2 run that failed validation).
@@ -260,6 +267,7 @@ struct AutoResult {
     double joinSeconds = 0;   ///< the one-pass join (gap closing, hole filling, repair)
     double relaxSeconds = 0;  ///< the sliver flips and the seam relaxation (both passes)
     double creaseSeconds = 0; ///< the crease recovery
+    double sliverSeconds = 0; ///< the sliver repair
 };
 
 /// The edge length a regular triangulation with \p vertices vertices of a surface of area \p area has:

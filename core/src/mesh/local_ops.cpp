@@ -3,7 +3,12 @@
 
 #include "mesh/triangle_geometry.h"
 
+#include <CGAL/Box_intersection_d/Box_with_info_d.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/boost/graph/Euler_operations.h>
+#include <CGAL/box_intersection_d.h>
+
+#include <algorithm>
 
 #include <numbers>
 
@@ -56,6 +61,49 @@ bool moveKeepsStar(const Mesh& mesh, VertexIndex v, const Eigen::Vector3d& to, d
         if (n0.isZero() || n.isZero() || angleBetween(n, n0) > maxTurn) return false;
     }
     return newMin >= std::min(oldMin, floor);
+}
+
+std::vector<std::pair<FaceIndex, FaceIndex>> intersectionsAround(const Mesh& mesh,
+                                                                 const std::vector<VertexIndex>& touched) {
+    std::vector<FaceIndex> near;
+    for (VertexIndex v : touched)
+        if (!mesh.is_removed(v))
+            for (FaceIndex f : CGAL::faces_around_target(mesh.halfedge(v), mesh))
+                if (f != Mesh::null_face()) near.push_back(f);
+    std::sort(near.begin(), near.end());
+    near.erase(std::unique(near.begin(), near.end()), near.end());
+    if (near.empty()) return {};
+    using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, FaceIndex>;
+    auto box = [&](FaceIndex f) {
+        const HalfedgeIndex h = mesh.halfedge(f);
+        return Box(mesh.point(mesh.source(h)).bbox() + mesh.point(mesh.target(h)).bbox() +
+                       mesh.point(mesh.target(mesh.next(h))).bbox(),
+                   f);
+    };
+    std::vector<Box> changed, all;
+    changed.reserve(near.size());
+    all.reserve(mesh.number_of_faces());
+    for (FaceIndex f : near)
+        changed.push_back(box(f));
+    for (FaceIndex f : mesh.faces())
+        all.push_back(box(f));
+    CGAL::box_intersection_d(changed.begin(), changed.end(), all.begin(), all.end(),
+                             [&](const Box&, const Box& other) { near.push_back(other.info()); });
+    std::sort(near.begin(), near.end());
+    near.erase(std::unique(near.begin(), near.end()), near.end());
+    std::vector<std::pair<FaceIndex, FaceIndex>> pairs;
+    CGAL::Polygon_mesh_processing::self_intersections(near, mesh, std::back_inserter(pairs));
+    return pairs;
+}
+
+std::vector<VertexIndex> cornersOf(const Mesh& mesh,
+                                   const std::vector<std::pair<FaceIndex, FaceIndex>>& pairs) {
+    std::vector<VertexIndex> out;
+    for (const auto& [f, g] : pairs)
+        for (FaceIndex h : {f, g})
+            for (VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(h), mesh))
+                out.push_back(v);
+    return out;
 }
 
 } // namespace fss::detail

@@ -9,6 +9,9 @@
 
 #include <Eigen/Core>
 
+#include <utility>
+#include <vector>
+
 namespace fss::detail {
 
 /// Whether the edge of \p h may be flipped keeping \p mesh a valid edge-manifold triangle mesh: it is not a
@@ -41,5 +44,17 @@ void undoSplitEdge(Mesh& mesh, HalfedgeIndex h, const EdgeSplit& split);
 /// its normal by more than \p maxTurn (radians), and the smallest angle of the star is not below the
 /// smaller of \p floor (radians) and the smallest angle before.
 bool moveKeepsStar(const Mesh& mesh, VertexIndex v, const Eigen::Vector3d& to, double maxTurn, double floor);
+
+/// The pairs of intersecting faces of \p mesh of which one lies around a vertex of \p touched (CGAL PMP's
+/// exact predicates, only the faces whose bounding boxes meet those faces' tested). When the mesh was free of
+/// intersections before the faces around \p touched changed (and no other face did), these are all the pairs
+/// PMP::self_intersections finds on the whole mesh, found in a fraction of its time.
+std::vector<std::pair<FaceIndex, FaceIndex>> intersectionsAround(const Mesh& mesh,
+                                                                 const std::vector<VertexIndex>& touched);
+
+/// The corners of the faces of \p pairs (with repeats), e.g. the vertices a stage that made those
+/// intersections leaves alone when it runs again.
+std::vector<VertexIndex> cornersOf(const Mesh& mesh,
+                                   const std::vector<std::pair<FaceIndex, FaceIndex>>& pairs);
 
 } // namespace fss::detail

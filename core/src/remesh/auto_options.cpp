@@ -28,6 +28,7 @@ void AutoOptions::validate() const {
     check.positive("fishboneBandWidth", fishboneBandWidth);
     check.intRange("morphologyRadius", morphologyRadius, 0, 1024);
     check.inRange("flipSliversBelowDeg", flipSliversBelowDeg, 0, 60, false, true);
+    check.inRange("repairSliversBelowDeg", repairSliversBelowDeg, 0, 60, false, true);
     check.intAtLeast("seamRelaxRounds", seamRelaxRounds, 0);
     check.inRange("seamRelaxMinAngleDeg", seamRelaxMinAngleDeg, 0, 60, false, true);
     check.intAtLeast("creaseSnapRounds", creaseSnapRounds, 0);

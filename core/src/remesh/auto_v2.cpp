@@ -20,7 +20,8 @@
 //     within L/4 of the reference; Surface_mesh::add_face refuses whatever would make the mesh non-manifold.
 //     CGAL's hole filling closes what is left (junctions of three regions), on an open reference only the
 //     cycles that do not run along its own boundary (ReferenceBorder).
-//  4. Seam relaxation and crease recovery once, as v1 ends (seam_relax.h, crease_snap.h).
+//  4. Seam relaxation and crease recovery once, as v1 ends (seam_relax.h, crease_snap.h), then the repair of
+//     the faces below 20° (sliver_repair.h; FSS_AUTO_V2_SLIVERS=1 prints where they lie before and after).
 //  5. Validation (validateJoin): as many boundary loops and connected components as the reference and the
 //     same Euler characteristic (genus), a vertex count within 10 % of the target (else parts went
 //     unsampled), closed when the reference is, no pinched vertex, no degenerate face, every vertex and face
@@ -35,6 +36,7 @@
 #include "remesh/crease_snap.h"
 #include "remesh/join_regions.h"
 #include "remesh/seam_relax.h"
+#include "remesh/sliver_repair.h"
 
 #include "fss/error.h"
 #include "fss/mask.h"
@@ -542,6 +544,36 @@ AutoResult autoRemeshV2(const Mesh& reference, const AutoOptions& options, const
         result.creaseRepairs = cr.repairs;
         result.creaseSeconds = since(t0);
         if (cr.snaps + cr.splits + cr.flips + cr.removals + cr.repairs > 0) relax();
+    }
+    if (std::getenv("FSS_AUTO_V2_SLIVERS"))
+        std::fprintf(stderr, "v2 slivers before repair: %s\n",
+                     sliverCensus(current, reference, L, options.featureAngleDeg, 20.0).format().c_str());
+    if (options.repairSliversBelowDeg > 0) {
+        const auto t0 = Clock::now();
+        SliverRepairOptions so;
+        so.belowDeg = options.repairSliversBelowDeg;
+        so.edgeLength = L;
+        so.featureAngleDeg = options.featureAngleDeg;
+        so.knownFree = currentFree;
+        const SliverRepairReport sr = repairSlivers(current, caster, so);
+        currentFree = sr.freeAfter;
+        result.sliversBefore = sr.before;
+        result.sliversAfter = sr.after;
+        result.sliverRepairFlips = sr.flips;
+        result.sliverCollapses = sr.collapses;
+        result.sliverMoves = sr.moves;
+        result.sliverSeconds = since(t0);
+        if (debug)
+            std::fprintf(
+                stderr,
+                "v2: slivers %zu -> %zu (%zu flips, %zu collapses, %zu moves, %d sweeps undone), %.3f s\n",
+                sr.before, sr.after, sr.flips, sr.collapses, sr.moves, sr.sweepsReverted,
+                result.sliverSeconds);
+    }
+    if (std::getenv("FSS_AUTO_V2_SLIVERS"))
+        std::fprintf(stderr, "v2 slivers after repair: %s\n",
+                     sliverCensus(current, reference, L, options.featureAngleDeg, 20.0).format().c_str());
+    {
         if (auto [onCrease, have] = current.property_map<VertexIndex, bool>(kOnCreaseProperty); have)
             current.remove_property_map(onCrease);
     }

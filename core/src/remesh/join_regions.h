@@ -7,6 +7,8 @@
 
 #include <CGAL/boost/graph/iterator.h>
 
+#include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 namespace fss::detail {
@@ -16,6 +18,33 @@ inline Eigen::Vector3d at(const Mesh& m, VertexIndex v) {
     const Point3& p = m.point(v);
     return {p.x(), p.y(), p.z()};
 }
+
+/// Points in a uniform grid of cell \p reach: which lie within \p reach of a query point.
+class PointGrid {
+public:
+    explicit PointGrid(double reach) : reach_(reach) {}
+    void add(const Eigen::Vector3d& p) { cells_[key(p)].push_back(p); }
+    bool near(const Eigen::Vector3d& c) const {
+        for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dz = -1; dz <= 1; ++dz) {
+                    const auto it = cells_.find(key(c + reach_ * Eigen::Vector3d(dx, dy, dz)));
+                    if (it == cells_.end()) continue;
+                    for (const Eigen::Vector3d& p : it->second)
+                        if ((p - c).squaredNorm() <= reach_ * reach_) return true;
+                }
+        return false;
+    }
+
+private:
+    std::int64_t key(const Eigen::Vector3d& p) const {
+        const Eigen::Vector3i c((p / reach_).array().floor().cast<int>());
+        return (std::int64_t(c.x() & 0x1FFFFF) << 42) | (std::int64_t(c.y() & 0x1FFFFF) << 21) |
+               std::int64_t(c.z() & 0x1FFFFF);
+    }
+    double reach_;
+    std::unordered_map<std::int64_t, std::vector<Eigen::Vector3d>> cells_;
+};
 
 /// The unit normal of face \p f (zero for a degenerate face).
 inline Eigen::Vector3d faceNormal(const Mesh& m, FaceIndex f) {

@@ -7,10 +7,8 @@
 
 #include "fss/raycast.h"
 
-#include <CGAL/Box_intersection_d/Box_with_info_d.h>
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/boost/graph/Euler_operations.h>
-#include <CGAL/box_intersection_d.h>
 
 #include <algorithm>
 #include <cmath>
@@ -51,11 +49,7 @@ public:
                 if (checkStages) {
                     const std::vector<std::pair<FaceIndex, FaceIndex>> pairs = intersectionsAtTouched();
                     if (!pairs.empty()) {
-                        std::vector<VertexIndex> frozen;
-                        for (const auto& [f, g] : pairs)
-                            for (FaceIndex h : {f, g})
-                                for (VertexIndex v : CGAL::vertices_around_face(m_.halfedge(h), m_))
-                                    frozen.push_back(v);
+                        const std::vector<VertexIndex> frozen = cornersOf(m_, pairs);
                         m_ = before; // vertex indices are those of `before` (stages only remove vertices)
                         fixed_ = fixedBefore;
                         fixedEdge_ = fixedEdgeBefore;
@@ -107,41 +101,10 @@ private:
     /// The vertices whose faces the current stage changed (moved, flipped, made by a collapse).
     std::vector<VertexIndex> touched_;
 
-    /// The pairs of intersecting faces of the mesh of which one lies around a vertex in touched_: as the mesh
-    /// was free of intersections before the stage (run checks stages only then) and the faces around no
-    /// touched vertex are as they were, these are all the pairs PMP::self_intersections finds on the whole
-    /// mesh, found in a fraction of its time (only the faces whose bounding boxes meet a changed face's are
-    /// tested, with the same exact predicates).
+    /// The pairs of intersecting faces around the vertices in touched_: as the mesh was free of
+    /// intersections before the stage (run checks stages only then), all the pairs of the whole mesh.
     std::vector<std::pair<FaceIndex, FaceIndex>> intersectionsAtTouched() const {
-        std::vector<FaceIndex> near;
-        for (VertexIndex v : touched_)
-            if (!m_.is_removed(v))
-                for (FaceIndex f : CGAL::faces_around_target(m_.halfedge(v), m_))
-                    if (f != Mesh::null_face()) near.push_back(f);
-        std::sort(near.begin(), near.end());
-        near.erase(std::unique(near.begin(), near.end()), near.end());
-        if (near.empty()) return {};
-        using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, FaceIndex>;
-        auto box = [&](FaceIndex f) {
-            const HalfedgeIndex h = m_.halfedge(f);
-            return Box(m_.point(m_.source(h)).bbox() + m_.point(m_.target(h)).bbox() +
-                           m_.point(m_.target(m_.next(h))).bbox(),
-                       f);
-        };
-        std::vector<Box> changed, all;
-        changed.reserve(near.size());
-        all.reserve(m_.number_of_faces());
-        for (FaceIndex f : near)
-            changed.push_back(box(f));
-        for (FaceIndex f : m_.faces())
-            all.push_back(box(f));
-        CGAL::box_intersection_d(changed.begin(), changed.end(), all.begin(), all.end(),
-                                 [&](const Box&, const Box& other) { near.push_back(other.info()); });
-        std::sort(near.begin(), near.end());
-        near.erase(std::unique(near.begin(), near.end()), near.end());
-        std::vector<std::pair<FaceIndex, FaceIndex>> pairs;
-        PMP::self_intersections(near, m_, std::back_inserter(pairs));
-        return pairs;
+        return intersectionsAround(m_, touched_);
     }
 
     void markFeaturesAndZone() {
