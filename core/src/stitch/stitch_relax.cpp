@@ -243,8 +243,7 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
     Mesh& S = loc.star.S;
     const double maxTurn = O_.maxNormalChangeDeg * kDeg;
     const auto near = seamNeighbourhood(loc);
-    std::vector<std::uint32_t> order(near.begin(), near.end());
-    std::sort(order.begin(), order.end());
+    const std::vector<std::uint32_t> order = near.sorted();
     std::size_t moved = 0;
     for (std::uint32_t vi : order) {
         progress_.tick();
@@ -379,7 +378,8 @@ std::size_t ComponentStitcher::refineOutside(Local& loc) {
     Mesh& S = loc.star.S;
     const auto near = seamNeighbourhood(loc);
     auto within = near;
-    for (EdgeIndex e : edgesAround(S, near))
+    const std::vector<EdgeIndex> edges = edgesAround(S, near); // (S does not change until the splits)
+    for (EdgeIndex e : edges)
         for (VertexIndex v : {S.source(S.halfedge(e)), S.target(S.halfedge(e))})
             within.insert(std::uint32_t(v));
     const auto dist = seamDistance(loc, within);
@@ -388,7 +388,7 @@ std::size_t ComponentStitcher::refineOutside(Local& loc) {
         return it == dist.end() ? std::numeric_limits<double>::infinity() : it->second;
     };
     std::vector<std::pair<double, EdgeIndex>> cands;
-    for (EdgeIndex e : edgesAround(S, near)) {
+    for (EdgeIndex e : edges) {
         const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
         const FaceIndex f = S.face(h), g = S.face(o);
         if (f == Mesh::null_face() || g == Mesh::null_face() || loc.star.kept[f] || loc.star.kept[g])
@@ -459,8 +459,7 @@ void ComponentStitcher::copyFace(Local& loc, FaceIndex from, FaceIndex to) {
     loc.offView[to] = loc.offView[from];
 }
 
-bool ComponentStitcher::flipAllowed(const Local& loc, HalfedgeIndex h,
-                                    const std::unordered_set<std::uint32_t>& near, double& oldMin,
+bool ComponentStitcher::flipAllowed(const Local& loc, HalfedgeIndex h, const VertexSet& near, double& oldMin,
                                     double& newMin, bool& nearPlanar) const {
     const Mesh& S = loc.star.S;
     const double maxTurn = O_.maxNormalChangeDeg * kDeg;
@@ -602,8 +601,8 @@ void ComponentStitcher::flipPass(Local& loc, Plan& plan) {
     plan.flips += flips;
 }
 
-std::vector<std::pair<double, FaceIndex>>
-ComponentStitcher::thinFaces(const Local& loc, const std::unordered_set<std::uint32_t>& near) {
+std::vector<std::pair<double, FaceIndex>> ComponentStitcher::thinFaces(const Local& loc,
+                                                                       const VertexSet& near) {
     const Mesh& S = loc.star.S;
     // The faces with a vertex in `near` (found around those vertices, not among all faces of S).
     std::vector<FaceIndex> faces;
