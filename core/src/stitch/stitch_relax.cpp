@@ -245,6 +245,11 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
     const auto near = seamNeighbourhood(loc);
     const std::vector<std::uint32_t> order = near.sorted();
     std::size_t moved = 0;
+    // Per vertex below (declared once: their storage is reused from vertex to vertex).
+    std::vector<Vec3> planes, dirs;
+    std::vector<std::pair<VertexIndex, VertexIndex>> ring; // (p, q): faces (v, p, q)
+    std::vector<FaceIndex> ringFaces;
+    std::vector<Triangle3> before;
     for (std::uint32_t vi : order) {
         progress_.tick();
         const VertexIndex v(vi);
@@ -260,10 +265,10 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
         const bool withPatch = loc.lid[v] >= 0;
         // All faces around: pieces of one mesh face (a Steiner point inside it, not on a mesh edge), or
         // of two (a point on the mesh edge between them: it moves along that edge's line).
-        std::vector<Vec3> planes;
+        planes.clear();
         bool outside = true;
-        std::vector<std::pair<VertexIndex, VertexIndex>> ring; // (p, q): faces (v, p, q)
-        std::vector<FaceIndex> ringFaces;
+        ring.clear();
+        ringFaces.clear();
         Vec3 centre(0, 0, 0);
         for (HalfedgeIndex g : CGAL::halfedges_around_target(S.halfedge(v), S)) {
             const FaceIndex f = S.face(g);
@@ -295,7 +300,7 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
                 spread = std::max(spread, angleBetween(n, m));
         }
         mean.normalize();
-        std::vector<Vec3> dirs;
+        dirs.clear();
         if (planes.size() == 1 || spread <= maxTurn) {
             const Vec3 e1 = mean.unitOrthogonal(), e2 = mean.cross(e1);
             for (int k = 0; k < 8; ++k) {
@@ -313,7 +318,7 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
         if (dirs.empty()) continue;
         const Vec3 target = centre - mean * mean.dot(centre - p0);
         // How far a point moved to lies from the surface around v before (zero in one plane).
-        std::vector<Triangle3> before;
+        before.clear();
         for (const auto& [p, q] : ring)
             before.emplace_back(toPoint(p0), S.point(p), S.point(q));
         const double maxGap = kNearPlanarFlipGap * comp_.h3;
