@@ -664,15 +664,19 @@ std::vector<EdgeIndex> ComponentStitcher::edgesAround(const Mesh& S, const Verte
     return out;
 }
 
-std::unordered_map<std::uint32_t, double> ComponentStitcher::seamDistance(const Local& loc,
-                                                                          const VertexSet& within) const {
+std::vector<double> ComponentStitcher::seamDistance(const Local& loc, const VertexSet& within) const {
     const Mesh& S = loc.star.S;
-    std::unordered_map<std::uint32_t, double> dist;
+    // By vertex index (infinity: not reached); `known` as the keys of a map would be.
+    std::vector<double> dist(S.num_vertices(), std::numeric_limits<double>::infinity());
+    std::vector<char> known(S.num_vertices(), 0);
     using Item = std::pair<double, std::uint32_t>;
     std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
     for (const auto& [a, b] : loc.seam)
         for (std::uint32_t v : {a, b})
-            if (dist.emplace(v, 0.0).second) queue.push({0.0, v});
+            if (!std::exchange(known[v], char(1))) {
+                dist[v] = 0.0;
+                queue.push({0.0, v});
+            }
     while (!queue.empty()) {
         const auto [d, v] = queue.top();
         queue.pop();
@@ -680,9 +684,8 @@ std::unordered_map<std::uint32_t, double> ComponentStitcher::seamDistance(const 
         for (VertexIndex w : CGAL::vertices_around_target(S.halfedge(VertexIndex(v)), S)) {
             if (!within.count(std::uint32_t(w))) continue;
             const double dw = d + (pt(S, VertexIndex(v)) - pt(S, w)).norm();
-            auto [it, fresh] = dist.try_emplace(std::uint32_t(w), dw);
-            if (fresh || dw < it->second) {
-                it->second = dw;
+            if (!std::exchange(known[std::size_t(w)], char(1)) || dw < dist[std::size_t(w)]) {
+                dist[std::size_t(w)] = dw;
                 queue.push({dw, std::uint32_t(w)});
             }
         }

@@ -389,8 +389,7 @@ std::size_t ComponentStitcher::refineOutside(Local& loc) {
             within.insert(std::uint32_t(v));
     const auto dist = seamDistance(loc, within);
     auto distance = [&](VertexIndex v) {
-        auto it = dist.find(std::uint32_t(v));
-        return it == dist.end() ? std::numeric_limits<double>::infinity() : it->second;
+        return std::size_t(v) < dist.size() ? dist[std::size_t(v)] : std::numeric_limits<double>::infinity();
     };
     std::vector<std::pair<double, EdgeIndex>> cands;
     for (EdgeIndex e : edges) {

@@ -474,7 +474,8 @@ private:
     // Edges incident to the given vertices (each once, in a deterministic order).
     static std::vector<EdgeIndex> edgesAround(const Mesh& S, const VertexSet& vertices);
     // Distance from the seam along edges (Dijkstra), for the vertices of the given set.
-    std::unordered_map<std::uint32_t, double> seamDistance(const Local& loc, const VertexSet& within) const;
+    // By vertex index of S (infinity where not reached).
+    std::vector<double> seamDistance(const Local& loc, const VertexSet& within) const;
 
     void optimise(Local& loc, Plan& plan);
 
