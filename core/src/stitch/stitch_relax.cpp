@@ -608,16 +608,20 @@ void ComponentStitcher::flipPass(Local& loc, Plan& plan) {
 std::vector<std::pair<double, FaceIndex>> ComponentStitcher::thinFaces(const Local& loc,
                                                                        const VertexSet& near) {
     const Mesh& S = loc.star.S;
-    // The faces with a vertex in `near` (found around those vertices, not among all faces of S).
-    std::vector<FaceIndex> faces;
+    // The faces with a vertex in `near` (found around those vertices, not among all faces of S), each once
+    // by increasing index: marked in a bitmap and read back in order (a FaceIndex is its index alone).
+    std::vector<std::uint64_t> marks(S.num_faces() / 64 + 1, 0);
     for (std::uint32_t vi : near) {
         const VertexIndex v(vi);
         if (S.is_removed(v) || S.is_isolated(v)) continue;
         for (FaceIndex f : CGAL::faces_around_target(S.halfedge(v), S))
-            if (f != Mesh::null_face()) faces.push_back(f);
+            if (f != Mesh::null_face())
+                marks[std::size_t(f) / 64] |= std::uint64_t(1) << (std::size_t(f) % 64);
     }
-    std::sort(faces.begin(), faces.end());
-    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    std::vector<FaceIndex> faces;
+    for (std::size_t w = 0; w < marks.size(); ++w)
+        for (std::uint64_t word = marks[w]; word; word &= word - 1)
+            faces.push_back(FaceIndex(std::uint32_t(64 * w + std::size_t(std::countr_zero(word)))));
     std::vector<std::pair<double, FaceIndex>> thin;
     for (FaceIndex f : faces) {
         progress_.tick();
