@@ -208,9 +208,9 @@ Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Ve
 
 namespace {
 
-// Faces (or vertices) of a local search, deduplicated with a small open-addressing set that is cleared by
-// bumping a generation stamp: no allocation per query once the scratch has grown (one per thread).
-template <class Index> class LocalIndexSet {
+// Faces of a local search, deduplicated with a small open-addressing set that is cleared by bumping a
+// generation stamp: no allocation per query once the scratch has grown (one per thread).
+class LocalFaceSet {
 public:
     void clear() {
         faces.clear();
@@ -220,7 +220,7 @@ public:
         }
     }
     // Adds f unless present; true when it was added.
-    bool insert(Index f) {
+    bool insert(FaceIndex f) {
         if (2 * (faces.size() + 1) > slot_.size()) grow();
         const std::uint32_t id = std::uint32_t(f.idx());
         const std::size_t mask = slot_.size() - 1;
@@ -234,31 +234,26 @@ public:
             if (slot_[i] == id) return false;
         }
     }
-    std::vector<Index> faces;
+    std::vector<FaceIndex> faces;
 
 private:
     static std::size_t hash(std::uint32_t id) { return std::size_t(id * 2654435761u); }
     void grow() {
-        const std::vector<Index> kept = faces;
+        const std::vector<FaceIndex> kept = faces;
         const std::size_t size = std::max<std::size_t>(64, 2 * slot_.size());
         slot_.assign(size, 0);
         stamp_.assign(size, 0);
         generation_ = 1;
         faces.clear();
-        for (Index f : kept)
+        for (FaceIndex f : kept)
             insert(f);
     }
     std::vector<std::uint32_t> slot_, stamp_;
     std::uint32_t generation_ = 1;
 };
-using LocalFaceSet = LocalIndexSet<FaceIndex>;
 
-// collectRings with the scratch set (same faces in the same order). A fan (the faces around a target)
-// that starts at a halfedge an earlier fan passed is the same cycle of halfedges: its faces are in the set
-// already, so it is skipped (a vertex is fanned once, usually, instead of once per face around it).
+// collectRings with the scratch set (same faces in the same order).
 void collectRingsInto(const Mesh& mesh, FaceIndex centre, int rings, LocalFaceSet& set) {
-    thread_local LocalIndexSet<HalfedgeIndex> passed;
-    passed.clear();
     set.clear();
     set.insert(centre);
     std::size_t begin = 0;
@@ -266,12 +261,8 @@ void collectRingsInto(const Mesh& mesh, FaceIndex centre, int rings, LocalFaceSe
         const std::size_t end = set.faces.size();
         for (std::size_t i = begin; i < end; ++i) {
             for (HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(set.faces[i]), mesh)) {
-                if (!passed.insert(h)) continue;
-                // (faces_around_target(h) is face(g) for these g, in this order)
-                for (HalfedgeIndex g : CGAL::halfedges_around_target(h, mesh)) {
-                    if (g != h) passed.insert(g);
-                    const FaceIndex f = mesh.face(g);
-                    if (f != Mesh::null_face()) set.insert(f);
+                for (FaceIndex g : CGAL::faces_around_target(h, mesh)) {
+                    if (g != Mesh::null_face()) set.insert(g);
                 }
             }
         }

@@ -129,30 +129,9 @@ RelaxReport relaxOnReference(Mesh& mesh, const Mesh& reference, const std::vecto
     // The reference does not change here: its rings are collected once (same results as closestPointNear).
     std::optional<LocalClosestPoint> own;
     LocalClosestPoint& search = shared ? *shared : own.emplace(reference, LocalSearchOptions{.rings = 1});
-    // A vertex's visit is a pure function of its own position and its neighbours' (with its hint, which
-    // changes only when it moves, and what is fixed here: the reference, its crease, the options): a vertex
-    // left where it was at its last visit is visited again only when it or a neighbour moved since. Its
-    // outcome then is the last one (counted again when that was a refusal): the same moves, in the same
-    // order, and the same report. Stamps: per mesh vertex the move that moved it last, per vertex given the
-    // number of moves before its last visit and whether that visit refused.
-    enum class Visit : char { None, Stayed, Refused };
-    std::vector<Visit> visit(vertices.size(), Visit::None);
-    std::vector<std::size_t> visitedAt(vertices.size(), 0), movedAt(mesh.num_vertices(), 0);
-    std::size_t moves = 0;
     for (int sweep = 0; sweep < options.iterations; ++sweep) {
         for (std::size_t k = 0; k < vertices.size(); ++k) {
             const VertexIndex v = vertices[k];
-            if (visit[k] != Visit::None) {
-                bool still = movedAt[std::size_t(v)] <= visitedAt[k];
-                for (VertexIndex w : CGAL::vertices_around_target(mesh.halfedge(v), mesh))
-                    still = still && movedAt[std::size_t(w)] <= visitedAt[k];
-                if (still) {
-                    report.refused += visit[k] == Visit::Refused;
-                    continue;
-                }
-            }
-            visit[k] = Visit::Stayed;
-            visitedAt[k] = moves;
             const Eigen::Vector3d p = pos(mesh, v);
             Eigen::Vector3d centroid(0, 0, 0);
             int n = 0;
@@ -176,7 +155,6 @@ RelaxReport relaxOnReference(Mesh& mesh, const Mesh& reference, const std::vecto
                 if (!onRef || onRef.distance > options.maxOffFootprints * footprints[k] ||
                     unitFaceNormal(reference, onRef.face).dot(firstNormal[k]) < cosCrease) {
                     ++report.refused;
-                    visit[k] = Visit::Refused;
                     continue;
                 }
                 target = onRef.point;
@@ -187,14 +165,11 @@ RelaxReport relaxOnReference(Mesh& mesh, const Mesh& reference, const std::vecto
             const Ring before = ringOf(mesh, v, p, nullptr, cosTurn, nullptr);
             if (!moveAccepted(mesh, v, target, before, cosTurn, facing)) {
                 ++report.refused;
-                visit[k] = Visit::Refused;
                 continue;
             }
             mesh.point(v) = Point3(target.x(), target.y(), target.z());
             hints[k] = face;
             ++report.moves;
-            movedAt[std::size_t(v)] = ++moves;
-            visit[k] = Visit::None;
         }
     }
     return report;
