@@ -161,7 +161,8 @@ RelaxReport relaxOnReference(Mesh& mesh, const Mesh& reference, const std::vecto
                 face = onRef.face;
             }
             if ((target - p).squaredNorm() == 0) continue;
-            const Ring before = ringOf(mesh, v, p, nullptr, cosTurn, facing);
+            // (moveAccepted reads before's normals and smallest angle, not its `ok`: no facing test)
+            const Ring before = ringOf(mesh, v, p, nullptr, cosTurn, nullptr);
             if (!moveAccepted(mesh, v, target, before, cosTurn, facing)) {
                 ++report.refused;
                 continue;

@@ -139,6 +139,15 @@ inline bool angleAtMost(const Eigen::Vector3d& u, const Eigen::Vector3d& v, cons
     return std::atan2(y, x) <= bound.limit;
 }
 
+/// Whether angleBetween(u, v) > \p bound.limit: the same answer for every input (NaN included), mostly
+/// without atan2, by the sign test of angleAtMost.
+inline bool angleAbove(const Eigen::Vector3d& u, const Eigen::Vector3d& v, const AngleLimit& bound) {
+    const double y = u.cross(v).norm(), x = u.dot(v);
+    const double d = y * bound.cos - x * bound.sin;
+    if (d * d > 1e-18 * (x * x + y * y)) return d > 0;
+    return std::atan2(y, x) > bound.limit;
+}
+
 /// Whether minAngle(a, b, c) < \p bound.limit: the same answer for every input, mostly without atan2. As in
 /// angleAtMost, y cos(limit) − x sin(limit) has the sign of corner − limit; a corner clearly below the limit
 /// answers yes, all three clearly above it no, else minAngle decides.

@@ -275,15 +275,14 @@ void BandRemesher::findOrigins() {
 }
 
 void BandRemesher::liftRelaxed(const std::vector<VertexIndex>& verts, const std::vector<V3>& before) {
-    const double maxTurn = in_.maxNormalTurnDeg * kBandDeg;
-    for (std::size_t k = 0; k < verts.size(); ++k) {
+    for (std::size_t k = 0; k < verts.size(); ++k) { // (maxTurn_: in_.maxNormalTurnDeg in radians)
         const VertexIndex v = verts[k];
         const V3 p = detail::pos(S_, v);
         if (p == before[k]) continue;
         const V3 q = smoothPoint(hint_[std::size_t(v)], p);
         // Where the lift would turn or flatten the star (it moves the vertex along the normal by about the
         // chord's sag), the relaxed place on the draft stays.
-        if (q == p || !starAcceptable(v, q, maxTurn) ||
+        if (q == p || !starAcceptable(v, q, maxTurn_) ||
             starMinAngle(v, q) < starMinAngle(v, p) - 0.5 * kBandDeg)
             continue;
         S_.point(v) = Point3(q.x(), q.y(), q.z());

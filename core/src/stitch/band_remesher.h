@@ -162,7 +162,8 @@ private:
         const HalfedgeIndex h = S_.halfedge(f);
         const V3 a = detail::pos(S_, S_.source(h)), b = detail::pos(S_, S_.target(h)),
                  c = detail::pos(S_, S_.target(S_.next(h)));
-        return detail::minAngle(a, b, c) >= kSliverDeg * kBandDeg ? detail::unitNormal(a, b, c) : fallback;
+        // (minAngle(a, b, c) >= kSliverDeg, decided as minAngleBelow does: the same answer)
+        return !detail::minAngleBelow(a, b, c, sliver_) ? detail::unitNormal(a, b, c) : fallback;
     }
     bool facing(const V3& a, const V3& b, const V3& c) const {
         const V3 n = (b - a).cross(c - a);
@@ -474,11 +475,12 @@ private:
             if (!creaseCollapseKeepsLine(from, to, other)) return false;
         }
         const HalfedgeIndex h = S_.halfedge(from, to);
-        if (!detail::canCollapse(S_, S_.edge(h), true)) return false;
-        // The survivor's valence, and the two opposite vertices' (one edge less each).
+        // The survivor's valence, and the two opposite vertices' (one edge less each); then the link
+        // condition (both pure tests: the cheaper first).
         if (!valenceOk(to, int(S_.degree(from)) - 4) || !valenceOk(S_.target(S_.next(h)), -1) ||
             !valenceOk(S_.target(S_.next(S_.opposite(h))), -1))
             return false;
+        if (!detail::canCollapse(S_, S_.edge(h), true)) return false;
         const V3 pt = detail::pos(S_, to);
         const double limit = limitFactor * sizeOf(to);
         V3 star(0, 0, 0);
@@ -595,9 +597,11 @@ private:
                               flippedAt[std::size_t(d)]}) <= l.stamp)
                     continue;
                 l = Left{stamp, {a, b, c, d}}; // (cleared below when it flips)
-                if (isCrease(a, b) || !detail::canFlip(S_, h)) continue;
+                if (isCrease(a, b) || c == d) continue;
                 for (VertexIndex v : {a, b, c, d})
                     know(v);
+                // detail::canFlip on the pass's degrees (h is interior), its edge test after the gain's.
+                if (degree[std::size_t(a)] <= 3 || degree[std::size_t(b)] <= 3) continue;
                 if (!valenceFits(a, -1) || !valenceFits(b, -1) || !valenceFits(c, 1) || !valenceFits(d, 1))
                     continue;
                 if (unseen(S_.face(h)) != unseen(S_.face(S_.opposite(h)))) continue;
@@ -615,6 +619,7 @@ private:
                 // deviation; never below the smaller of the angle before and the aim.
                 const double gain = (newMin - oldMin) / kBandDeg - 3.0 * double(devNew - devOld);
                 if (!(gain > 0.5) || newMin < std::min(oldMin, in_.minAngleDeg * kBandDeg)) continue;
+                if (CGAL::halfedge(c, d, S_).second) continue; // (the edge the flip makes exists already)
                 const V3 quad = (areaVector(S_.face(h)) + areaVector(S_.face(S_.opposite(h)))).normalized();
                 const bool seen = !unseen(S_.face(h));
                 const V3 n1 = referenceNormal(S_.face(h), quad),
@@ -717,6 +722,9 @@ private:
         return m.value();
     }
     bool starAcceptable(VertexIndex v, const V3& at, double maxTurn) const {
+        return starAcceptable(v, at, detail::AngleLimit(maxTurn));
+    }
+    bool starAcceptable(VertexIndex v, const V3& at, const detail::AngleLimit& maxTurn) const {
         V3 star(0, 0, 0);
         for (HalfedgeIndex h : CGAL::halfedges_around_target(S_.halfedge(v), S_))
             star += areaVector(S_.face(h));
@@ -725,7 +733,7 @@ private:
             const V3 b = detail::pos(S_, S_.source(h)), c = detail::pos(S_, S_.target(S_.next(h)));
             if (!unseen(S_.face(h)) && !facing(b, at, c)) return false;
             const V3 n = detail::unitNormal(b, at, c);
-            if (detail::angleBetween(n, referenceNormal(S_.face(h), star)) > maxTurn) return false;
+            if (detail::angleAbove(n, referenceNormal(S_.face(h), star), maxTurn)) return false;
         }
         return true;
     }
@@ -733,6 +741,7 @@ private:
     const BandRemeshInput& in_;
     Mesh& S_;
     const detail::AngleLimit maxTurn_{in_.maxNormalTurnDeg * kBandDeg}; // acceptableFace's normal bound
+    const detail::AngleLimit sliver_{kSliverDeg * kBandDeg};            // referenceNormal's reliable face
     Mesh ref_; // the draft band, onto which vertices are projected
     // closestPointNear on ref_ (which does not change after setup) with 1 and 2 rings: the same results,
     // each face's rings collected once.

@@ -35,6 +35,7 @@
 #include <set>
 #include <stdexcept>
 #include <string_view>
+#include <type_traits>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -228,6 +229,21 @@ public:
                 }
         });
     }
+    // Whether pred(id) holds for one of the ids query(b, …) would visit, visited in query's order up to the
+    // first that does (what a query whose callback ignores the ids after a hit answers, without them).
+    template <class P> bool any(const CGAL::Bbox_2& b, P&& pred) {
+        ++current_;
+        return forCells(b, [&](std::int64_t x, std::int64_t y) {
+            const std::vector<int>* cell = find(x, y);
+            if (!cell) return false;
+            for (int id : *cell)
+                if (stamp_[std::size_t(id)] != current_) {
+                    stamp_[std::size_t(id)] = current_;
+                    if (pred(id)) return true;
+                }
+            return false;
+        });
+    }
 
 private:
     static std::uint64_t key(std::int64_t x, std::int64_t y) {
@@ -249,14 +265,22 @@ private:
         auto it = cells_.find(key(x, y));
         return it == cells_.end() ? nullptr : &it->second;
     }
-    template <class F> void forCells(const CGAL::Bbox_2& b, F&& f) const {
+    // Calls f(x, y) for the cells b touches; an f returning bool stops the walk at its first true (then
+    // the result is true).
+    template <class F> bool forCells(const CGAL::Bbox_2& b, F&& f) const {
         const auto x0 = std::int64_t(std::floor(b.xmin() * inv_)),
                    x1 = std::int64_t(std::floor(b.xmax() * inv_));
         const auto y0 = std::int64_t(std::floor(b.ymin() * inv_)),
                    y1 = std::int64_t(std::floor(b.ymax() * inv_));
         for (std::int64_t x = x0; x <= x1; ++x)
-            for (std::int64_t y = y0; y <= y1; ++y)
-                f(x, y);
+            for (std::int64_t y = y0; y <= y1; ++y) {
+                if constexpr (std::is_same_v<decltype(f(x, y)), bool>) {
+                    if (f(x, y)) return true;
+                } else {
+                    f(x, y);
+                }
+            }
+        return false;
     }
     double inv_ = 1.0;
     std::unordered_map<std::uint64_t, std::vector<int>> cells_;

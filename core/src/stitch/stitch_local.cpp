@@ -618,18 +618,18 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> ComponentStitcher::bordersArou
     return out;
 }
 
-std::unordered_set<std::uint32_t> ComponentStitcher::seamNeighbourhood(Local& loc) const {
+VertexSet ComponentStitcher::seamNeighbourhood(Local& loc) const {
     const Mesh& S = loc.star.S;
-    std::unordered_set<std::uint32_t> inside;
+    VertexSet inside(S.num_vertices());
     std::vector<VertexIndex> ring;
     for (const auto& [a, b] : loc.seam)
         for (std::uint32_t v : {a, b})
-            if (inside.insert(v).second) ring.push_back(VertexIndex(v));
+            if (inside.insert(v)) ring.push_back(VertexIndex(v));
     for (int r = 0; r < O_.seamRings; ++r) {
         std::vector<VertexIndex> next;
         for (VertexIndex v : ring)
             for (VertexIndex w : CGAL::vertices_around_target(S.halfedge(v), S))
-                if (inside.insert(std::uint32_t(w)).second) next.push_back(w);
+                if (inside.insert(std::uint32_t(w))) next.push_back(w);
         ring.swap(next);
     }
     return inside;
@@ -647,12 +647,13 @@ bool ComponentStitcher::oriented(const Local& loc, FaceIndex f, VertexIndex a, V
     return oriented(loc, f, loc.uv[a], loc.uv[b], loc.uv[c], pt(S, a), pt(S, b), pt(S, c));
 }
 
-std::vector<EdgeIndex> ComponentStitcher::edgesAround(const Mesh& S,
-                                                      const std::unordered_set<std::uint32_t>& vertices) {
-    std::vector<std::uint32_t> vs(vertices.begin(), vertices.end());
-    std::sort(vs.begin(), vs.end());
+std::vector<EdgeIndex> ComponentStitcher::edgesAround(const Mesh& S, const VertexSet& vertices) {
+    // Not just the set of edges: an EdgeIndex keeps the halfedge it was made from (S.halfedge(e) returns
+    // that one, and callers read directions from it), so which of an edge's two copies the sort leaves
+    // first depends on the exact sequence std::sort is given. Keep it: the vertices in increasing order,
+    // each one's halfedges in circulation order.
     std::vector<EdgeIndex> out;
-    for (std::uint32_t v : vs) {
+    for (std::uint32_t v : vertices.sorted()) {
         const VertexIndex x(v);
         if (S.is_removed(x) || S.halfedge(x) == Mesh::null_halfedge()) continue;
         for (HalfedgeIndex h : CGAL::halfedges_around_target(S.halfedge(x), S))
@@ -663,15 +664,19 @@ std::vector<EdgeIndex> ComponentStitcher::edgesAround(const Mesh& S,
     return out;
 }
 
-std::unordered_map<std::uint32_t, double>
-ComponentStitcher::seamDistance(const Local& loc, const std::unordered_set<std::uint32_t>& within) const {
+std::vector<double> ComponentStitcher::seamDistance(const Local& loc, const VertexSet& within) const {
     const Mesh& S = loc.star.S;
-    std::unordered_map<std::uint32_t, double> dist;
+    // By vertex index (infinity: not reached); `known` as the keys of a map would be.
+    std::vector<double> dist(S.num_vertices(), std::numeric_limits<double>::infinity());
+    std::vector<char> known(S.num_vertices(), 0);
     using Item = std::pair<double, std::uint32_t>;
     std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
     for (const auto& [a, b] : loc.seam)
         for (std::uint32_t v : {a, b})
-            if (dist.emplace(v, 0.0).second) queue.push({0.0, v});
+            if (!std::exchange(known[v], char(1))) {
+                dist[v] = 0.0;
+                queue.push({0.0, v});
+            }
     while (!queue.empty()) {
         const auto [d, v] = queue.top();
         queue.pop();
@@ -679,9 +684,8 @@ ComponentStitcher::seamDistance(const Local& loc, const std::unordered_set<std::
         for (VertexIndex w : CGAL::vertices_around_target(S.halfedge(VertexIndex(v)), S)) {
             if (!within.count(std::uint32_t(w))) continue;
             const double dw = d + (pt(S, VertexIndex(v)) - pt(S, w)).norm();
-            auto [it, fresh] = dist.try_emplace(std::uint32_t(w), dw);
-            if (fresh || dw < it->second) {
-                it->second = dw;
+            if (!std::exchange(known[std::size_t(w)], char(1)) || dw < dist[std::size_t(w)]) {
+                dist[std::size_t(w)] = dw;
                 queue.push({dw, std::uint32_t(w)});
             }
         }

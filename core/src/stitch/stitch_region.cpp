@@ -220,26 +220,23 @@ bool ComponentStitcher::meetsComponent(FaceIndex f) {
     const Vec3 A = toVec(M_.point(fv[0]));
     const Vec3 n = normalOf(A, toVec(M_.point(fv[1])), toVec(M_.point(fv[2])));
     const CGAL::Bbox_2 box = grown(t.bbox(), comp_.margin);
-    bool hit = false;
     // Cheap tests first (this runs for every face under the patch): a patch triangle whose box misses
     // the face's box grown by the snapping distance is farther than that; the gaps along the view rays
     // need no triangle test; a corner of either triangle inside the other means they meet.
-    comp_.grid.query(box, [&](int i) {
-        if (hit) return;
+    return comp_.grid.any(box, [&](int i) {
         const int pf = faces_[std::size_t(i)];
-        if (!CGAL::do_overlap(box, triBox(pf))) return;
+        if (!CGAL::do_overlap(box, triBox(pf))) return false;
         bool onSheet = false;
         for (int v : P_.tri[std::size_t(pf)])
             if (gapToPlane(P_.pos[std::size_t(v)], A, n) <= tolerance) {
                 onSheet = true;
                 break;
             }
-        if (!onSheet) return;
+        if (!onSheet) return false;
         const Triangle2 p = patchTriangle(pf);
-        hit = inTriangle(p[0], t[0], t[1], t[2]) || inTriangle(t[0], p[0], p[1], p[2]) ||
-              CGAL::do_intersect(t, p) || CGAL::squared_distance(t, p) <= r2;
+        return inTriangle(p[0], t[0], t[1], t[2]) || inTriangle(t[0], p[0], p[1], p[2]) ||
+               CGAL::do_intersect(t, p) || CGAL::squared_distance(t, p) <= r2;
     });
-    return hit;
 }
 
 double ComponentStitcher::gapToPatch(const Vec3& p, const Point2& uv) {
@@ -402,13 +399,10 @@ bool ComponentStitcher::preTrim(Attempt& a) {
 }
 
 bool ComponentStitcher::insidePatch(const Point2& p) {
-    bool in = false;
-    comp_.grid.query(p.bbox(), [&](int i) {
-        if (in) return;
+    return comp_.grid.any(p.bbox(), [&](int i) {
         const Triangle2 t = patchTriangle(faces_[std::size_t(i)]);
-        in = inTriangle(p, t[0], t[1], t[2]);
+        return inTriangle(p, t[0], t[1], t[2]);
     });
-    return in;
 }
 
 bool ComponentStitcher::interiorsOverlap(const Triangle2& s, const Triangle2& t) {

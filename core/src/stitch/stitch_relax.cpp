@@ -243,9 +243,13 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
     Mesh& S = loc.star.S;
     const double maxTurn = O_.maxNormalChangeDeg * kDeg;
     const auto near = seamNeighbourhood(loc);
-    std::vector<std::uint32_t> order(near.begin(), near.end());
-    std::sort(order.begin(), order.end());
+    const std::vector<std::uint32_t> order = near.sorted();
     std::size_t moved = 0;
+    // Per vertex below (declared once: their storage is reused from vertex to vertex).
+    std::vector<Vec3> planes, dirs;
+    std::vector<std::pair<VertexIndex, VertexIndex>> ring; // (p, q): faces (v, p, q)
+    std::vector<FaceIndex> ringFaces;
+    std::vector<Triangle3> before;
     for (std::uint32_t vi : order) {
         progress_.tick();
         const VertexIndex v(vi);
@@ -261,10 +265,10 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
         const bool withPatch = loc.lid[v] >= 0;
         // All faces around: pieces of one mesh face (a Steiner point inside it, not on a mesh edge), or
         // of two (a point on the mesh edge between them: it moves along that edge's line).
-        std::vector<Vec3> planes;
+        planes.clear();
         bool outside = true;
-        std::vector<std::pair<VertexIndex, VertexIndex>> ring; // (p, q): faces (v, p, q)
-        std::vector<FaceIndex> ringFaces;
+        ring.clear();
+        ringFaces.clear();
         Vec3 centre(0, 0, 0);
         for (HalfedgeIndex g : CGAL::halfedges_around_target(S.halfedge(v), S)) {
             const FaceIndex f = S.face(g);
@@ -296,7 +300,7 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
                 spread = std::max(spread, angleBetween(n, m));
         }
         mean.normalize();
-        std::vector<Vec3> dirs;
+        dirs.clear();
         if (planes.size() == 1 || spread <= maxTurn) {
             const Vec3 e1 = mean.unitOrthogonal(), e2 = mean.cross(e1);
             for (int k = 0; k < 8; ++k) {
@@ -314,7 +318,7 @@ std::size_t ComponentStitcher::smoothOutside(Local& loc, bool search) {
         if (dirs.empty()) continue;
         const Vec3 target = centre - mean * mean.dot(centre - p0);
         // How far a point moved to lies from the surface around v before (zero in one plane).
-        std::vector<Triangle3> before;
+        before.clear();
         for (const auto& [p, q] : ring)
             before.emplace_back(toPoint(p0), S.point(p), S.point(q));
         const double maxGap = kNearPlanarFlipGap * comp_.h3;
@@ -379,16 +383,16 @@ std::size_t ComponentStitcher::refineOutside(Local& loc) {
     Mesh& S = loc.star.S;
     const auto near = seamNeighbourhood(loc);
     auto within = near;
-    for (EdgeIndex e : edgesAround(S, near))
+    const std::vector<EdgeIndex> edges = edgesAround(S, near); // (S does not change until the splits)
+    for (EdgeIndex e : edges)
         for (VertexIndex v : {S.source(S.halfedge(e)), S.target(S.halfedge(e))})
             within.insert(std::uint32_t(v));
     const auto dist = seamDistance(loc, within);
     auto distance = [&](VertexIndex v) {
-        auto it = dist.find(std::uint32_t(v));
-        return it == dist.end() ? std::numeric_limits<double>::infinity() : it->second;
+        return std::size_t(v) < dist.size() ? dist[std::size_t(v)] : std::numeric_limits<double>::infinity();
     };
     std::vector<std::pair<double, EdgeIndex>> cands;
-    for (EdgeIndex e : edgesAround(S, near)) {
+    for (EdgeIndex e : edges) {
         const HalfedgeIndex h = S.halfedge(e), o = S.opposite(h);
         const FaceIndex f = S.face(h), g = S.face(o);
         if (f == Mesh::null_face() || g == Mesh::null_face() || loc.star.kept[f] || loc.star.kept[g])
@@ -459,8 +463,7 @@ void ComponentStitcher::copyFace(Local& loc, FaceIndex from, FaceIndex to) {
     loc.offView[to] = loc.offView[from];
 }
 
-bool ComponentStitcher::flipAllowed(const Local& loc, HalfedgeIndex h,
-                                    const std::unordered_set<std::uint32_t>& near, double& oldMin,
+bool ComponentStitcher::flipAllowed(const Local& loc, HalfedgeIndex h, const VertexSet& near, double& oldMin,
                                     double& newMin, bool& nearPlanar) const {
     const Mesh& S = loc.star.S;
     const double maxTurn = O_.maxNormalChangeDeg * kDeg;
@@ -602,19 +605,23 @@ void ComponentStitcher::flipPass(Local& loc, Plan& plan) {
     plan.flips += flips;
 }
 
-std::vector<std::pair<double, FaceIndex>>
-ComponentStitcher::thinFaces(const Local& loc, const std::unordered_set<std::uint32_t>& near) {
+std::vector<std::pair<double, FaceIndex>> ComponentStitcher::thinFaces(const Local& loc,
+                                                                       const VertexSet& near) {
     const Mesh& S = loc.star.S;
-    // The faces with a vertex in `near` (found around those vertices, not among all faces of S).
-    std::vector<FaceIndex> faces;
+    // The faces with a vertex in `near` (found around those vertices, not among all faces of S), each once
+    // by increasing index: marked in a bitmap and read back in order (a FaceIndex is its index alone).
+    std::vector<std::uint64_t> marks(S.num_faces() / 64 + 1, 0);
     for (std::uint32_t vi : near) {
         const VertexIndex v(vi);
         if (S.is_removed(v) || S.is_isolated(v)) continue;
         for (FaceIndex f : CGAL::faces_around_target(S.halfedge(v), S))
-            if (f != Mesh::null_face()) faces.push_back(f);
+            if (f != Mesh::null_face())
+                marks[std::size_t(f) / 64] |= std::uint64_t(1) << (std::size_t(f) % 64);
     }
-    std::sort(faces.begin(), faces.end());
-    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    std::vector<FaceIndex> faces;
+    for (std::size_t w = 0; w < marks.size(); ++w)
+        for (std::uint64_t word = marks[w]; word; word &= word - 1)
+            faces.push_back(FaceIndex(std::uint32_t(64 * w + std::size_t(std::countr_zero(word)))));
     std::vector<std::pair<double, FaceIndex>> thin;
     for (FaceIndex f : faces) {
         progress_.tick();

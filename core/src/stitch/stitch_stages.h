@@ -6,6 +6,7 @@
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 
+#include <bit>
 #include <memory>
 
 namespace fss::detail::stitching {
@@ -87,6 +88,42 @@ public:
 
 private:
     std::vector<std::uint64_t> bits_;
+};
+// A set of vertex indices of the local mesh: a bitmap by index (grown on demand) and the indices in the
+// order inserted. What std::unordered_set gave the seam optimisation (insert, count, iteration; every user
+// iterates it order-independently or sorts) without a node allocation and a hash probe per element.
+class VertexSet {
+public:
+    explicit VertexSet(std::size_t size = 0) : bits_(size / 64 + 1, 0) {}
+    // Inserts v; whether it was not there.
+    bool insert(std::uint32_t v) {
+        if (v / 64 >= bits_.size()) bits_.resize(std::max(std::size_t(v / 64 + 1), 2 * bits_.size()), 0);
+        std::uint64_t& word = bits_[v / 64];
+        const std::uint64_t bit = std::uint64_t(1) << (v % 64);
+        if (word & bit) return false;
+        word |= bit;
+        list_.push_back(v);
+        return true;
+    }
+    std::size_t count(std::uint32_t v) const {
+        return v / 64 < bits_.size() && ((bits_[v / 64] >> (v % 64)) & 1u);
+    }
+    std::size_t size() const { return list_.size(); }
+    // The indices in increasing order (read off the bitmap).
+    std::vector<std::uint32_t> sorted() const {
+        std::vector<std::uint32_t> out;
+        out.reserve(list_.size());
+        for (std::size_t w = 0; w < bits_.size(); ++w)
+            for (std::uint64_t word = bits_[w]; word; word &= word - 1)
+                out.push_back(std::uint32_t(64 * w + std::size_t(std::countr_zero(word))));
+        return out;
+    }
+    std::vector<std::uint32_t>::const_iterator begin() const { return list_.begin(); }
+    std::vector<std::uint32_t>::const_iterator end() const { return list_.end(); }
+
+private:
+    std::vector<std::uint64_t> bits_;
+    std::vector<std::uint32_t> list_;
 };
 // VProj's fields without initialisers (DenseCache leaves what it has not been asked for uninitialised).
 struct VProjSlot {
@@ -427,7 +464,7 @@ private:
     std::set<std::pair<std::uint32_t, std::uint32_t>> bordersAround(Local& loc) const;
 
     // Seam neighbourhood: vertices within seamRings rings of the seam, over new faces.
-    std::unordered_set<std::uint32_t> seamNeighbourhood(Local& loc) const;
+    VertexSet seamNeighbourhood(Local& loc) const;
     Vec3 pt(const Mesh& S, VertexIndex v) const { return toVec(S.point(v)); }
     // Is the triangle (a, b, c), in place of new face f, oriented as f must be: counter-clockwise in the
     // view, or, for a piece of a mesh face the view does not see, like that face in 3D?
@@ -435,11 +472,10 @@ private:
                          const Vec3& a, const Vec3& b, const Vec3& c);
     bool oriented(const Local& loc, FaceIndex f, VertexIndex a, VertexIndex b, VertexIndex c) const;
     // Edges incident to the given vertices (each once, in a deterministic order).
-    static std::vector<EdgeIndex> edgesAround(const Mesh& S,
-                                              const std::unordered_set<std::uint32_t>& vertices);
+    static std::vector<EdgeIndex> edgesAround(const Mesh& S, const VertexSet& vertices);
     // Distance from the seam along edges (Dijkstra), for the vertices of the given set.
-    std::unordered_map<std::uint32_t, double>
-    seamDistance(const Local& loc, const std::unordered_set<std::uint32_t>& within) const;
+    // By vertex index of S (infinity where not reached).
+    std::vector<double> seamDistance(const Local& loc, const VertexSet& within) const;
 
     void optimise(Local& loc, Plan& plan);
 
@@ -483,8 +519,8 @@ private:
     // or in 3D for pieces the view does not see) and not degenerate (exact); on the patch side no normal
     // turns more than maxNormalChangeDeg, outside it the surface stays (see below). Sets the smallest angles
     // before and after, and `nearPlanar` when the flip joins pieces of two nearly coplanar mesh faces.
-    bool flipAllowed(const Local& loc, HalfedgeIndex h, const std::unordered_set<std::uint32_t>& near,
-                     double& oldMin, double& newMin, bool& nearPlanar) const;
+    bool flipAllowed(const Local& loc, HalfedgeIndex h, const VertexSet& near, double& oldMin, double& newMin,
+                     bool& nearPlanar) const;
     // Flips the edge of h (checked by flipAllowed).
     void flip(Local& loc, HalfedgeIndex h, bool nearPlanar);
 
@@ -493,8 +529,7 @@ private:
 
     // The new faces near the seam (a vertex in `near`) whose smallest angle is below kNeedleDeg, with that
     // angle, smallest first.
-    std::vector<std::pair<double, FaceIndex>> thinFaces(const Local& loc,
-                                                        const std::unordered_set<std::uint32_t>& near);
+    std::vector<std::pair<double, FaceIndex>> thinFaces(const Local& loc, const VertexSet& near);
 
     // -- valence: a seam vertex with more than kMaxSeamValence edges loses one by the flip of one of them
     // (every check of flipAllowed) that keeps the smallest angle there at least min(before, 15°) and
