@@ -50,7 +50,7 @@ inline bool bandDiagnosticsVerbose() {
     return on;
 }
 
-// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,endslide,creasefilter,collapseall,short,star,bridge (and lift,
+// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,endslide,finish,creasefilter,collapseall,short,star,bridge (and lift,
 // split, smooth) turns parts of the band remesh off (to measure what each brings).
 inline bool stageOff(const char* name) {
     static const std::string off = [] {
@@ -112,6 +112,8 @@ public:
             flipPass();
             if (!changed) break;
         }
+        for (int it = 0; it < 2 && !stageOff("finish"); ++it)
+            finishPass();
         measure(report_.minAngleAfterDeg, report_.fracAbove30After);
         for (std::size_t f = 0; f < band_.size(); ++f)
             if (band_[f] && !S_.is_removed(FaceIndex(std::uint32_t(f))))
@@ -697,6 +699,11 @@ private:
     // Crease vertices of faces below the aim slide along their (nearly straight) crease: candidates on the
     // two crease edges, the one that maximises the star's smallest angle wins.
     void slidePass();
+    // Free vertices of faces below 30 deg move where fewer faces of their star are below it (band_finish.cpp).
+    void finishPass();
+    // The faces of v's star (v at \p at) with a smallest angle below \p bound (radians); \p smallest gets the
+    // star's smallest angle.
+    int starBelow(VertexIndex v, const V3& at, double bound, double& smallest) const;
     // Crease ends of faces below the aim slide along their one crease edge (band_crease_end.cpp).
     void slideCreaseEndPass();
     // Puts crease vertex v at p, at its place pos on the draft's crease polyline (none: chain < 0), with
