@@ -5,6 +5,8 @@
 // have their small angle at a vertex held by kept faces, with room for a larger angle in the wedge of new
 // faces there). Here a free vertex of such a face moves where fewer faces of its star are below 30 deg,
 // without the star's smallest angle falling below the smaller of its value before and kFinishFloorDeg.
+// Also the relocation helpers that improvePass (band_remesh.cpp) shares with it, and the corner lists of the
+// slide passes.
 #include "stitch/band_remesher.h"
 
 namespace fss::stitch::band {
@@ -15,6 +17,87 @@ constexpr double kFinishFloorDeg = 24.0;
 // The aim: issue 19's bound on the share of created faces.
 constexpr double kFinishAimDeg = 30.0;
 } // namespace
+
+std::vector<VertexIndex> BandRemesher::cornersOfFacesBelow(double aim,
+                                                           const std::function<bool(VertexIndex)>& take) {
+    std::vector<VertexIndex> verts;
+    std::unordered_set<std::uint32_t> seen;
+    for (std::size_t f = 0; f < band_.size(); ++f) {
+        const FaceIndex g(static_cast<std::uint32_t>(f));
+        if (!band_[f] || S_.is_removed(g) || faceMinAngle(g) >= aim) continue;
+        for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_))
+            if (take(v) && seen.insert(std::uint32_t(v)).second) verts.push_back(v);
+    }
+    std::sort(verts.begin(), verts.end());
+    return verts;
+}
+
+bool BandRemesher::relocatable(VertexIndex v) {
+    return !isFixed(v) && creaseDegree(v) == 0 && wholeStarInBand(v) &&
+           at(hint_, std::size_t(v), Mesh::null_face()) != Mesh::null_face();
+}
+
+bool BandRemesher::tangentFrame(FaceIndex hint, V3& n0, V3& u, V3& w) const {
+    const HalfedgeIndex rh = ref_.halfedge(hint);
+    n0 = detail::unitNormal(detail::pos(ref_, ref_.source(rh)), detail::pos(ref_, ref_.target(rh)),
+                            detail::pos(ref_, ref_.target(ref_.next(rh))));
+    if (!(n0.squaredNorm() > 0)) return false;
+    u = (std::abs(n0.x()) < 0.9 ? V3(1, 0, 0) : V3(0, 1, 0)).cross(n0).normalized();
+    w = n0.cross(u);
+    return true;
+}
+
+bool BandRemesher::ontoDraft(const V3& q, FaceIndex hint, double maxDistance, const V3& n0, double creaseCos,
+                             V3& lifted, FaceIndex& face) {
+    const SurfacePoint sp = near1_(q, hint);
+    if (!sp || sp.distance > maxDistance) return false;
+    const HalfedgeIndex sh = ref_.halfedge(sp.face);
+    const V3 n = detail::unitNormal(detail::pos(ref_, ref_.source(sh)), detail::pos(ref_, ref_.target(sh)),
+                                    detail::pos(ref_, ref_.target(ref_.next(sh))));
+    if (n.dot(n0) < creaseCos) return false;
+    lifted = smoothPoint(sp.face, sp.point);
+    face = sp.face;
+    return true;
+}
+
+double BandRemesher::shortestEdgeAt(VertexIndex v) const {
+    double shortest = std::numeric_limits<double>::infinity();
+    for (VertexIndex x : CGAL::vertices_around_target(S_.halfedge(v), S_))
+        shortest = std::min(shortest, (detail::pos(S_, x) - detail::pos(S_, v)).norm());
+    return shortest;
+}
+
+bool BandRemesher::aroundOnDraft(VertexIndex v, std::initializer_list<double> radii, int directions,
+                                 const std::function<void(const V3&, FaceIndex)>& tryPoint) {
+    const V3 p = detail::pos(S_, v);
+    const FaceIndex hint = hint_[std::size_t(v)];
+    V3 n0, u, w;
+    if (!tangentFrame(hint, n0, u, w)) return false;
+    const double shortest = shortestEdgeAt(v), creaseCos = std::cos(in_.creaseAngleDeg * kBandDeg);
+    for (double r : radii)
+        for (int k = 0; k < directions; ++k) {
+            const double t = 2 * std::numbers::pi * k / directions;
+            const V3 q = p + r * shortest * (std::cos(t) * u + std::sin(t) * w);
+            V3 lifted;
+            FaceIndex face;
+            if (ontoDraft(q, hint, 0.5 * r * shortest, n0, creaseCos, lifted, face)) tryPoint(lifted, face);
+        }
+    return true;
+}
+
+bool BandRemesher::raisesStar(VertexIndex v, const V3& q, double& best, double maxTurn) const {
+    const double a = starMinAngle(v, q);
+    if (!(a > best + 1e-9 && starAcceptable(v, q, maxTurn))) return false;
+    best = a;
+    return true;
+}
+
+void BandRemesher::relocate(VertexIndex v, const V3& p, FaceIndex face) {
+    S_.point(v) = Point3(p.x(), p.y(), p.z());
+    hint_[std::size_t(v)] = face;
+    touch(v);
+    ++report_.moves;
+}
 
 int BandRemesher::starBelow(VertexIndex v, const V3& at, double bound, double& smallest) const {
     int n = 0;
@@ -31,69 +114,31 @@ int BandRemesher::starBelow(VertexIndex v, const V3& at, double bound, double& s
 
 void BandRemesher::finishPass() {
     const double aim = kFinishAimDeg * kBandDeg, floor = kFinishFloorDeg * kBandDeg;
-    std::vector<VertexIndex> verts;
-    std::unordered_set<std::uint32_t> seen;
-    for (std::size_t f = 0; f < band_.size(); ++f) {
-        const FaceIndex g(static_cast<std::uint32_t>(f));
-        if (!band_[f] || S_.is_removed(g) || faceMinAngle(g) >= aim) continue;
-        for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_))
-            if (!isFixed(v) && creaseDegree(v) == 0 && wholeStarInBand(v) &&
-                at(hint_, std::size_t(v), Mesh::null_face()) != Mesh::null_face() &&
-                seen.insert(std::uint32_t(v)).second)
-                verts.push_back(v);
-    }
-    std::sort(verts.begin(), verts.end());
-    const double creaseCos = std::cos(in_.creaseAngleDeg * kBandDeg);
+    const std::vector<VertexIndex> verts =
+        cornersOfFacesBelow(aim, [&](VertexIndex v) { return relocatable(v); });
     const double maxTurn = in_.maxNormalTurnDeg * kBandDeg;
     for (VertexIndex v : verts) {
         const V3 p = detail::pos(S_, v);
         double minBefore = 0;
         const int below = starBelow(v, p, aim, minBefore);
         if (below == 0) continue;
-        const FaceIndex hint = hint_[std::size_t(v)];
-        const HalfedgeIndex rh = ref_.halfedge(hint);
-        const V3 n0 =
-            detail::unitNormal(detail::pos(ref_, ref_.source(rh)), detail::pos(ref_, ref_.target(rh)),
-                               detail::pos(ref_, ref_.target(ref_.next(rh))));
-        if (!(n0.squaredNorm() > 0)) continue;
-        const V3 u = (std::abs(n0.x()) < 0.9 ? V3(1, 0, 0) : V3(0, 1, 0)).cross(n0).normalized();
-        const V3 w = n0.cross(u);
-        double shortest = std::numeric_limits<double>::infinity();
-        for (VertexIndex x : CGAL::vertices_around_target(S_.halfedge(v), S_))
-            shortest = std::min(shortest, (detail::pos(S_, x) - p).norm());
         const double keep = std::min(minBefore, floor);
         int bestBelow = below;
         double bestMin = minBefore;
         V3 bestP = p;
-        FaceIndex bestFace = hint;
-        for (double r : {0.4, 0.25, 0.1})
-            for (int k = 0; k < 16; ++k) {
-                const double t = 2 * std::numbers::pi * k / 16;
-                const V3 q = p + r * shortest * (std::cos(t) * u + std::sin(t) * w);
-                const SurfacePoint sp = near1_(q, hint);
-                if (!sp || sp.distance > 0.5 * r * shortest) continue;
-                const HalfedgeIndex sh = ref_.halfedge(sp.face);
-                const V3 n =
-                    detail::unitNormal(detail::pos(ref_, ref_.source(sh)), detail::pos(ref_, ref_.target(sh)),
-                                       detail::pos(ref_, ref_.target(ref_.next(sh))));
-                if (n.dot(n0) < creaseCos) continue;
-                const V3 lifted = smoothPoint(sp.face, sp.point);
-                double m = 0;
-                const int b = starBelow(v, lifted, aim, m);
-                if (m < keep || b > bestBelow || (b == bestBelow && !(m > bestMin + 1e-9))) continue;
-                if (b == below) continue; // fewer faces below the aim, or nothing (improvePass's job)
-                if (!starAcceptable(v, lifted, maxTurn)) continue;
-                bestBelow = b;
-                bestMin = m;
-                bestP = lifted;
-                bestFace = sp.face;
-            }
-        if (bestP != p) {
-            S_.point(v) = Point3(bestP.x(), bestP.y(), bestP.z());
-            hint_[std::size_t(v)] = bestFace;
-            touch(v);
-            ++report_.moves;
-        }
+        FaceIndex bestFace = hint_[std::size_t(v)];
+        aroundOnDraft(v, {0.4, 0.25, 0.1}, 16, [&](const V3& lifted, FaceIndex face) {
+            double m = 0;
+            const int b = starBelow(v, lifted, aim, m);
+            if (m < keep || b > bestBelow || (b == bestBelow && !(m > bestMin + 1e-9))) return;
+            if (b == below) return; // fewer faces below the aim, or nothing (improvePass's job)
+            if (!starAcceptable(v, lifted, maxTurn)) return;
+            bestBelow = b;
+            bestMin = m;
+            bestP = lifted;
+            bestFace = face;
+        });
+        if (bestP != p) relocate(v, bestP, bestFace);
     }
 }
 
