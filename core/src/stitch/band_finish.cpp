@@ -3,8 +3,9 @@
 // faces (repairFlip); where a star holds several faces just below 30 deg beside a held rim, no single move
 // raises its minimum, so they stay (measured, FSS_STITCH_PROPERTY_DIAG=1: most created faces below 30 deg
 // have their small angle at a vertex held by kept faces, with room for a larger angle in the wedge of new
-// faces there). Here a free vertex of such a face moves where fewer faces of its star are below 30 deg,
-// without the star's smallest angle falling below the smaller of its value before and kFinishFloorDeg.
+// faces there). Here a free vertex of such a face moves on the draft, and a crease vertex along its crease,
+// where fewer faces of its star are below 30 deg, without the star's smallest angle falling below the smaller
+// of its value before and kFinishFloorDeg.
 // Also the relocation helpers that improvePass (band_remesh.cpp) shares with it, and the corner lists of the
 // slide passes.
 #include "stitch/band_remesher.h"
@@ -114,31 +115,58 @@ int BandRemesher::starBelow(VertexIndex v, const V3& at, double bound, double& s
 
 void BandRemesher::finishPass() {
     const double aim = kFinishAimDeg * kBandDeg, floor = kFinishFloorDeg * kBandDeg;
-    const std::vector<VertexIndex> verts =
-        cornersOfFacesBelow(aim, [&](VertexIndex v) { return relocatable(v); });
     const double maxTurn = in_.maxNormalTurnDeg * kBandDeg;
-    for (VertexIndex v : verts) {
+    // The search for one vertex: its star's faces below the aim now, the fewest found, the smallest angle
+    // there and the least it may fall to.
+    struct Search {
+        int below = 0, best = 0;
+        double bestMin = 0, keep = 0;
+    };
+    auto start = [&](VertexIndex v, Search& s) {
+        s.below = s.best = starBelow(v, detail::pos(S_, v), aim, s.bestMin);
+        s.keep = std::min(s.bestMin, floor);
+        return s.below > 0;
+    };
+    // Whether v at q beats the best so far (then it becomes the best): fewer faces below the aim than now,
+    // no more than the best, a larger smallest angle at equal counts, never below the floor, acceptable.
+    auto better = [&](VertexIndex v, const V3& q, Search& s) {
+        double m = 0;
+        const int b = starBelow(v, q, aim, m);
+        if (m < s.keep || b >= s.below || b > s.best || (b == s.best && !(m > s.bestMin + 1e-9)))
+            return false;
+        if (!starAcceptable(v, q, maxTurn)) return false;
+        s.best = b;
+        s.bestMin = m;
+        return true;
+    };
+    for (VertexIndex v : cornersOfFacesBelow(aim, [&](VertexIndex v) { return relocatable(v); })) {
+        Search s;
+        if (!start(v, s)) continue;
         const V3 p = detail::pos(S_, v);
-        double minBefore = 0;
-        const int below = starBelow(v, p, aim, minBefore);
-        if (below == 0) continue;
-        const double keep = std::min(minBefore, floor);
-        int bestBelow = below;
-        double bestMin = minBefore;
         V3 bestP = p;
         FaceIndex bestFace = hint_[std::size_t(v)];
         aroundOnDraft(v, {0.4, 0.25, 0.1}, 16, [&](const V3& lifted, FaceIndex face) {
-            double m = 0;
-            const int b = starBelow(v, lifted, aim, m);
-            if (m < keep || b > bestBelow || (b == bestBelow && !(m > bestMin + 1e-9))) return;
-            if (b == below) return; // fewer faces below the aim, or nothing (improvePass's job)
-            if (!starAcceptable(v, lifted, maxTurn)) return;
-            bestBelow = b;
-            bestMin = m;
-            bestP = lifted;
-            bestFace = face;
+            if (better(v, lifted, s)) bestP = lifted, bestFace = face;
         });
         if (bestP != p) relocate(v, bestP, bestFace);
+    }
+    // Crease vertices between two crease edges: along them, on the draft's crease polyline.
+    for (VertexIndex v : cornersOfFacesBelow(
+             aim, [&](VertexIndex v) { return !isFixed(v) && creaseDegree(v) == 2 && wholeStarInBand(v); })) {
+        Search s;
+        if (!start(v, s)) continue;
+        const V3 p = detail::pos(S_, v);
+        V3 bestP = p;
+        CreasePos bestPos;
+        for (VertexIndex e : CGAL::vertices_around_target(S_.halfedge(v), S_)) {
+            if (!isCrease(v, e)) continue;
+            for (double t : {0.1, 0.2, 0.3, 0.4}) {
+                V3 q = p + t * (detail::pos(S_, e) - p);
+                const CreasePos cp = creaseBetween(v, e, t, q);
+                if (cp.chain >= 0 && better(v, q, s)) bestP = q, bestPos = cp;
+            }
+        }
+        if (bestP != p) moveAlongCrease(v, bestP, bestPos);
     }
 }
 
