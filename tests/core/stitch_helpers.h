@@ -265,6 +265,20 @@ inline Camera orbitCamera(const Vec3& from, double distance, int res, double ang
     return c;
 }
 
+// The smallest angle of face f (degrees).
+inline double faceMinAngleDeg(const Mesh& m, FaceIndex f) {
+    std::array<Vec3, 3> p;
+    int k = 0;
+    for (VertexIndex v : CGAL::vertices_around_face(m.halfedge(f), m))
+        p[std::size_t(k++)] = vec(m.point(v));
+    double best = 180;
+    for (std::size_t i = 0; i < 3; ++i) {
+        const Vec3 u = p[(i + 1) % 3] - p[i], w = p[(i + 2) % 3] - p[i];
+        best = std::min(best, std::atan2(u.cross(w).norm(), u.dot(w)) * 180.0 / std::numbers::pi);
+    }
+    return best;
+}
+
 inline std::function<bool(int, int)> disk(double cx, double cy, double r) {
     return [=](int x, int y) {
         return (x + 0.5 - cx) * (x + 0.5 - cx) + (y + 0.5 - cy) * (y + 0.5 - cy) <= r * r;

@@ -528,6 +528,7 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
         // that also touch an unchanged face or a face of another scan id (where the patch meets the old
         // mesh, and the rim of the changed region); seam faces are the changed faces with a seam vertex.
         bool angleCriteria = false; // issue 19's three shape criteria on this stitch
+        std::string diagCriteria;   // FSS_STITCH_PROPERTY_DIAG=1: the criteria this stitch fails
         {
             auto sid = current.property_map<FaceIndex, std::int32_t>(fss::props::faceScanId);
             std::unordered_set<std::uint32_t> changed;
@@ -633,14 +634,46 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
             fig.stitchesValence90 += fracValence >= 0.9;
             fig.worstStitchFrac30 = std::min(fig.worstStitchFrac30, frac30);
             angleCriteria = created >= 20 && frac30 >= 0.98 && fracValence >= 0.9;
-            if (fss::test::stitchPropertyDiag() && created < 20) {
+            if (fss::test::stitchPropertyDiag() && !angleCriteria) {
                 std::set<std::array<double, 3>> patchPoints;
                 for (auto v : scan.patch.mesh.vertices()) {
                     const Point3& p = scan.patch.mesh.point(v);
                     patchPoints.insert({p.x(), p.y(), p.z()});
                 }
-                fss::test::printWorstCreatedFace(cs.file, scanId, created, before, current, worstFace,
-                                                 changed, patchPoints);
+                char buf[160];
+                std::snprintf(buf, sizeof buf, "%s%s%s", created < 20 ? " min20" : "",
+                              frac30 < 0.98 ? " frac30" : "", fracValence < 0.9 ? " valence" : "");
+                diagCriteria = buf;
+                if (created < 20)
+                    fss::test::printWorstCreatedFace(cs.file, scanId, created, before, current, worstFace,
+                                                     changed, patchPoints, &cam);
+                if (frac30 < 0.98) {
+                    std::map<std::string, int> classes;
+                    for (FaceIndex f : changedAfter) {
+                        if (patchFaces.count(keyOf(current, f))) continue;
+                        const auto c = corners(current, f);
+                        if (seamAngleDeg(vec(current.point(c[0])), vec(current.point(c[1])),
+                                         vec(current.point(c[2]))) >= 30)
+                            continue;
+                        ++classes[fss::test::classifyCreatedFace(before, current, f, changed, patchPoints,
+                                                                 &cam, nullptr)];
+                    }
+                    std::string list;
+                    for (const auto& [k, n] : classes)
+                        list += " " + k + ":" + std::to_string(n);
+                    std::fprintf(stderr, "diag30 %s stitch %d: %.4f of %zu >= 30;%s\n", cs.file, scanId,
+                                 frac30, n, list.c_str());
+                }
+                if (fracValence < 0.9) {
+                    std::map<std::size_t, int> hist;
+                    for (std::uint32_t v : seamVertices)
+                        ++hist[current.degree(VertexIndex(v))];
+                    std::string list;
+                    for (const auto& [d, k] : hist)
+                        list += " " + std::to_string(d) + ":" + std::to_string(k);
+                    std::fprintf(stderr, "diagval %s stitch %d: %.4f of %zu;%s\n", cs.file, scanId,
+                                 fracValence, seamVertices.size(), list.c_str());
+                }
             }
         }
 
@@ -714,6 +747,9 @@ TEST_P(StitchProperty, ChainedRandomScansKeepEveryInvariant) {
             EXPECT_LE(worst, 1.0) << "reference -> current: " << where;
             fig.worstFromRef = std::max(fig.worstFromRef, worst);
             fig.stitchesAllFour += angleCriteria && toRefOk && worst <= 1.0 && !HasFailure();
+            if (fss::test::stitchPropertyDiag() && !(angleCriteria && toRefOk && worst <= 1.0))
+                std::fprintf(stderr, "fail4 %s stitch %d:%s%s\n", cs.file, scanId, diagCriteria.c_str(),
+                             toRefOk && worst <= 1.0 ? "" : " hausdorff");
         }
         fig.checkSeconds += seconds(t);
         if (HasFailure()) {

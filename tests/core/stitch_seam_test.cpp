@@ -10,6 +10,7 @@
 #include "fss/scan_pipeline.h"
 #include "fss/stitch.h"
 
+#include "stitch_helpers.h"
 #include "test_data.h"
 
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
@@ -32,22 +33,6 @@ using fss::Mesh;
 using fss::VertexIndex;
 
 namespace {
-
-double minAngleDeg(const Mesh& m, FaceIndex f) {
-    std::array<Eigen::Vector3d, 3> p;
-    int k = 0;
-    for (auto v : CGAL::vertices_around_face(m.halfedge(f), m)) {
-        const auto& q = m.point(v);
-        p[std::size_t(k++)] = {q.x(), q.y(), q.z()};
-    }
-    double best = 180;
-    for (int i = 0; i < 3; ++i) {
-        const Eigen::Vector3d u = p[std::size_t((i + 1) % 3)] - p[std::size_t(i)],
-                              w = p[std::size_t((i + 2) % 3)] - p[std::size_t(i)];
-        best = std::min(best, std::atan2(u.cross(w).norm(), u.dot(w)) * 180.0 / std::numbers::pi);
-    }
-    return best;
-}
 
 struct SeamFigures {
     double smallestAngleDeg = 0;   // smallest angle of the seam triangles
@@ -103,7 +88,7 @@ SeamFigures fandiskSeam(fss::StandardView view, const char* name,
     double worst = 180;
     std::size_t above25 = 0;
     for (FaceIndex f : seamFaces) {
-        const double a = minAngleDeg(current, f);
+        const double a = stitch_test_helpers::faceMinAngleDeg(current, f);
         worst = std::min(worst, a);
         above25 += a >= 25.0;
     }
@@ -112,7 +97,7 @@ SeamFigures fandiskSeam(fss::StandardView view, const char* name,
         const Eigen::Vector3d eye = scan.grid.camera.eye;
         std::map<std::string, int> kinds;
         for (FaceIndex f : seamFaces) {
-            const double a = minAngleDeg(current, f);
+            const double a = stitch_test_helpers::faceMinAngleDeg(current, f);
             if (a >= 25) continue;
             std::array<Eigen::Vector3d, 3> p;
             int k = 0;
@@ -265,7 +250,7 @@ TEST(StitchSeam, BandGrowsPastAHeldRimVertex) {
         for (VertexIndex v : CGAL::vertices_around_face(current.halfedge(f), current))
             c += Eigen::Vector3d(current.point(v).x(), current.point(v).y(), current.point(v).z()) / 3.0;
         if ((c - place).norm() >= 0.05) continue;
-        const double a = minAngleDeg(current, f);
+        const double a = stitch_test_helpers::faceMinAngleDeg(current, f);
         nearest = std::min(nearest, a);
         if (!inputFaces.count(cornersOf(current, f))) nearestCreated = std::min(nearestCreated, a);
     }

@@ -378,17 +378,8 @@ bool BandRemesher::repairSplit(FaceIndex f) {
 
 void BandRemesher::slidePass() {
     const double aim = in_.minAngleDeg * kBandDeg, maxTurn = in_.maxNormalTurnDeg * kBandDeg;
-    std::vector<VertexIndex> verts;
-    std::unordered_set<std::uint32_t> seen;
-    for (std::size_t f = 0; f < band_.size(); ++f) {
-        const FaceIndex g(static_cast<std::uint32_t>(f));
-        if (!band_[f] || S_.is_removed(g) || faceMinAngle(g) >= aim) continue;
-        for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_))
-            if (!isFixed(v) && creaseDegree(v) == 2 && wholeStarInBand(v) &&
-                seen.insert(std::uint32_t(v)).second)
-                verts.push_back(v);
-    }
-    std::sort(verts.begin(), verts.end());
+    const std::vector<VertexIndex> verts = cornersOfFacesBelow(
+        aim, [&](VertexIndex v) { return !isFixed(v) && creaseDegree(v) == 2 && wholeStarInBand(v); });
     for (VertexIndex v : verts) {
         std::vector<VertexIndex> ends;
         for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(v), S_))
@@ -413,9 +404,7 @@ void BandRemesher::slideTowards(VertexIndex v, const std::vector<VertexIndex>& e
             V3 q = p + t * (detail::pos(S_, e) - p);
             const CreasePos cp = lift ? creaseBetween(v, e, t, q) : CreasePos{};
             if (cp.chain < 0 && !chords) continue;
-            const double a = starMinAngle(v, q);
-            if (a > best + 1e-9 && starAcceptable(v, q, maxTurn)) {
-                best = a;
+            if (raisesStar(v, q, best, maxTurn)) {
                 bestP = q;
                 bestPos = cp;
             }

@@ -11,17 +11,9 @@ namespace fss::stitch::band {
 
 void BandRemesher::slideCreaseEndPass() {
     const double aim = in_.minAngleDeg * kBandDeg, maxTurn = in_.maxNormalTurnDeg * kBandDeg;
-    std::vector<VertexIndex> ends;
-    std::unordered_set<std::uint32_t> seen;
-    for (std::size_t f = 0; f < band_.size(); ++f) {
-        const FaceIndex g(static_cast<std::uint32_t>(f));
-        if (!band_[f] || S_.is_removed(g) || faceMinAngle(g) >= aim) continue;
-        for (VertexIndex v : CGAL::vertices_around_face(S_.halfedge(g), S_))
-            if (creaseDegree(v) == 1 && wholeStarInBand(v) && !(in_.fixed && in_.fixed(v)) &&
-                seen.insert(std::uint32_t(v)).second)
-                ends.push_back(v);
-    }
-    std::sort(ends.begin(), ends.end());
+    const std::vector<VertexIndex> ends = cornersOfFacesBelow(aim, [&](VertexIndex v) {
+        return creaseDegree(v) == 1 && wholeStarInBand(v) && !(in_.fixed && in_.fixed(v));
+    });
     for (VertexIndex v : ends) {
         VertexIndex e = Mesh::null_vertex();
         for (VertexIndex w : CGAL::vertices_around_target(S_.halfedge(v), S_))

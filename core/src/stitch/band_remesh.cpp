@@ -82,65 +82,21 @@ void BandRemesher::setup() {
 }
 
 void BandRemesher::improvePass() {
-    std::vector<VertexIndex> verts;
-    std::unordered_set<std::uint32_t> seen;
-    for (std::size_t f = 0; f < band_.size(); ++f) {
-        const FaceIndex g(static_cast<std::uint32_t>(f));
-        if (!band_[f] || S_.is_removed(g)) continue;
-        const HalfedgeIndex h = S_.halfedge(g);
-        if (detail::minAngle(detail::pos(S_, S_.source(h)), detail::pos(S_, S_.target(h)),
-                             detail::pos(S_, S_.target(S_.next(h)))) >= in_.minAngleDeg * kBandDeg)
-            continue;
-        for (VertexIndex v : CGAL::vertices_around_face(h, S_))
-            if (!isFixed(v) && creaseDegree(v) == 0 && wholeStarInBand(v) &&
-                at(hint_, std::size_t(v), Mesh::null_face()) != Mesh::null_face() &&
-                seen.insert(std::uint32_t(v)).second)
-                verts.push_back(v);
-    }
-    std::sort(verts.begin(), verts.end());
-    const double creaseCos = std::cos(in_.creaseAngleDeg * kBandDeg);
+    const std::vector<VertexIndex> verts =
+        cornersOfFacesBelow(in_.minAngleDeg * kBandDeg, [&](VertexIndex v) { return relocatable(v); });
     const double maxTurn = in_.maxNormalTurnDeg * kBandDeg;
     for (VertexIndex v : verts) {
         const V3 p = detail::pos(S_, v);
-        const FaceIndex hint = hint_[std::size_t(v)];
-        const HalfedgeIndex rh = ref_.halfedge(hint);
-        const V3 n0 =
-            detail::unitNormal(detail::pos(ref_, ref_.source(rh)), detail::pos(ref_, ref_.target(rh)),
-                               detail::pos(ref_, ref_.target(ref_.next(rh))));
-        if (!(n0.squaredNorm() > 0)) continue;
-        const V3 u = (std::abs(n0.x()) < 0.9 ? V3(1, 0, 0) : V3(0, 1, 0)).cross(n0).normalized();
-        const V3 w = n0.cross(u);
-        double shortest = std::numeric_limits<double>::infinity();
-        for (VertexIndex x : CGAL::vertices_around_target(S_.halfedge(v), S_))
-            shortest = std::min(shortest, (detail::pos(S_, x) - p).norm());
         double best = starMinAngle(v, p);
         V3 bestP = p;
-        FaceIndex bestFace = hint;
-        for (double r : {0.4, 0.2, 0.1})
-            for (int k = 0; k < 12; ++k) {
-                const double t = 2 * std::numbers::pi * k / 12;
-                const V3 q = p + r * shortest * (std::cos(t) * u + std::sin(t) * w);
-                const SurfacePoint sp = near1_(q, hint);
-                if (!sp || sp.distance > 0.5 * r * shortest) continue;
-                const HalfedgeIndex sh = ref_.halfedge(sp.face);
-                const V3 n =
-                    detail::unitNormal(detail::pos(ref_, ref_.source(sh)), detail::pos(ref_, ref_.target(sh)),
-                                       detail::pos(ref_, ref_.target(ref_.next(sh))));
-                if (n.dot(n0) < creaseCos) continue;
-                const V3 lifted = smoothPoint(sp.face, sp.point);
-                const double a = starMinAngle(v, lifted);
-                if (a > best + 1e-9 && starAcceptable(v, lifted, maxTurn)) {
-                    best = a;
-                    bestP = lifted;
-                    bestFace = sp.face;
-                }
+        FaceIndex bestFace = hint_[std::size_t(v)];
+        aroundOnDraft(v, {0.4, 0.2, 0.1}, 12, [&](const V3& lifted, FaceIndex face) {
+            if (raisesStar(v, lifted, best, maxTurn)) {
+                bestP = lifted;
+                bestFace = face;
             }
-        if (bestP != p) {
-            S_.point(v) = Point3(bestP.x(), bestP.y(), bestP.z());
-            hint_[std::size_t(v)] = bestFace;
-            touch(v);
-            ++report_.moves;
-        }
+        });
+        if (bestP != p) relocate(v, bestP, bestFace);
     }
 }
 

@@ -20,6 +20,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
+#include <initializer_list>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -50,8 +52,8 @@ inline bool bandDiagnosticsVerbose() {
     return on;
 }
 
-// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,endslide,creasefilter,collapseall,short,star,bridge (and lift,
-// split, smooth) turns parts of the band remesh off (to measure what each brings).
+// FSS_STITCH_BAND_OFF=grow,unseen,repair,slide,endslide,finish,creasefilter,collapseall,short,star,bridge
+// (and lift, split, smooth) turns parts of the band remesh off (to measure what each brings).
 inline bool stageOff(const char* name) {
     static const std::string off = [] {
         const char* e = std::getenv("FSS_STITCH_BAND_OFF");
@@ -112,6 +114,8 @@ public:
             flipPass();
             if (!changed) break;
         }
+        for (int it = 0; it < 2 && !stageOff("finish"); ++it)
+            finishPass();
         measure(report_.minAngleAfterDeg, report_.fracAbove30After);
         for (std::size_t f = 0; f < band_.size(); ++f)
             if (band_[f] && !S_.is_removed(FaceIndex(std::uint32_t(f))))
@@ -694,6 +698,30 @@ private:
             if (detail::pos(S_, verts[k]) != before[k]) touch(verts[k]);
     }
 
+    // The corners of band faces below \p aim (radians) that \p take accepts, each once, in descriptor order:
+    // the vertices the relocation and slide passes try. (These helpers: band_finish.cpp.)
+    std::vector<VertexIndex> cornersOfFacesBelow(double aim, const std::function<bool(VertexIndex)>& take);
+    // Whether v may be relocated on the draft (improvePass, finishPass): free, on no crease, its whole star
+    // in the band, with a face of the draft at it.
+    bool relocatable(VertexIndex v);
+    // The unit normal n0 of draft face \p hint and two tangents u, w with it (false: a degenerate face).
+    bool tangentFrame(FaceIndex hint, V3& n0, V3& u, V3& w) const;
+    // Point q taken onto the draft near \p hint and lifted onto its smooth surface (\p lifted, on draft face
+    // \p face); false where the draft is farther than \p maxDistance or its face there turns from n0 by more
+    // than the crease angle (cosine \p creaseCos).
+    bool ontoDraft(const V3& q, FaceIndex hint, double maxDistance, const V3& n0, double creaseCos,
+                   V3& lifted, FaceIndex& face);
+    double shortestEdgeAt(VertexIndex v) const;
+    // Calls \p tryPoint(lifted, face) for the points around relocatable vertex v at each of \p radii times
+    // its shortest edge in \p directions evenly spaced directions of the draft's tangent plane, each taken
+    // onto the draft (ontoDraft, within half its offset); false where the draft face at v is degenerate.
+    bool aroundOnDraft(VertexIndex v, std::initializer_list<double> radii, int directions,
+                       const std::function<void(const V3&, FaceIndex)>& tryPoint);
+    // Whether v at q raises its star's smallest angle above \p best (then set to it) and stays acceptable.
+    bool raisesStar(VertexIndex v, const V3& q, double& best, double maxTurn) const;
+    // Moves v to p on draft face \p face (a relocation).
+    void relocate(VertexIndex v, const V3& p, FaceIndex face);
+
     // ---- relocation of the free vertices of faces below the aim: the place on the draft around the vertex
     // (a search over tangential offsets, each projected) that maximises the smallest angle of its star.
     // Own search rather than a smoothing rule: near a fixed, irregular border the centroid is often not
@@ -702,6 +730,12 @@ private:
     // Crease vertices of faces below the aim slide along their (nearly straight) crease: candidates on the
     // two crease edges, the one that maximises the star's smallest angle wins.
     void slidePass();
+    // Free vertices of faces below 30 deg move where fewer faces of their star are below it
+    // (band_finish.cpp).
+    void finishPass();
+    // The faces of v's star (v at \p at) with a smallest angle below \p bound (radians); \p smallest gets the
+    // star's smallest angle.
+    int starBelow(VertexIndex v, const V3& at, double bound, double& smallest) const;
     // Crease ends of faces below the aim slide along their one crease edge (band_crease_end.cpp).
     void slideCreaseEndPass();
     // Puts crease vertex v at p, at its place pos on the draft's crease polyline (none: chain < 0), with
