@@ -730,8 +730,7 @@ private:
     // Crease vertices of faces below the aim slide along their (nearly straight) crease: candidates on the
     // two crease edges, the one that maximises the star's smallest angle wins.
     void slidePass();
-    // Free vertices of faces below 30 deg move where fewer faces of their star are below it
-    // (band_finish.cpp).
+    // Vertices of faces below 30 deg move (crease ones along it) to fewer star faces below (band_finish.cpp).
     void finishPass();
     // The faces of v's star (v at \p at) with a smallest angle below \p bound (radians); \p smallest gets the
     // star's smallest angle.
