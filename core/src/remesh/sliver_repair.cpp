@@ -16,8 +16,10 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <numbers>
 #include <optional>
+#include <unordered_map>
 #include <vector>
 
 namespace fss::detail {
@@ -161,9 +163,35 @@ private:
         return creases_.closest(p, q, d) && d <= 0.1 * o_.edgeLength;
     }
 
+    /// The reference's point closest to \p p. The reference never changes, so the answer depends on \p p
+    /// alone: it is kept by the bits of \p p for the whole run (the sweeps measure the same corners, edge
+    /// midpoints and centroids again and again, and a sweep undone is run again on the same mesh).
+    struct PointKey {
+        std::uint64_t x, y, z;
+        bool operator==(const PointKey&) const = default;
+    };
+    struct PointKeyHash {
+        std::size_t operator()(const PointKey& k) const {
+            std::uint64_t h = k.x * 0x9E3779B97F4A7C15ull;
+            h ^= k.y + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
+            h ^= k.z + 0x94D049BB133111EBull + (h << 6) + (h >> 2);
+            return std::size_t(h);
+        }
+    };
+    mutable std::unordered_map<PointKey, SurfacePoint, PointKeyHash> closest_;
+    const SurfacePoint& closestPoint(const Vec& p) const {
+        PointKey key{};
+        std::memcpy(&key.x, &p.x(), sizeof(double));
+        std::memcpy(&key.y, &p.y(), sizeof(double));
+        std::memcpy(&key.z, &p.z(), sizeof(double));
+        auto [it, inserted] = closest_.try_emplace(key);
+        if (inserted) it->second = caster_.closestPoint(p);
+        return it->second;
+    }
+
     /// The reference's unit normal at the point closest to \p p, and the distance to it.
     std::pair<Vec, double> referenceAt(const Vec& p) const {
-        const SurfacePoint sp = caster_.closestPoint(p);
+        const SurfacePoint& sp = closestPoint(p);
         if (!sp) return {Vec::Zero(), 0.0};
         return {faceNormal(caster_.mesh(), sp.face), sp.distance};
     }
@@ -310,7 +338,7 @@ private:
 
     void tryMove(VertexIndex v, const Vec& target, Candidate& best) const {
         if (fixed_[v.idx()]) return;
-        const SurfacePoint sp = caster_.closestPoint(target);
+        const SurfacePoint sp = closestPoint(target);
         if (sp) tryPosition(v, sp.point, best);
     }
 
@@ -403,7 +431,7 @@ private:
                 const VertexIndex a = m_.source(h), b = m_.target(h);
                 tryCollapse(h, pos(m_, a), best);
                 if (!fixed_[a.idx()] && !fixed_[b.idx()])
-                    if (const SurfacePoint sp = caster_.closestPoint(0.5 * (pos(m_, a) + pos(m_, b))))
+                    if (const SurfacePoint sp = closestPoint(0.5 * (pos(m_, a) + pos(m_, b))))
                         tryCollapse(h, sp.point, best);
             }
             for (HalfedgeIndex h : hs)
